@@ -1,0 +1,38 @@
+// liveset command-line entry point: global options, subcommand dispatch, and error reporting
+// (one line on stderr and a non-zero exit status; never a crash).
+#include <fmt/core.h>
+
+#include <CLI/CLI.hpp>
+
+#include <cstdio>
+#include <exception>
+#include <new>
+
+#include "cli_common.hpp"
+
+int main(int argc, char** argv) {
+    CLI::App app{"liveset: real-time interactive level-set segmentation of 3D medical images"};
+    app.set_version_flag("--version", std::string("liveset ") + LIVESET_VERSION);
+    app.require_subcommand(1);
+    int threads = 0;
+    app.add_option("--threads", threads, "worker threads (0 = all cores)")
+        ->check(CLI::Range(0, 1024))
+        ->capture_default_str();
+    liveset::cli::add_flow_commands(app, threads);
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    } catch (const liveset::cli::UsageError& e) {
+        fmt::print(stderr, "liveset: error: {}\n", e.what());
+        return 1;
+    } catch (const std::bad_alloc&) {
+        fmt::print(stderr, "liveset: error: out of memory\n");
+        return 1;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "liveset: error: {}\n", e.what());
+        return 1;
+    }
+    return 0;
+}

@@ -1,0 +1,93 @@
+// Level-set benchmarks: the box mean-curvature-flow experiment (ms per step, 1 and 2 threads),
+// local bump updates on spheres of growing lattices (must stay flat), and level-set memory.
+// Results and the commands that produced them: docs/BENCHMARKS.md.
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "liveset/levelset/curvature_flow.hpp"
+#include "liveset/levelset/shapes.hpp"
+
+using namespace liveset;
+
+namespace {
+
+double peak_rss_mb() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
+
+// Box 50³ in 100³ until it vanishes; one iteration = one whole flow.
+void BM_BoxFlow(benchmark::State& state) {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+    BoxFlowReport last;
+    for (auto _ : state) {
+        state.PauseTiming();
+        SparseField f = make_box_field({});
+        state.ResumeTiming();
+        last = run_curvature_flow(f, 5000, 0.5f);
+        benchmark::DoNotOptimize(last.steps.size());
+    }
+    state.counters["steps"] = static_cast<double>(last.steps.size());
+    state.counters["median_step_ms"] = last.median_step_ms();
+    state.counters["total_s"] = last.total_ms / 1000.0;
+    state.counters["vanished"] = last.vanished ? 1 : 0;
+}
+BENCHMARK(BM_BoxFlow)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// A radius-3 Gaussian bump raised and lowered on a sphere of radius 0.4·N in N³: each iteration is
+// one local update (edits at the ~30 zero-layer points of the bump + layer repair around them).
+void BM_LocalBump(benchmark::State& state) {
+    const int n = static_cast<int>(state.range(0));
+    static std::map<int, std::unique_ptr<SparseField>> cache;  // building 512³ takes seconds
+    auto& slot = cache[n];
+    if (!slot) {
+        slot = std::make_unique<SparseField>(Lattice({n, n, n}), 2);
+        const double c = (n - 1) / 2.0;
+        slot->init_from_sdf(shapes::Sphere({c, c, c}, 0.4 * n));
+    }
+    SparseField& f = *slot;
+    const double c = (n - 1) / 2.0;
+    const Vec3i centre{static_cast<int>(std::lround(c + 0.4 * n)), static_cast<int>(std::lround(c)),
+                       static_cast<int>(std::lround(c))};
+    float sign = 1.0f;
+    std::size_t touched = 0, updates = 0;
+    for (auto _ : state) {
+        const ChangedPoints x = f.apply_in_box(centre - Vec3i{3, 3, 3}, centre + Vec3i{3, 3, 3}, [&](Vec3i p, float) {
+            const Vec3i d = p - centre;
+            const double d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+            return d2 > 9.0 ? 0.0f : sign * 0.4f * static_cast<float>(std::exp(-d2 / 9.0));
+        });
+        sign = -sign;
+        touched += x.size();
+        ++updates;
+    }
+    state.counters["changed_points"] = static_cast<double>(touched) / static_cast<double>(std::max<std::size_t>(updates, 1));
+    state.counters["band"] = static_cast<double>(f.band_size());
+}
+BENCHMARK(BM_LocalBump)->Arg(64)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
+
+// Peak resident memory after building a sphere level set in N³ (run one size per process).
+void BM_Memory(benchmark::State& state) {
+    const int n = static_cast<int>(state.range(0));
+    const double before = peak_rss_mb();
+    for (auto _ : state) {
+        SparseField f(Lattice({n, n, n}), 2);
+        const double c = (n - 1) / 2.0;
+        f.init_from_sdf(shapes::Sphere({c, c, c}, 0.4 * n));
+        state.counters["band"] = static_cast<double>(f.band_size());
+        state.counters["peak_rss_MB"] = peak_rss_mb();
+    }
+    state.counters["rss_before_MB"] = before;
+}
+BENCHMARK(BM_Memory)->Arg(256)->Arg(512)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

@@ -1,0 +1,443 @@
+// SparseField implementation: initialisation, the global step, local edits, and the shared
+// order-independent band repair (see sparse_field.hpp for the scheme).
+#include "liveset/levelset/sparse_field.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+#include "liveset/grid/sampling.hpp"
+#include "liveset/levelset/layer_value.hpp"
+
+namespace liveset {
+
+namespace {
+
+// Temporary status codes used only inside one update (never visible outside it).
+constexpr std::int8_t kPendPos = 100;   // to be re-layered, outside sign
+constexpr std::int8_t kPendNeg = -100;  // to be re-layered, inside sign
+constexpr std::int8_t kPendZero = 101;  // on the new zero layer
+constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;
+constexpr std::size_t kParallelMin = 4096;  // below this, loops run serially
+
+bool is_temp(std::int8_t s) { return s >= kPendPos || s <= kPendNeg; }
+
+template <class F>
+void for_each_neighbor6(const Lattice& lat, PointIndex i, F&& f) {
+    const Vec3i c = lat.coord(i);
+    const Vec3i d = lat.dims();
+    const auto sy = static_cast<PointIndex>(lat.stride_y());
+    const auto sz = static_cast<PointIndex>(lat.stride_z());
+    if (c.x > 0) f(i - 1);
+    if (c.x < d.x - 1) f(i + 1);
+    if (c.y > 0) f(i - sy);
+    if (c.y < d.y - 1) f(i + sy);
+    if (c.z > 0) f(i - sz);
+    if (c.z < d.z - 1) f(i + sz);
+}
+
+template <class F>
+void parallel_range(std::size_t n, F&& f) {
+    if (n < kParallelMin) {
+        for (std::size_t i = 0; i < n; ++i) f(i);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
+    });
+}
+
+std::string point_text(const Lattice& lat, PointIndex i) {
+    const Vec3i c = lat.coord(i);
+    std::ostringstream os;
+    os << '(' << c.x << ',' << c.y << ',' << c.z << ')';
+    return os.str();
+}
+
+}  // namespace
+
+SparseField::SparseField(const Lattice& lattice, int layers) : layers_(layers) {
+    if (layers < 1 || layers > kMaxLayers)
+        throw std::invalid_argument("number of layers must be between 1 and " + std::to_string(kMaxLayers) +
+                                    ", got " + std::to_string(layers));
+    phi_ = Grid<float>(lattice, static_cast<float>(layers + 1));
+    status_ = Grid<std::int8_t>(lattice, far_outside());
+    slot_ = Grid<std::uint32_t>(lattice, kNoSlot);
+    lists_.assign(2 * static_cast<std::size_t>(layers) + 1, {});
+    for (int z = -layers; z <= layers; ++z)
+        for (int y = -layers; y <= layers; ++y)
+            for (int x = -layers; x <= layers; ++x)
+                if (std::abs(x) + std::abs(y) + std::abs(z) <= layers) ball_.push_back({x, y, z});
+}
+
+std::span<const PointIndex> SparseField::layer(int k) const {
+    if (k < -layers_ || k > layers_) throw std::out_of_range("layer index out of range");
+    return lists_[static_cast<std::size_t>(k + layers_)];
+}
+
+std::size_t SparseField::band_size() const {
+    std::size_t n = 0;
+    for (const auto& l : lists_) n += l.size();
+    return n;
+}
+
+void SparseField::list_add(PointIndex i, int layer) {
+    auto& list = lists_[static_cast<std::size_t>(layer + layers_)];
+    slot_[i] = static_cast<std::uint32_t>(list.size());
+    list.push_back(i);
+}
+
+void SparseField::list_remove(PointIndex i, int layer) {
+    auto& list = lists_[static_cast<std::size_t>(layer + layers_)];
+    const std::uint32_t pos = slot_[i];
+    const PointIndex last = list.back();
+    list[pos] = last;
+    slot_[last] = pos;
+    list.pop_back();
+    slot_[i] = kNoSlot;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Initialisation
+
+void SparseField::evaluate_sdf(const std::function<double(Vec3d)>& sdf) {
+    for (auto& l : lists_) l.clear();
+    slot_.fill(kNoSlot);
+    const Vec3i d = lattice().dims();
+    const float far = static_cast<float>(layers_ + 1);
+    // Evaluate the distance everywhere (clamped to the far value); zero layer = |φ| ≤ 0.5.
+    tbb::parallel_for(0, d.z, [&](int z) {
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                const double v = sdf(Vec3d{static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)});
+                const PointIndex i = lattice().index({x, y, z});
+                if (!std::isfinite(v)) {
+                    phi_[i] = std::numeric_limits<float>::quiet_NaN();
+                    continue;
+                }
+                phi_[i] = static_cast<float>(std::clamp(v, -static_cast<double>(far), static_cast<double>(far)));
+            }
+    });
+    for (std::size_t i = 0; i < phi_.size(); ++i)
+        if (!std::isfinite(phi_[static_cast<PointIndex>(i)]))
+            throw std::invalid_argument("signed distance is not finite at " +
+                                        point_text(lattice(), static_cast<PointIndex>(i)));
+}
+
+void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {
+    evaluate_sdf(sdf);
+    // A sign change between two far points (a function steeper than a distance) would leave the
+    // front without zero-layer points: pull both sides onto the zero layer.
+    std::vector<PointIndex> steep;
+    for (std::size_t n = 0; n < phi_.size(); ++n) {
+        const auto i = static_cast<PointIndex>(n);
+        const float v = phi_[i];
+        if (std::abs(v) <= 0.5f) continue;
+        bool opposite = false;
+        for_each_neighbor6(lattice(), i, [&](PointIndex q) {
+            if (std::abs(phi_[q]) > 0.5f && ((phi_[q] < 0) != (v < 0))) opposite = true;
+        });
+        if (opposite) steep.push_back(i);
+    }
+    for (PointIndex i : steep) phi_[i] = phi_[i] < 0 ? -0.5f : 0.5f;
+
+    const float far = static_cast<float>(layers_ + 1);
+    std::vector<PointIndex> zero;
+    for (std::size_t n = 0; n < phi_.size(); ++n) {
+        const auto i = static_cast<PointIndex>(n);
+        if (std::abs(phi_[i]) <= 0.5f) {
+            status_[i] = 0;
+            zero.push_back(i);
+            list_add(i, 0);
+        } else {
+            status_[i] = phi_[i] < 0 ? far_inside() : far_outside();
+            phi_[i] = phi_[i] < 0 ? -far : far;
+        }
+    }
+    std::vector<RegionPoint> region;
+    region.reserve(zero.size() * 4);
+    for (PointIndex i : zero) mark_pending(i, region);
+    for (PointIndex i : zero) collect_ball(i, region);
+    sweep_layers(region);
+    finish(region);
+}
+
+void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
+    if (!(mask.dims() == lattice().dims()))
+        throw std::invalid_argument("mask dimensions " + mask.lattice().describe() +
+                                    " differ from the level-set lattice " + lattice().describe());
+    // Boundary voxels of either side become the zero layer (±0.5: the front lies half-way).
+    const Lattice& lat = lattice();
+    const std::function<double(Vec3d)> from_mask = [&](Vec3d p) {
+        const PointIndex i = lat.index(p.cast<int>());
+        const bool inside = mask[i] != 0;
+        bool boundary = false;
+        for_each_neighbor6(lat, i, [&](PointIndex q) { boundary = boundary || ((mask[q] != 0) != inside); });
+        const double far = layers_ + 1;
+        if (boundary) return inside ? -0.5 : 0.5;
+        return inside ? -far : far;
+    };
+    init_from_sdf(from_mask);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Global step
+
+std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const StepOptions& options,
+                                                     double* dt_out) const {
+    if (!(options.cfl > 0.0f) || options.cfl > 0.5f || !std::isfinite(options.cfl))
+        throw std::invalid_argument("CFL number must be in (0, 0.5]");
+    if (!(options.max_dt > 0.0f)) throw std::invalid_argument("maximum time step must be positive");
+    const auto zero = zero_layer();
+    std::vector<double> rate(zero.size());
+    parallel_range(zero.size(), [&](std::size_t n) {
+        const Vec3i p = lattice().coord(zero[n]);
+        const SpeedSample s = speed.at(phi_, p);
+        double r = 0.0;
+        if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi_, p, s.propagation);
+        if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi_, p));
+        rate[n] = r;
+    });
+    double max_rate = 0.0;
+    for (double r : rate) {
+        if (!std::isfinite(r)) throw std::runtime_error("speed term returned a non-finite value");
+        max_rate = std::max(max_rate, std::abs(r));
+    }
+    double dt = options.max_dt;
+    if (max_rate > 0.0) dt = std::min(dt, static_cast<double>(options.cfl) / max_rate);
+    if (speed.curvature_weight() > 0.0f) dt = std::min(dt, 1.0 / (6.0 * speed.curvature_weight()));
+    std::vector<ZeroLayerEdit> edits(zero.size());
+    parallel_range(zero.size(), [&](std::size_t n) {
+        edits[n] = {zero[n], static_cast<float>(std::clamp(dt * rate[n], -0.5, 0.5))};
+    });
+    if (dt_out != nullptr) *dt_out = dt;
+    return edits;
+}
+
+StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
+    StepResult result;
+    result.zero_layer = zero_layer().size();
+    const auto edits = compute_step(speed, options, &result.dt);
+    result.changed = commit(edits, RepairScope::kGlobal);
+    return result;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Local edits
+
+ChangedPoints SparseField::apply_edits(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
+    std::vector<ZeroLayerEdit> merged(edits.begin(), edits.end());
+    std::sort(merged.begin(), merged.end(), [](const auto& a, const auto& b) { return a.point < b.point; });
+    std::size_t out = 0;
+    for (std::size_t n = 0; n < merged.size(); ++n) {
+        const ZeroLayerEdit& e = merged[n];
+        if (e.point >= phi_.size()) throw std::invalid_argument("edit outside the lattice");
+        if (!std::isfinite(e.delta))
+            throw std::invalid_argument("edit at " + point_text(lattice(), e.point) + " has a non-finite change");
+        if (status_[e.point] != 0)
+            throw std::invalid_argument("edit at " + point_text(lattice(), e.point) + " is not on the zero layer");
+        if (out > 0 && merged[out - 1].point == e.point)
+            merged[out - 1].delta += e.delta;
+        else
+            merged[out++] = e;
+    }
+    merged.resize(out);
+    for (auto& e : merged) e.delta = std::clamp(e.delta, -0.5f, 0.5f);
+    return commit(merged, scope);
+}
+
+ChangedPoints SparseField::apply_in_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta) {
+    const Vec3i d = lattice().dims();
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = std::max(lo[a], 0);
+        hi[a] = std::min(hi[a], d[a] - 1);
+    }
+    std::vector<ZeroLayerEdit> edits;
+    for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x) {
+                const PointIndex i = lattice().index({x, y, z});
+                if (status_[i] != 0) continue;
+                const float dv = delta({x, y, z}, phi_[i]);
+                if (dv != 0.0f) edits.push_back({i, dv});
+            }
+    return apply_edits(edits, RepairScope::kLocal);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The shared repair
+
+ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
+    const std::size_t n = edits.size();
+    if (n == 0) return {};
+
+    // 1. New zero-layer values (all Δ were computed from the old state, so this is Jacobi).
+    std::vector<float> old_phi(n);
+    parallel_range(n, [&](std::size_t k) {
+        old_phi[k] = phi_[edits[k].point];
+        phi_[edits[k].point] = old_phi[k] + edits[k].delta;
+    });
+
+    // 2. Classify: +1 leaves outwards, -1 inwards, 0 stays. A point whose neighbour leaves the
+    //    other way stays, clamped to ±0.5, so the front never jumps over a lattice edge.
+    std::vector<std::int8_t> move(n, 0);
+    parallel_range(n, [&](std::size_t k) {
+        const PointIndex i = edits[k].point;
+        const float v = phi_[i];
+        if (std::abs(v) <= 0.5f) return;
+        const bool up = v > 0.5f;
+        bool blocked = false;
+        for_each_neighbor6(lattice(), i, [&](PointIndex q) {
+            if (status_[q] == 0 && (up ? phi_[q] < -0.5f : phi_[q] > 0.5f)) blocked = true;
+        });
+        move[k] = blocked ? static_cast<std::int8_t>(up ? 2 : -2) : static_cast<std::int8_t>(up ? 1 : -1);
+    });
+    for (std::size_t k = 0; k < n; ++k)
+        if (std::abs(move[k]) == 2) {
+            phi_[edits[k].point] = move[k] > 0 ? 0.5f : -0.5f;
+            move[k] = 0;
+        }
+
+    // 3. The front passes to the neighbours on the other side: an L∓1 neighbour of a leaving point
+    //    enters the zero layer with the value implied by the old zero layer's new values.
+    std::vector<RegionPoint> region;
+    for (std::size_t k = 0; k < n; ++k) {
+        if (move[k] == 0) continue;
+        const std::int8_t from = move[k] > 0 ? std::int8_t{-1} : std::int8_t{1};
+        for_each_neighbor6(lattice(), edits[k].point, [&](PointIndex q) {
+            if (status_[q] != from) return;
+            float w = from > 0 ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+            for_each_neighbor6(lattice(), q, [&](PointIndex r) {
+                if (status_[r] != 0) return;
+                w = from > 0 ? std::min(w, phi_[r] + 1.0f) : std::max(w, phi_[r] - 1.0f);
+            });
+            region.push_back({q, status_[q], phi_[q]});
+            status_[q] = kPendZero;
+            phi_[q] = w;
+        });
+    }
+    for (std::size_t k = 0; k < n; ++k) {
+        const PointIndex i = edits[k].point;
+        region.push_back({i, 0, old_phi[k]});
+        status_[i] = move[k] > 0 ? kPendPos : (move[k] < 0 ? kPendNeg : kPendZero);
+    }
+
+    // 4. The region to re-layer: every point within Manhattan distance N of a changed point
+    //    (a layer-k point depends on points up to k away, layer_value.hpp), or, for a global
+    //    update, the whole band plus its outer ring.
+    if (scope == RepairScope::kLocal) {
+        const std::size_t seeds = region.size();
+        for (std::size_t k = 0; k < seeds; ++k) collect_ball(region[k].point, region);
+    } else {
+        collect_band(region);
+    }
+
+    // 5. Outer layers from the new zero layer; 6. bookkeeping and the change report.
+    sweep_layers(region);
+    return finish(region);
+}
+
+void SparseField::mark_pending(PointIndex i, std::vector<RegionPoint>& region) {
+    const std::int8_t s = status_[i];
+    if (is_temp(s)) return;
+    region.push_back({i, s, phi_[i]});
+    status_[i] = s == 0 ? kPendZero : (s > 0 ? kPendPos : kPendNeg);
+}
+
+void SparseField::collect_ball(PointIndex seed, std::vector<RegionPoint>& region) {
+    const Vec3i c = lattice().coord(seed);
+    const Vec3i d = lattice().dims();
+    const int r = layers_;
+    const bool interior = c.x >= r && c.y >= r && c.z >= r && c.x < d.x - r && c.y < d.y - r && c.z < d.z - r;
+    const auto sy = static_cast<std::int64_t>(lattice().stride_y());
+    const auto sz = static_cast<std::int64_t>(lattice().stride_z());
+    for (const Vec3i o : ball_) {
+        if (!interior && !lattice().contains(c + o)) continue;
+        const std::int64_t q = static_cast<std::int64_t>(seed) + o.x + o.y * sy + o.z * sz;
+        mark_pending(static_cast<PointIndex>(q), region);
+    }
+}
+
+void SparseField::collect_band(std::vector<RegionPoint>& region) {
+    // Marking changes statuses, never the lists, so iterating the lists here is safe.
+    for (const auto& list : lists_)
+        for (PointIndex i : list) mark_pending(i, region);
+    for (int side : {-layers_, layers_}) {
+        const std::int8_t far = side > 0 ? far_outside() : far_inside();
+        for (PointIndex i : layer(side))
+            for_each_neighbor6(lattice(), i, [&](PointIndex q) {
+                if (status_[q] == far) mark_pending(q, region);
+            });
+    }
+}
+
+float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
+    const std::int8_t inner = static_cast<std::int8_t>(outside ? k - 1 : -(k - 1));
+    const auto is_inner = [&](std::int8_t s) { return k == 1 ? (s == 0 || s == kPendZero) : s == inner; };
+    return detail::layer_value(phi_, status_, i, outside, is_inner);
+}
+
+void SparseField::sweep_layers(std::span<const RegionPoint> region) {
+    std::vector<PointIndex> pending;
+    for (const RegionPoint& r : region)
+        if (status_[r.point] == kPendPos || status_[r.point] == kPendNeg) pending.push_back(r.point);
+
+    std::vector<float> value;
+    std::vector<PointIndex> next;
+    for (int k = 1; k <= layers_ && !pending.empty(); ++k) {
+        value.assign(pending.size(), 0.0f);
+        // Decide (reads only), then write: Jacobi within a layer, so any thread order agrees.
+        parallel_range(pending.size(), [&](std::size_t m) {
+            const PointIndex i = pending[m];
+            const bool outside = status_[i] == kPendPos;
+            value[m] = inner_layer_value(i, k, outside);
+        });
+        next.clear();
+        for (std::size_t m = 0; m < pending.size(); ++m) {
+            const PointIndex i = pending[m];
+            if (std::isinf(value[m])) {
+                next.push_back(i);
+                continue;
+            }
+            status_[i] = static_cast<std::int8_t>(status_[i] == kPendPos ? k : -k);
+            phi_[i] = value[m];
+        }
+        pending.swap(next);
+    }
+}
+
+ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
+    ChangedPoints changed;
+    const float far = static_cast<float>(layers_ + 1);
+    for (const RegionPoint& r : region) {
+        const PointIndex i = r.point;
+        std::int8_t s = status_[i];
+        if (s == kPendZero) {
+            s = 0;
+        } else if (s == kPendPos) {
+            s = far_outside();
+            phi_[i] = far;
+        } else if (s == kPendNeg) {
+            s = far_inside();
+            phi_[i] = -far;
+        }
+        status_[i] = s;
+        if (s != r.old_status) {
+            if (r.old_status >= -layers_ && r.old_status <= layers_) list_remove(i, r.old_status);
+            if (s >= -layers_ && s <= layers_) list_add(i, s);
+        }
+        if (s != r.old_status || std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(r.old_phi))
+            changed.points.push_back(i);
+    }
+    return changed;
+}
+
+}  // namespace liveset

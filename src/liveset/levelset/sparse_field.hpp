@@ -1,0 +1,125 @@
+// SparseField: Whitaker's sparse-field level set (1998) with local modification.
+//
+// φ < 0 inside. The band is the zero layer L0 (φ in [-0.5, 0.5]) and layers L±1..L±N (φ in
+// [k-0.5, k+0.5]); points beyond are "far" with φ clamped to ±(N+1). A status lattice holds each
+// point's layer (±(N+1) when far) and one list per layer holds the band points.
+//
+// Every update has the same shape:
+//   1. zero-layer values change by Δ (|Δ| ≤ 0.5, the step bound);
+//   2. points leaving L0 (φ beyond ±0.5) pass the front to their neighbours in L∓1, which enter L0;
+//      two neighbours moving in opposite directions both stay (clamped to ±0.5), so no order matters;
+//   3. the outer layers are recomputed from the new zero layer, layer by layer (L±k from L±(k-1):
+//      φ = min/max over neighbours of φ ± 1, layer_value.hpp), as Jacobi sweeps over a region.
+// The layers are a pure function of the zero layer, its values and the points' signs, and each
+// point depends only on points within Manhattan distance N. So a *global* update (region = whole
+// band) and a *local* one (region = the N-ball around the changed points, cost proportional to the
+// points touched) give bitwise-identical φ and status, whatever the thread count.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/levelset/speed.hpp"
+
+namespace liveset {
+
+// X in the paper: lattice points whose φ or status changed in one update (the mesher's input).
+struct ChangedPoints {
+    std::vector<PointIndex> points;
+    bool empty() const { return points.empty(); }
+    std::size_t size() const { return points.size(); }
+};
+
+// A requested change of φ at a zero-layer point.
+struct ZeroLayerEdit {
+    PointIndex point;
+    float delta;
+};
+
+enum class RepairScope {
+    kLocal,   // repair only around the edited points
+    kGlobal,  // recompute the whole band (what a global update does)
+};
+
+struct StepOptions {
+    float cfl = 0.5f;        // largest |Δφ| of one step (at most 0.5, the sparse-field step bound)
+    float max_dt = 1.0e9f;   // optional cap on the time step
+};
+
+struct StepResult {
+    double dt = 0.0;               // time step taken
+    std::size_t zero_layer = 0;    // zero-layer size before the step
+    ChangedPoints changed;         // points whose φ or status changed
+};
+
+class SparseField {
+public:
+    static constexpr int kMaxLayers = 8;
+
+    // layers: N ≥ 1 (N = 2 gives L0, L±1, L±2). Throws std::invalid_argument otherwise.
+    explicit SparseField(const Lattice& lattice, int layers = 2);
+
+    // --- initialisation (each replaces the whole state) -------------------------------------
+    // From a signed distance (index-space position -> distance in voxels, negative inside).
+    void init_from_sdf(const std::function<double(Vec3d)>& sdf);
+    // From a binary mask on the same lattice dimensions (non-zero = inside).
+    void init_from_mask(const Grid<std::uint8_t>& mask);
+
+    // --- state ----------------------------------------------------------------------------
+    const Lattice& lattice() const { return phi_.lattice(); }
+    int layers() const { return layers_; }
+    const Grid<float>& phi() const { return phi_; }
+    const Grid<std::int8_t>& status() const { return status_; }
+    std::int8_t far_outside() const { return static_cast<std::int8_t>(layers_ + 1); }
+    std::int8_t far_inside() const { return static_cast<std::int8_t>(-(layers_ + 1)); }
+    // Points of layer k, k in [-N, N]; order is unspecified but deterministic.
+    std::span<const PointIndex> layer(int k) const;
+    std::span<const PointIndex> zero_layer() const { return layer(0); }
+    std::size_t band_size() const;
+    bool in_band(PointIndex i) const { return status_[i] >= -layers_ && status_[i] <= layers_; }
+
+    // --- updates ----------------------------------------------------------------------------
+    // One global step of ∂φ/∂t = |∇φ| F with a CFL time step (|Δφ| ≤ cfl and the parabolic bound
+    // dt ≤ 1/(6·curvature weight)), multithreaded over the zero layer.
+    StepResult step(const Speed& speed, const StepOptions& options = {});
+    // The Δφ a global step would apply (one edit per zero-layer point) and its time step.
+    std::vector<ZeroLayerEdit> compute_step(const Speed& speed, const StepOptions& options, double* dt) const;
+
+    // Applies edits to zero-layer points (duplicates are summed; each Δ is clamped to ±0.5) and
+    // repairs the band. Throws std::invalid_argument, before changing anything, if a point is not
+    // on the zero layer or a Δ is not finite.
+    ChangedPoints apply_edits(std::span<const ZeroLayerEdit> edits, RepairScope scope = RepairScope::kLocal);
+    // Local edit of the zero-layer points inside the box [lo, hi] (inclusive, clipped to the
+    // lattice): delta(p, φ(p)) gives each point's Δ. Cost grows with the box, not the band.
+    ChangedPoints apply_in_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta);
+
+private:
+    struct RegionPoint {
+        PointIndex point;
+        std::int8_t old_status;
+        float old_phi;
+    };
+
+    void evaluate_sdf(const std::function<double(Vec3d)>& sdf);
+    ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);
+    void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
+    void collect_band(std::vector<RegionPoint>& region);
+    void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
+    void sweep_layers(std::span<const RegionPoint> region);
+    float inner_layer_value(PointIndex i, int k, bool outside) const;
+    ChangedPoints finish(std::span<const RegionPoint> region);
+    void list_add(PointIndex i, int layer);
+    void list_remove(PointIndex i, int layer);
+
+    int layers_;
+    Grid<float> phi_;
+    Grid<std::int8_t> status_;
+    Grid<std::uint32_t> slot_;                 // position of a band point in its layer list
+    std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
+    std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
+};
+
+}  // namespace liveset

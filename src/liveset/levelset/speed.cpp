@@ -1,0 +1,39 @@
+// Mean curvature by the difference of normals, and the curvature speed term.
+#include "liveset/levelset/speed.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace liveset {
+
+namespace {
+
+// Unit normal component along `a` at the half-way point p + ½·dir·e_a (dir = ±1).
+float half_point_normal(const Grid<float>& phi, Vec3i p, int a, int dir) {
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    Vec3i q = p;
+    q[a] += dir;  // the other end of the half edge
+    Vec3i eb{0, 0, 0}, ec{0, 0, 0};
+    eb[b] = 1;
+    ec[c] = 1;
+    const float ga = static_cast<float>(dir) * (phi.clamped(q) - phi.clamped(p));
+    const float gb = 0.25f * (phi.clamped(p + eb) + phi.clamped(q + eb) - phi.clamped(p - eb) - phi.clamped(q - eb));
+    const float gc = 0.25f * (phi.clamped(p + ec) + phi.clamped(q + ec) - phi.clamped(p - ec) - phi.clamped(q - ec));
+    const float len = std::sqrt(ga * ga + gb * gb + gc * gc);
+    return len > 1e-6f ? ga / len : 0.0f;
+}
+
+}  // namespace
+
+float mean_curvature(const Grid<float>& phi, Vec3i p) {
+    float k = 0.0f;
+    for (int a = 0; a < 3; ++a) k += half_point_normal(phi, p, a, +1) - half_point_normal(phi, p, a, -1);
+    return k;
+}
+
+CurvatureSpeed::CurvatureSpeed(float weight) : weight_(weight) {
+    if (!std::isfinite(weight) || weight < 0)
+        throw std::invalid_argument("curvature weight must be finite and non-negative");
+}
+
+}  // namespace liveset

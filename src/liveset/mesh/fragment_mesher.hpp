@@ -1,0 +1,114 @@
+// Incremental marching cubes over a lattice of mesh fragments (Feltell & Bai §2.1): each fragment
+// owns the V/T arrays of a block of cells; an update takes the changed φ points X, finds the
+// affected fragments U (deduplicated with the flag lattice B), re-polygonises only those (in
+// parallel with oneTBB) and returns U so a renderer re-uploads exactly those buffers.
+//
+// Border policy (better than the paper's): fragment f owns exactly the cells
+// [origin, origin + S) ∩ lattice cells, so every cell - and so every triangle - belongs to exactly
+// one fragment and no triangle is built twice. Only the vertices on the faces shared by two
+// fragments are computed in both (each fragment's V/T must be a self-contained GPU buffer); they are
+// bit-identical because make_edge_vertex() is a pure function of φ.
+//
+// Surface-proportional rebuilds: each fragment keeps the sorted list of its cells that hold a
+// crossing (corner signs differ). A cell's signs change only if one of its corners is in X, so a
+// rebuild visits (old crossing cells) ∪ (cells with a corner in X) and keeps those that still
+// cross; it never scans the fragment, so a single whole-lattice fragment (the paper's x100 case)
+// costs O(surface), not O(volume). The only O(volume) pass is full_rebuild(φ) without a zero layer.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/mesh/cell_polygoniser.hpp"
+#include "liveset/mesh/mesh.hpp"
+
+namespace liveset {
+
+using FragmentId = std::uint32_t;  // linear index in the fragment lattice (x fastest)
+
+// One fragment's buffers as seen by a renderer.
+struct FragmentView {
+    FragmentId id = 0;
+    Vec3i cell_origin{};  // first owned cell
+    Vec3i cell_extent{};  // number of owned cells per axis (smaller at the lattice's far border)
+    std::span<const Vertex> vertices;       // V, index space
+    std::span<const std::uint32_t> indices;  // T, 3 per triangle, local to V
+    MeshView mesh() const { return {vertices, indices}; }
+};
+
+struct FragmentUpdateStats {
+    std::size_t fragments_rebuilt = 0;
+    std::size_t cells_visited = 0;       // candidate cells examined
+    std::size_t vertices_computed = 0;   // edge vertices computed (border vertices count per fragment)
+};
+
+// Thread safety: update()/full_rebuild() parallelise internally and must not run concurrently
+// with each other or with readers of fragment() spans (which they invalidate for the fragments in U).
+class FragmentMesher {
+public:
+    // fragment_size S: cells per fragment edge (>= 1; the paper's smallest workable size is 3).
+    // A size >= the largest cell dimension gives a single fragment (naive whole-lattice meshing).
+    // Throws std::invalid_argument on S < 1 or an empty lattice.
+    FragmentMesher(const Lattice& lattice, int fragment_size);
+    ~FragmentMesher();
+    FragmentMesher(FragmentMesher&&) noexcept;
+    FragmentMesher& operator=(FragmentMesher&&) noexcept;
+
+    const Lattice& lattice() const { return lattice_; }
+    int fragment_size() const { return size_; }
+    Vec3i fragment_dims() const { return fdims_; }  // fragments per axis
+    std::size_t fragment_count() const { return fragments_.size(); }
+    FragmentId fragment_id(Vec3i fragment_coord) const;
+    Vec3i fragment_coord(FragmentId id) const;
+    FragmentId fragment_of_cell(Vec3i cell) const;
+    FragmentView fragment(FragmentId id) const;
+
+    // Rebuilds every fragment by scanning all cells (O(volume)); returns nothing since all changed.
+    void full_rebuild(const Grid<float>& phi);
+    // Rebuilds every fragment visiting only cells with a corner in `zero_layer` (see
+    // marching_cubes_band for the completeness condition).
+    void full_rebuild(const Grid<float>& phi, std::span<const PointIndex> zero_layer);
+
+    // Incremental update after the φ values at `changed` (X) were modified; every modified point must
+    // be listed (duplicates allowed). Re-polygonises the affected fragments U and returns their ids,
+    // sorted ascending. A fragment is affected when one of its cells has a corner in X (signs and
+    // vertex positions) or a corner that is a 6-neighbour of a point of X (vertex normals read φ
+    // through the central-difference stencil). φ must have this mesher's lattice dimensions.
+    std::vector<FragmentId> update(const Grid<float>& phi, std::span<const PointIndex> changed);
+
+    // The fragments update() would rebuild for `changed`, without rebuilding (sorted).
+    std::vector<FragmentId> affected_fragments(std::span<const PointIndex> changed) const;
+
+    std::size_t triangle_count() const;
+    std::size_t vertex_count() const;  // sum over fragments (border vertices counted per fragment)
+    Mesh merged() const;               // all fragments concatenated (border vertices duplicated)
+    const FragmentUpdateStats& last_stats() const { return stats_; }
+
+private:
+    struct Fragment {
+        Vec3i origin{}, extent{};
+        Mesh mesh;                      // V and T
+        std::vector<CellKey> crossing;  // sorted keys of owned cells with a sign change
+        std::vector<CellKey> pending;   // cells whose corners changed since the last rebuild
+    };
+    struct Scratch;
+
+    void check_phi(const Grid<float>& phi) const;
+    template <class Visit>
+    void for_each_affected(PointIndex x, Visit&& visit) const;
+    void rebuild(const Grid<float>& phi, std::span<const FragmentId> ids, bool scan);
+
+    Lattice lattice_;
+    int size_ = 0;
+    Vec3i cells_{};  // cells per axis
+    Vec3i fdims_{};
+    std::vector<Fragment> fragments_;
+    std::vector<std::uint8_t> flags_;  // B
+    FragmentUpdateStats stats_;
+    std::unique_ptr<Scratch> scratch_;  // per-thread polygonisers
+};
+
+}  // namespace liveset

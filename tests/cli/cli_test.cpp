@@ -1,0 +1,98 @@
+// The `liveset` command line as a user meets it: --help/--version, a small experiment with a JSON
+// report, and bad flags/values rejected with one clear line on stderr and a non-zero exit.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace {
+
+struct Result {
+    int rc = -1;
+    std::string out, err;
+};
+
+std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+Result run_cli(const std::string& args) {
+    const auto dir = std::filesystem::temp_directory_path() / ("liveset_cli_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const std::string cmd = std::string(LIVESET_CLI_PATH) + " " + args + " >" + (dir / "out").string() + " 2>" +
+                            (dir / "err").string() + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    Result r;
+    r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    r.out = slurp(dir / "out");
+    r.err = slurp(dir / "err");
+    std::filesystem::remove_all(dir);
+    return r;
+}
+
+int lines(const std::string& s) {
+    int n = 0;
+    for (char c : s) n += c == '\n';
+    return n;
+}
+
+}  // namespace
+
+TEST(Cli, VersionAndHelp) {
+    const Result v = run_cli("--version");
+    EXPECT_EQ(v.rc, 0);
+    EXPECT_NE(v.out.find("liveset "), std::string::npos);
+    const Result h = run_cli("--help");
+    EXPECT_EQ(h.rc, 0);
+    EXPECT_NE(h.out.find("demo"), std::string::npos);
+    EXPECT_NE(h.out.find("flow"), std::string::npos);
+    for (const char* sub : {"demo", "flow"}) {
+        const Result s = run_cli(std::string(sub) + " --help");
+        EXPECT_EQ(s.rc, 0) << sub;
+        EXPECT_NE(s.out.find("--json"), std::string::npos) << sub;
+    }
+}
+
+TEST(Cli, FlowReportsAVanishingBoxAsJson) {
+    const Result r = run_cli("--threads 2 flow --lattice 24 --box 10 --json --check-every 5");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.out.find("\"vanished\":true"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\"invariants_ok\":true"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("\"volume_monotone\":true"), std::string::npos) << r.out;
+    EXPECT_EQ(lines(r.out), 1);
+}
+
+TEST(Cli, FlowWritesItsCsvAtomically) {
+    const auto csv = std::filesystem::temp_directory_path() / "liveset_cli_flow.csv";
+    std::filesystem::remove(csv);
+    const Result r = run_cli("flow --lattice 20 --box 8 --quiet --csv " + csv.string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const std::string text = slurp(csv);
+    EXPECT_EQ(text.rfind("step,time,dt,zero_layer,band,changed,ms\n", 0), 0u);
+    EXPECT_GT(lines(text), 5);
+    EXPECT_FALSE(std::filesystem::exists(csv.string() + ".tmp"));
+    std::filesystem::remove(csv);
+    const Result bad = run_cli("flow --lattice 20 --box 8 --quiet --csv /nonexistent-dir/x.csv");
+    EXPECT_NE(bad.rc, 0);
+    EXPECT_EQ(lines(bad.err), 1) << bad.err;
+}
+
+TEST(Cli, BadInputGetsOneLineAndNonZeroExit) {
+    for (const char* args : {"", "nonsense", "flow --lattice 0", "flow --lattice abc", "flow --box 200",
+                             "flow --layers 0", "flow --cfl nan", "flow --cfl 0.9", "flow --steps -3",
+                             "--threads -1 flow", "flow --unknown-flag"}) {
+        const Result r = run_cli(args);
+        EXPECT_NE(r.rc, 0) << args;
+        EXPECT_FALSE(r.err.empty()) << args;
+        EXPECT_LE(lines(r.err), 2) << args << ": " << r.err;  // CLI11 adds a "Run with --help" hint
+        EXPECT_EQ(r.err.find("terminate"), std::string::npos) << args;
+    }
+}

@@ -1,0 +1,79 @@
+// Sparse-field initialisation: from signed distances, masks and seeds; invariants; bad input.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "levelset_test_util.hpp"
+#include "liveset/levelset/shapes.hpp"
+
+using namespace liveset;
+using liveset::testing::expect_valid;
+
+TEST(SparseFieldInit, SphereHasValidLayersAndTheRightVolume) {
+    for (int layers : {1, 2, 3}) {
+        SparseField f(Lattice({48, 48, 48}), layers);
+        f.init_from_sdf(shapes::Sphere({23.5, 23.5, 23.5}, 15.0));
+        expect_valid(f, "sphere");
+        EXPECT_GT(f.zero_layer().size(), 1000u);
+        for (int k = -layers; k <= layers; ++k) EXPECT_FALSE(f.layer(k).empty()) << k;
+        const double v = enclosed_volume(f);
+        const double exact = 4.0 / 3.0 * std::numbers::pi * 15.0 * 15.0 * 15.0;
+        EXPECT_NEAR(v / exact, 1.0, 0.01);
+        // Zero-layer values are the exact distances.
+        for (PointIndex i : f.zero_layer()) {
+            const Vec3d p = f.lattice().coord(i).cast<double>();
+            EXPECT_NEAR(f.phi()[i], norm(p - Vec3d{23.5, 23.5, 23.5}) - 15.0, 1e-5);
+        }
+    }
+}
+
+TEST(SparseFieldInit, FromMaskPutsTheFrontHalfwayBetweenVoxels) {
+    Grid<std::uint8_t> mask(Lattice({20, 20, 20}), 0);
+    for (int z = 5; z < 15; ++z)
+        for (int y = 5; y < 15; ++y)
+            for (int x = 5; x < 15; ++x) mask({x, y, z}) = 1;
+    SparseField f(mask.lattice(), 2);
+    f.init_from_mask(mask);
+    expect_valid(f, "mask");
+    EXPECT_FLOAT_EQ(f.phi()({5, 10, 10}), -0.5f);
+    EXPECT_FLOAT_EQ(f.phi()({4, 10, 10}), 0.5f);
+    EXPECT_FLOAT_EQ(f.phi()({3, 10, 10}), 1.5f);
+    EXPECT_FLOAT_EQ(f.phi()({6, 10, 10}), -1.5f);
+    EXPECT_EQ(f.status()({10, 10, 10}), f.far_inside());
+    EXPECT_NEAR(enclosed_volume(f), 1000.0, 1e-9);
+}
+
+TEST(SparseFieldInit, SeedSpheresUnion) {
+    const Lattice lat({40, 30, 30});
+    SparseField f(lat, 2);
+    f.init_from_sdf(shapes::SeedSpheres(lat, {shapes::Sphere({10, 15, 15}, 4), shapes::Sphere({30, 15, 15}, 5)}));
+    expect_valid(f, "seeds");
+    EXPECT_LT(f.phi()({10, 15, 15}), 0);
+    EXPECT_LT(f.phi()({30, 15, 15}), 0);
+    EXPECT_GT(f.phi()({20, 15, 15}), 0);
+}
+
+TEST(SparseFieldInit, SteepFunctionStillGetsAClosedFront) {
+    // A step function (not a distance) would leave no zero layer; both sides are pulled onto it.
+    SparseField f(Lattice({16, 16, 16}), 2);
+    f.init_from_sdf([](Vec3d p) { return p.x < 8 ? -10.0 : 10.0; });
+    expect_valid(f, "step");
+    EXPECT_EQ(f.status()({7, 3, 3}), 0);
+    EXPECT_EQ(f.status()({8, 3, 3}), 0);
+}
+
+TEST(SparseFieldInit, RejectsBadParameters) {
+    const Lattice lat({16, 16, 16});
+    EXPECT_THROW(SparseField(lat, 0), std::invalid_argument);
+    EXPECT_THROW(SparseField(lat, SparseField::kMaxLayers + 1), std::invalid_argument);
+    EXPECT_THROW(shapes::Sphere({1, 1, 1}, -2), std::invalid_argument);
+    EXPECT_THROW(shapes::Sphere({1, NAN, 1}, 2), std::invalid_argument);
+    EXPECT_THROW(shapes::Box({1, 1, 1}, {1, 0, 1}), std::invalid_argument);
+    EXPECT_THROW(shapes::SeedSpheres(lat, {shapes::Sphere({20, 1, 1}, 2)}), std::invalid_argument);
+    EXPECT_THROW(shapes::SeedSpheres(lat, {}), std::invalid_argument);
+    SparseField f(lat, 2);
+    EXPECT_THROW(f.init_from_sdf([](Vec3d) { return NAN; }), std::invalid_argument);
+    Grid<std::uint8_t> wrong(Lattice({8, 8, 8}), 0);
+    EXPECT_THROW(f.init_from_mask(wrong), std::invalid_argument);
+}

@@ -1,0 +1,77 @@
+// Helpers shared by the level-set tests: bitwise state comparison, brute-force change sets and
+// random zero-layer edits (fixed seeds).
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "liveset/levelset/invariants.hpp"
+#include "liveset/levelset/sparse_field.hpp"
+
+namespace liveset::testing {
+
+inline bool same_state(const SparseField& a, const SparseField& b) {
+    const auto pa = a.phi().values(), pb = b.phi().values();
+    const auto sa = a.status().values(), sb = b.status().values();
+    for (std::size_t i = 0; i < pa.size(); ++i)
+        if (std::bit_cast<std::uint32_t>(pa[i]) != std::bit_cast<std::uint32_t>(pb[i]) || sa[i] != sb[i]) return false;
+    return true;
+}
+
+// Every point whose φ (bitwise) or status differs between two states, sorted.
+inline std::vector<PointIndex> brute_force_changes(const SparseField& before, const SparseField& after) {
+    std::vector<PointIndex> out;
+    const auto pa = before.phi().values(), pb = after.phi().values();
+    const auto sa = before.status().values(), sb = after.status().values();
+    for (std::size_t i = 0; i < pa.size(); ++i)
+        if (std::bit_cast<std::uint32_t>(pa[i]) != std::bit_cast<std::uint32_t>(pb[i]) || sa[i] != sb[i])
+            out.push_back(static_cast<PointIndex>(i));
+    return out;
+}
+
+inline std::vector<PointIndex> sorted(std::vector<PointIndex> v) {
+    std::sort(v.begin(), v.end());
+    return v;
+}
+
+// A random local edit: a Gaussian bump (raise or lower) of the given radius around a random
+// zero-layer point, or a handful of scattered single-point edits.
+inline std::vector<ZeroLayerEdit> random_edit(const SparseField& f, std::mt19937& rng, double radius = 3.0) {
+    std::vector<ZeroLayerEdit> edits;
+    const auto zero = f.zero_layer();
+    if (zero.empty()) return edits;
+    std::uniform_int_distribution<std::size_t> pick(0, zero.size() - 1);
+    std::uniform_real_distribution<float> amp(-0.5f, 0.5f);
+    if (rng() % 4 == 0) {
+        const int n = 1 + static_cast<int>(rng() % 6);
+        for (int k = 0; k < n; ++k) edits.push_back({zero[pick(rng)], amp(rng)});
+        return edits;
+    }
+    const Vec3i c = f.lattice().coord(zero[pick(rng)]);
+    const float a = amp(rng);
+    const int r = static_cast<int>(std::ceil(radius));
+    for (int z = c.z - r; z <= c.z + r; ++z)
+        for (int y = c.y - r; y <= c.y + r; ++y)
+            for (int x = c.x - r; x <= c.x + r; ++x) {
+                const Vec3i p{x, y, z};
+                if (!f.lattice().contains(p)) continue;
+                const PointIndex i = f.lattice().index(p);
+                if (f.status()[i] != 0) continue;
+                const double d2 = dot((p - c).cast<double>(), (p - c).cast<double>());
+                if (d2 > radius * radius) continue;
+                edits.push_back({i, a * static_cast<float>(std::exp(-d2 / (radius * radius)))});
+            }
+    return edits;
+}
+
+inline void expect_valid(const SparseField& f, const char* where) {
+    const InvariantReport r = check_invariants(f);
+    EXPECT_TRUE(r.ok()) << where << ": " << r.summary();
+}
+
+}  // namespace liveset::testing
