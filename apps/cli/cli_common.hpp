@@ -21,7 +21,12 @@ CLI::Validator finite_number();
 // Limits TBB to `threads` workers for the lifetime of the returned object (0 = all cores).
 std::shared_ptr<void> limit_threads(int threads);
 
+// Writes `text` to `path` through a temporary file in the same directory and a rename, so readers
+// never see a half-written file. Throws UsageError when the file cannot be written.
+void write_atomically(const std::string& path, const std::string& text);
+
 // Each subcommand registers itself on the app.
 void add_flow_commands(CLI::App& app, const int& threads);
+void add_bench_commands(CLI::App& app, const int& threads);
 
 }  // namespace liveset::cli

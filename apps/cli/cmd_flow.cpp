@@ -2,8 +2,6 @@
 // F = κ until it vanishes), with periodic band invariant checks and a short report.
 #include <fmt/core.h>
 
-#include <filesystem>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -24,29 +22,6 @@ struct FlowArgs {
     bool quiet = false;
     std::string csv;
 };
-
-void write_atomically(const std::string& path, const std::string& text) {
-    namespace fs = std::filesystem;
-    const fs::path target(path);
-    const fs::path tmp = target.parent_path() / (target.filename().string() + ".tmp");
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw UsageError("cannot write " + path);
-        out << text;
-        out.flush();
-        if (!out) {
-            out.close();
-            fs::remove(tmp);
-            throw UsageError("failed writing " + path);
-        }
-    }
-    std::error_code ec;
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        fs::remove(tmp);
-        throw UsageError("cannot write " + path + ": " + ec.message());
-    }
-}
 
 int run_flow(const FlowArgs& a, int threads, const char* title) {
     const auto guard = limit_threads(threads);

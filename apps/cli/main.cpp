@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
     liveset::cli::add_flow_commands(app, threads);
+    liveset::cli::add_bench_commands(app, threads);
 
     try {
         app.parse(argc, argv);

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# One-step set-up on a fresh Debian 12 machine: installs the Debian packages liveset needs (only
+# those missing, so it is idempotent and fast on re-runs) and builds everything into ./build.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+packages=(
+  cmake g++ ninja-build pkg-config            # toolchain
+  libtbb-dev                                  # oneTBB: parallel level-set update and meshing
+  libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
+  libcli11-dev libfmt-dev nlohmann-json3-dev  # command line, formatting, JSON reports
+  gnuplot-nox                                 # plots of the Figure 3 experiment
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}" >&2
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_WERROR=ON >/dev/null
+cmake --build build -j "$jobs"
