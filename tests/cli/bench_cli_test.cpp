@@ -14,46 +14,22 @@
 #include <string>
 #include <vector>
 
+#include "cli_run.hpp"
+
 namespace {
 
+using liveset::testing::lines;
+using liveset::testing::run_cli;
+using liveset::testing::slurp;
+using Result = liveset::testing::CliResult;
+
 namespace fs = std::filesystem;
-
-struct Result {
-    int rc = -1;
-    std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
 
 fs::path scratch_dir(const std::string& name) {
     const fs::path dir = fs::temp_directory_path() / ("liveset_bench_cli_" + std::to_string(::getpid()) + "_" + name);
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
-}
-
-Result run_cli(const std::string& args) {
-    const fs::path dir = scratch_dir("io");
-    const std::string cmd = std::string(LIVESET_CLI_PATH) + " " + args + " >" + (dir / "out").string() + " 2>" +
-                            (dir / "err").string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(dir / "out");
-    r.err = slurp(dir / "err");
-    fs::remove_all(dir);
-    return r;
-}
-
-int lines(const std::string& s) {
-    int n = 0;
-    for (char c : s) n += c == '\n';
-    return n;
 }
 
 std::vector<std::string> split(const std::string& s, char sep) {

@@ -10,41 +10,12 @@
 #include <sstream>
 #include <string>
 
-namespace {
+#include "cli_run.hpp"
 
-struct Result {
-    int rc = -1;
-    std::string out, err;
-};
-
-std::string slurp(const std::filesystem::path& p) {
-    std::ifstream in(p);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-Result run_cli(const std::string& args) {
-    const auto dir = std::filesystem::temp_directory_path() / ("liveset_cli_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    const std::string cmd = std::string(LIVESET_CLI_PATH) + " " + args + " >" + (dir / "out").string() + " 2>" +
-                            (dir / "err").string() + " </dev/null";
-    const int status = std::system(cmd.c_str());
-    Result r;
-    r.rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    r.out = slurp(dir / "out");
-    r.err = slurp(dir / "err");
-    std::filesystem::remove_all(dir);
-    return r;
-}
-
-int lines(const std::string& s) {
-    int n = 0;
-    for (char c : s) n += c == '\n';
-    return n;
-}
-
-}  // namespace
+using liveset::testing::lines;
+using liveset::testing::run_cli;
+using liveset::testing::slurp;
+using Result = liveset::testing::CliResult;
 
 TEST(Cli, VersionAndHelp) {
     const Result v = run_cli("--version");
