@@ -3,6 +3,7 @@
 #include "liveset/mesh/cell_polygoniser.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -17,32 +18,46 @@ namespace {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
+// central_gradient() with a fast path for points whose 6-neighbours are all inside the lattice:
+// the same arithmetic ((φ(p+e) - φ(p-e)) / 2), so bit-identical results, without clamping.
+inline Vec3f gradient(const Grid<float>& phi, Vec3i p) {
+    const Vec3i d = phi.dims();
+    if (p.x < 1 || p.y < 1 || p.z < 1 || p.x > d.x - 2 || p.y > d.y - 2 || p.z > d.z - 2) return central_gradient(phi, p);
+    const Lattice& l = phi.lattice();
+    const std::size_t sy = l.stride_y(), sz = l.stride_z(), i = l.index(p);
+    const float* v = phi.values().data();
+    return {(v[i + 1] - v[i - 1]) / 2.0f, (v[i + sy] - v[i - sy]) / 2.0f, (v[i + sz] - v[i - sz]) / 2.0f};
+}
+
 }  // namespace
 
 Vertex make_edge_vertex(const Grid<float>& phi, Vec3i p, int axis) {
+    const Lattice& l = phi.lattice();
+    const std::size_t step = axis == 0 ? 1 : axis == 1 ? l.stride_y() : l.stride_z();
+    const std::size_t i = l.index(p);
+    const float a = phi[static_cast<PointIndex>(i)];
+    const float b = phi[static_cast<PointIndex>(i + step)];
+    float t = a / (a - b);
+    if (!std::isfinite(t)) t = 0.5f;
+    t = std::clamp(t, kEdgeVertexMargin, 1.0f - kEdgeVertexMargin);
+
     Vec3i q = p;
     q[axis] += 1;
-    const double a = phi(p);
-    const double b = phi(q);
-    double t = a / (a - b);
-    if (!std::isfinite(t)) t = 0.5;
-    const double m = kEdgeVertexMargin;
-    t = std::clamp(t, m, 1.0 - m);
-
-    const Vec3f ga = central_gradient(phi, p);
-    const Vec3f gb = central_gradient(phi, q);
-    double n[3];
-    for (int k = 0; k < 3; ++k) n[k] = (1.0 - t) * ga[k] + t * gb[k];
-    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    const Vec3f ga = gradient(phi, p);
+    const Vec3f gb = gradient(phi, q);
+    const float s = 1.0f - t;
+    const float n[3] = {s * ga.x + t * gb.x, s * ga.y + t * gb.y, s * ga.z + t * gb.z};
+    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
     Vertex v{};
-    if (std::isfinite(len) && len > 1e-20) {
-        for (int k = 0; k < 3; ++k) v.normal[k] = static_cast<float>(n[k] / len);
+    if (std::isfinite(len) && len > 1e-20f) {
+        const float inv = 1.0f / len;
+        for (int k = 0; k < 3; ++k) v.normal[k] = n[k] * inv;
     } else {
         // Degenerate gradient: point along the edge from its inside end to its outside end.
-        v.normal[axis] = is_inside(static_cast<float>(a)) ? 1.0f : -1.0f;
+        v.normal[axis] = is_inside(a) ? 1.0f : -1.0f;
     }
     for (int k = 0; k < 3; ++k) v.position[k] = static_cast<float>(p[k]);
-    v.position[axis] = static_cast<float>(p[axis] + t);
+    v.position[axis] = static_cast<float>(p[axis]) + t;
     return v;
 }
 
@@ -67,71 +82,92 @@ void CellPolygoniser::prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi) {
             throw std::out_of_range(os.str());
         }
     }
+    if (!(decoder_dims_ == d)) {
+        decoder_ = IndexDecoder(phi.lattice());
+        decoder_dims_ = d;
+    }
     lo_ = lo;
     px_ = hi.x - lo.x + 1;
     py_ = hi.y - lo.y + 1;
-    const std::size_t need = std::size_t{2} * static_cast<std::size_t>(px_) * static_cast<std::size_t>(py_) * 3;
-    if (dirty_) {
-        std::fill(g_.begin(), g_.end(), kNone);
-        written_[0].clear();
-        written_[1].clear();
-    }
-    // Entries are all kNone between calls, so growing keeps that invariant whatever the layout.
-    if (g_.size() < need) g_.resize(need, kNone);
+    slice_ = static_cast<std::size_t>(px_) * static_cast<std::size_t>(py_) * 3;
+    const std::size_t need = 2 * slice_;
+    if (g_.size() < need) g_.resize(need, 0);  // generation 0 is never current: new entries are unset
+    renew_slot(0);
+    renew_slot(1);
     layer_ = INT_MIN;
     computed_ = 0;
-    dirty_ = true;
 }
 
-void CellPolygoniser::clear_slot(int slot) {
-    for (std::uint32_t i : written_[slot]) g_[i] = kNone;
-    written_[slot].clear();
+void CellPolygoniser::renew_slot(int slot) {
+    if (next_generation_ == 0xFFFF'FFFFu) {  // wrapped: forget every entry once every 2^32 slices
+        std::fill(g_.begin(), g_.end(), 0);
+        next_generation_ = 1;
+    }
+    generation_[slot] = std::uint64_t{next_generation_++} << 32;
 }
 
 void CellPolygoniser::enter_layer(int z) {
     if (z == layer_) return;
     if (layer_ != INT_MIN && z < layer_) throw std::invalid_argument("cells must be visited in ascending order");
     if (layer_ != INT_MIN && z == layer_ + 1) {
-        clear_slot(layer_ & 1);  // slice layer_ is done; its slot now holds slice z + 1
+        renew_slot(layer_ & 1);  // slice layer_ is done; its slot now holds slice z + 1
     } else {
-        clear_slot(0);
-        clear_slot(1);
+        renew_slot(0);
+        renew_slot(1);
     }
     layer_ = z;
 }
 
-std::uint32_t CellPolygoniser::edge_vertex(const Grid<float>& phi, Vec3i p, int axis, Mesh& out) {
-    const int slot = p.z & 1;
-    const std::size_t gi =
-        ((static_cast<std::size_t>(slot) * static_cast<std::size_t>(py_) + static_cast<std::size_t>(p.y - lo_.y)) *
-             static_cast<std::size_t>(px_) +
-         static_cast<std::size_t>(p.x - lo_.x)) *
-            3 +
-        static_cast<std::size_t>(axis);
-    std::uint32_t& slot_ref = g_[gi];
-    if (slot_ref != kNone) return slot_ref;
-    if (out.vertices.size() >= kNone) throw std::length_error("mesh has too many vertices for 32-bit indices");
-    const auto id = static_cast<std::uint32_t>(out.vertices.size());
-    out.vertices.push_back(make_edge_vertex(phi, p, axis));
-    slot_ref = id;
-    written_[slot].push_back(static_cast<std::uint32_t>(gi));
-    ++computed_;
-    return id;
-}
+namespace {
+
+// Per cell edge e: the offset of its start corner and its axis, as used to index G.
+struct EdgeStart {
+    int dx, dy, dz, axis;
+};
+constexpr std::array<EdgeStart, mc::kEdges> kEdgeStarts = [] {
+    std::array<EdgeStart, mc::kEdges> t{};
+    for (int e = 0; e < mc::kEdges; ++e) {
+        const mc::EdgeInfo info = mc::edge_info(e);
+        t[static_cast<std::size_t>(e)] = {mc::corner_offset(info.start_corner, 0), mc::corner_offset(info.start_corner, 1),
+                                          mc::corner_offset(info.start_corner, 2), info.axis};
+    }
+    return t;
+}();
+
+}  // namespace
 
 void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& out) {
     const auto& tables = mc::kTables;
-    const unsigned mask = tables.edges[cs];
+    // G offset of the cell's minimum corner; a corner (dx, dy, dz) adds dx*3 + dy*px*3 and picks the
+    // slot of its z slice.
+    const std::size_t row = (static_cast<std::size_t>(c.y - lo_.y) * static_cast<std::size_t>(px_) +
+                             static_cast<std::size_t>(c.x - lo_.x)) * 3;
+    const std::size_t row_step = static_cast<std::size_t>(px_) * 3;
+    const int slot0 = c.z & 1;
     std::uint32_t v[mc::kEdges];
-    for (int e = 0; e < mc::kEdges; ++e) {
-        if (!((mask >> e) & 1u)) continue;
-        const mc::EdgeInfo info = mc::edge_info(e);
-        const Vec3i p{c.x + mc::corner_offset(info.start_corner, 0), c.y + mc::corner_offset(info.start_corner, 1),
-                      c.z + mc::corner_offset(info.start_corner, 2)};
-        v[e] = edge_vertex(phi, p, info.axis, out);
+    for (unsigned mask = tables.edges[static_cast<std::size_t>(cs)]; mask != 0; mask &= mask - 1) {
+        const int e = std::countr_zero(mask);
+        const EdgeStart& es = kEdgeStarts[static_cast<std::size_t>(e)];
+        const int slot = slot0 ^ es.dz;
+        const std::size_t gi = static_cast<std::size_t>(slot) * slice_ + row + static_cast<std::size_t>(es.dy) * row_step +
+                               static_cast<std::size_t>(es.dx) * 3 + static_cast<std::size_t>(es.axis);
+        std::uint64_t& entry = g_[gi];
+        if ((entry & 0xFFFF'FFFF'0000'0000ull) == generation_[slot]) {
+            v[e] = static_cast<std::uint32_t>(entry);
+            continue;
+        }
+        if (out.vertices.size() >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
+        const auto id = static_cast<std::uint32_t>(out.vertices.size());
+        out.vertices.push_back(make_edge_vertex(phi, {c.x + es.dx, c.y + es.dy, c.z + es.dz}, es.axis));
+        entry = generation_[slot] | id;
+        v[e] = id;
+        ++computed_;
     }
-    const auto& tri = tables.triangles[cs];
-    for (int j = 0; tri[j] != mc::kEnd; ++j) out.indices.push_back(v[tri[j]]);
+    const auto& tri = tables.triangles[static_cast<std::size_t>(cs)];
+    const int n = 3 * tables.triangle_count[static_cast<std::size_t>(cs)];
+    const std::size_t base = out.indices.size();
+    out.indices.resize(base + static_cast<std::size_t>(n));
+    for (int j = 0; j < n; ++j) out.indices[base + static_cast<std::size_t>(j)] = v[tri[static_cast<std::size_t>(j)]];
 }
 
 void CellPolygoniser::polygonise_box(const Grid<float>& phi, Vec3i lo, Vec3i hi, Mesh& out,
@@ -150,15 +186,15 @@ void CellPolygoniser::polygonise_box(const Grid<float>& phi, Vec3i lo, Vec3i hi,
             }
         }
     }
-    clear_slot(0);
-    clear_slot(1);
-    dirty_ = false;
 }
 
 void CellPolygoniser::polygonise_cells(const Grid<float>& phi, Vec3i lo, Vec3i hi, std::span<const CellKey> cells,
                                        Mesh& out, std::vector<CellKey>* crossing_cells) {
     prepare(phi, lo, hi);
     const Lattice& l = phi.lattice();
+    const std::size_t sy = l.stride_y(), sz = l.stride_z();
+    const std::size_t off[8] = {0, 1, sy, sy + 1, sz, sz + 1, sz + sy, sz + sy + 1};
+    const float* values = phi.values().data();
     bool first = true;
     CellKey prev = 0;
     for (CellKey key : cells) {
@@ -166,18 +202,16 @@ void CellPolygoniser::polygonise_cells(const Grid<float>& phi, Vec3i lo, Vec3i h
         first = false;
         prev = key;
         if (key >= l.size()) throw std::out_of_range("cell key outside the lattice");
-        const Vec3i c = l.coord(key);
+        const Vec3i c = decoder_.coord(key);
         if (c.x < lo.x || c.y < lo.y || c.z < lo.z || c.x >= hi.x || c.y >= hi.y || c.z >= hi.z)
             throw std::out_of_range("listed cell outside the polygonised box");
-        const int cs = cell_case(phi, c);
+        int cs = 0;
+        for (int k = 0; k < 8; ++k) cs |= static_cast<int>(is_inside(values[key + off[k]])) << k;
         if (cs == 0 || cs == 255) continue;
         enter_layer(c.z);
         emit_cell(phi, c, cs, out);
         if (crossing_cells) crossing_cells->push_back(key);
     }
-    clear_slot(0);
-    clear_slot(1);
-    dirty_ = false;
 }
 
 }  // namespace liveset

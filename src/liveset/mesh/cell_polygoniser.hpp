@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
+#include "liveset/grid/index_decoder.hpp"
 #include "liveset/mesh/mesh.hpp"
 
 namespace liveset {
@@ -40,8 +41,8 @@ using CellKey = PointIndex;
 
 // Polygonises cells of one half-open box [lo, hi) of cell coordinates (a cell c has corners
 // c .. c+1; valid cells satisfy 0 <= c < dims-1). G is held for two z-slices of lattice points only
-// (a ring indexed by z parity), so memory is O(box footprint in x*y) whatever the box depth, and it
-// is reset by undoing only the entries written (O(vertices)), never by clearing the whole array.
+// (a ring indexed by z parity), so memory is O(box footprint in x*y) whatever the box depth; a
+// slice is reset in O(1) by a generation stamp, never by clearing the array.
 // Not thread-safe; use one per thread. Output is a deterministic function of (φ, box, cells).
 class CellPolygoniser {
 public:
@@ -59,17 +60,22 @@ public:
 private:
     void prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi);
     void enter_layer(int z);
-    void clear_slot(int slot);
+    void renew_slot(int slot);
     void emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& out);
-    std::uint32_t edge_vertex(const Grid<float>& phi, Vec3i p, int axis, Mesh& out);
 
-    std::vector<std::uint32_t> g_;                    // G: 2 slices * px * py * 3, kNone when unset
-    std::array<std::vector<std::uint32_t>, 2> written_;  // G entries set, per slice slot
+    // G: 2 slices * px * py * 3 entries, each (generation << 32 | vertex id). An entry is set only
+    // when its generation equals its slot's current one, so a slice is cleared in O(1) by giving
+    // its slot a new generation.
+    std::vector<std::uint64_t> g_;
+    std::array<std::uint64_t, 2> generation_{};  // current generation per slot, in the high half
+    std::uint32_t next_generation_ = 1;
+    IndexDecoder decoder_;  // for the lattice of dims decoder_dims_
+    Vec3i decoder_dims_{};
     Vec3i lo_{};
     int px_ = 0, py_ = 0;
-    int layer_ = INT_MIN;  // cell layer z currently being polygonised
+    std::size_t slice_ = 0;  // entries per slice
+    int layer_ = INT_MIN;    // cell layer z currently being polygonised
     std::size_t computed_ = 0;
-    bool dirty_ = false;  // an exception left G partially written
 };
 
 }  // namespace liveset

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <sstream>
 #include <stdexcept>
 
@@ -21,6 +22,8 @@ struct FragmentMesher::Scratch {
         CellPolygoniser poly;
         std::vector<CellKey> candidates;
         std::vector<CellKey> crossing;
+        std::vector<FragmentId> flagged;   // fragments this thread flagged in B during update()
+        std::vector<PointIndex> flipped;   // changed points whose sign flipped
     };
     tbb::enumerable_thread_specific<Local> locals;
 };
@@ -38,6 +41,22 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
                           static_cast<std::size_t>(fdims_.z);
     fragments_.resize(n);
     flags_.assign(n, 0);
+    decode_ = IndexDecoder(lattice);
+    inside_.assign(lattice.size() / 64 + 1, 0);
+    if (n > 0) {
+        for (int a = 0; a < 3; ++a) {
+            auto& t = ranges_[a];
+            t.resize(static_cast<std::size_t>(d[a]));
+            const int last = cells_[a] - 1;
+            for (int v = 0; v < d[a]; ++v) {
+                AxisRange& r = t[static_cast<std::size_t>(v)];
+                r.narrow_lo = std::max(v - 1, 0) / size_;
+                r.narrow_hi = std::min(v, last) / size_;
+                r.wide_lo = std::max(v - 2, 0) / size_;
+                r.wide_hi = std::min(v + 1, last) / size_;
+            }
+        }
+    }
     for (FragmentId id = 0; id < n; ++id) {
         Fragment& f = fragments_[id];
         const Vec3i fc = fragment_coord(id);
@@ -79,25 +98,27 @@ void FragmentMesher::check_phi(const Grid<float>& phi) const {
 }
 
 template <class Visit>
-void FragmentMesher::for_each_affected(PointIndex x, Visit&& visit) const {
-    const Vec3i p = lattice_.coord(x);
-    // Cells with a corner at p or at a 6-neighbour of p (the central-difference stencil).
-    for (int k = 0; k < 7; ++k) {
-        Vec3i q = p;
-        if (k > 0) q[(k - 1) / 2] += (k % 2) ? -1 : 1;
-        if (!lattice_.contains(q)) continue;
-        Vec3i flo, fhi;
-        bool empty = false;
-        for (int a = 0; a < 3; ++a) {
-            const int lo = std::max(q[a] - 1, 0), hi = std::min(q[a], cells_[a] - 1);
-            if (lo > hi) empty = true;
-            flo[a] = lo / size_;
-            fhi[a] = hi / size_;
+void FragmentMesher::for_each_affected(Vec3i p, Visit&& visit) const {
+    // Cells with a corner at p or at a 6-neighbour of p (the central-difference stencil): per axis a,
+    // the box "wide on a, narrow on the others"; their union is what a change at p can touch.
+    const AxisRange& rx = ranges_[0][static_cast<std::size_t>(p.x)];
+    const AxisRange& ry = ranges_[1][static_cast<std::size_t>(p.y)];
+    const AxisRange& rz = ranges_[2][static_cast<std::size_t>(p.z)];
+    if (rx.wide_lo == rx.wide_hi && ry.wide_lo == ry.wide_hi && rz.wide_lo == rz.wide_hi) {
+        visit(static_cast<FragmentId>(rx.wide_lo + fdims_.x * (ry.wide_lo + fdims_.y * rz.wide_lo)));  // interior
+        return;
+    }
+    const AxisRange* r[3] = {&rx, &ry, &rz};
+    for (int a = 0; a < 3; ++a) {
+        int lo[3], hi[3];
+        for (int b = 0; b < 3; ++b) {
+            lo[b] = a == b ? r[b]->wide_lo : r[b]->narrow_lo;
+            hi[b] = a == b ? r[b]->wide_hi : r[b]->narrow_hi;
         }
-        if (empty) continue;
-        for (int z = flo.z; z <= fhi.z; ++z)
-            for (int y = flo.y; y <= fhi.y; ++y)
-                for (int xx = flo.x; xx <= fhi.x; ++xx) visit(fragment_id({xx, y, z}));
+        for (int z = lo[2]; z <= hi[2]; ++z)
+            for (int y = lo[1]; y <= hi[1]; ++y)
+                for (int x = lo[0]; x <= hi[0]; ++x)
+                    visit(static_cast<FragmentId>(x + fdims_.x * (y + fdims_.y * z)));
     }
 }
 
@@ -105,7 +126,7 @@ std::vector<FragmentId> FragmentMesher::affected_fragments(std::span<const Point
     std::vector<FragmentId> ids;
     for (PointIndex x : changed) {
         if (x >= lattice_.size()) throw std::out_of_range("changed point index outside the lattice");
-        for_each_affected(x, [&](FragmentId f) { ids.push_back(f); });
+        if (!fragments_.empty()) for_each_affected(decode_.coord(x), [&](FragmentId f) { ids.push_back(f); });
     }
     std::sort(ids.begin(), ids.end());
     ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
@@ -146,8 +167,25 @@ void FragmentMesher::rebuild(const Grid<float>& phi, std::span<const FragmentId>
     stats_.vertices_computed = computed;
 }
 
+void FragmentMesher::sync_signs(const Grid<float>& phi) {
+    const std::span<const float> v = phi.values();
+    const std::size_t n = v.size();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, inside_.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t w = r.begin(); w != r.end(); ++w) {
+            std::uint64_t bits = 0;
+            const std::size_t base = w * 64;
+            const std::size_t stop = std::min(base + 64, n);
+            for (std::size_t i = base; i < stop; ++i)
+                if (is_inside(v[i])) bits |= std::uint64_t{1} << (i - base);
+            inside_[w] = bits;
+        }
+    });
+    initialised_ = true;
+}
+
 void FragmentMesher::full_rebuild(const Grid<float>& phi) {
     check_phi(phi);
+    sync_signs(phi);
     std::vector<FragmentId> all(fragments_.size());
     for (FragmentId i = 0; i < all.size(); ++i) all[i] = i;
     rebuild(phi, all, true);
@@ -156,6 +194,7 @@ void FragmentMesher::full_rebuild(const Grid<float>& phi) {
 void FragmentMesher::full_rebuild(const Grid<float>& phi, std::span<const PointIndex> zero_layer) {
     check_phi(phi);
     const std::vector<CellKey> cells = cells_around_points(lattice_, zero_layer);  // validates indices
+    sync_signs(phi);
     for (Fragment& f : fragments_) {
         f.crossing.clear();
         f.pending.clear();
@@ -170,16 +209,59 @@ std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span
     check_phi(phi);
     for (PointIndex x : changed)
         if (x >= lattice_.size()) throw std::out_of_range("changed point index outside the lattice");
-    std::vector<FragmentId> u;
-    for (PointIndex x : changed) {
-        for_each_affected(x, [&](FragmentId f) {
-            if (!flags_[f]) {
-                flags_[f] = 1;
-                u.push_back(f);
+    if (fragments_.empty()) {
+        stats_ = {};
+        return {};
+    }
+    if (!initialised_) {  // nothing to be incremental against yet
+        full_rebuild(phi);
+        std::vector<FragmentId> all(fragments_.size());
+        for (FragmentId i = 0; i < all.size(); ++i) all[i] = i;
+        return all;
+    }
+
+    // Pass over X (parallel): flag the affected fragments in B, and find the points whose sign
+    // flipped - only their cells can start or stop crossing; every other cell that may cross now
+    // is in its fragment's crossing list already.
+    for (auto& local : scratch_->locals) {
+        local.flagged.clear();
+        local.flipped.clear();
+    }
+    const std::span<const float> values = phi.values();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, changed.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+        Scratch::Local& local = scratch_->locals.local();
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            if (k + 16 < r.end()) {  // X is in band-list order, scattered over the lattice
+                const PointIndex ahead = changed[k + 16];
+                __builtin_prefetch(values.data() + ahead);
+                __builtin_prefetch(inside_.data() + (ahead >> 6));
             }
-        });
+            const PointIndex x = changed[k];
+            for_each_affected(decode_.coord(x), [&](FragmentId f) {
+                std::atomic_ref<std::uint8_t> flag(flags_[f]);
+                if (flag.load(std::memory_order_relaxed) == 0 && flag.exchange(1, std::memory_order_relaxed) == 0)
+                    local.flagged.push_back(f);
+            });
+            const bool now = is_inside(values[x]);
+            const std::uint64_t bit = std::uint64_t{1} << (x & 63u);
+            std::atomic_ref<std::uint64_t> word(inside_[x >> 6]);
+            if (((word.load(std::memory_order_relaxed) & bit) != 0) != now) {
+                const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed)
+                                              : word.fetch_and(~bit, std::memory_order_relaxed);
+                if (((old & bit) != 0) != now) local.flipped.push_back(x);  // exactly one thread sees the flip
+            }
+        }
+    });
+    std::vector<FragmentId> u;
+    std::vector<PointIndex> flipped;
+    for (auto& local : scratch_->locals) {
+        u.insert(u.end(), local.flagged.begin(), local.flagged.end());
+        flipped.insert(flipped.end(), local.flipped.begin(), local.flipped.end());
+    }
+    std::sort(u.begin(), u.end());
+    for (PointIndex x : flipped) {
         // Cells with x as a corner may change sign pattern: queue them in their fragments.
-        const Vec3i p = lattice_.coord(x);
+        const Vec3i p = decode_.coord(x);
         const int x0 = std::max(p.x - 1, 0), x1 = std::min(p.x, cells_.x - 1);
         const int y0 = std::max(p.y - 1, 0), y1 = std::min(p.y, cells_.y - 1);
         const int z0 = std::max(p.z - 1, 0), z1 = std::min(p.z, cells_.z - 1);
@@ -190,11 +272,11 @@ std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span
                     fragments_[fragment_of_cell(c)].pending.push_back(lattice_.index(c));
                 }
     }
-    std::sort(u.begin(), u.end());
     try {
         rebuild(phi, u, false);
     } catch (...) {
         for (FragmentId f : u) flags_[f] = 0;
+        initialised_ = false;  // crossing lists may be stale: the next update starts from scratch
         throw;
     }
     for (FragmentId f : u) flags_[f] = 0;

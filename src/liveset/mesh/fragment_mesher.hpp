@@ -10,18 +10,22 @@
 // bit-identical because make_edge_vertex() is a pure function of φ.
 //
 // Surface-proportional rebuilds: each fragment keeps the sorted list of its cells that hold a
-// crossing (corner signs differ). A cell's signs change only if one of its corners is in X, so a
-// rebuild visits (old crossing cells) ∪ (cells with a corner in X) and keeps those that still
-// cross; it never scans the fragment, so a single whole-lattice fragment (the paper's x100 case)
+// crossing (corner signs differ), and the mesher keeps one sign bit per lattice point. A cell
+// starts or stops crossing only if one of its corners flips sign, so a rebuild visits (old
+// crossing cells) ∪ (cells with a corner whose sign flipped) and keeps those that still cross -
+// under a moving front, X holds the whole band but only a thin sheet of it flips sign. It never
+// scans the fragment, so a single whole-lattice fragment (the paper's x100 case)
 // costs O(surface), not O(volume). The only O(volume) pass is full_rebuild(φ) without a zero layer.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
+#include "liveset/grid/index_decoder.hpp"
 #include "liveset/mesh/cell_polygoniser.hpp"
 #include "liveset/mesh/mesh.hpp"
 
@@ -73,7 +77,8 @@ public:
     void full_rebuild(const Grid<float>& phi, std::span<const PointIndex> zero_layer);
 
     // Incremental update after the φ values at `changed` (X) were modified; every modified point must
-    // be listed (duplicates allowed). Re-polygonises the affected fragments U and returns their ids,
+    // be listed (duplicates allowed). Before the first full_rebuild() it performs one (scan) and
+    // returns every fragment. Re-polygonises the affected fragments U and returns their ids,
     // sorted ascending. A fragment is affected when one of its cells has a corner in X (signs and
     // vertex positions) or a corner that is a 6-neighbour of a point of X (vertex normals read φ
     // through the central-difference stencil). φ must have this mesher's lattice dimensions.
@@ -97,8 +102,15 @@ private:
     struct Scratch;
 
     void check_phi(const Grid<float>& phi) const;
+    // Fragment-coordinate ranges of the cells around a point coordinate v on one axis: narrow =
+    // cells with a corner at v ([v-1, v]), wide = with a corner at v-1, v or v+1 ([v-2, v+1]).
+    struct AxisRange {
+        int narrow_lo, narrow_hi, wide_lo, wide_hi;
+    };
+
     template <class Visit>
-    void for_each_affected(PointIndex x, Visit&& visit) const;
+    void for_each_affected(Vec3i p, Visit&& visit) const;
+    void sync_signs(const Grid<float>& phi);
     void rebuild(const Grid<float>& phi, std::span<const FragmentId> ids, bool scan);
 
     Lattice lattice_;
@@ -107,6 +119,10 @@ private:
     Vec3i fdims_{};
     std::vector<Fragment> fragments_;
     std::vector<std::uint8_t> flags_;  // B
+    IndexDecoder decode_;
+    std::array<std::vector<AxisRange>, 3> ranges_;  // per axis, indexed by point coordinate
+    std::vector<std::uint64_t> inside_;             // sign bit per lattice point, as last meshed
+    bool initialised_ = false;                      // inside_ and crossing lists are valid
     FragmentUpdateStats stats_;
     std::unique_ptr<Scratch> scratch_;  // per-thread polygonisers
 };
