@@ -1,0 +1,118 @@
+// Robust intensity normalisation and seed-neighbourhood statistics.
+#include "liveset/segment/intensity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace liveset {
+
+namespace {
+
+void check_roi(const Grid<float>& image, const Grid<std::uint8_t>* roi) {
+    if (roi && !(roi->dims() == image.dims())) {
+        std::ostringstream os;
+        os << "region-of-interest mask " << roi->dims() << " does not match the image " << image.dims();
+        throw std::invalid_argument(os.str());
+    }
+}
+
+// Value at fraction q in [0, 1] of `v` (linear interpolation between order statistics); reorders v.
+double quantile(std::vector<float>& v, double q) {
+    const double pos = q * static_cast<double>(v.size() - 1);
+    const auto lo = static_cast<std::size_t>(std::floor(pos));
+    const std::size_t hi = std::min(lo + 1, v.size() - 1);
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(lo), v.end());
+    const double a = v[lo];
+    if (hi == lo) return a;
+    const double b = *std::min_element(v.begin() + static_cast<std::ptrdiff_t>(lo) + 1, v.end());
+    return a + (pos - static_cast<double>(lo)) * (b - a);
+}
+
+}  // namespace
+
+double IntensityScale::to_unit(double raw) const {
+    return std::clamp((raw - low) / (high - low), 0.0, 1.0);
+}
+
+double IntensityScale::to_raw(double unit) const { return low + unit * (high - low); }
+
+IntensityScale robust_scale(const Grid<float>& image, const Grid<std::uint8_t>* roi, const ScaleOptions& options) {
+    check_roi(image, roi);
+    const double lp = options.low_percentile, hp = options.high_percentile;
+    if (!(lp >= 0.0 && hp <= 100.0 && lp < hp))
+        throw std::invalid_argument("intensity percentiles must satisfy 0 <= low < high <= 100");
+    std::vector<float> v;
+    v.reserve(image.size());
+    const std::span<const float> values = image.values();
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        if (roi && (*roi)[static_cast<PointIndex>(i)] == 0) continue;
+        if (!std::isfinite(values[i])) throw std::invalid_argument("image has non-finite voxels");
+        v.push_back(values[i]);
+    }
+    if (v.empty()) throw std::invalid_argument("region-of-interest mask selects no voxel");
+    IntensityScale s;
+    s.low = quantile(v, lp / 100.0);
+    s.high = quantile(v, hp / 100.0);
+    if (!(s.high > s.low)) {
+        std::ostringstream os;
+        os << "image intensities are flat between the " << lp << "th and " << hp << "th percentiles (" << s.low
+           << "): nothing to segment";
+        throw std::invalid_argument(os.str());
+    }
+    return s;
+}
+
+Grid<float> normalise(const Grid<float>& image, const IntensityScale& scale) {
+    Grid<float> out(image.lattice());
+    const std::span<const float> in = image.values();
+    const std::span<float> o = out.values();
+    for (std::size_t i = 0; i < in.size(); ++i) o[i] = static_cast<float>(scale.to_unit(in[i]));
+    return out;
+}
+
+SeedStatistics seed_statistics(const Grid<float>& image, std::span<const SeedBall> seeds, const Grid<std::uint8_t>* roi) {
+    check_roi(image, roi);
+    const Lattice& l = image.lattice();
+    std::vector<float> v;
+    for (const SeedBall& s : seeds) {
+        if (!l.contains(s.center)) {
+            std::ostringstream os;
+            os << "seed " << s.center << " lies outside the image " << l.dims();
+            throw std::invalid_argument(os.str());
+        }
+        if (!std::isfinite(s.radius) || s.radius < 0) throw std::invalid_argument("seed radius must be finite and >= 0");
+        const Vec3i d = l.dims();
+        Vec3i lo, hi;
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::max(0, static_cast<int>(std::floor(s.center[a] - s.radius)));
+            hi[a] = std::min(d[a] - 1, static_cast<int>(std::ceil(s.center[a] + s.radius)));
+        }
+        for (int z = lo.z; z <= hi.z; ++z)
+            for (int y = lo.y; y <= hi.y; ++y)
+                for (int x = lo.x; x <= hi.x; ++x) {
+                    const Vec3i p{x, y, z};
+                    const Vec3d q{static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)};
+                    if (norm(q - s.center) > std::max(s.radius, 0.5)) continue;
+                    if (roi && (*roi)(p) == 0) continue;
+                    v.push_back(image(p));
+                }
+    }
+    if (v.empty()) throw std::invalid_argument("the seeds cover no voxel (inside the region of interest)");
+    SeedStatistics st;
+    st.voxels = v.size();
+    double sum = 0, sum2 = 0;
+    for (float x : v) {
+        sum += x;
+        sum2 += static_cast<double>(x) * x;
+    }
+    st.mean = sum / static_cast<double>(v.size());
+    st.stddev = std::sqrt(std::max(0.0, sum2 / static_cast<double>(v.size()) - st.mean * st.mean));
+    st.median = quantile(v, 0.5);
+    for (float& x : v) x = static_cast<float>(std::abs(x - st.median));
+    st.mad_sigma = 1.4826 * quantile(v, 0.5);
+    return st;
+}
+
+}  // namespace liveset

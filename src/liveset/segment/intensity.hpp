@@ -1,0 +1,59 @@
+// Intensity handling for threshold segmentation: the robust normalisation of a raw MR image to
+// [0, 1] (paper Eq. 3 assumes I(p) ∈ [0, 1]) and the estimate of the threshold window (µ, ε) from
+// the intensities around the user's seeds.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+
+namespace liveset {
+
+// Linear map raw -> unit: u = clamp((raw - low) / (high - low), 0, 1), with low/high robust
+// percentiles of the image (or of the region of interest), so a few hot or dark voxels do not
+// squash the tissue contrast.
+struct IntensityScale {
+    double low = 0.0;
+    double high = 1.0;
+    double to_unit(double raw) const;   // clamped to [0, 1]
+    double to_raw(double unit) const;   // inverse (unclamped)
+    double unit_length(double raw_length) const { return raw_length / (high - low); }
+    double raw_length(double unit_length) const { return unit_length * (high - low); }
+};
+
+struct ScaleOptions {
+    double low_percentile = 0.5;    // in percent
+    double high_percentile = 99.5;  // in percent
+};
+
+// Percentiles over the voxels of `image` (inside `roi` when given: non-zero voxels; same
+// dimensions). Throws std::invalid_argument on bad percentiles, a ROI of other dimensions or with
+// no voxel, non-finite voxels, or a flat image (high == low).
+IntensityScale robust_scale(const Grid<float>& image, const Grid<std::uint8_t>* roi = nullptr,
+                            const ScaleOptions& options = {});
+
+// The image mapped to [0, 1] with `scale`.
+Grid<float> normalise(const Grid<float>& image, const IntensityScale& scale);
+
+// A seed: a ball in index coordinates (voxels).
+struct SeedBall {
+    Vec3d center;
+    double radius = 2.0;
+};
+
+struct SeedStatistics {
+    std::size_t voxels = 0;
+    double mean = 0.0;
+    double median = 0.0;
+    double stddev = 0.0;
+    double mad_sigma = 0.0;  // 1.4826 × median absolute deviation (robust σ)
+};
+
+// Statistics of `image` over the lattice points inside the seed balls (inside `roi` when given).
+// Throws std::invalid_argument when a seed centre lies outside the lattice or no voxel is covered.
+SeedStatistics seed_statistics(const Grid<float>& image, std::span<const SeedBall> seeds,
+                               const Grid<std::uint8_t>* roi = nullptr);
+
+}  // namespace liveset

@@ -1,0 +1,63 @@
+// The segmentation loop: global sparse-field steps under a speed until the front stops moving,
+// an iteration limit, or an interrupt (Ctrl-C in the CLI, the pause button in the viewer), with a
+// progress hook that also receives each step's changed points X (for the incremental mesher).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <string>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/levelset/sparse_field.hpp"
+#include "liveset/segment/intensity.hpp"
+
+namespace liveset {
+
+struct SegmentationOptions {
+    int max_iterations = 2000;
+    // Converged when, over the last `window` iterations, fewer than
+    // max(1, tolerance × zero-layer size) lattice points changed side (inside <-> outside).
+    int window = 20;
+    double tolerance = 1e-3;
+    StepOptions step;
+};
+
+// Throws std::invalid_argument for non-positive limits or a negative/non-finite tolerance.
+void validate(const SegmentationOptions& options);
+
+struct SegmentationProgress {
+    int iteration = 0;          // 1-based
+    std::size_t zero_layer = 0;  // after the step
+    std::size_t band = 0;
+    std::size_t changed = 0;     // |X|
+    std::size_t flips = 0;       // points that changed side in this step
+    std::size_t inside = 0;      // points inside after the step
+    double dt = 0.0;
+    double ms = 0.0;             // wall time of the step
+};
+
+enum class StopReason { kConverged, kIterationLimit, kInterrupted, kVanished };
+std::string to_string(StopReason reason);
+
+struct SegmentationResult {
+    int iterations = 0;
+    StopReason reason = StopReason::kIterationLimit;
+    double seconds = 0.0;
+    std::size_t inside = 0;
+};
+
+// Called after every step with the progress and X; returning false interrupts the run.
+using SegmentationHook = std::function<bool(const SegmentationProgress&, const ChangedPoints&)>;
+
+SegmentationResult run_segmentation(SparseField& field, const Speed& speed, const SegmentationOptions& options,
+                                    const SegmentationHook& hook = {}, const std::atomic<bool>* interrupt = nullptr);
+
+// Initialises `field` from seed balls (index space): φ is the signed distance to their union.
+void init_from_seeds(SparseField& field, std::span<const SeedBall> seeds);
+
+// φ < 0, intersected with the ROI when given (non-zero voxels), as a 0/1 mask.
+Grid<std::uint8_t> inside_mask(const Grid<float>& phi, const Grid<std::uint8_t>* roi = nullptr);
+
+}  // namespace liveset

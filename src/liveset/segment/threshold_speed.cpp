@@ -1,0 +1,61 @@
+// Threshold speed (paper Eq. 2-3), tabulated per voxel.
+#include "liveset/segment/threshold_speed.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace liveset {
+
+void validate(const ThresholdParams& p) {
+    auto fail = [](const std::string& m) { throw std::invalid_argument(m); };
+    if (!std::isfinite(p.mu) || p.mu < 0.0 || p.mu > 1.0) fail("mu must be a normalised intensity in [0, 1]");
+    if (!std::isfinite(p.epsilon) || p.epsilon <= 0.0) fail("epsilon must be positive");
+    if (!std::isfinite(p.n) || p.n <= 0.0 || p.n > 100.0) fail("n must be in (0, 100]");
+    if (!std::isfinite(p.alpha) || p.alpha < 0.0 || p.alpha >= 1.0) fail("alpha must be in [0, 1)");
+}
+
+double threshold_term(double intensity, const ThresholdParams& p) {
+    const double d = std::abs(p.mu - intensity);
+    // 2 dⁿ / (εⁿ + dⁿ) − 1 written as (dⁿ − εⁿ) / (dⁿ + εⁿ) = (r − 1) / (r + 1), r = (d/ε)ⁿ, which
+    // stays finite for any n (r may overflow to +inf: the limit is 1).
+    const double r = std::pow(d / p.epsilon, p.n);
+    if (!std::isfinite(r)) return 1.0;
+    return (r - 1.0) / (r + 1.0);
+}
+
+ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi)
+    : params_(params), propagation_(unit_image.lattice()), curvature_(unit_image.lattice(), 1) {
+    validate(params);
+    if (roi && !(roi->dims() == unit_image.dims())) {
+        std::ostringstream os;
+        os << "region-of-interest mask " << roi->dims() << " does not match the image " << unit_image.dims();
+        throw std::invalid_argument(os.str());
+    }
+    const double w = 0.5 * (1.0 - params.alpha);
+    const std::span<const float> img = unit_image.values();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, img.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto pi = static_cast<PointIndex>(i);
+            if (roi && (*roi)[pi] == 0) {
+                propagation_[pi] = 0.5f;
+                curvature_[pi] = 0;
+                continue;
+            }
+            const float v = img[i];
+            if (!std::isfinite(v)) throw std::invalid_argument("normalised image has non-finite voxels");
+            propagation_[pi] = static_cast<float>(w * threshold_term(v, params));
+        }
+    });
+}
+
+SpeedSample ThresholdSpeed::at(const Grid<float>& phi, Vec3i p) const {
+    const PointIndex i = phi.lattice().index(p);
+    if (!curvature_[i]) return {propagation_[i], 0.0f};
+    return {propagation_[i], curvature_weight() * mean_curvature(phi, p)};
+}
+
+}  // namespace liveset

@@ -1,0 +1,53 @@
+// The paper's threshold speed (Feltell & Bai Eq. 2-3) for MR tissue segmentation:
+//   D(p) = 2 |µ − I(p)|ⁿ / (εⁿ + |µ − I(p)|ⁿ) − 1      ∈ [−1, 1), negative inside the window µ ± ε
+//   F(p) = ½ ((1 − α) D(p) + α κ(p))
+// with I normalised to [0, 1] (intensity.hpp), κ the difference-of-normals mean curvature, and the
+// level set's convention ∂φ/∂t = |∇φ| F (φ < 0 inside): D < 0 expands the front, D > 0 contracts
+// it, and the curvature term smooths it and keeps it from leaking through thin gaps.
+//
+// Region of interest (as ITK-SNAP's mask): at a point outside the ROI, F = +½ (pure contraction,
+// no curvature), so the front cannot settle there; segmentations intersect the final mask with the
+// ROI as well (the front may overshoot the ROI border by less than one voxel during a step).
+#pragma once
+
+#include <cstdint>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/levelset/speed.hpp"
+
+namespace liveset {
+
+struct ThresholdParams {
+    double mu = 0.5;       // ideal intensity, normalised units
+    double epsilon = 0.1;  // acceptable error (half window), normalised units, > 0
+    double n = 2.0;        // steepness of D at the window edge, > 0
+    double alpha = 0.2;    // curvature weight in [0, 1)
+};
+
+// Throws std::invalid_argument with a one-line message for non-finite values, ε ≤ 0, n ≤ 0,
+// α outside [0, 1), µ outside [0, 1].
+void validate(const ThresholdParams& params);
+
+// D(I) of Eq. 3 for one normalised intensity.
+double threshold_term(double intensity, const ThresholdParams& params);
+
+class ThresholdSpeed final : public Speed {
+public:
+    // `unit_image` (normalised to [0, 1]) and `roi` (optional, non-zero = allowed) must outlive
+    // the speed and match each other's dimensions; D is tabulated per voxel at construction.
+    ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi = nullptr);
+
+    SpeedSample at(const Grid<float>& phi, Vec3i p) const override;
+    float curvature_weight() const override { return static_cast<float>(0.5 * params_.alpha); }
+
+    const ThresholdParams& params() const { return params_; }
+    // ½(1 − α)·D at a lattice point (+½ outside the ROI).
+    float propagation(Vec3i p) const { return propagation_(p); }
+
+private:
+    ThresholdParams params_;
+    Grid<float> propagation_;       // ½(1 − α) D(p), or +½ outside the ROI
+    Grid<std::uint8_t> curvature_;  // 1 where the curvature term applies (inside the ROI)
+};
+
+}  // namespace liveset

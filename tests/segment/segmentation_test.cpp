@@ -1,0 +1,139 @@
+// The segmentation loop on images with a known answer: a bright ball is recovered from one seed,
+// the region of interest stops the front, interrupts stop the loop, thread count does not matter.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+
+#include <tbb/global_control.h>
+
+#include "liveset/segment/segmentation.hpp"
+#include "liveset/segment/threshold_speed.hpp"
+
+using namespace liveset;
+
+namespace {
+
+constexpr double kRadius = 12.0;
+const Vec3d kCentre{24.0, 24.0, 24.0};
+
+// Bright ball (0.7) in a dark background (0.2), partial volume at the border by 4x4x4 supersampling.
+Grid<float> ball_image() {
+    Grid<float> g(Lattice({48, 48, 48}), 0.2f);
+    for (int z = 0; z < 48; ++z)
+        for (int y = 0; y < 48; ++y)
+            for (int x = 0; x < 48; ++x) {
+                int in = 0;
+                for (int k = 0; k < 64; ++k) {
+                    const Vec3d q{x + ((k & 3) - 1.5) / 4, y + (((k >> 2) & 3) - 1.5) / 4, z + ((k >> 4) - 1.5) / 4};
+                    in += norm(q - kCentre) < kRadius;
+                }
+                g({x, y, z}) = static_cast<float>(0.2 + 0.5 * in / 64.0);
+            }
+    return g;
+}
+
+double dice(const Grid<std::uint8_t>& a, const Grid<std::uint8_t>& b) {
+    std::size_t na = 0, nb = 0, both = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        na += a[p] != 0;
+        nb += b[p] != 0;
+        both += a[p] != 0 && b[p] != 0;
+    }
+    return 2.0 * static_cast<double>(both) / static_cast<double>(na + nb);
+}
+
+Grid<std::uint8_t> truth_ball(const Lattice& l, bool half) {
+    Grid<std::uint8_t> t(l, 0);
+    for (std::size_t i = 0; i < t.size(); ++i) {
+        const Vec3i p = l.coord(static_cast<PointIndex>(i));
+        const Vec3d q{static_cast<double>(p.x), static_cast<double>(p.y), static_cast<double>(p.z)};
+        t[static_cast<PointIndex>(i)] = norm(q - kCentre) < kRadius && (!half || p.x < 24);
+    }
+    return t;
+}
+
+const ThresholdParams kParams{0.7, 0.25, 2.0, 0.2};
+const SeedBall kSeeds[] = {{{24, 24, 24}, 2.0}};
+
+}  // namespace
+
+TEST(Segmentation, RecoversABrightBallFromOneSeed) {
+    const Grid<float> img = ball_image();
+    const ThresholdSpeed speed(img, kParams);
+    SparseField field(img.lattice(), 2);
+    init_from_seeds(field, kSeeds);
+    int calls = 0;
+    const SegmentationResult r = run_segmentation(field, speed, {}, [&](const SegmentationProgress& p, const ChangedPoints& x) {
+        ++calls;
+        EXPECT_EQ(p.iteration, calls);
+        EXPECT_EQ(p.changed, x.size());
+        return true;
+    });
+    EXPECT_EQ(r.reason, StopReason::kConverged) << r.iterations;
+    EXPECT_EQ(calls, r.iterations);
+    EXPECT_LT(r.iterations, 400);
+    const Grid<std::uint8_t> mask = inside_mask(field.phi());
+    EXPECT_GE(dice(mask, truth_ball(img.lattice(), false)), 0.97);
+    std::size_t inside = 0;
+    for (std::size_t i = 0; i < mask.size(); ++i) inside += mask[static_cast<PointIndex>(i)];
+    EXPECT_EQ(r.inside, inside);
+}
+
+TEST(Segmentation, RegionOfInterestStopsTheFront) {
+    const Grid<float> img = ball_image();
+    Grid<std::uint8_t> roi(img.lattice(), 0);
+    for (std::size_t i = 0; i < roi.size(); ++i) roi[static_cast<PointIndex>(i)] = img.lattice().coord(static_cast<PointIndex>(i)).x < 24;
+    const ThresholdSpeed speed(img, kParams, &roi);
+    SparseField field(img.lattice(), 2);
+    const SeedBall seeds[] = {{{18, 24, 24}, 2.0}};
+    init_from_seeds(field, seeds);
+    run_segmentation(field, speed, {});
+    // The raw front never settles more than a voxel outside the ROI; the mask is clipped to it.
+    std::size_t beyond = 0;
+    for (int z = 0; z < 48; ++z)
+        for (int y = 0; y < 48; ++y)
+            for (int x = 25; x < 48; ++x) beyond += field.phi()({x, y, z}) < 0.0f;
+    EXPECT_EQ(beyond, 0u);
+    const Grid<std::uint8_t> mask = inside_mask(field.phi(), &roi);
+    EXPECT_GE(dice(mask, truth_ball(img.lattice(), true)), 0.95);
+}
+
+TEST(Segmentation, InterruptAndLimits) {
+    const Grid<float> img = ball_image();
+    const ThresholdSpeed speed(img, kParams);
+    SparseField field(img.lattice(), 2);
+    init_from_seeds(field, kSeeds);
+    std::atomic<bool> stop{true};
+    const SegmentationResult r = run_segmentation(field, speed, {}, {}, &stop);
+    EXPECT_EQ(r.reason, StopReason::kInterrupted);
+    EXPECT_EQ(r.iterations, 0);
+    SegmentationOptions few;
+    few.max_iterations = 5;
+    EXPECT_EQ(run_segmentation(field, speed, few).reason, StopReason::kIterationLimit);
+    const SegmentationResult by_hook =
+        run_segmentation(field, speed, {}, [](const SegmentationProgress& p, const ChangedPoints&) { return p.iteration < 3; });
+    EXPECT_EQ(by_hook.reason, StopReason::kInterrupted);
+    EXPECT_EQ(by_hook.iterations, 3);
+    SegmentationOptions bad;
+    bad.window = 0;
+    EXPECT_THROW(run_segmentation(field, speed, bad), std::invalid_argument);
+    const SeedBall outside[] = {{{60, 1, 1}, 2.0}};
+    EXPECT_THROW(init_from_seeds(field, outside), std::invalid_argument);
+}
+
+TEST(Segmentation, SameResultForAnyThreadCount) {
+    const Grid<float> img = ball_image();
+    const ThresholdSpeed speed(img, kParams);
+    auto run = [&](int threads) {
+        tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+        SparseField field(img.lattice(), 2);
+        init_from_seeds(field, kSeeds);
+        SegmentationOptions o;
+        o.max_iterations = 60;
+        run_segmentation(field, speed, o);
+        return std::vector<float>(field.phi().values().begin(), field.phi().values().end());
+    };
+    EXPECT_EQ(run(1), run(2));
+}

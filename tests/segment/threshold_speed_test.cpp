@@ -1,0 +1,66 @@
+// The paper's threshold speed: D at analytic points, F's split into propagation and curvature,
+// and the region of interest.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "liveset/levelset/shapes.hpp"
+#include "liveset/levelset/sparse_field.hpp"
+#include "liveset/segment/threshold_speed.hpp"
+
+using namespace liveset;
+
+TEST(ThresholdTerm, MatchesEquation3) {
+    const ThresholdParams p{0.5, 0.1, 2.0, 0.2};
+    EXPECT_DOUBLE_EQ(threshold_term(0.5, p), -1.0);                 // at the ideal value
+    EXPECT_NEAR(threshold_term(0.6, p), 0.0, 1e-12);                // at the window edge
+    EXPECT_NEAR(threshold_term(0.4, p), 0.0, 1e-12);
+    const double d = 0.3;  // |µ − I| = 0.3: 2·0.09/(0.01 + 0.09) − 1 = 0.8
+    EXPECT_NEAR(threshold_term(0.8, p), 2 * d * d / (0.01 + d * d) - 1, 1e-12);
+    EXPECT_NEAR(threshold_term(0.8, p), 0.8, 1e-12);
+    EXPECT_LT(threshold_term(0.55, p), 0.0);
+    EXPECT_GT(threshold_term(0.65, p), 0.0);
+    // Steeper n: closer to a step.
+    const ThresholdParams steep{0.5, 0.1, 16.0, 0.2};
+    EXPECT_LT(threshold_term(0.59, steep), threshold_term(0.59, p));
+    EXPECT_GT(threshold_term(0.61, steep), threshold_term(0.61, p));
+    EXPECT_DOUBLE_EQ(threshold_term(1.0, ThresholdParams{0.0, 1e-6, 100.0, 0.0}), 1.0);  // overflow -> limit
+}
+
+TEST(ThresholdParams, Validation) {
+    EXPECT_NO_THROW(validate(ThresholdParams{}));
+    EXPECT_THROW(validate(ThresholdParams{0.5, 0.0, 2, 0.2}), std::invalid_argument);
+    EXPECT_THROW(validate(ThresholdParams{0.5, -1, 2, 0.2}), std::invalid_argument);
+    EXPECT_THROW(validate(ThresholdParams{0.5, 0.1, 0, 0.2}), std::invalid_argument);
+    EXPECT_THROW(validate(ThresholdParams{0.5, 0.1, 2, 1.0}), std::invalid_argument);
+    EXPECT_THROW(validate(ThresholdParams{1.5, 0.1, 2, 0.2}), std::invalid_argument);
+    EXPECT_THROW(validate(ThresholdParams{std::nan(""), 0.1, 2, 0.2}), std::invalid_argument);
+}
+
+TEST(ThresholdSpeed, PropagationCurvatureAndRoi) {
+    const Lattice lat({32, 32, 32});
+    Grid<float> img(lat, 0.5f);
+    img({3, 3, 3}) = 0.9f;
+    Grid<std::uint8_t> roi(lat, 1);
+    roi({4, 4, 4}) = 0;
+    const ThresholdParams p{0.5, 0.1, 2.0, 0.3};
+    const ThresholdSpeed speed(img, p, &roi);
+    EXPECT_FLOAT_EQ(speed.curvature_weight(), 0.15f);
+    EXPECT_FLOAT_EQ(speed.propagation({10, 10, 10}), static_cast<float>(0.5 * 0.7 * -1.0));
+    EXPECT_FLOAT_EQ(speed.propagation({3, 3, 3}), static_cast<float>(0.35 * threshold_term(0.9, p)));
+    EXPECT_FLOAT_EQ(speed.propagation({4, 4, 4}), 0.5f);
+
+    SparseField f(lat, 2);
+    f.init_from_sdf(shapes::Sphere({16, 16, 16}, 8.0));
+    const PointIndex z0 = f.zero_layer()[0];
+    const Vec3i q = lat.coord(z0);
+    const SpeedSample s = speed.at(f.phi(), q);
+    EXPECT_FLOAT_EQ(s.propagation, -0.35f);
+    EXPECT_FLOAT_EQ(s.curvature, 0.15f * mean_curvature(f.phi(), q));
+    EXPECT_GT(s.curvature, 0.0f);  // convex sphere
+
+    Grid<std::uint8_t> wrong(Lattice({8, 8, 8}), 1);
+    EXPECT_THROW(ThresholdSpeed(img, p, &wrong), std::invalid_argument);
+    EXPECT_THROW(ThresholdSpeed(img, ThresholdParams{0.5, -0.1, 2, 0.3}), std::invalid_argument);
+}
