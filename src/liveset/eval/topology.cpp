@@ -1,0 +1,214 @@
+// Connected-component labelling, cubical-complex Euler characteristic and Betti numbers of a mask.
+#include "liveset/eval/topology.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdlib>
+#include <initializer_list>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace liveset {
+
+namespace {
+
+// Union-find over provisional labels; the root of a set is its smallest label.
+struct LabelForest {
+    std::vector<std::uint32_t> parent{0};  // label 0 is the background, never used
+    std::uint32_t make() {
+        const auto l = static_cast<std::uint32_t>(parent.size());
+        parent.push_back(l);
+        return l;
+    }
+    std::uint32_t find(std::uint32_t l) {
+        while (parent[l] != l) {
+            parent[l] = parent[parent[l]];
+            l = parent[l];
+        }
+        return l;
+    }
+    std::uint32_t unite(std::uint32_t a, std::uint32_t b) {
+        a = find(a);
+        b = find(b);
+        if (a == b) return a;
+        if (b < a) std::swap(a, b);
+        parent[b] = a;
+        return a;
+    }
+};
+
+// Two-pass raster-scan labelling of the voxels whose foreground-ness equals `foreground`: the first
+// pass links each voxel to its already-scanned neighbours (3 for 6-connectivity, 13 for 26), the
+// second renumbers the sets in scan order of their first voxel.
+std::vector<std::uint32_t> label_voxels(const Grid<std::uint8_t>& mask, int connectivity, bool foreground,
+                                        std::size_t* count) {
+    if (connectivity != 6 && connectivity != 26) {
+        throw std::invalid_argument("label_components: connectivity must be 6 or 26, got " +
+                                    std::to_string(connectivity));
+    }
+    const Lattice& lat = mask.lattice();
+    const Vec3i d = lat.dims();
+    struct Backward {
+        Vec3i offset;
+        std::ptrdiff_t delta;
+    };
+    std::vector<Backward> backward;  // neighbours that precede a voxel in scan order
+    for (int dz = -1; dz <= 0; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const bool before = dz < 0 || dy < 0 || (dy == 0 && dx < 0);
+                const int manhattan = std::abs(dx) + std::abs(dy) + std::abs(dz);
+                if (!before || (connectivity == 6 && manhattan > 1)) continue;
+                backward.push_back({{dx, dy, dz},
+                                    dx + dy * static_cast<std::ptrdiff_t>(lat.stride_y()) +
+                                        dz * static_cast<std::ptrdiff_t>(lat.stride_z())});
+            }
+
+    const std::uint8_t* in = mask.values().data();
+    std::vector<std::uint32_t> labels(mask.size(), 0);
+    LabelForest forest;
+    for (int z = 0; z < d.z; ++z) {
+        for (int y = 0; y < d.y; ++y) {
+            const std::size_t row = lat.index({0, y, z});
+            for (int x = 0; x < d.x; ++x) {
+                const std::size_t i = row + static_cast<std::size_t>(x);
+                if ((in[i] != 0) != foreground) continue;
+                std::uint32_t label = 0;
+                for (const Backward& b : backward) {
+                    const int nx = x + b.offset.x, ny = y + b.offset.y, nz = z + b.offset.z;
+                    if (nx < 0 || nx >= d.x || ny < 0 || ny >= d.y || nz < 0) continue;
+                    const std::uint32_t n = labels[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(i) + b.delta)];
+                    if (n == 0 || n == label) continue;
+                    label = label == 0 ? n : forest.unite(label, n);
+                }
+                labels[i] = label != 0 ? label : forest.make();
+            }
+        }
+    }
+
+    std::vector<std::uint32_t> final_label(forest.parent.size(), 0);
+    std::uint32_t next = 0;
+    for (std::uint32_t& l : labels) {
+        if (l == 0) continue;
+        const std::uint32_t root = forest.find(l);
+        if (final_label[root] == 0) final_label[root] = ++next;
+        l = final_label[root];
+    }
+    if (count) *count = next;
+    return labels;
+}
+
+// Contribution to V - E + F - C of the cells "owned" by one lattice vertex: the vertex itself, the
+// three edges, three faces and one cube that leave it in the +x/+y/+z directions. A cell belongs to
+// the closed-cube union when any voxel incident to it is foreground. Configuration bit
+// (dx + 2·dy + 4·dz) is voxel (i-1+dx, j-1+dy, k-1+dz) around vertex (i, j, k).
+constexpr std::array<int, 256> make_euler_table() {
+    std::array<int, 256> t{};
+    for (int c = 0; c < 256; ++c) {
+        auto any = [c](std::initializer_list<int> bits) {
+            for (int b : bits)
+                if (c & (1 << b)) return 1;
+            return 0;
+        };
+        const int vertex = c != 0 ? 1 : 0;
+        const int edges = any({1, 3, 5, 7}) + any({2, 3, 6, 7}) + any({4, 5, 6, 7});
+        const int faces = any({3, 7}) + any({5, 7}) + any({6, 7});
+        const int cube = any({7});
+        t[static_cast<std::size_t>(c)] = vertex - edges + faces - cube;
+    }
+    return t;
+}
+constexpr std::array<int, 256> kEulerTable = make_euler_table();
+
+// Spreads a 4-bit column (bit dy + 2·dz) to configuration bits dx + 2·dy + 4·dz.
+constexpr unsigned spread_column(unsigned col, unsigned dx) {
+    unsigned out = 0;
+    for (unsigned b = 0; b < 4; ++b)
+        if (col & (1u << b)) out |= 1u << (dx + 2 * b);
+    return out;
+}
+
+long euler_characteristic(const Grid<std::uint8_t>& mask) {
+    const Lattice& lat = mask.lattice();
+    const Vec3i d = lat.dims();
+    if (mask.size() == 0) return 0;
+    const std::uint8_t* data = mask.values().data();
+    // Vertices run over (d.x+1)·(d.y+1)·(d.z+1); slices of vertices along z are summed in parallel.
+    // Integer sums are exact, so the result does not depend on how the range is split.
+    return tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, d.z + 1), 0L,
+        [&](const tbb::blocked_range<int>& r, long acc) {
+            for (int k = r.begin(); k < r.end(); ++k) {
+                for (int j = 0; j <= d.y; ++j) {
+                    // The four voxel rows around this vertex row, or null outside the image.
+                    std::array<const std::uint8_t*, 4> rows{};
+                    for (int b = 0; b < 4; ++b) {
+                        const int y = j - 1 + (b & 1);
+                        const int z = k - 1 + (b >> 1);
+                        rows[static_cast<std::size_t>(b)] =
+                            (y >= 0 && y < d.y && z >= 0 && z < d.z) ? data + lat.index({0, y, z}) : nullptr;
+                    }
+                    unsigned previous = 0;  // column of voxels at x = i-1
+                    for (int i = 0; i <= d.x; ++i) {
+                        unsigned current = 0;
+                        if (i < d.x)
+                            for (unsigned b = 0; b < 4; ++b)
+                                if (rows[b] && rows[b][i] != 0) current |= 1u << b;
+                        const unsigned config = spread_column(previous, 0) | spread_column(current, 1);
+                        acc += kEulerTable[config];
+                        previous = current;
+                    }
+                }
+            }
+            return acc;
+        },
+        [](long a, long b) { return a + b; });
+}
+
+// Background 6-components that touch no image border face.
+std::size_t count_cavities(const Grid<std::uint8_t>& mask) {
+    std::size_t background = 0;
+    const std::vector<std::uint32_t> labels = label_voxels(mask, 6, false, &background);
+    if (background == 0) return 0;
+    std::vector<std::uint8_t> touches_border(background + 1, 0);
+    const Lattice& lat = mask.lattice();
+    const Vec3i d = lat.dims();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y) {
+            const bool face = z == 0 || y == 0 || z == d.z - 1 || y == d.y - 1;
+            if (face) {
+                for (int x = 0; x < d.x; ++x) touches_border[labels[lat.index({x, y, z})]] = 1;
+            } else {
+                touches_border[labels[lat.index({0, y, z})]] = 1;
+                touches_border[labels[lat.index({d.x - 1, y, z})]] = 1;
+            }
+        }
+    std::size_t cavities = 0;
+    for (std::size_t l = 1; l <= background; ++l) cavities += touches_border[l] == 0;
+    return cavities;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> label_components(const Grid<std::uint8_t>& mask, int connectivity,
+                                            std::size_t* count) {
+    return label_voxels(mask, connectivity, true, count);
+}
+
+Topology mask_topology(const Grid<std::uint8_t>& mask) {
+    Topology t;
+    label_voxels(mask, 26, true, &t.components);
+    t.cavities = count_cavities(mask);
+    t.euler_solid = euler_characteristic(mask);
+    t.euler = 2 * t.euler_solid;
+    t.genus = static_cast<long>(t.components) + static_cast<long>(t.cavities) - t.euler_solid;
+    return t;
+}
+
+long holes_between(const Topology& truth, const Topology& mask) { return (truth.euler - mask.euler) / 2; }
+
+}  // namespace liveset

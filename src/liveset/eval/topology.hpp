@@ -1,0 +1,43 @@
+// Topology of a binary mask: connected components, enclosed cavities, Euler characteristic of the
+// voxel solid and of its surface, and the number of tunnels/handles — the measures used to count the
+// "holes" a segmentation has compared with its ground truth. Also a reusable connected-component
+// labelling.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+
+namespace liveset {
+
+// Connected-component labelling of the nonzero voxels. connectivity is 6 (face neighbours) or 26
+// (face, edge and corner neighbours); anything else throws std::invalid_argument. Returns one label
+// per voxel (linear index): 0 for background, 1..count for foreground, numbered in scan order
+// (x fastest) of each component's first voxel, so the result is deterministic. `count` may be null.
+std::vector<std::uint32_t> label_components(const Grid<std::uint8_t>& mask, int connectivity,
+                                            std::size_t* count);
+
+// The mask's foreground is read as the union of its closed unit voxel cubes; everything outside the
+// image counts as background. With that reading, 26-connectivity of the foreground and
+// 6-connectivity of the background are exactly the connectivity of the solid and of its complement.
+struct Topology {
+    std::size_t components = 0;  // foreground components, 26-connected (Betti number b0)
+    std::size_t cavities = 0;    // background components (6-connected) not touching the image border (b2)
+    long euler_solid = 0;        // χ of the union of closed voxel cubes: V - E + F - C
+    long euler = 0;              // χ of its boundary surface = 2·euler_solid
+    long genus = 0;              // b1 = components + cavities - euler_solid: tunnels/handles
+};
+
+// O(volume). The Euler characteristic is counted from 2x2x2 voxel configurations with a lookup
+// table (no per-voxel allocation); the component counts use label_components.
+Topology mask_topology(const Grid<std::uint8_t>& mask);
+
+// The paper's "holes" of a mask relative to its ground truth: (truth.euler - mask.euler) / 2.
+// A closed thick spherical shell has euler 4; each perforation through it lowers euler by 2, so a
+// shell with k perforations has k holes relative to the closed shell. Negative when the mask has
+// fewer tunnels/more closed pieces than the truth.
+long holes_between(const Topology& truth, const Topology& mask);
+
+}  // namespace liveset

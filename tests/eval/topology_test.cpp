@@ -1,0 +1,282 @@
+// Topology: Euler characteristic, components, cavities and genus of hand-countable shapes (voxel,
+// ball, torus, shells with 1..4 drilled perforations, diagonal contacts, shapes on the image
+// border), the paper's holes count, and the connected-component labelling.
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "eval/mask_shapes.hpp"
+#include "liveset/eval/topology.hpp"
+
+using namespace liveset;
+using liveset::test::Mask;
+using liveset::test::paint;
+using liveset::test::paint_ball;
+using liveset::test::paint_box;
+
+namespace {
+
+void expect_topology(const Topology& t, std::size_t components, std::size_t cavities, long euler_solid,
+                     long genus) {
+    EXPECT_EQ(t.components, components);
+    EXPECT_EQ(t.cavities, cavities);
+    EXPECT_EQ(t.euler_solid, euler_solid);
+    EXPECT_EQ(t.euler, 2 * euler_solid);
+    EXPECT_EQ(t.genus, genus);
+}
+
+// Thick spherical shell about the centre of a 28³ image: 6 < r <= 11 voxels.
+Mask thick_shell() {
+    Mask m(Lattice({28, 28, 28}, {1.0, 1.2, 0.9}));
+    const Vec3d c{13.5, 13.5, 13.5};
+    paint(m, [&](Vec3d p) {
+        const double r = norm(p - c);
+        return r > 6.0 && r <= 11.0;
+    });
+    return m;
+}
+
+// Drills a cylinder of radius 2 from the shell's centre out along one of ±x, ±y: one perforation
+// through the wall each.
+void drill(Mask& m, int which) {
+    const Vec3d c{13.5, 13.5, 13.5};
+    const int axis = which / 2;          // 0: x, 1: y
+    const double sign = which % 2 ? -1 : 1;
+    paint(m, [&](Vec3d p) {
+        const Vec3d q = p - c;
+        const double along = sign * q[axis];
+        const double off_a = q[1 - axis];
+        const double off_b = q.z;
+        return along > 0 && off_a * off_a + off_b * off_b <= 4.0;
+    }, 0);
+}
+
+}  // namespace
+
+TEST(Topology, SingleVoxel) {
+    Mask m(Lattice({5, 5, 5}));
+    m({2, 2, 2}) = 1;
+    expect_topology(mask_topology(m), 1, 0, 1, 0);
+    EXPECT_EQ(mask_topology(m).euler, 2);
+}
+
+TEST(Topology, EmptyMask) {
+    const Mask m(Lattice({4, 4, 4}));
+    expect_topology(mask_topology(m), 0, 0, 0, 0);
+}
+
+TEST(Topology, SolidBall) {
+    Mask m(Lattice({20, 20, 20}));
+    paint_ball(m, {9.5, 9.5, 9.5}, 7.0);
+    expect_topology(mask_topology(m), 1, 0, 1, 0);
+}
+
+TEST(Topology, TwoDisjointBalls) {
+    Mask m(Lattice({30, 16, 16}));
+    paint_ball(m, {7.5, 7.5, 7.5}, 5.0);
+    paint_ball(m, {21.5, 7.5, 7.5}, 5.0);
+    expect_topology(mask_topology(m), 2, 0, 2, 0);
+    EXPECT_EQ(mask_topology(m).euler, 4);
+}
+
+TEST(Topology, SolidTorusHasGenusOne) {
+    Mask m(Lattice({30, 30, 12}));
+    const Vec3d c{14.5, 14.5, 5.5};
+    paint(m, [&](Vec3d p) {
+        const Vec3d q = p - c;
+        const double ring = std::hypot(q.x, q.y) - 9.0;
+        return ring * ring + q.z * q.z <= 3.5 * 3.5;
+    });
+    expect_topology(mask_topology(m), 1, 0, 0, 1);
+    EXPECT_EQ(mask_topology(m).euler, 0);
+}
+
+TEST(Topology, SquareFrameAndDoubleFrame) {
+    // A 10x10x3 slab with one 4x4 hole punched through: a box torus.
+    Mask one(Lattice({14, 14, 7}));
+    paint_box(one, {2, 2, 2}, {12, 12, 5});
+    paint_box(one, {5, 5, 2}, {9, 9, 5}, 0);
+    expect_topology(mask_topology(one), 1, 0, 0, 1);
+    // Two holes: genus 2, χ = 1 - 2.
+    Mask two(Lattice({20, 14, 7}));
+    paint_box(two, {2, 2, 2}, {18, 12, 5});
+    paint_box(two, {4, 5, 2}, {8, 9, 5}, 0);
+    paint_box(two, {12, 5, 2}, {16, 9, 5}, 0);
+    expect_topology(mask_topology(two), 1, 0, -1, 2);
+}
+
+TEST(Topology, ThickSphericalShell) {
+    const Mask shell = thick_shell();
+    const Topology t = mask_topology(shell);
+    expect_topology(t, 1, 1, 2, 0);
+    EXPECT_EQ(t.euler, 4);
+    EXPECT_EQ(holes_between(t, t), 0);
+}
+
+TEST(Topology, EachPerforationOfTheShellIsOneHole) {
+    const Topology closed = mask_topology(thick_shell());
+    Mask perforated = thick_shell();
+    for (int k = 1; k <= 4; ++k) {
+        drill(perforated, k - 1);
+        const Topology t = mask_topology(perforated);
+        SCOPED_TRACE("perforations: " + std::to_string(k));
+        // Opening the shell merges the cavity with the outside; every further opening adds a tunnel.
+        expect_topology(t, 1, 0, 2 - k, k - 1);
+        EXPECT_EQ(t.euler, 4 - 2 * k);
+        EXPECT_EQ(holes_between(closed, t), k);
+        EXPECT_EQ(holes_between(t, closed), -k);
+    }
+}
+
+TEST(Topology, DiagonalContactsAreOneComponent) {
+    // Corner contact: 8+8-1 vertices, 24 edges, 12 faces, 2 cubes: χ = 1.
+    Mask corner(Lattice({6, 6, 6}));
+    corner({2, 2, 2}) = 1;
+    corner({3, 3, 3}) = 1;
+    expect_topology(mask_topology(corner), 1, 0, 1, 0);
+    // Edge contact: 14 vertices, 23 edges, 12 faces, 2 cubes: χ = 1.
+    Mask edge(Lattice({6, 6, 6}));
+    edge({2, 2, 2}) = 1;
+    edge({3, 3, 2}) = 1;
+    expect_topology(mask_topology(edge), 1, 0, 1, 0);
+    // Three voxels pairwise sharing an edge, all three edges meeting in the corner (3,3,3): the
+    // union is star-shaped about that corner, hence contractible (no tunnel through the pinch).
+    Mask ring(Lattice({6, 6, 6}));
+    ring({2, 2, 2}) = 1;
+    ring({3, 3, 2}) = 1;
+    ring({2, 3, 3}) = 1;
+    expect_topology(mask_topology(ring), 1, 0, 1, 0);
+}
+
+TEST(Topology, ShapesOnTheImageBorder) {
+    // A box in the image corner: outside the image is background, so it is still a ball.
+    Mask corner(Lattice({10, 10, 10}));
+    paint_box(corner, {0, 0, 0}, {4, 4, 4});
+    expect_topology(mask_topology(corner), 1, 0, 1, 0);
+    // The whole image foreground, including a 1x1x1 image.
+    expect_topology(mask_topology(Mask(Lattice({7, 5, 3}), 1)), 1, 0, 1, 0);
+    expect_topology(mask_topology(Mask(Lattice({1, 1, 1}), 1)), 1, 0, 1, 0);
+    // Image-filling box with a hidden 4³ hollow: one cavity, χ = 2.
+    Mask hollow(Lattice({8, 8, 8}), 1);
+    paint_box(hollow, {2, 2, 2}, {6, 6, 6}, 0);
+    expect_topology(mask_topology(hollow), 1, 1, 2, 0);
+    // Image-filling box with a tunnel of background running out through two border faces: the
+    // tunnel's background touches the border, so it is no cavity; the solid is a torus.
+    Mask tunnel(Lattice({8, 8, 8}), 1);
+    for (int x = 0; x < 8; ++x) tunnel({x, 4, 4}) = 0;
+    expect_topology(mask_topology(tunnel), 1, 0, 0, 1);
+    // A background pocket open to one border face only is no cavity and no tunnel, whichever of
+    // the six faces it opens onto.
+    for (int face = 0; face < 6; ++face) {
+        SCOPED_TRACE("pocket open to face " + std::to_string(face));
+        const int axis = face / 2;
+        Vec3i lo{3, 3, 3}, hi{5, 5, 5};
+        if (face % 2 == 0) lo[axis] = 0; else hi[axis] = 8;
+        Mask pocket(Lattice({8, 8, 8}), 1);
+        paint_box(pocket, lo, hi, 0);
+        expect_topology(mask_topology(pocket), 1, 0, 1, 0);
+    }
+    // Two boxes in opposite corners.
+    Mask two(Lattice({9, 9, 9}));
+    paint_box(two, {0, 0, 0}, {3, 3, 3});
+    paint_box(two, {6, 6, 6}, {9, 9, 9});
+    expect_topology(mask_topology(two), 2, 0, 2, 0);
+}
+
+TEST(Topology, CavitiesSealedAtAVoxelCornerStayCavities) {
+    // Image-filling box with a 4³ hollow, plus background voxels (1,1,1) and (0,0,0) forming a
+    // corner-to-corner chain from the hollow out to the image border. Closed voxel cubes seal every
+    // corner contact, so with 6-connected background there are two cavities (the hollow and the
+    // single voxel (1,1,1)) and (0,0,0) is just a notch in the border: χ = 1 + 2, genus 0.
+    Mask m(Lattice({8, 8, 8}), 1);
+    paint_box(m, {2, 2, 2}, {6, 6, 6}, 0);
+    m({1, 1, 1}) = 0;
+    m({0, 0, 0}) = 0;
+    expect_topology(mask_topology(m), 1, 2, 3, 0);
+}
+
+TEST(Topology, DoesNotDependOnThreadCount) {
+    Mask perforated = thick_shell();
+    drill(perforated, 0);
+    drill(perforated, 2);
+    const Topology parallel = mask_topology(perforated);
+    Topology serial;
+    {
+        tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+        serial = mask_topology(perforated);
+    }
+    EXPECT_EQ(parallel.euler_solid, serial.euler_solid);
+    EXPECT_EQ(parallel.components, serial.components);
+    EXPECT_EQ(parallel.cavities, serial.cavities);
+}
+
+TEST(LabelComponents, ConnectivityDecidesDiagonalContacts) {
+    Mask m(Lattice({6, 6, 6}));
+    m({2, 2, 2}) = 1;
+    m({3, 3, 3}) = 1;
+    std::size_t count = 0;
+    std::vector<std::uint32_t> six = label_components(m, 6, &count);
+    EXPECT_EQ(count, 2u);
+    EXPECT_EQ(six[m.lattice().index({2, 2, 2})], 1u);
+    EXPECT_EQ(six[m.lattice().index({3, 3, 3})], 2u);
+    std::vector<std::uint32_t> all = label_components(m, 26, &count);
+    EXPECT_EQ(count, 1u);
+    EXPECT_EQ(all[m.lattice().index({3, 3, 3})], 1u);
+    EXPECT_EQ(all[m.lattice().index({0, 0, 0})], 0u);
+    EXPECT_NO_THROW(label_components(m, 26, nullptr));
+}
+
+TEST(LabelComponents, LabelsFollowScanOrderOfFirstVoxel) {
+    Mask m(Lattice({10, 6, 6}));
+    paint_box(m, {6, 0, 0}, {9, 2, 2});  // first voxel (6,0,0): label 1
+    paint_box(m, {0, 4, 0}, {3, 6, 6});  // first voxel (0,4,0): label 2
+    paint_box(m, {5, 3, 2}, {9, 6, 6});  // first voxel (5,3,2): label 3 (6-separated from the others)
+    std::size_t count = 0;
+    const std::vector<std::uint32_t> labels = label_components(m, 6, &count);
+    ASSERT_EQ(count, 3u);
+    const Lattice& lat = m.lattice();
+    EXPECT_EQ(labels[lat.index({8, 1, 1})], 1u);
+    EXPECT_EQ(labels[lat.index({2, 5, 5})], 2u);
+    EXPECT_EQ(labels[lat.index({8, 5, 5})], 3u);
+    // Every foreground voxel is labelled, every background voxel is 0, and the box sizes add up.
+    std::vector<std::size_t> sizes(count + 1, 0);
+    for (PointIndex i = 0; i < m.size(); ++i) {
+        EXPECT_EQ(labels[i] == 0, m[i] == 0);
+        ++sizes[labels[i]];
+    }
+    EXPECT_EQ(sizes[1], 12u);
+    EXPECT_EQ(sizes[2], 36u);
+    EXPECT_EQ(sizes[3], 48u);
+}
+
+TEST(LabelComponents, MergedBranchesGetOneCompactLabel) {
+    // A U: two pillars that only join at z = 3, seen as separate pieces until then, and a lone
+    // pillar that starts on the first slice between them in scan order.
+    Mask m(Lattice({9, 3, 5}));
+    paint_box(m, {1, 1, 0}, {2, 2, 4});  // left arm
+    paint_box(m, {4, 1, 0}, {5, 2, 4});  // right arm
+    paint_box(m, {1, 1, 3}, {5, 2, 4});  // bar joining them on top
+    paint_box(m, {7, 1, 0}, {8, 2, 5});  // separate pillar
+    for (int connectivity : {6, 26}) {
+        std::size_t count = 0;
+        const std::vector<std::uint32_t> labels = label_components(m, connectivity, &count);
+        EXPECT_EQ(count, 2u);
+        const Lattice& lat = m.lattice();
+        EXPECT_EQ(labels[lat.index({1, 1, 0})], 1u);
+        EXPECT_EQ(labels[lat.index({4, 1, 0})], 1u);
+        EXPECT_EQ(labels[lat.index({3, 1, 3})], 1u);
+        EXPECT_EQ(labels[lat.index({7, 1, 0})], 2u);
+        EXPECT_EQ(labels[lat.index({7, 1, 4})], 2u);
+        EXPECT_EQ(*std::max_element(labels.begin(), labels.end()), 2u);
+    }
+}
+
+TEST(LabelComponents, RejectsUnsupportedConnectivity) {
+    const Mask m(Lattice({3, 3, 3}));
+    EXPECT_THROW(label_components(m, 18, nullptr), std::invalid_argument);
+    EXPECT_THROW(label_components(m, 4, nullptr), std::invalid_argument);
+}
