@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
   libcli11-dev libfmt-dev nlohmann-json3-dev  # command line, formatting, JSON reports
   gnuplot-nox                                 # plots of the Figure 3 experiment
+  libinsighttoolkit5-dev zlib1g-dev           # image IO (NIfTI, MetaImage, NRRD, MINC, DICOM)
 )
 
 missing=()

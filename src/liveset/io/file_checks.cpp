@@ -1,0 +1,229 @@
+// Raw-byte checks of NIfTI and MetaImage files (see file_checks.hpp), with zlib's gz* functions,
+// which read plain and gzip-compressed files alike.
+#include "liveset/io/file_checks.hpp"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <vector>
+
+namespace liveset::io_detail {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+template <class T>
+T load(const unsigned char* p, bool swap) {
+    std::array<unsigned char, sizeof(T)> b;
+    std::memcpy(b.data(), p, sizeof(T));
+    if (swap) std::reverse(b.begin(), b.end());
+    T v;
+    std::memcpy(&v, b.data(), sizeof(T));
+    return v;
+}
+
+template <class T>
+std::uint64_t count_non_finite(const unsigned char* p, std::size_t bytes, bool swap) {
+    std::uint64_t bad = 0;
+    for (std::size_t i = 0; i + sizeof(T) <= bytes; i += sizeof(T)) bad += !std::isfinite(load<T>(p + i, swap));
+    return bad;
+}
+
+std::string holds(std::uint64_t have, std::uint64_t need) {
+    return "holds " + std::to_string(have) + " of " + std::to_string(need) + " data bytes";
+}
+
+struct GzClose {
+    void operator()(gzFile_s* f) const { gzclose(f); }
+};
+
+// The gzip trailer's ISIZE: the uncompressed length modulo 2^32 (of the last member).
+bool gzip_isize(const std::string& path, std::uint32_t& isize) {
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    if (!in || in.tellg() < 18) return false;
+    in.seekg(-4, std::ios::end);
+    unsigned char b[4];
+    if (!in.read(reinterpret_cast<char*>(b), 4)) return false;
+    isize = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24;
+    return true;
+}
+
+std::string trim(const std::string& s) {
+    const auto a = s.find_first_not_of(" \t\r");
+    if (a == std::string::npos) return "";
+    return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
+}
+
+}  // namespace
+
+DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values) {
+    DataCheck result;
+    std::unique_ptr<gzFile_s, GzClose> file(gzopen(path.c_str(), "rb"));
+    if (!file) return result;
+    gzFile f = file.get();
+    // Read exactly the header (348 bytes for NIfTI-1, 540 for NIfTI-2): the data starts later.
+    unsigned char h[540] = {};
+    int got = gzread(f, h, 348);
+    if (got < 348) return result;  // ITK reads the header; nothing to add here
+    // NIfTI-1 (348-byte header) or NIfTI-2 (540), either byte order; single file only.
+    const auto size_le = load<std::int32_t>(h, false), size_be = load<std::int32_t>(h, true);
+    const bool swap = !(size_le == 348 || size_le == 540);
+    const std::int32_t sizeof_hdr = swap ? size_be : size_le;
+    std::int64_t dim[8] = {};
+    int datatype = 0, bitpix = 0;
+    double vox_offset = 0;
+    if (sizeof_hdr == 348) {
+        if (std::memcmp(h + 344, "n+1", 4) != 0) return result;
+        for (int i = 0; i < 8; ++i) dim[i] = load<std::int16_t>(h + 40 + 2 * i, swap);
+        datatype = load<std::int16_t>(h + 70, swap);
+        bitpix = load<std::int16_t>(h + 72, swap);
+        vox_offset = std::max<double>(352, load<float>(h + 108, swap));
+    } else if (sizeof_hdr == 540) {
+        if (gzread(f, h + 348, 192) != 192) return result;
+        got = 540;
+        if (std::memcmp(h + 4, "n+2", 4) != 0) return result;
+        for (int i = 0; i < 8; ++i) dim[i] = load<std::int64_t>(h + 16 + 8 * i, swap);
+        datatype = load<std::int16_t>(h + 12, swap);
+        bitpix = load<std::int16_t>(h + 14, swap);
+        vox_offset = std::max<double>(544, static_cast<double>(load<std::int64_t>(h + 168, swap)));
+    } else {
+        return result;
+    }
+    if (dim[0] < 1 || dim[0] > 7 || bitpix <= 0 || bitpix % 8 != 0 || !(vox_offset < 1e15)) return result;
+    std::uint64_t data_bytes = static_cast<std::uint64_t>(bitpix / 8);
+    for (int i = 1; i <= dim[0]; ++i) {
+        if (dim[i] <= 0) return result;
+        data_bytes *= static_cast<std::uint64_t>(dim[i]);
+    }
+    const auto offset = static_cast<std::uint64_t>(vox_offset);
+    const std::uint64_t end = offset + data_bytes;
+    const bool is_float = datatype == 16 || datatype == 64;  // FLOAT32, FLOAT64
+    const bool scan_values = count_non_finite_values && is_float;
+    const bool compressed = gzdirect(f) == 0;
+
+    // Cheap answers when no value needs looking at.
+    if (!scan_values) {
+        if (!compressed) {
+            std::error_code ec;
+            const std::uint64_t size = fs::file_size(path, ec);
+            if (!ec && size < end) {
+                result.truncated = true;
+                result.detail = holds(size > offset ? size - offset : 0, data_bytes);
+            }
+            return result;
+        }
+        std::uint32_t isize = 0;
+        if (gzip_isize(path, isize) && isize == static_cast<std::uint32_t>(end)) return result;
+    }
+
+    // Stream the data: count the bytes that are really there (and non-finite values).
+    std::vector<unsigned char> buf(std::size_t{1} << 20);
+    std::uint64_t pos = static_cast<std::uint64_t>(got);
+    std::uint64_t have = 0;
+    bool error = false;
+    while (pos < offset) {  // skip to the data (header extensions)
+        const auto want = static_cast<unsigned>(std::min<std::uint64_t>(buf.size(), offset - pos));
+        const int n = gzread(f, buf.data(), want);
+        if (n <= 0) {
+            error = n < 0;
+            break;
+        }
+        pos += static_cast<std::uint64_t>(n);
+    }
+    while (pos >= offset && have < data_bytes) {
+        // Chunks are multiples of 8 bytes, so no value straddles two chunks (the data starts at
+        // the first value; `have` stays a multiple of the value size).
+        const auto want = static_cast<unsigned>(std::min<std::uint64_t>(buf.size(), data_bytes - have));
+        const int n = gzread(f, buf.data(), want);
+        if (n <= 0) {
+            error = n < 0;
+            break;
+        }
+        if (scan_values)
+            result.non_finite += datatype == 16 ? count_non_finite<float>(buf.data(), std::size_t(n), swap)
+                                                : count_non_finite<double>(buf.data(), std::size_t(n), swap);
+        have += static_cast<std::uint64_t>(n);
+    }
+    int errnum = Z_OK;
+    gzerror(f, &errnum);
+    if (have < data_bytes || error || (errnum != Z_OK && errnum != Z_STREAM_END)) {
+        result.truncated = true;
+        result.detail = holds(have, data_bytes);
+        if (errnum != Z_OK && errnum != Z_STREAM_END) {
+            const std::string why = gzerror(f, &errnum);  // "<path>: unexpected end of file"
+            const auto colon = why.rfind(": ");
+            result.detail += ", " + (colon == std::string::npos ? why : why.substr(colon + 2));
+        }
+    }
+    return result;
+}
+
+DataCheck check_metaimage_data(const std::string& path, std::uint64_t raw_bytes) {
+    DataCheck result;
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return result;
+    bool compressed = false;
+    std::uint64_t compressed_size = 0;
+    long long header_size = 0;
+    std::string data_file;
+    std::string line;
+    for (int lines = 0; lines < 500 && std::getline(in, line); ++lines) {
+        const auto eq = line.find('=');
+        if (eq == std::string::npos) continue;
+        const std::string key = trim(line.substr(0, eq)), value = trim(line.substr(eq + 1));
+        try {
+            if (key == "CompressedData") compressed = value == "True" || value == "true" || value == "1";
+            if (key == "CompressedDataSize") compressed_size = std::stoull(value);
+            if (key == "HeaderSize") header_size = std::stoll(value);
+        } catch (const std::exception&) {
+            return result;  // odd header: leave it to ITK
+        }
+        if (key == "ElementDataFile") {
+            data_file = value;
+            break;
+        }
+    }
+    if (data_file.empty()) return result;
+    fs::path data;
+    std::uint64_t offset = 0;
+    std::string upper = data_file;
+    for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    if (upper == "LOCAL") {
+        data = path;
+        const auto at = in.tellg();
+        if (at < 0) return result;
+        offset = static_cast<std::uint64_t>(at);
+    } else {
+        if (upper.rfind("LIST", 0) == 0 || data_file.find('%') != std::string::npos ||
+            data_file.find(' ') != std::string::npos)
+            return result;
+        data = fs::path(data_file).is_absolute() ? fs::path(data_file) : fs::path(path).parent_path() / data_file;
+    }
+    std::error_code ec;
+    const std::uint64_t size = fs::file_size(data, ec);
+    if (ec) {
+        result.truncated = true;
+        result.detail = "data file " + data.filename().string() + " is missing";
+        return result;
+    }
+    std::uint64_t need = compressed ? compressed_size : raw_bytes;
+    if (compressed && compressed_size == 0) return result;  // size unknown: leave it to ITK
+    if (!compressed && header_size > 0) offset += static_cast<std::uint64_t>(header_size);
+    if (!compressed && header_size == -1) offset = size > raw_bytes ? size - raw_bytes : 0;  // data at the end
+    const std::uint64_t have = size > offset ? size - offset : 0;
+    if (have < need) {
+        result.truncated = true;
+        result.detail = holds(have, need);
+    }
+    return result;
+}
+
+}  // namespace liveset::io_detail

@@ -1,0 +1,26 @@
+// Internal to liveset_io: checks on the raw bytes of image files, for the cases where ITK's readers
+// hide damage. niftilib zero-fills the missing part of a short file and silently replaces NaN and
+// infinite floats by 0; MetaIO only prints a warning when a data file is short. No ITK in here.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace liveset::io_detail {
+
+struct DataCheck {
+    bool truncated = false;
+    std::string detail;            // why, when truncated ("holds 1000 of 2772 data bytes")
+    std::uint64_t non_finite = 0;  // NaN / infinite voxels counted (NIfTI float data only)
+};
+
+// Single-file NIfTI-1/-2 (.nii, .nii.gz; compressed or not): the data the header promises is all
+// there; with count_non_finite, NaN and infinite values of float32/float64 data are counted
+// (which means decompressing the file once more). Other layouts (.hdr/.img) pass unchecked.
+DataCheck check_nifti_data(const std::string& path, bool count_non_finite);
+
+// MetaImage (.mha with LOCAL data, .mhd with one data file): the data file holds `raw_bytes`
+// (uncompressed) or the header's CompressedDataSize. Multi-file (LIST, pattern) data is unchecked.
+DataCheck check_metaimage_data(const std::string& path, std::uint64_t raw_bytes);
+
+}  // namespace liveset::io_detail

@@ -1,0 +1,586 @@
+// Image IO through ITK. ITK ImageIO objects are driven directly (no ImageFileReader/Writer
+// templates per pixel type), the IO factories liveset supports are registered explicitly once,
+// and every ITK failure is turned into a one-line ImageIoError that names the file.
+#include "liveset/io/image_io.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <limits>
+#include <mutex>
+#include <new>
+#include <sstream>
+#include <type_traits>
+#include <vector>
+
+#include <itkGDCMImageIO.h>
+#include <itkGDCMImageIOFactory.h>
+#include <itkGDCMSeriesFileNames.h>
+#include <itkImage.h>
+#include <itkImageIOBase.h>
+#include <itkImageIOFactory.h>
+#include <itkImageSeriesReader.h>
+#include <itkMINCImageIOFactory.h>
+#include <itkMetaImageIOFactory.h>
+#include <itkNiftiImageIOFactory.h>
+#include <itkNrrdImageIOFactory.h>
+
+#include "liveset/io/atomic_output.hpp"
+#include "liveset/io/file_checks.hpp"
+#include "liveset/io/messages.hpp"
+
+namespace liveset {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Component = itk::IOComponentEnum;
+using io_detail::bytes_text;
+using io_detail::dims_text;
+using io_detail::quoted;
+using io_detail::voxels_are_non_finite;
+
+// ---------------------------------------------------------------------------------------------
+// Factories and messages
+
+// Registers the image IO factories liveset supports, once per process, in priority order. Done
+// here explicitly (not through UseITK's static registration header) so it cannot be dropped by
+// the linker or depend on static initialisation order in a static library.
+void register_factories() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+        itk::NiftiImageIOFactory::RegisterOneFactory();
+        itk::MetaImageIOFactory::RegisterOneFactory();
+        itk::NrrdImageIOFactory::RegisterOneFactory();
+        itk::MINCImageIOFactory::RegisterOneFactory();
+        itk::GDCMImageIOFactory::RegisterOneFactory();
+    });
+}
+
+[[noreturn]] void fail_read(const std::string& path, const std::string& what) {
+    throw ImageIoError("cannot read " + quoted(path) + ": " + what);
+}
+[[noreturn]] void fail_write(const std::string& path, const std::string& what) {
+    throw ImageIoError("cannot write " + quoted(path) + ": " + what);
+}
+
+std::string condense(const itk::ExceptionObject& e, const std::string& path) {
+    return io_detail::condense(e.GetDescription(), path);
+}
+
+std::string format_name(const itk::ImageIOBase& io) {
+    const std::string cls = io.GetNameOfClass();
+    if (cls == "NiftiImageIO") return "NIfTI";
+    if (cls == "MetaImageIO") return "MetaImage";
+    if (cls == "NrrdImageIO") return "NRRD";
+    if (cls == "MINCImageIO") return "MINC";
+    if (cls == "GDCMImageIO") return "DICOM";
+    const auto at = cls.find("ImageIO");
+    return at == std::string::npos ? cls : cls.substr(0, at);
+}
+
+const char* kFormatsHint =
+    "liveset reads .nii/.nii.gz, .mha/.mhd, .nrrd/.nhdr, .mnc and folders of DICOM slices";
+
+// ---------------------------------------------------------------------------------------------
+// Opening: header of a file or of a DICOM series folder
+
+struct Source {
+    std::string path;
+    ImageHeader header;
+    std::vector<std::uint64_t> size;        // every axis the file stores
+    bool scalar = true;                     // pixel type SCALAR (or a 1-component equivalent)
+    itk::ImageIOBase::Pointer io;           // set for files
+    std::vector<std::string> dicom_files;   // set for DICOM series folders
+};
+
+// The DICOM series in a folder (file lists sorted by slice position), largest first.
+std::vector<std::vector<std::string>> dicom_series(const std::string& dir) {
+    auto names = itk::GDCMSeriesFileNames::New();
+    names->SetUseSeriesDetails(true);  // keeps scouts / other orientations out of the volume
+    // "No Series were found" is our answer to give, not a warning to print.
+    const bool warnings = itk::Object::GetGlobalWarningDisplay();
+    itk::Object::GlobalWarningDisplayOff();
+    std::vector<std::string> uids;
+    try {
+        names->SetDirectory(dir);
+        uids = names->GetSeriesUIDs();
+    } catch (...) {
+        itk::Object::SetGlobalWarningDisplay(warnings);
+        throw;
+    }
+    itk::Object::SetGlobalWarningDisplay(warnings);
+    std::vector<std::vector<std::string>> series;
+    for (const auto& uid : uids) {
+        auto files = names->GetFileNames(uid);
+        if (!files.empty()) series.push_back(std::move(files));
+    }
+    std::stable_sort(series.begin(), series.end(),
+                     [](const auto& a, const auto& b) { return a.size() > b.size(); });
+    return series;
+}
+
+void fill_geometry(Source& src, unsigned n, const std::vector<double>& spacing, const std::vector<double>& origin,
+                   const std::vector<std::vector<double>>& axes) {
+    ImageHeader& h = src.header;
+    h.dimension = static_cast<int>(n);
+    for (unsigned a = 0; a < 3; ++a) {
+        if (a >= n) continue;  // 2D: the third axis keeps size 1, identity direction
+        if (src.size[a] > static_cast<std::uint64_t>(std::numeric_limits<int>::max()))
+            fail_read(src.path, "is too large: the header claims " + dims_text(src.size) + " voxels");
+        h.dims[static_cast<int>(a)] = static_cast<int>(src.size[a]);
+        h.spacing[static_cast<int>(a)] = spacing[a];
+        h.origin[static_cast<int>(a)] = origin[a];
+        for (unsigned r = 0; r < 3; ++r)
+            h.direction[r * 3 + a] = r < n && r < axes[a].size() ? axes[a][r] : (r == a ? 1.0 : 0.0);
+    }
+    for (unsigned a = n; a < 3; ++a) h.dims[static_cast<int>(a)] = 1;
+}
+
+void open_file(Source& src) {
+    const std::string& path = src.path;
+    if (::access(path.c_str(), R_OK) != 0)
+        fail_read(path, std::string("cannot open it (") + std::strerror(errno) + ")");
+    std::error_code ec;
+    if (fs::file_size(path, ec) == 0 && !ec) fail_read(path, "file is empty (0 bytes)");
+    itk::ImageIOBase::Pointer io;
+    try {
+        io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::IOFileModeEnum::ReadMode);
+    } catch (const itk::ExceptionObject& e) {
+        fail_read(path, "file is corrupt or truncated (" + condense(e, path) + ")");
+    }
+    if (!io) fail_read(path, std::string("unknown image format or damaged header (") + kFormatsHint + ")");
+    try {
+        io->SetFileName(path);
+        io->ReadImageInformation();
+    } catch (const itk::ExceptionObject& e) {
+        fail_read(path, "file is corrupt or truncated (" + condense(e, path) + ")");
+    } catch (const std::exception& e) {
+        fail_read(path, std::string("file is corrupt or truncated (") + e.what() + ")");
+    }
+    const unsigned n = io->GetNumberOfDimensions();
+    src.size.resize(n);
+    std::vector<double> spacing(n), origin(n);
+    std::vector<std::vector<double>> axes(n);
+    for (unsigned a = 0; a < n; ++a) {
+        src.size[a] = io->GetDimensions(a);
+        spacing[a] = io->GetSpacing(a);
+        origin[a] = io->GetOrigin(a);
+        axes[a] = io->GetDirection(a);
+    }
+    fill_geometry(src, n, spacing, origin, axes);
+    src.header.components = static_cast<int>(io->GetNumberOfComponents());
+    src.scalar = io->GetPixelType() == itk::IOPixelEnum::SCALAR && io->GetNumberOfComponents() == 1;
+    src.header.pixel_type = itk::ImageIOBase::GetComponentTypeAsString(io->GetComponentType());
+    if (!src.scalar)
+        src.header.pixel_type = itk::ImageIOBase::GetPixelTypeAsString(io->GetPixelType()) + " of " +
+                                src.header.pixel_type;
+    src.header.format = format_name(*io);
+    src.io = io;
+}
+
+using DicomImage = itk::Image<float, 3>;
+using DicomReader = itk::ImageSeriesReader<DicomImage>;
+
+DicomReader::Pointer dicom_reader(const std::vector<std::string>& files, itk::GDCMImageIO::Pointer& gdcm) {
+    gdcm = itk::GDCMImageIO::New();
+    auto reader = DicomReader::New();
+    reader->SetImageIO(gdcm);
+    reader->SetFileNames(files);
+    return reader;
+}
+
+void open_dicom_dir(Source& src) {
+    const std::string& path = src.path;
+    if (::access(path.c_str(), R_OK | X_OK) != 0)
+        fail_read(path, std::string("cannot open the folder (") + std::strerror(errno) + ")");
+    std::vector<std::vector<std::string>> series;
+    try {
+        series = dicom_series(path);
+    } catch (const itk::ExceptionObject& e) {
+        fail_read(path, "cannot scan the folder for DICOM files (" + condense(e, path) + ")");
+    }
+    if (series.empty())
+        fail_read(path, "is a folder with no DICOM series (give an image file, or a folder of DICOM slices)");
+    src.dicom_files = series.front();
+    itk::GDCMImageIO::Pointer gdcm;
+    auto reader = dicom_reader(src.dicom_files, gdcm);
+    try {
+        reader->UpdateOutputInformation();
+    } catch (const itk::ExceptionObject& e) {
+        fail_read(path, "DICOM series is corrupt (" + condense(e, path) + ")");
+    }
+    const DicomImage* image = reader->GetOutput();
+    const auto region = image->GetLargestPossibleRegion();
+    src.size.resize(3);
+    std::vector<double> spacing(3), origin(3);
+    std::vector<std::vector<double>> axes(3, std::vector<double>(3));
+    for (unsigned a = 0; a < 3; ++a) {
+        src.size[a] = region.GetSize(a);
+        spacing[a] = image->GetSpacing()[a];
+        origin[a] = image->GetOrigin()[a];
+        for (unsigned r = 0; r < 3; ++r) axes[a][r] = image->GetDirection()[r][a];
+    }
+    fill_geometry(src, 3, spacing, origin, axes);
+    src.header.components = static_cast<int>(gdcm->GetNumberOfComponents());
+    src.scalar = gdcm->GetNumberOfComponents() == 1;
+    src.header.pixel_type = itk::ImageIOBase::GetComponentTypeAsString(gdcm->GetComponentType());
+    if (!src.scalar)
+        src.header.pixel_type = itk::ImageIOBase::GetPixelTypeAsString(gdcm->GetPixelType()) + " of " +
+                                src.header.pixel_type;
+    src.header.format = "DICOM series";
+    if (series.size() > 1)
+        src.header.format += " (largest of " + std::to_string(series.size()) + " in the folder)";
+}
+
+Source open_source(const std::string& path) {
+    if (path.empty()) throw ImageIoError("cannot read an image: the path is empty");
+    register_factories();
+    Source src;
+    src.path = path;
+    std::error_code ec;
+    const auto status = fs::status(path, ec);
+    if (!fs::exists(status)) fail_read(path, "no such file or folder");
+    if (fs::is_directory(status))
+        open_dicom_dir(src);
+    else
+        open_file(src);
+    return src;
+}
+
+// Refuses images liveset cannot hold as a 3D scalar Lattice; everything from the header only.
+Lattice validate(const Source& src, std::uint64_t max_bytes) {
+    const std::string& path = src.path;
+    const ImageHeader& h = src.header;
+    const std::string dims = dims_text(src.size);
+    if (std::any_of(src.size.begin(), src.size.end(), [](std::uint64_t s) { return s == 0; }))
+        fail_read(path, "image is empty (size " + dims + ")");
+    const std::string slice_hint =
+        h.format == "DICOM" ? " (for a DICOM series, give the folder that holds all its slices)" : "";
+    if (src.size.size() < 3) fail_read(path, "is a 2D image (" + dims + "); liveset needs a 3D volume" + slice_hint);
+    for (std::size_t a = 3; a < src.size.size(); ++a)
+        if (src.size[a] > 1)
+            fail_read(path, "is a " + std::to_string(src.size.size()) + "D image (" + dims +
+                                "); liveset reads 3D volumes only (extract one volume first)");
+    if (!src.scalar || h.components != 1)
+        fail_read(path, "has " + std::to_string(h.components) + " components per voxel (" + h.pixel_type +
+                            "); liveset needs a scalar (grey-level) image");
+    double points = 1;
+    for (std::size_t a = 0; a < 3; ++a) points *= static_cast<double>(src.size[a]);
+    if (points > static_cast<double>(kMaxLatticePoints))
+        fail_read(path, "image is too large: the header claims " + dims + " voxels, more than liveset's limit of " +
+                            std::to_string(kMaxLatticePoints));
+    if (points * sizeof(float) > static_cast<double>(max_bytes))
+        fail_read(path, "image is too large: the header claims " + dims + " voxels (" +
+                            bytes_text(points * sizeof(float)) + " as float), more than the memory limit of " +
+                            bytes_text(static_cast<double>(max_bytes)));
+    if (h.dims.x == 1 || h.dims.y == 1 || h.dims.z == 1)
+        fail_read(path, "is a 2D image (a single slice, " + dims + "); liveset needs a 3D volume" + slice_hint);
+    for (int a = 0; a < 3; ++a)
+        if (!std::isfinite(h.spacing[a]) || h.spacing[a] <= 0) {
+            std::ostringstream os;
+            os << "has invalid spacing " << h.spacing.x << " x " << h.spacing.y << " x " << h.spacing.z
+               << " (spacing must be positive and finite)";
+            fail_read(path, os.str());
+        }
+    if (!all_finite(h.origin)) fail_read(path, "has a non-finite origin");
+    try {
+        return Lattice(h.dims, h.spacing, h.origin, h.direction);
+    } catch (const std::invalid_argument&) {
+        fail_read(path, "has a singular or non-finite direction matrix");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Pixels
+
+template <class F>
+void dispatch(Component c, const std::string& path, F&& f) {
+    switch (c) {
+        case Component::UCHAR: return f(std::type_identity<unsigned char>{});
+        case Component::CHAR: return f(std::type_identity<signed char>{});
+        case Component::USHORT: return f(std::type_identity<unsigned short>{});
+        case Component::SHORT: return f(std::type_identity<short>{});
+        case Component::UINT: return f(std::type_identity<unsigned int>{});
+        case Component::INT: return f(std::type_identity<int>{});
+        case Component::ULONG: return f(std::type_identity<unsigned long>{});
+        case Component::LONG: return f(std::type_identity<long>{});
+        case Component::ULONGLONG: return f(std::type_identity<unsigned long long>{});
+        case Component::LONGLONG: return f(std::type_identity<long long>{});
+        case Component::FLOAT: return f(std::type_identity<float>{});
+        case Component::DOUBLE: return f(std::type_identity<double>{});
+        default:
+            fail_read(path, "unsupported pixel type " + itk::ImageIOBase::GetComponentTypeAsString(c));
+    }
+}
+
+// Reads the whole file into `buffer` (which holds size() values of the file's component type).
+void read_file_pixels(const Source& src, void* buffer) {
+    itk::ImageIORegion region(static_cast<unsigned>(src.size.size()));
+    for (unsigned a = 0; a < src.size.size(); ++a) {
+        region.SetIndex(a, 0);
+        region.SetSize(a, src.size[a]);
+    }
+    try {
+        src.io->SetIORegion(region);
+        src.io->Read(buffer);
+    } catch (const itk::ExceptionObject& e) {
+        fail_read(src.path, "file is corrupt or truncated (" + condense(e, src.path) + ")");
+    } catch (const std::bad_alloc&) {
+        fail_read(src.path, "not enough memory to read the image");
+    } catch (const std::exception& e) {
+        fail_read(src.path, std::string("file is corrupt or truncated (") + e.what() + ")");
+    }
+}
+
+// Calls sink(const T* values, count) with all voxels, T the stored type (float for DICOM).
+template <class Sink>
+void with_pixels(const Source& src, std::size_t count, Sink&& sink) {
+    if (!src.dicom_files.empty()) {
+        itk::GDCMImageIO::Pointer gdcm;
+        auto reader = dicom_reader(src.dicom_files, gdcm);
+        try {
+            reader->Update();
+        } catch (const itk::ExceptionObject& e) {
+            fail_read(src.path, "DICOM series is corrupt or truncated (" + condense(e, src.path) + ")");
+        } catch (const std::bad_alloc&) {
+            fail_read(src.path, "not enough memory to read the image");
+        }
+        const DicomImage* image = reader->GetOutput();
+        if (image->GetBufferedRegion().GetNumberOfPixels() != count)
+            fail_read(src.path, "DICOM series changed while it was read");
+        sink(image->GetBufferPointer(), count);
+        return;
+    }
+    dispatch(src.io->GetComponentType(), src.path, [&](auto tag) {
+        using T = typename decltype(tag)::type;
+        std::vector<T> buffer;
+        try {
+            buffer.resize(count);
+        } catch (const std::bad_alloc&) {
+            fail_read(src.path, "not enough memory to read the image");
+        }
+        read_file_pixels(src, buffer.data());
+        sink(static_cast<const T*>(buffer.data()), count);
+    });
+}
+
+void check_finite(const std::string& path, std::span<const float> values) {
+    std::uint64_t bad = 0;
+    for (float v : values) bad += !std::isfinite(v);
+    if (bad) fail_read(path, voxels_are_non_finite(bad));
+}
+
+// What ITK's readers would hide: a short NIfTI is zero-filled and its NaN/Inf floats become 0, a
+// short MetaImage only prints a warning. `io` has read the header of `file`.
+io_detail::DataCheck check_data(const itk::ImageIOBase& io, const std::string& file, bool count_non_finite) {
+    const std::string cls = io.GetNameOfClass();
+    if (cls == "NiftiImageIO") return io_detail::check_nifti_data(file, count_non_finite);
+    if (cls == "MetaImageIO") {
+        std::uint64_t bytes = io.GetComponentSize() * io.GetNumberOfComponents();
+        for (unsigned a = 0; a < io.GetNumberOfDimensions(); ++a) bytes *= io.GetDimensions(a);
+        return io_detail::check_metaimage_data(file, bytes);
+    }
+    return {};
+}
+
+void verify_data(const Source& src) {
+    if (!src.io) return;
+    const io_detail::DataCheck check = check_data(*src.io, src.path, true);
+    if (check.truncated) fail_read(src.path, "file is corrupt or truncated (" + check.detail + ")");
+    if (check.non_finite) fail_read(src.path, voxels_are_non_finite(check.non_finite));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+void write_grid(const void* data, Component component, const Lattice& lattice, const std::string& path) {
+    if (path.empty()) throw ImageIoError("cannot write an image: the path is empty");
+    if (lattice.size() == 0) fail_write(path, "the image is empty");
+    const fs::path target(path);
+    const std::string filename = target.filename().string();
+    const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    std::error_code ec;
+    const auto dir_status = fs::status(dir, ec);
+    if (!fs::exists(dir_status)) fail_write(path, "folder " + quoted(dir.string()) + " does not exist");
+    if (!fs::is_directory(dir_status)) fail_write(path, quoted(dir.string()) + " is not a folder");
+    if (filename.empty() || fs::is_directory(target, ec)) fail_write(path, "is a folder, not a file name");
+    const std::string ext = io_detail::extension_of(filename);
+    const char* formats = "use .nii.gz, .nii, .mha, .mhd, .nrrd, .nhdr or .mnc";
+    if (ext.empty()) fail_write(path, std::string("no file extension to choose the format (") + formats + ")");
+
+    register_factories();
+    itk::ImageIOBase::Pointer io;
+    try {
+        io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::IOFileModeEnum::WriteMode);
+    } catch (const itk::ExceptionObject&) {
+        io = nullptr;
+    }
+    if (!io) fail_write(path, "unknown image format " + quoted(ext) + " for writing (" + formats + ")");
+    const std::string cls = io->GetNameOfClass();
+    if (cls == "GDCMImageIO") fail_write(path, std::string("writing DICOM is not supported (") + formats + ")");
+
+    io->SetNumberOfDimensions(3);
+    const Vec3i d = lattice.dims();
+    const Vec3d s = lattice.spacing(), o = lattice.origin();
+    const Mat3d& m = lattice.direction();
+    itk::ImageIORegion region(3);
+    for (unsigned a = 0; a < 3; ++a) {
+        const int ai = static_cast<int>(a);
+        io->SetDimensions(a, static_cast<itk::SizeValueType>(d[ai]));
+        io->SetSpacing(a, s[ai]);
+        io->SetOrigin(a, o[ai]);
+        io->SetDirection(a, std::vector<double>{m[a], m[3 + a], m[6 + a]});
+        region.SetIndex(a, 0);
+        region.SetSize(a, static_cast<itk::SizeValueType>(d[ai]));
+    }
+    io->SetPixelType(itk::IOPixelEnum::SCALAR);
+    io->SetComponentType(component);
+    io->SetNumberOfComponents(1);
+    // Two-file formats stay uncompressed (.raw, readable by anything); single files are compressed
+    // where the format allows it (.nii vs .nii.gz is decided by the extension itself).
+    const bool two_file = cls == "MetaImageIO" ? ext != ".mha" : (cls == "NrrdImageIO" && ext != ".nrrd");
+    io->SetUseCompression(!two_file);
+    io->SetIORegion(region);
+
+    // Uncompressed output must fit, known before writing. Checked up front because some writers
+    // do not clean up after a failed write: teem keeps a detached .raw open (its disk space stays
+    // used), libminc leaks its HDF5 file (HDF5 may then crash at exit). MINC is checked against
+    // the uncompressed size.
+    std::string ext_lc = ext;
+    for (char& c : ext_lc) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const double bytes = double(lattice.size()) * (component == Component::FLOAT ? 4 : 1) + 65536;
+    const auto space = fs::space(dir, ec);
+    if ((two_file || ext_lc == ".nii" || cls == "MINCImageIO") && !ec && double(space.available) < bytes)
+        fail_write(path, "not enough free space in folder " + quoted(dir.string()) + " (" +
+                             bytes_text(double(space.available)) + " free, about " + bytes_text(bytes) + " needed)");
+
+    // Written to a hidden temporary next to the target, checked, then renamed over the target.
+    // Every failure below removes the temporaries (AtomicOutput's destructor).
+    io_detail::AtomicOutput out(target);
+    const std::string tmp = out.temp_path().string();
+    try {
+        out.create();  // a clear reason (permissions, read-only file system) before ITK tries
+        io->SetFileName(tmp);
+        io->Write(data);
+        // Read the temporary back: catches writers that do not report short writes (disk full).
+        auto check = itk::ImageIOFactory::CreateImageIO(tmp.c_str(), itk::IOFileModeEnum::ReadMode);
+        if (!check) fail_write(path, "the written file cannot be read back (disk full?)");
+        check->SetFileName(tmp);
+        check->ReadImageInformation();
+        for (unsigned a = 0; a < 3; ++a)
+            if (check->GetDimensions(a) != static_cast<itk::SizeValueType>(d[static_cast<int>(a)]))
+                fail_write(path, "the written file does not read back with the same size (disk full?)");
+        const io_detail::DataCheck data_check = check_data(*check, tmp, false);
+        if (data_check.truncated) fail_write(path, "the file came out short, " + data_check.detail + " (disk full?)");
+        out.commit(two_file);
+    } catch (const ImageIoError&) {
+        throw;
+    } catch (const itk::ExceptionObject& e) {
+        fail_write(path, condense(e, tmp));
+    } catch (const std::exception& e) {
+        fail_write(path, e.what());
+    }
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Public API
+
+ImageHeader read_image_header(const std::string& path) { return open_source(path).header; }
+
+Grid<float> read_image(const std::string& path, std::uint64_t max_bytes) {
+    const Source src = open_source(path);
+    const Lattice lattice = validate(src, max_bytes);
+    verify_data(src);
+    Grid<float> grid;
+    try {
+        grid = Grid<float>(lattice);
+    } catch (const std::bad_alloc&) {
+        fail_read(path, "not enough memory for " + dims_text(src.size) + " voxels");
+    }
+    std::span<float> out = grid.values();
+    if (src.io && src.io->GetComponentType() == Component::FLOAT) {
+        read_file_pixels(src, out.data());  // no conversion: straight into the grid
+    } else {
+        with_pixels(src, out.size(), [&](const auto* values, std::size_t n) {
+            std::transform(values, values + n, out.begin(), [](auto v) { return static_cast<float>(v); });
+        });
+    }
+    check_finite(path, out);
+    return grid;
+}
+
+Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_bytes) {
+    const Source src = open_source(path);
+    const Lattice lattice = validate(src, max_bytes);
+    verify_data(src);
+    Grid<std::uint8_t> grid;
+    try {
+        grid = Grid<std::uint8_t>(lattice);
+    } catch (const std::bad_alloc&) {
+        fail_read(path, "not enough memory for " + dims_text(src.size) + " voxels");
+    }
+    std::span<std::uint8_t> out = grid.values();
+    with_pixels(src, out.size(), [&](const auto* values, std::size_t n) {
+        using T = std::remove_cv_t<std::remove_pointer_t<decltype(values)>>;
+        std::size_t non_finite = 0, bad = 0, first_bad = n;
+        for (std::size_t i = 0; i < n; ++i) {
+            const T v = values[i];
+            bool ok;
+            if constexpr (std::is_floating_point_v<T>) {
+                if (!std::isfinite(v)) {
+                    ++non_finite;
+                    continue;
+                }
+                ok = v >= 0 && v <= 255 && v == std::floor(v);
+            } else if constexpr (std::is_signed_v<T>) {
+                ok = v >= 0 && v <= 255;
+            } else {
+                ok = v <= 255;
+            }
+            if (!ok) {
+                if (!bad++) first_bad = i;
+                continue;
+            }
+            out[i] = static_cast<std::uint8_t>(v);
+        }
+        if (non_finite) fail_read(path, voxels_are_non_finite(non_finite));
+        if (bad) {
+            std::ostringstream os;
+            os.precision(9);
+            os << "is not a label image: " << bad << (bad == 1 ? " voxel is" : " voxels are")
+               << " not an integer in 0..255 (e.g. " << +values[first_bad] << " at voxel "
+               << lattice.coord(static_cast<PointIndex>(first_bad)) << ")";
+            fail_read(path, os.str());
+        }
+    });
+    return grid;
+}
+
+void write_image(const Grid<float>& image, const std::string& path) {
+    write_grid(image.values().data(), Component::FLOAT, image.lattice(), path);
+}
+
+void write_label_image(const Grid<std::uint8_t>& labels, const std::string& path) {
+    write_grid(labels.values().data(), Component::UCHAR, labels.lattice(), path);
+}
+
+bool is_dicom_series_dir(const std::string& path) {
+    std::error_code ec;
+    if (path.empty() || !fs::is_directory(path, ec)) return false;
+    register_factories();
+    try {
+        return !dicom_series(path).empty();
+    } catch (...) {
+        return false;
+    }
+}
+
+}  // namespace liveset

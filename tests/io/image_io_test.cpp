@@ -1,0 +1,539 @@
+// Image IO tests: round trips through every supported format with oblique, anisotropic geometry,
+// DICOM series written by ITK's GDCM writer, every refusal (each with the path and a specific
+// phrase), atomic writes that leave no temporaries behind, and the BrainWeb data when present.
+#include <gtest/gtest.h>
+#include <sys/mount.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "dicom_writer.hpp"
+#include "liveset/io/image_io.hpp"
+
+namespace liveset {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A fresh folder per test, removed afterwards.
+class ImageIo : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        std::string name = info->name();  // "Case/param" for parameterised tests
+        for (char& c : name) c = (c == '/') ? '_' : c;
+        dir_ = fs::temp_directory_path() / ("liveset_io_" + std::to_string(::getpid()) + "_" + name);
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override {
+        std::error_code ec;
+        fs::remove_all(dir_, ec);
+    }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    std::set<std::string> listing(const fs::path& folder) const {
+        std::set<std::string> names;
+        for (const auto& e : fs::directory_iterator(folder)) names.insert(e.path().filename().string());
+        return names;
+    }
+    std::set<std::string> listing() const { return listing(dir_); }
+
+    fs::path dir_;
+};
+
+// Rotation by `deg` degrees about the (normalised) axis a: an oblique, proper direction matrix.
+Mat3d rotation(Vec3d a, double deg) {
+    a = a / norm(a);
+    const double t = deg * std::acos(-1.0) / 180.0, c = std::cos(t), s = std::sin(t), C = 1 - c;
+    return {c + a.x * a.x * C,       a.x * a.y * C - a.z * s, a.x * a.z * C + a.y * s,
+            a.y * a.x * C + a.z * s, c + a.y * a.y * C,       a.y * a.z * C - a.x * s,
+            a.z * a.x * C - a.y * s, a.z * a.y * C + a.x * s, c + a.z * a.z * C};
+}
+
+Lattice test_lattice() {
+    return Lattice({7, 9, 11}, {0.7, 1.3, 2.1}, {-12.5, 30.25, 4.0}, rotation({1, 2, 3}, 25));
+}
+
+Grid<float> test_image() {
+    Grid<float> g(test_lattice());
+    for (PointIndex i = 0; i < g.size(); ++i) {
+        const Vec3i p = g.lattice().coord(i);
+        g[i] = 0.5f * float(p.x) - 1.25f * float(p.y) + 3.1f * float(p.z) + 0.01f * float(p.x * p.y * p.z) - 7.0f;
+    }
+    return g;
+}
+
+Grid<std::uint8_t> test_labels() {
+    Grid<std::uint8_t> g(test_lattice());
+    for (PointIndex i = 0; i < g.size(); ++i) g[i] = static_cast<std::uint8_t>((i * 37u) % 256u);
+    return g;
+}
+
+void expect_same_geometry(const Lattice& a, const Lattice& b, double tol = 1e-4) {
+    EXPECT_EQ(a.dims(), b.dims());
+    for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(a.spacing()[k], b.spacing()[k], tol) << "spacing axis " << k;
+        EXPECT_NEAR(a.origin()[k], b.origin()[k], tol) << "origin axis " << k;
+    }
+    for (std::size_t k = 0; k < 9; ++k) EXPECT_NEAR(a.direction()[k], b.direction()[k], tol) << "direction " << k;
+}
+
+// Runs f, expects ImageIoError whose one-line message holds `path` and `phrase`; returns it.
+template <class F>
+std::string expect_error(F&& f, const std::string& path, const std::string& phrase) {
+    try {
+        f();
+    } catch (const ImageIoError& e) {
+        const std::string msg = e.what();
+        if (std::getenv("LIVESET_IO_TEST_PRINT")) std::cout << "  message: " << msg << "\n";
+        EXPECT_NE(msg.find(path), std::string::npos) << "message lacks the path: " << msg;
+        EXPECT_NE(msg.find(phrase), std::string::npos) << "message lacks \"" << phrase << "\": " << msg;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << "message is not one line: " << msg;
+        return msg;
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "expected ImageIoError, got another exception: " << e.what();
+        return {};
+    }
+    ADD_FAILURE() << "expected ImageIoError (\"" << phrase << "\") for " << path;
+    return {};
+}
+
+void write_text(const std::string& path, const std::string& text) { std::ofstream(path, std::ios::binary) << text; }
+
+// A hand-written MetaImage with the data inline (ElementDataFile = LOCAL).
+void write_mha(const std::string& path, const std::string& header_lines, const void* data, std::size_t bytes) {
+    std::ofstream out(path, std::ios::binary);
+    out << "ObjectType = Image\n" << header_lines << "ElementDataFile = LOCAL\n";
+    out.write(static_cast<const char*>(data), static_cast<std::streamsize>(bytes));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Round trips
+
+class RoundTrip : public ImageIo, public ::testing::WithParamInterface<const char*> {};
+
+TEST_P(RoundTrip, FloatImageKeepsValuesAndObliqueGeometry) {
+    const std::string ext = GetParam();
+    const Grid<float> image = test_image();
+    const std::string file = path("image" + ext);
+    write_image(image, file);
+    const Grid<float> back = read_image(file);
+    expect_same_geometry(image.lattice(), back.lattice());
+    ASSERT_EQ(back.size(), image.size());
+    for (PointIndex i = 0; i < image.size(); ++i) ASSERT_NEAR(back[i], image[i], 1e-5f * (1 + std::abs(image[i]))) << i;
+
+    const ImageHeader h = read_image_header(file);
+    EXPECT_EQ(h.dims, (Vec3i{7, 9, 11}));
+    EXPECT_EQ(h.dimension, 3);
+    EXPECT_EQ(h.components, 1);
+    EXPECT_EQ(h.pixel_type, "float");
+    EXPECT_FALSE(h.format.empty());
+    for (const auto& name : listing()) EXPECT_EQ(name.find(".tmp-"), std::string::npos) << "left behind: " << name;
+}
+
+TEST_P(RoundTrip, LabelImageIsExact) {
+    const std::string ext = GetParam();
+    const Grid<std::uint8_t> labels = test_labels();
+    const std::string file = path("labels" + ext);
+    write_label_image(labels, file);
+    const Grid<std::uint8_t> back = read_label_image(file);
+    expect_same_geometry(labels.lattice(), back.lattice());
+    ASSERT_EQ(back.size(), labels.size());
+    for (PointIndex i = 0; i < labels.size(); ++i) ASSERT_EQ(back[i], labels[i]) << i;
+    EXPECT_EQ(read_image_header(file).pixel_type, "unsigned_char");
+    // Labels also read as a float image (e.g. a mask used as a speed image).
+    const Grid<float> as_float = read_image(file);
+    for (PointIndex i = 0; i < labels.size(); ++i) ASSERT_EQ(as_float[i], float(labels[i])) << i;
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, RoundTrip,
+                         ::testing::Values(".nii", ".nii.gz", ".mha", ".mhd", ".nrrd", ".nhdr", ".mnc"),
+                         [](const auto& info) {
+                             std::string n = info.param + 1;
+                             for (char& c : n) c = (c == '.') ? '_' : c;
+                             return n;
+                         });
+
+TEST_F(ImageIo, HeaderNamesTheFormat) {
+    const Grid<float> image = test_image();
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"a.nii.gz", "NIfTI"}, {"a.mha", "MetaImage"}, {"a.nrrd", "NRRD"}, {"a.mnc", "MINC"}};
+    for (const auto& [name, format] : cases) {
+        write_image(image, path(name));
+        EXPECT_EQ(read_image_header(path(name)).format, format) << name;
+    }
+}
+
+// Independent of ITK's reader: the NIfTI sform must be the RAS form of our LPS geometry, which is
+// what FSLeyes, 3D Slicer and ITK-SNAP display.
+TEST_F(ImageIo, NiftiSformIsRasOfTheLpsGeometry) {
+    const Grid<float> image = test_image();
+    write_image(image, path("g.nii"));
+    std::ifstream in(path("g.nii"), std::ios::binary);
+    char h[348];
+    ASSERT_TRUE(in.read(h, sizeof h));
+    std::int16_t sform_code;
+    std::memcpy(&sform_code, h + 254, 2);
+    EXPECT_GT(sform_code, 0);
+    float srow[3][4];
+    std::memcpy(srow, h + 280, sizeof srow);
+    const Lattice& l = image.lattice();
+    for (int r = 0; r < 3; ++r) {
+        const double flip = r < 2 ? -1.0 : 1.0;  // LPS -> RAS
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(srow[r][c], flip * l.direction()[std::size_t(r * 3 + c)] * l.spacing()[c], 1e-5) << r << c;
+        EXPECT_NEAR(srow[r][3], flip * l.origin()[r], 1e-4) << r;
+    }
+}
+
+TEST_F(ImageIo, TwoFileFormatsGetFinalDataFileNames) {
+    write_image(test_image(), path("vol.mhd"));
+    write_image(test_image(), path("vol2.nhdr"));
+    EXPECT_EQ(listing(), (std::set<std::string>{"vol.mhd", "vol.raw", "vol2.nhdr", "vol2.raw"}));
+    std::ifstream in(path("vol.mhd"));
+    const std::string text((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_NE(text.find("ElementDataFile = vol.raw"), std::string::npos) << text;
+    // Still readable after moving the pair elsewhere (the reference is relative).
+    fs::create_directory(dir_ / "moved");
+    fs::rename(dir_ / "vol.mhd", dir_ / "moved" / "vol.mhd");
+    fs::rename(dir_ / "vol.raw", dir_ / "moved" / "vol.raw");
+    EXPECT_EQ(read_image((dir_ / "moved" / "vol.mhd").string()).dims(), (Vec3i{7, 9, 11}));
+}
+
+TEST_F(ImageIo, OverwriteReplacesTheFileAtomically) {
+    const std::string file = path("out.nii.gz");
+    write_image(test_image(), file);
+    Grid<float> second = test_image();
+    second.fill(42.0f);
+    write_image(second, file);
+    EXPECT_EQ(read_image(file)[5], 42.0f);
+    EXPECT_EQ(listing(), std::set<std::string>{"out.nii.gz"});
+}
+
+TEST_F(ImageIo, AnyStoredPixelTypeReadsAsFloat) {
+    const std::vector<std::pair<std::string, std::vector<unsigned char>>> cases = {
+        {"MET_UCHAR", {0, 7, 200, 255, 1, 2, 3, 4}},
+        {"MET_CHAR", {0, 7, 0x80, 0xFF, 1, 2, 3, 4}},  // 0x80 = -128, 0xFF = -1
+    };
+    for (const auto& [type, bytes] : cases) {
+        const std::string file = path("t_" + type + ".mha");
+        write_mha(file, "NDims = 3\nDimSize = 2 2 2\nElementType = " + type + "\n", bytes.data(), bytes.size());
+        const Grid<float> g = read_image(file);
+        EXPECT_EQ(g[2], type == "MET_UCHAR" ? 200.0f : -128.0f);
+        EXPECT_EQ(g[3], type == "MET_UCHAR" ? 255.0f : -1.0f);
+    }
+    const short shorts[8] = {-1000, 0, 1, 2, 3, 4, 5, 32000};
+    write_mha(path("s.mha"), "NDims = 3\nDimSize = 2 2 2\nElementType = MET_SHORT\n", shorts, sizeof shorts);
+    EXPECT_EQ(read_image(path("s.mha"))[0], -1000.0f);
+    EXPECT_EQ(read_image(path("s.mha"))[7], 32000.0f);
+    const double doubles[8] = {0.25, -1.5, 1e6, 2, 3, 4, 5, 6};
+    write_mha(path("d.mha"), "NDims = 3\nDimSize = 2 2 2\nElementType = MET_DOUBLE\n", doubles, sizeof doubles);
+    EXPECT_EQ(read_image(path("d.mha"))[1], -1.5f);
+    EXPECT_EQ(read_image_header(path("d.mha")).pixel_type, "double");
+}
+
+TEST_F(ImageIo, FourDWithSingletonExtraAxisIsAccepted) {
+    const float values[2 * 3 * 4] = {};
+    write_mha(path("v.mha"), "NDims = 4\nDimSize = 2 3 4 1\nElementType = MET_FLOAT\n", values, sizeof values);
+    EXPECT_EQ(read_image_header(path("v.mha")).dimension, 4);
+    EXPECT_EQ(read_image(path("v.mha")).dims(), (Vec3i{2, 3, 4}));
+}
+
+// ---------------------------------------------------------------------------------------------
+// DICOM series
+
+TEST_F(ImageIo, DicomSeriesFolderReadsBack) {
+    Grid<float> image(Lattice({6, 5, 8}, {0.8, 0.9, 2.5}, {-20, 15, 7.5}, rotation({1, 2, 3}, 25)));
+    for (PointIndex i = 0; i < image.size(); ++i) image[i] = float(int(i * 7) % 500 - 100);
+    const fs::path series = dir_ / "series";
+    fs::create_directory(series);
+    test::write_dicom_series(image, series.string(), 1);
+    ASSERT_TRUE(is_dicom_series_dir(series.string()));
+    EXPECT_FALSE(is_dicom_series_dir(dir_.string()));  // holds only a folder
+    EXPECT_FALSE(is_dicom_series_dir(path("missing")));
+
+    const ImageHeader h = read_image_header(series.string());
+    EXPECT_EQ(h.format, "DICOM series");
+    EXPECT_EQ(h.dims, (Vec3i{6, 5, 8}));
+    const Grid<float> back = read_image(series.string());
+    expect_same_geometry(image.lattice(), back.lattice(), 1e-3);
+    for (PointIndex i = 0; i < image.size(); ++i) ASSERT_NEAR(back[i], image[i], 1e-3) << i;
+}
+
+TEST_F(ImageIo, DicomFolderWithSeveralSeriesReadsTheLargest) {
+    const fs::path folder = dir_ / "dicom";
+    fs::create_directory(folder);
+    Grid<float> small(Lattice({4, 4, 3}, {1, 1, 1}));
+    small.fill(5);
+    Grid<float> large(Lattice({4, 4, 6}, {1, 1, 2}));
+    large.fill(9);
+    test::write_dicom_series(small, folder.string(), 1, "a");
+    test::write_dicom_series(large, folder.string(), 2, "b");
+    const ImageHeader h = read_image_header(folder.string());
+    EXPECT_NE(h.format.find("largest of 2"), std::string::npos) << h.format;
+    const Grid<float> g = read_image(folder.string());
+    EXPECT_EQ(g.dims(), (Vec3i{4, 4, 6}));
+    EXPECT_NEAR(g.lattice().spacing().z, 2.0, 1e-6);
+    EXPECT_EQ(g[0], 9.0f);
+}
+
+TEST_F(ImageIo, DicomErrors) {
+    const fs::path empty = dir_ / "empty";
+    fs::create_directory(empty);
+    write_text((empty / "notes.txt").string(), "not dicom");
+    expect_error([&] { read_image(empty.string()); }, empty.string(), "no DICOM series");
+    const fs::path one = dir_ / "one";
+    fs::create_directory(one);
+    Grid<float> slice(Lattice({5, 5, 1}));
+    test::write_dicom_series(slice, one.string(), 3);
+    expect_error([&] { read_image(one.string()); }, one.string(), "2D");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Refusals while reading
+
+TEST_F(ImageIo, MissingFile) {
+    expect_error([&] { read_image(path("nope.nii.gz")); }, path("nope.nii.gz"), "no such file or folder");
+    expect_error([&] { read_image_header(path("nope.mha")); }, path("nope.mha"), "no such file or folder");
+    expect_error([&] { read_label_image(path("nope")); }, path("nope"), "no such file or folder");
+}
+
+TEST_F(ImageIo, UnreadableFile) {
+    if (::geteuid() == 0) GTEST_SKIP() << "running as root: file permissions are not enforced";
+    write_image(test_image(), path("locked.nii"));
+    fs::permissions(path("locked.nii"), fs::perms::none);
+    expect_error([&] { read_image(path("locked.nii")); }, path("locked.nii"), "Permission denied");
+}
+
+TEST_F(ImageIo, UnknownFormat) {
+    write_text(path("x.nii.gz"), "this is a text file, not an image\n");
+    expect_error([&] { read_image(path("x.nii.gz")); }, path("x.nii.gz"), "unknown image format");
+    write_text(path("y.png2"), "?");
+    expect_error([&] { read_image(path("y.png2")); }, path("y.png2"), "unknown image format");
+    write_text(path("zero.nii"), "");
+    expect_error([&] { read_image(path("zero.nii")); }, path("zero.nii"), "empty");
+}
+
+TEST_F(ImageIo, TruncatedFiles) {
+    for (const std::string name : {"cut.nii", "cut.nii.gz", "cut.mha", "cut.nrrd"}) {
+        const std::string file = path(name);
+        write_image(test_image(), file);
+        const auto size = fs::file_size(file);
+        fs::resize_file(file, size / 2);
+        expect_error([&] { read_image(file); }, file, "corrupt or truncated");
+    }
+    write_image(test_image(), path("lost.mhd"));
+    fs::remove(path("lost.raw"));
+    expect_error([&] { read_image(path("lost.mhd")); }, path("lost.mhd"), "corrupt or truncated");
+}
+
+TEST_F(ImageIo, TwoDImage) {
+    const float v[12] = {};
+    write_mha(path("flat.mha"), "NDims = 2\nDimSize = 3 4\nElementType = MET_FLOAT\n", v, sizeof v);
+    expect_error([&] { read_image(path("flat.mha")); }, path("flat.mha"), "2D");
+    EXPECT_EQ(read_image_header(path("flat.mha")).dimension, 2);  // the header still reads
+    write_mha(path("slice.mha"), "NDims = 3\nDimSize = 3 4 1\nElementType = MET_FLOAT\n", v, sizeof v);
+    expect_error([&] { read_image(path("slice.mha")); }, path("slice.mha"), "2D");
+}
+
+TEST_F(ImageIo, FourDImage) {
+    const float v[2 * 2 * 2 * 3] = {};
+    write_mha(path("time.mha"), "NDims = 4\nDimSize = 2 2 2 3\nElementType = MET_FLOAT\n", v, sizeof v);
+    expect_error([&] { read_image(path("time.mha")); }, path("time.mha"), "4D");
+}
+
+TEST_F(ImageIo, RgbImage) {
+    const unsigned char v[2 * 2 * 2 * 3] = {};
+    write_mha(path("rgb.mha"), "NDims = 3\nDimSize = 2 2 2\nElementNumberOfChannels = 3\nElementType = MET_UCHAR\n", v,
+              sizeof v);
+    EXPECT_EQ(read_image_header(path("rgb.mha")).components, 3);
+    expect_error([&] { read_image(path("rgb.mha")); }, path("rgb.mha"), "3 components per voxel");
+    expect_error([&] { read_label_image(path("rgb.mha")); }, path("rgb.mha"), "3 components per voxel");
+}
+
+TEST_F(ImageIo, EmptyImage) {
+    write_text(path("e.mha"),
+               "ObjectType = Image\nNDims = 3\nDimSize = 4 0 4\nElementType = MET_FLOAT\nElementDataFile = LOCAL\n");
+    expect_error([&] { read_image(path("e.mha")); }, path("e.mha"), "image is empty (size 4x0x4)");
+    // teem refuses a zero size while parsing the header already.
+    write_text(path("e.nhdr"), "NRRD0004\ntype: float\ndimension: 3\nsizes: 0 4 4\nencoding: raw\ndata file: e.raw\n");
+    write_text(path("e.raw"), "");
+    expect_error([&] { read_image(path("e.nhdr")); }, path("e.nhdr"), "size is zero");
+}
+
+TEST_F(ImageIo, NanVoxels) {
+    Grid<float> image = test_image();
+    image[3] = std::numeric_limits<float>::quiet_NaN();
+    image[10] = std::numeric_limits<float>::infinity();
+    image[11] = -std::numeric_limits<float>::infinity();
+    write_image(image, path("nan.nii.gz"));  // writing is faithful
+    expect_error([&] { read_image(path("nan.nii.gz")); }, path("nan.nii.gz"), "3 voxels are NaN or infinite");
+    expect_error([&] { read_label_image(path("nan.nii.gz")); }, path("nan.nii.gz"), "NaN or infinite");
+}
+
+TEST_F(ImageIo, AbsurdSizeFailsFastWithoutAllocating) {
+    const auto start = std::chrono::steady_clock::now();
+    write_text(path("huge.mhd"), "ObjectType = Image\nNDims = 3\nDimSize = 1000000 1000000 1000000\n"
+                                 "ElementType = MET_FLOAT\nElementDataFile = huge.raw\n");
+    write_text(path("huge.raw"), "tiny");
+    expect_error([&] { read_image(path("huge.mhd")); }, path("huge.mhd"), "too large");
+    expect_error([&] { read_label_image(path("huge.mhd")); }, path("huge.mhd"), "too large");
+    write_text(path("huge.nhdr"), "NRRD0004\ntype: short\ndimension: 3\nsizes: 1000000 1000000 1000000\n"
+                                  "encoding: raw\nendian: little\ndata file: huge.raw\n");
+    expect_error([&] { read_image(path("huge.nhdr")); }, path("huge.nhdr"), "too large");
+    EXPECT_EQ(read_image_header(path("huge.nhdr")).dims, (Vec3i{1000000, 1000000, 1000000}));
+    // Under the point limit but over a given memory limit.
+    write_image(test_image(), path("small.nii"));
+    expect_error([&] { read_image(path("small.nii"), 1000); }, path("small.nii"), "memory limit");
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_LT(seconds, 2.0);
+}
+
+TEST_F(ImageIo, BadSpacingAndDirection) {
+    const float v[8] = {};
+    write_mha(path("neg.mha"), "NDims = 3\nDimSize = 2 2 2\nElementSpacing = -1 1 1\nElementType = MET_FLOAT\n", v,
+              sizeof v);
+    expect_error([&] { read_image(path("neg.mha")); }, path("neg.mha"), "invalid spacing");
+    write_mha(path("zero.mha"), "NDims = 3\nDimSize = 2 2 2\nElementSpacing = 1 0 1\nElementType = MET_FLOAT\n", v,
+              sizeof v);
+    expect_error([&] { read_image(path("zero.mha")); }, path("zero.mha"), "invalid spacing");
+    write_text(path("neg.nhdr"), "NRRD0004\ntype: float\ndimension: 3\nsizes: 2 2 2\nspacings: 1 -2 1\n"
+                                 "encoding: raw\nendian: little\ndata file: neg.raw\n");
+    std::ofstream(path("neg.raw"), std::ios::binary).write(reinterpret_cast<const char*>(v), sizeof v);
+    expect_error([&] { read_image(path("neg.nhdr")); }, path("neg.nhdr"), "invalid spacing");
+    write_mha(path("sing.mha"),
+              "NDims = 3\nDimSize = 2 2 2\nTransformMatrix = 1 0 0 1 0 0 0 0 1\nElementType = MET_FLOAT\n", v,
+              sizeof v);
+    expect_error([&] { read_image(path("sing.mha")); }, path("sing.mha"), "singular");
+}
+
+TEST_F(ImageIo, LabelValuesMustBeIntegersIn0To255) {
+    Grid<float> image = test_image();  // non-integer values
+    write_image(image, path("f.nii.gz"));
+    expect_error([&] { read_label_image(path("f.nii.gz")); }, path("f.nii.gz"), "not an integer in 0..255");
+    const short big[8] = {0, 1, 2, 300, 4, 5, 6, 7};
+    write_mha(path("big.mha"), "NDims = 3\nDimSize = 2 2 2\nElementType = MET_SHORT\n", big, sizeof big);
+    const std::string msg =
+        expect_error([&] { read_label_image(path("big.mha")); }, path("big.mha"),
+                     "1 voxel is not an integer in 0..255");
+    EXPECT_NE(msg.find("300"), std::string::npos) << msg;
+    const short neg[8] = {0, -1, 2, 3, 4, 5, 6, 7};
+    write_mha(path("neg.mha"), "NDims = 3\nDimSize = 2 2 2\nElementType = MET_SHORT\n", neg, sizeof neg);
+    expect_error([&] { read_label_image(path("neg.mha")); }, path("neg.mha"), "not an integer in 0..255");
+    // Integer-valued floats and wide integer types are fine.
+    const float fl[8] = {0, 1, 2, 255, 4, 5, 6, 7};
+    write_mha(path("ok.mha"), "NDims = 3\nDimSize = 2 2 2\nElementType = MET_FLOAT\n", fl, sizeof fl);
+    EXPECT_EQ(read_label_image(path("ok.mha"))[3], 255);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Refusals while writing; nothing half-written is ever left behind
+
+TEST_F(ImageIo, WriteIntoMissingFolder) {
+    const std::string file = path("no/such/folder/out.nii.gz");
+    expect_error([&] { write_image(test_image(), file); }, file, "does not exist");
+    EXPECT_EQ(listing(), std::set<std::string>{});
+}
+
+TEST_F(ImageIo, WriteIntoUnwritableFolder) {
+    if (::geteuid() == 0) {
+        // Root ignores permission bits; /proc refuses new files even to root.
+        const std::string file = "/proc/liveset_io_test.nii.gz";
+        expect_error([&] { write_image(test_image(), file); }, file, "cannot write");
+        for (const auto& e : fs::directory_iterator("/proc"))
+            EXPECT_EQ(e.path().filename().string().find("liveset_io_test"), std::string::npos);
+        return;
+    }
+    const fs::path ro = dir_ / "readonly";
+    fs::create_directory(ro);
+    fs::permissions(ro, fs::perms::owner_read | fs::perms::owner_exec);
+    const std::string file = (ro / "out.nii.gz").string();
+    expect_error([&] { write_image(test_image(), file); }, file, "ermission denied");
+    EXPECT_TRUE(listing(ro).empty());
+    fs::permissions(ro, fs::perms::owner_all);
+}
+
+TEST_F(ImageIo, WriteBadTargets) {
+    expect_error([&] { write_image(test_image(), path("out.xyz")); }, path("out.xyz"), "unknown image format");
+    expect_error([&] { write_image(test_image(), path("noext")); }, path("noext"), "extension");
+    expect_error([&] { write_image(test_image(), path("out.dcm")); }, path("out.dcm"), "DICOM");
+    fs::create_directory(dir_ / "sub.nii");
+    expect_error([&] { write_image(test_image(), path("sub.nii")); }, path("sub.nii"), "is a folder");
+    expect_error([&] { write_image(Grid<float>(), path("e.nii")); }, path("e.nii"), "empty");
+    EXPECT_EQ(listing(), std::set<std::string>{"sub.nii"});
+}
+
+// Disk full: a tiny tmpfs (needs root and mount permission; skipped otherwise).
+TEST_F(ImageIo, WriteOnFullDiskLeavesNothing) {
+    const fs::path mnt = dir_ / "tiny";
+    fs::create_directory(mnt);
+    if (::mount("tmpfs", mnt.c_str(), "tmpfs", 0, "size=16k") != 0)
+        GTEST_SKIP() << "cannot mount a small tmpfs (" << std::strerror(errno) << ")";
+    struct Unmount {
+        fs::path at;
+        // Lazy: a writer that failed may still hold a descriptor on the full file system.
+        ~Unmount() { ::umount2(at.c_str(), MNT_DETACH); }
+    } unmount{mnt};
+    Grid<float> big(Lattice({40, 40, 40}));  // 256 kB as float
+    std::uint32_t state = 12345;  // incompressible values, so compressed formats overflow too
+    for (PointIndex i = 0; i < big.size(); ++i) {
+        state = state * 1664525u + 1013904223u;
+        big[i] = float(state >> 8) * 1e-3f;
+    }
+    // Compressed output: its size is unknown until written, so the write itself fails.
+    for (const std::string name : {"full.nii.gz", "full.mha", "full.nrrd"}) {
+        const std::string file = (mnt / name).string();
+        expect_error([&] { write_image(big, file); }, file, "cannot write");
+        EXPECT_TRUE(listing(mnt).empty()) << name << " left " << *listing(mnt).begin();
+        EXPECT_EQ(fs::space(mnt).available, fs::space(mnt).capacity) << name << " still holds disk space";
+    }
+    // Uncompressed output (and MINC) is refused before writing.
+    for (const std::string name : {"full.nii", "full.mhd", "full.nhdr", "full.mnc"}) {
+        const std::string file = (mnt / name).string();
+        expect_error([&] { write_image(big, file); }, file, "not enough free space");
+        EXPECT_TRUE(listing(mnt).empty()) << name;
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Real data: BrainWeb (skipped when ../shared/data is absent)
+
+TEST(ImageIoData, BrainWeb) {
+    const std::string base = std::string(LIVESET_SHARED_DATA) + "/brainweb/";
+    if (!fs::exists(base + "t1.mha")) GTEST_SKIP() << "no BrainWeb data in " << base;
+    const Grid<float> t1 = read_image(base + "t1.mha");
+    const Grid<std::uint8_t> labels = read_label_image(base + "labels_crisp.nii.gz");
+    const Grid<std::uint8_t> mask = read_label_image(base + "brain_mask.nii.gz");
+    for (const std::string name : {"t1.mha", "labels_crisp.nii.gz", "brain_mask.nii.gz"}) {
+        const ImageHeader h = read_image_header(base + name);
+        std::cout << name << ": " << h.format << ' ' << h.pixel_type << ", " << h.dims.x << 'x' << h.dims.y << 'x'
+                  << h.dims.z << ", spacing " << h.spacing << ", origin " << h.origin << ", direction";
+        for (double v : h.direction) std::cout << ' ' << v;
+        std::cout << '\n';
+    }
+    EXPECT_EQ(t1.dims(), labels.dims());
+    EXPECT_EQ(t1.dims(), mask.dims());
+    EXPECT_TRUE(labels.lattice().same_geometry(t1.lattice(), 1e-3));
+    EXPECT_TRUE(mask.lattice().same_geometry(t1.lattice(), 1e-3));
+    std::uint8_t max_label = 0;
+    std::size_t brain = 0;
+    for (auto v : labels.values()) max_label = std::max(max_label, v);
+    for (auto v : mask.values()) brain += v != 0;
+    std::cout << "labels 0.." << int(max_label) << ", brain mask " << brain << " of " << mask.size() << " voxels\n";
+    EXPECT_GT(max_label, 1);
+    EXPECT_GT(brain, mask.size() / 20);
+    EXPECT_LT(brain, mask.size() / 2);
+}
+
+}  // namespace
+}  // namespace liveset
