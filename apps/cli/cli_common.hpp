@@ -28,5 +28,8 @@ void write_atomically(const std::string& path, const std::string& text);
 // Each subcommand registers itself on the app.
 void add_flow_commands(CLI::App& app, const int& threads);
 void add_bench_commands(CLI::App& app, const int& threads);
+void add_segment_commands(CLI::App& app, const int& threads);
+void add_eval_commands(CLI::App& app, const int& threads);
+void add_demo_command(CLI::App& app, const int& threads);
 
 }  // namespace liveset::cli

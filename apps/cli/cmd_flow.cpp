@@ -1,4 +1,4 @@
-// `liveset flow` and `liveset demo`: the mean-curvature-flow experiment (a box contracting under
+// `liveset flow`: the mean-curvature-flow experiment (a box contracting under
 // F = κ until it vanishes), with periodic band invariant checks and a short report.
 #include <fmt/core.h>
 
@@ -122,13 +122,6 @@ void add_flow_commands(CLI::App& app, const int& threads) {
         if (rc != 0) throw std::runtime_error("the experiment failed its checks");
     });
 
-    static FlowArgs demo_args;
-    auto* demo = app.add_subcommand("demo", "the main job: run the built-in experiment and print a report");
-    demo->add_flag("--json", demo_args.json, "print the report as one JSON object");
-    demo->callback([&threads] {
-        const int rc = run_flow(demo_args, threads, "liveset demo");
-        if (rc != 0) throw std::runtime_error("the demo failed its checks");
-    });
 }
 
 }  // namespace liveset::cli

@@ -9,6 +9,7 @@
 #include <new>
 
 #include "cli_common.hpp"
+#include "liveset/io/image_io.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"liveset: real-time interactive level-set segmentation of 3D medical images"};
@@ -19,7 +20,10 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
     liveset::cli::add_flow_commands(app, threads);
+    liveset::cli::add_segment_commands(app, threads);
+    liveset::cli::add_eval_commands(app, threads);
     liveset::cli::add_bench_commands(app, threads);
+    liveset::cli::add_demo_command(app, threads);
 
     try {
         app.parse(argc, argv);
@@ -31,6 +35,9 @@ int main(int argc, char** argv) {
     } catch (const std::bad_alloc&) {
         fmt::print(stderr, "liveset: error: out of memory\n");
         return 1;
+    } catch (const liveset::ImageIoError& e) {
+        fmt::print(stderr, "liveset: error: {}\n", e.what());
+        return 2;
     } catch (const std::exception& e) {
         fmt::print(stderr, "liveset: error: {}\n", e.what());
         return 1;

@@ -222,7 +222,20 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
     return edits;
 }
 
+void SparseField::sort_lists() {
+    for (auto& list : lists_) {
+        std::sort(list.begin(), list.end());
+        for (std::size_t k = 0; k < list.size(); ++k) slot_[list[k]] = static_cast<std::uint32_t>(k);
+    }
+}
+
 StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
+    // Layer lists drift into a scattered order as points enter and leave; every few steps put
+    // them back in lattice order so the sweeps below walk memory mostly forwards.
+    if (++steps_since_sort_ >= 8) {
+        sort_lists();
+        steps_since_sort_ = 0;
+    }
     StepResult result;
     result.zero_layer = zero_layer().size();
     const auto edits = compute_step(speed, options, &result.dt);

@@ -111,6 +111,7 @@ private:
     void sweep_layers(std::span<const RegionPoint> region);
     float inner_layer_value(PointIndex i, int k, bool outside) const;
     ChangedPoints finish(std::span<const RegionPoint> region);
+    void sort_lists();  // each layer list in ascending point order (values unchanged)
     void list_add(PointIndex i, int layer);
     void list_remove(PointIndex i, int layer);
 
@@ -120,6 +121,7 @@ private:
     Grid<std::uint32_t> slot_;                 // position of a band point in its layer list
     std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
+    int steps_since_sort_ = 0;
 };
 
 }  // namespace liveset

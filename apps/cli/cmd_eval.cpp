@@ -1,0 +1,136 @@
+// `liveset eval` (overlap, surface distance and topology of a mask against a ground truth) and
+// `liveset phantom` (the synthetic cortex MR volume with its exact ground truth).
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "cli_common.hpp"
+#include "cli_support.hpp"
+#include "image_commands.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/phantom/phantom.hpp"
+
+namespace liveset::cli {
+
+namespace {
+
+struct EvalArgs {
+    std::string mask, truth;
+    int label = -1, mask_label = -1;
+    bool json = false;
+};
+
+Grid<std::uint8_t> select_label(Grid<std::uint8_t> g, int label) {
+    for (std::uint8_t& v : g.values()) v = label < 0 ? v != 0 : v == label;
+    return g;
+}
+
+void run_eval(const EvalArgs& a, int threads) {
+    const auto guard = limit_threads(threads);
+    const Grid<std::uint8_t> truth = select_label(read_label_image(a.truth), a.label);
+    const Grid<std::uint8_t> mask = select_label(read_label_image(a.mask), a.mask_label);
+    try {
+        require_same_geometry(mask.lattice(), truth.lattice(), "eval");
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(fmt::format("{} and {} do not overlay: {}", a.mask, a.truth, e.what()));
+    }
+    std::size_t n = 0;
+    for (std::uint8_t v : truth.values()) n += v;
+    if (n == 0)
+        throw UsageError(a.label >= 0 ? fmt::format("{} has no voxel with label {}", a.truth, a.label)
+                                      : fmt::format("{} is empty (no non-zero voxel)", a.truth));
+    nlohmann::json j = evaluation_report(mask, truth);
+    j["mask"] = a.mask;
+    j["truth"]["path"] = a.truth;
+    if (a.label >= 0) j["truth"]["label"] = a.label;
+    if (a.json) {
+        fmt::print("{}\n", j.dump());
+    } else {
+        fmt::print("liveset eval: {} against {}{}\n", a.mask, a.truth, a.label >= 0 ? fmt::format(" (label {})", a.label) : "");
+        print_evaluation(j);
+    }
+}
+
+struct PhantomArgs {
+    std::string out;
+    PhantomOptions options;
+    bool json = false, quiet = false;
+};
+
+nlohmann::json voxels_json(const std::vector<Vec3i>& v) {
+    nlohmann::json a = nlohmann::json::array();
+    for (const Vec3i& p : v) a.push_back({p.x, p.y, p.z});
+    return a;
+}
+
+void run_phantom(const PhantomArgs& a, int threads) {
+    namespace fs = std::filesystem;
+    const auto guard = limit_threads(threads);
+    try {
+        validate(a.options);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(e.what());
+    }
+    std::error_code ec;
+    fs::create_directories(a.out, ec);
+    if (ec || !fs::is_directory(a.out)) throw UsageError(fmt::format("cannot create output folder {}", a.out));
+    const fs::path dir(a.out);
+    check_output_path((dir / "t1.nii.gz").string(), OutputKind::kImage, "--out");
+    const Phantom ph = make_phantom(a.options);
+    write_image(ph.image, (dir / "t1.nii.gz").string());
+    write_label_image(ph.labels, (dir / "labels.nii.gz").string());
+    write_label_image(ph.truth, (dir / "truth_gm.nii.gz").string());
+    write_image(ph.bias_field, (dir / "bias.nii.gz").string());
+    const IntensityWindow w = gm_window(ph);
+    nlohmann::json j;
+    j["size"] = a.options.size;
+    j["spacing_mm"] = a.options.spacing_mm;
+    j["seed"] = a.options.seed;
+    j["noise"] = a.options.noise;
+    j["bias"] = a.options.bias;
+    j["intensities"] = {{"wm", ph.wm_intensity}, {"gm", ph.gm_intensity}, {"csf", ph.csf_intensity}, {"background", ph.background_intensity}};
+    j["gm_window_raw"] = {{"lo", w.lo}, {"hi", w.hi}, {"mu", w.centre()}, {"epsilon", w.half_width()}};
+    j["seeds"] = voxels_json(ph.seeds);
+    j["weak_spots"] = voxels_json(ph.weak_spots);
+    j["files"] = {{"image", "t1.nii.gz"}, {"labels", "labels.nii.gz"}, {"truth", "truth_gm.nii.gz"}, {"bias", "bias.nii.gz"}};
+    write_atomically((dir / "phantom.json").string(), j.dump(2) + "\n");
+    if (a.json) {
+        fmt::print("{}\n", j.dump());
+    } else if (!a.quiet) {
+        std::string seeds;
+        for (const Vec3i& s : ph.seeds) seeds += fmt::format(" --seed {},{},{}", s.x, s.y, s.z);
+        fmt::print("liveset phantom: {}^3 voxels of {} mm in {} (t1.nii.gz, labels.nii.gz, truth_gm.nii.gz, bias.nii.gz, phantom.json)\n",
+                   a.options.size, a.options.spacing_mm, a.out);
+        fmt::print("  grey matter window {:.0f}..{:.0f}; segment it with:\n  liveset segment {}{} --out-mask seg.nii.gz\n", w.lo,
+                   w.hi, (dir / "t1.nii.gz").string(), seeds);
+    }
+}
+
+}  // namespace
+
+void add_eval_commands(CLI::App& app, const int& threads) {
+    static EvalArgs ea;
+    auto* ev = app.add_subcommand("eval", "compare a mask with a ground truth: Dice, Jaccard, HD95, topology and holes");
+    ev->add_option("--mask", ea.mask, "segmentation mask (non-zero = foreground)")->required();
+    ev->add_option("--truth", ea.truth, "ground-truth mask or label image")->required();
+    ev->add_option("--label", ea.label, "use truth == LABEL (e.g. 2 = grey matter in BrainWeb labels)")->check(CLI::Range(0, 255));
+    ev->add_option("--mask-label", ea.mask_label, "use mask == LABEL")->check(CLI::Range(0, 255));
+    ev->add_flag("--json", ea.json, "print one JSON object (dice, jaccard, volume_difference, hausdorff95_mm, components, euler, genus, holes)");
+    ev->callback([&threads] { run_eval(ea, threads); });
+
+    static PhantomArgs pa;
+    auto* ph = app.add_subcommand("phantom", "write the synthetic cortex MR phantom and its ground truth");
+    ph->add_option("--out", pa.out, "output folder")->required();
+    ph->add_option("--size", pa.options.size, "voxels per axis")->check(CLI::Range(32, 512))->capture_default_str();
+    ph->add_option("--spacing", pa.options.spacing_mm, "voxel size in mm")->check(finite_number())->capture_default_str();
+    ph->add_option("--seed", pa.options.seed, "noise seed")->capture_default_str();
+    ph->add_option("--anatomy-seed", pa.options.anatomy_seed, "folding pattern seed")->capture_default_str();
+    ph->add_option("--noise", pa.options.noise, "noise sigma / WM intensity")->check(finite_number())->capture_default_str();
+    ph->add_option("--bias", pa.options.bias, "peak bias-field gain")->check(finite_number())->capture_default_str();
+    ph->add_flag("--json", pa.json, "print the description as one JSON object");
+    ph->add_flag("--quiet,-q", pa.quiet, "print nothing");
+    ph->callback([&threads] { run_phantom(pa, threads); });
+}
+
+}  // namespace liveset::cli

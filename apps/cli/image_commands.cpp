@@ -1,0 +1,119 @@
+// Shared image-command pieces: mask loading, the segmentation run, reports.
+#include "image_commands.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+#include "cli_common.hpp"
+#include "cli_support.hpp"
+#include "liveset/io/image_io.hpp"
+
+namespace liveset::cli {
+
+Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& reference, const std::string& option) {
+    Grid<std::uint8_t> m = read_label_image(path);
+    try {
+        require_same_geometry(m.lattice(), reference, option);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(fmt::format("{} {} does not overlay the image: {}", option, path, e.what()));
+    }
+    for (std::uint8_t& v : m.values()) v = v != 0;
+    return m;
+}
+
+SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest& request, bool quiet,
+                                 const std::string& log_path) {
+    InterruptGuard interrupt;
+    ProgressLine progress(quiet);
+    const int limit = request.loop.max_iterations;
+    std::string log;
+    const SegmentationHook hook = [&](const SegmentationProgress& p, const ChangedPoints&) {
+        if (!log_path.empty())
+            log += fmt::format("{{\"iteration\":{},\"zero_layer\":{},\"band\":{},\"changed\":{},\"flips\":{},\"inside\":{},\"dt\":{:.6g},\"ms\":{:.3f}}}\n",
+                               p.iteration, p.zero_layer, p.band, p.changed, p.flips, p.inside, p.dt, p.ms);
+        progress.update(fmt::format("segmenting: iteration {}/{}  zero layer {}  band {}  changed {}  flips {}", p.iteration,
+                                    limit, p.zero_layer, p.band, p.changed, p.flips));
+        return true;
+    };
+    SegmentRun run{segment_image(image, request, hook, &interrupt.flag()), false};
+    progress.finish();
+    run.interrupted = run.outcome.result.reason == StopReason::kInterrupted;
+    if (!log_path.empty() && !run.interrupted) write_atomically(log_path, log);
+    return run;
+}
+
+nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& lattice) {
+    const Vec3d s = lattice.spacing();
+    const double voxel_mm3 = s.x * s.y * s.z;
+    std::size_t inside = 0;
+    for (std::uint8_t v : o.mask.values()) inside += v;
+    nlohmann::json j;
+    j["iterations"] = o.result.iterations;
+    j["stop"] = to_string(o.result.reason);
+    j["seconds"] = o.result.seconds;
+    j["ms_per_iteration"] = o.result.iterations > 0 ? 1000.0 * o.result.seconds / o.result.iterations : 0.0;
+    j["mu"] = o.params.mu;
+    j["epsilon"] = o.params.epsilon;
+    j["mu_raw"] = o.scale.to_raw(o.params.mu);
+    j["epsilon_raw"] = o.scale.raw_length(o.params.epsilon);
+    j["n"] = o.params.n;
+    j["alpha"] = o.params.alpha;
+    j["window_estimated"] = o.seed_stats.has_value();
+    j["intensity_scale"] = {{"low", o.scale.low}, {"high", o.scale.high}};
+    j["voxels"] = inside;
+    j["volume_mm3"] = static_cast<double>(inside) * voxel_mm3;
+    j["zero_layer"] = o.field->zero_layer().size();
+    return j;
+}
+
+void print_segmentation_summary(const nlohmann::json& j) {
+    fmt::print("  segmentation {} iterations ({}), {:.2f} s, {:.2f} ms/iteration\n", j["iterations"].get<int>(),
+               j["stop"].get<std::string>(), j["seconds"].get<double>(), j["ms_per_iteration"].get<double>());
+    fmt::print("  window       mu {:.4f} epsilon {:.4f} (raw {:.1f} +- {:.1f}{}), n {}, alpha {}\n", j["mu"].get<double>(),
+               j["epsilon"].get<double>(), j["mu_raw"].get<double>(), j["epsilon_raw"].get<double>(),
+               j["window_estimated"].get<bool>() ? ", estimated from the seeds" : "", j["n"].get<double>(),
+               j["alpha"].get<double>());
+    fmt::print("  volume       {} voxels, {:.1f} ml\n", j["voxels"].get<std::size_t>(), j["volume_mm3"].get<double>() / 1000.0);
+}
+
+namespace {
+
+nlohmann::json number(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+}  // namespace
+
+nlohmann::json evaluation_report(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth) {
+    const OverlapMetrics ov = compare_overlap(mask, truth);
+    const SurfaceDistance sd = surface_distance(mask, truth);
+    const Topology tm = mask_topology(mask);
+    const Topology tt = mask_topology(truth);
+    nlohmann::json j;
+    j["dice"] = ov.dice;
+    j["jaccard"] = ov.jaccard;
+    j["volume_difference"] = number(ov.volume_difference);
+    j["mask_volume_mm3"] = ov.mask_volume_mm3;
+    j["truth_volume_mm3"] = ov.truth_volume_mm3;
+    j["hausdorff95_mm"] = number(sd.hausdorff95_mm);
+    j["hausdorff_mm"] = number(sd.hausdorff_mm);
+    j["mean_surface_mm"] = number(sd.mean_mm);
+    j["components"] = tm.components;
+    j["cavities"] = tm.cavities;
+    j["euler"] = tm.euler;
+    j["genus"] = tm.genus;
+    j["holes"] = holes_between(tt, tm);
+    j["truth"] = {{"components", tt.components}, {"cavities", tt.cavities}, {"euler", tt.euler}, {"genus", tt.genus}};
+    return j;
+}
+
+void print_evaluation(const nlohmann::json& j, const std::string& in) {
+    auto num = [](const nlohmann::json& v, const char* f) { return v.is_null() ? std::string("n/a") : fmt::format(fmt::runtime(f), v.get<double>()); };
+    fmt::print("{}dice {:.4f}  jaccard {:.4f}  volume difference {}  HD95 {} mm  (HD {} mm, mean {} mm)\n", in,
+               j["dice"].get<double>(), j["jaccard"].get<double>(), (j["volume_difference"].is_null() ? std::string("n/a") : fmt::format("{:+.2f}%", 100.0 * j["volume_difference"].get<double>())),
+               num(j["hausdorff95_mm"], "{:.2f}"), num(j["hausdorff_mm"], "{:.2f}"), num(j["mean_surface_mm"], "{:.2f}"));
+    fmt::print("{}topology: {} component(s), {} cavity(ies), Euler characteristic {}, genus {}; holes {} (truth: euler {}, genus {})\n",
+               in, j["components"].get<std::size_t>(), j["cavities"].get<std::size_t>(), j["euler"].get<long>(),
+               j["genus"].get<long>(), j["holes"].get<long>(), j["truth"]["euler"].get<long>(), j["truth"]["genus"].get<long>());
+}
+
+}  // namespace liveset::cli

@@ -1,0 +1,39 @@
+// Pieces shared by the image commands (segment, eval, repair, demo): loading masks that must
+// overlay an image, the segmentation run with its progress line, and the JSON reports.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "liveset/eval/overlap.hpp"
+#include "liveset/eval/surface_distance.hpp"
+#include "liveset/eval/topology.hpp"
+#include "liveset/segment/pipeline.hpp"
+
+namespace liveset::cli {
+
+// Reads a mask/label image and checks that it overlays `reference` (same dims, spacing, origin
+// and direction within tolerance); UsageError naming `option` otherwise. Non-zero -> 1.
+Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& reference, const std::string& option);
+
+struct SegmentRun {
+    SegmentOutcome outcome;
+    bool interrupted = false;  // Ctrl-C (nothing must be written)
+};
+// segment_image() with Ctrl-C handling and a progress line on a terminal.
+// With a non-empty `log_path`, one JSON line per iteration (iteration, zero_layer, band, changed,
+// flips, inside, dt, ms) is written there (atomically, after the run).
+SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest& request, bool quiet,
+                                 const std::string& log_path = {});
+
+// Parameters, iterations, timing and volume of a segmentation.
+nlohmann::json segmentation_report(const SegmentOutcome& outcome, const Lattice& lattice);
+void print_segmentation_summary(const nlohmann::json& report);
+
+// `liveset eval` metrics of a mask against a truth mask: dice, jaccard, volume_difference,
+// hausdorff95_mm (+ hausdorff_mm, mean_surface_mm), components, euler, genus, cavities, holes and
+// the truth's topology.
+nlohmann::json evaluation_report(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth);
+void print_evaluation(const nlohmann::json& report, const std::string& indent = "  ");
+
+}  // namespace liveset::cli
