@@ -19,6 +19,7 @@ namespace liveset::cli {
 namespace {
 
 std::atomic<bool> g_interrupted{false};
+int g_guard_depth = 0;  // nested guards share one handler and one flag
 
 extern "C" void on_signal(int) { g_interrupted.store(true); }
 
@@ -106,6 +107,7 @@ void check_output_path(const std::string& path, OutputKind kind, const std::stri
 }
 
 InterruptGuard::InterruptGuard() {
+    if (g_guard_depth++ > 0) return;
     g_interrupted.store(false);
     struct sigaction sa {};
     sa.sa_handler = on_signal;
@@ -115,6 +117,7 @@ InterruptGuard::InterruptGuard() {
 }
 
 InterruptGuard::~InterruptGuard() {
+    if (--g_guard_depth > 0) return;
     struct sigaction sa {};
     sa.sa_handler = SIG_DFL;
     sigemptyset(&sa.sa_mask);

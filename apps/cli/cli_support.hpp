@@ -25,7 +25,8 @@ enum class OutputKind { kImage, kMesh, kText };
 // path is a folder, or the extension is not one the writer knows.
 void check_output_path(const std::string& path, OutputKind kind, const std::string& option);
 
-// Installs a SIGINT/SIGTERM handler for its lifetime; interrupted() turns true on Ctrl-C.
+// Installs a SIGINT/SIGTERM handler for its lifetime; interrupted() turns true on Ctrl-C. Guards
+// nest: a command installs one before reading its inputs, so a Ctrl-C at any time is seen.
 class InterruptGuard {
 public:
     InterruptGuard();

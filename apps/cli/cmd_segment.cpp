@@ -34,6 +34,7 @@ struct SegmentArgs {
 
 int run_segment(const SegmentArgs& a, int threads) {
     const auto guard = limit_threads(threads);
+    const InterruptGuard interrupt;
     check_output_path(a.out_mask, OutputKind::kImage, "--out-mask");
     if (!a.out_phi.empty()) check_output_path(a.out_phi, OutputKind::kImage, "--out-phi");
     if (!a.out_mesh.empty()) check_output_path(a.out_mesh, OutputKind::kMesh, "--out-mesh");

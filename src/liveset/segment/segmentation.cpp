@@ -38,7 +38,6 @@ SegmentationResult run_segmentation(SparseField& field, const Speed& speed, cons
 
     SegmentationResult result;
     std::deque<std::size_t> recent;
-    std::size_t recent_sum = 0;
     for (int it = 1; it <= options.max_iterations; ++it) {
         if (interrupt && interrupt->load(std::memory_order_relaxed)) {
             result.reason = StopReason::kInterrupted;
@@ -72,16 +71,16 @@ SegmentationResult run_segmentation(SparseField& field, const Speed& speed, cons
             result.reason = StopReason::kInterrupted;
             break;
         }
-        recent.push_back(pr.flips);
-        recent_sum += pr.flips;
-        if (recent.size() > static_cast<std::size_t>(options.window)) {
-            recent_sum -= recent.front();
-            recent.pop_front();
-        }
-        if (recent.size() == static_cast<std::size_t>(options.window) &&
-            static_cast<double>(recent_sum) < std::max(1.0, options.tolerance * static_cast<double>(pr.zero_layer))) {
-            result.reason = StopReason::kConverged;
-            break;
+        // Net change of the inside count over the window: points oscillating across the front at
+        // the edge of the threshold window cancel out, a front still advancing does not.
+        recent.push_back(pr.inside);
+        if (recent.size() > static_cast<std::size_t>(options.window) + 1) recent.pop_front();
+        if (recent.size() == static_cast<std::size_t>(options.window) + 1) {
+            const double net = std::abs(static_cast<double>(recent.back()) - static_cast<double>(recent.front()));
+            if (net < std::max(1.0, options.tolerance * static_cast<double>(pr.zero_layer))) {
+                result.reason = StopReason::kConverged;
+                break;
+            }
         }
         if (it == options.max_iterations) result.reason = StopReason::kIterationLimit;
     }

@@ -17,8 +17,9 @@ namespace liveset {
 
 struct SegmentationOptions {
     int max_iterations = 2000;
-    // Converged when, over the last `window` iterations, fewer than
-    // max(1, tolerance × zero-layer size) lattice points changed side (inside <-> outside).
+    // Converged when the number of inside points changed by less than
+    // max(1, tolerance × zero-layer size) over the last `window` iterations (net: points flickering
+    // across the front at the edge of the threshold window cancel out).
     int window = 20;
     double tolerance = 1e-3;
     StepOptions step;

@@ -1,0 +1,235 @@
+// The image commands end to end through the real binary: phantom -> segment -> mesh -> eval, the
+// eval numbers against hand-made masks, Ctrl-C, and bad input (one line on stderr, non-zero exit,
+// no output file left behind).
+#include <gtest/gtest.h>
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "cli_run.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/mesh/mesh_analysis.hpp"
+#include "liveset/mesh/mesh_io.hpp"
+
+extern char** environ;
+
+namespace fs = std::filesystem;
+using liveset::testing::lines;
+using liveset::testing::run_cli;
+using liveset::testing::slurp;
+using Result = liveset::testing::CliResult;
+using namespace liveset;
+
+namespace {
+
+fs::path work_dir() {
+    static const fs::path dir = [] {
+        const fs::path d = fs::temp_directory_path() / ("liveset_segment_cli_" + std::to_string(::getpid()));
+        fs::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+// The phantom (64^3) written once for the suite, and the seed flags from its phantom.json.
+struct PhantomFiles {
+    fs::path dir;
+    std::string seeds;
+};
+
+const PhantomFiles& phantom64() {
+    static const PhantomFiles files = [] {
+        PhantomFiles f;
+        f.dir = work_dir() / "phantom64";
+        const Result r = run_cli("phantom --size 64 --quiet --out " + f.dir.string());
+        EXPECT_EQ(r.rc, 0) << r.err;
+        const nlohmann::json j = nlohmann::json::parse(slurp(f.dir / "phantom.json"));
+        for (const auto& s : j["seeds"]) f.seeds += " --seed " + std::to_string(s[0].get<int>()) + "," +
+                                                    std::to_string(s[1].get<int>()) + "," + std::to_string(s[2].get<int>());
+        return f;
+    }();
+    return files;
+}
+
+Grid<std::uint8_t> box_mask(Vec3i lo, Vec3i hi) {
+    Grid<std::uint8_t> g(Lattice({20, 20, 20}), 0);
+    for (int z = lo.z; z < hi.z; ++z)
+        for (int y = lo.y; y < hi.y; ++y)
+            for (int x = lo.x; x < hi.x; ++x) g({x, y, z}) = 1;
+    return g;
+}
+
+}  // namespace
+
+TEST(SegmentCli, PhantomSegmentMeshEval) {
+    const PhantomFiles& ph = phantom64();
+    for (const char* f : {"t1.nii.gz", "labels.nii.gz", "truth_gm.nii.gz", "bias.nii.gz", "phantom.json"})
+        EXPECT_TRUE(fs::exists(ph.dir / f)) << f;
+    const fs::path mask = work_dir() / "seg.nii.gz", phi = work_dir() / "phi.nii.gz", mesh = work_dir() / "seg.ply";
+    const Result seg = run_cli("segment " + (ph.dir / "t1.nii.gz").string() + ph.seeds + " --json --out-mask " +
+                               mask.string() + " --out-phi " + phi.string() + " --out-mesh " + mesh.string());
+    ASSERT_EQ(seg.rc, 0) << seg.err;
+    EXPECT_EQ(lines(seg.out), 1);
+    const nlohmann::json sj = nlohmann::json::parse(seg.out);
+    EXPECT_EQ(sj["stop"], "converged");
+    EXPECT_TRUE(sj["window_estimated"].get<bool>());
+
+    // Outputs overlay the input: same geometry.
+    const Grid<float> img = read_image((ph.dir / "t1.nii.gz").string());
+    const Grid<std::uint8_t> m = read_label_image(mask.string());
+    EXPECT_TRUE(m.lattice().same_geometry(img.lattice()));
+    const Grid<float> p = read_image(phi.string());
+    for (std::size_t i = 0; i < m.size(); ++i) ASSERT_EQ(m[static_cast<PointIndex>(i)] != 0, p[static_cast<PointIndex>(i)] < 0.0f);
+
+    // The exported surface is closed and lies in the image's physical space.
+    const Mesh surface = read_mesh(mesh);
+    EXPECT_EQ(surface.triangle_count(), sj["mesh_triangles"].get<std::size_t>());
+    const Mesh welded = weld_vertices(surface.view());
+    EXPECT_TRUE(edge_stats(welded.view()).closed_manifold());
+
+    const Result ev = run_cli("eval --json --mask " + mask.string() + " --truth " + (ph.dir / "labels.nii.gz").string() +
+                              " --label 2");
+    ASSERT_EQ(ev.rc, 0) << ev.err;
+    const nlohmann::json ej = nlohmann::json::parse(ev.out);
+    for (const char* key : {"dice", "jaccard", "volume_difference", "hausdorff95_mm", "components", "euler", "genus", "holes"})
+        EXPECT_TRUE(ej.contains(key)) << key;
+    EXPECT_GE(ej["dice"].get<double>(), 0.90);  // 64^3: coarse; the 128^3 demo is held to 0.95
+
+    // `mesh` of the mask and of phi.
+    const Result mm = run_cli("mesh " + mask.string() + " --json --out " + (work_dir() / "mask.stl").string());
+    ASSERT_EQ(mm.rc, 0) << mm.err;
+    EXPECT_EQ(nlohmann::json::parse(mm.out)["input_kind"], "mask");
+    const Result mp = run_cli("mesh " + phi.string() + " --fragment 8 --json --out " + (work_dir() / "phi.obj").string());
+    ASSERT_EQ(mp.rc, 0) << mp.err;
+    EXPECT_EQ(nlohmann::json::parse(mp.out)["input_kind"], "phi");
+    EXPECT_GT(nlohmann::json::parse(mp.out)["triangles"].get<std::size_t>(), 1000u);
+}
+
+TEST(SegmentCli, EvalMatchesHandComputedOverlap) {
+    // Truth 10^3 = 1000 voxels, mask 10x10x5 inside it = 500: dice 2*500/1500, jaccard 0.5, volume -50 %.
+    const fs::path t = work_dir() / "truth_box.nii.gz", m = work_dir() / "mask_box.nii.gz";
+    write_label_image(box_mask({5, 5, 5}, {15, 15, 15}), t.string());
+    write_label_image(box_mask({5, 5, 5}, {15, 15, 10}), m.string());
+    const Result r = run_cli("eval --json --mask " + m.string() + " --truth " + t.string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_NEAR(j["dice"].get<double>(), 2.0 / 3.0, 1e-12);
+    EXPECT_NEAR(j["jaccard"].get<double>(), 0.5, 1e-12);
+    EXPECT_NEAR(j["volume_difference"].get<double>(), -0.5, 1e-12);
+    EXPECT_NEAR(j["hausdorff95_mm"].get<double>(), 5.0, 1e-9);  // the truth's far face is 5 voxels away
+    EXPECT_EQ(j["components"], 1);
+    EXPECT_EQ(j["euler"], 2);
+    EXPECT_EQ(j["genus"], 0);
+    EXPECT_EQ(j["holes"], 0);
+    const Result text = run_cli("eval --mask " + m.string() + " --truth " + t.string());
+    EXPECT_EQ(text.rc, 0);
+    EXPECT_NE(text.out.find("dice 0.6667"), std::string::npos) << text.out;
+}
+
+TEST(SegmentCli, CtrlCStopsTheRunAndWritesNothing) {
+    // A 160^3 noisy image whose every voxel is in the window: the front needs hundreds of
+    // iterations to fill it, so the run is still going when Ctrl-C arrives.
+    const fs::path img = work_dir() / "big.nii";
+    {
+        Grid<float> g(Lattice({160, 160, 160}));
+        std::uint32_t state = 12345;
+        for (float& v : g.values()) {
+            state = state * 1664525u + 1013904223u;
+            v = 100.0f + static_cast<float>(state >> 24);
+        }
+        write_image(g, img.string());
+    }
+    const fs::path out = work_dir() / "interrupted.nii.gz";
+    std::vector<std::string> args{LIVESET_CLI_PATH, "segment", img.string(), "--seed", "5,5,5",
+                                  "--mu", "0.5", "--epsilon", "0.9", "--iterations", "100000", "--quiet",
+                                  "--out-mask", out.string()};
+    std::vector<char*> argv;
+    for (auto& s : args) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, LIVESET_CLI_PATH, nullptr, nullptr, argv.data(), environ), 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    ::kill(pid, SIGINT);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_FALSE(fs::exists(out));
+    for (const auto& e : fs::directory_iterator(work_dir())) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);
+}
+
+TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
+    const PhantomFiles& ph = phantom64();
+    const std::string img = (ph.dir / "t1.nii.gz").string();
+    const fs::path out = work_dir() / "never.nii.gz";
+    const std::string o = " --out-mask " + out.string();
+    // Hostile files.
+    const fs::path text = work_dir() / "text.nii.gz", nan_img = work_dir() / "nan.nii.gz", flat = work_dir() / "flat.nii.gz";
+    { std::ofstream(text) << "not an image\n"; }
+    Grid<float> g(Lattice({16, 16, 16}), 1.0f);
+    write_image(g, flat.string());
+    Grid<std::uint8_t> small(Lattice({16, 16, 16}), 1);
+    write_label_image(small, (work_dir() / "small_mask.nii.gz").string());
+    {  // a NIfTI file with a NaN voxel, written through ITK then patched (ITK refuses nothing on write)
+        Grid<float> n(Lattice({8, 8, 8}), 1.0f);
+        n[100] = 12345.0f;
+        const fs::path plain = work_dir() / "nan.nii";
+        write_image(n, plain.string());
+        std::string bytes = slurp(plain);
+        const float marker = 12345.0f, nan = std::nanf("");
+        const std::string key(reinterpret_cast<const char*>(&marker), 4);
+        bytes.replace(bytes.find(key), 4, std::string(reinterpret_cast<const char*>(&nan), 4));
+        std::ofstream(work_dir() / "nan.nii", std::ios::binary) << bytes;
+    }
+    struct Case {
+        std::string args, phrase;
+    };
+    const std::vector<Case> cases{
+        {"segment /no/such.nii.gz --seed 1,1,1" + o, "no such file"},
+        {"segment " + text.string() + " --seed 1,1,1" + o, "cannot read"},
+        {"segment " + (work_dir() / "nan.nii").string() + " --seed 1,1,1" + o, "NaN"},
+        {"segment " + flat.string() + " --seed 1,1,1" + o, "flat"},
+        {"segment " + img + " --seed 500,1,1" + o, "outside the image"},
+        {"segment " + img + " --seed 1,2" + o, "three"},
+        {"segment " + img + " --seed a,b,c" + o, "bad seed"},
+        {"segment " + img + " --seed 32,32,32:-1" + o, "radius"},
+        {"segment " + img + o, "seed"},
+        {"segment " + img + " --seed 32,32,32 --epsilon 0" + o, "epsilon"},
+        {"segment " + img + " --seed 32,32,32 --epsilon -0.1" + o, "epsilon"},
+        {"segment " + img + " --seed 32,32,32 --alpha 1.5" + o, "alpha"},
+        {"segment " + img + " --seed 32,32,32 --mu nan" + o, ""},
+        {"segment " + img + " --seed 32,32,32 --roi " + (work_dir() / "small_mask.nii.gz").string() + o, "overlay"},
+        {"segment " + img + " --seed 32,32,32 --out-mask /no/such/dir/m.nii.gz", "does not exist"},
+        {"segment " + img + " --seed 32,32,32 --out-mask " + (work_dir() / "m.png").string(), "unknown image format"},
+        {"segment " + img + " --seed 32,32,32 --out-mesh " + (work_dir() / "m.vtk").string() + o, "mesh format"},
+        {"eval --mask " + img + " --truth /no/such.nii.gz", "no such file"},
+        {"eval --mask " + (work_dir() / "small_mask.nii.gz").string() + " --truth " + (ph.dir / "truth_gm.nii.gz").string(), "overlay"},
+        {"eval --mask " + img + " --truth " + (ph.dir / "truth_gm.nii.gz").string(), "label image"},
+        {"mesh /no/such.nii.gz --out " + (work_dir() / "x.ply").string(), "no such file"},
+        {"mesh " + flat.string() + " --out " + (work_dir() / "x.ply").string(), "no surface"},
+        {"phantom --size 8 --out " + (work_dir() / "p").string(), ""},
+        {"phantom --noise -1 --out " + (work_dir() / "p").string(), "noise"},
+    };
+    for (const Case& c : cases) {
+        const Result r = run_cli(c.args);
+        // CLI11's own parse errors add a "Run with --help" hint line; ours are exactly one line.
+        EXPECT_NE(r.rc, 0) << c.args;
+        EXPECT_GE(lines(r.err), 1) << c.args;
+        EXPECT_LE(lines(r.err), 2) << c.args << ": " << r.err;
+        EXPECT_EQ(r.err.find("terminate"), std::string::npos) << c.args;
+        if (!c.phrase.empty()) {
+            EXPECT_NE(r.err.find(c.phrase), std::string::npos) << c.args << ": " << r.err;
+        }
+        EXPECT_FALSE(fs::exists(out)) << c.args;
+        EXPECT_FALSE(fs::exists(work_dir() / "x.ply")) << c.args;
+    }
+}
