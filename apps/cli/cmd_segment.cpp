@@ -26,7 +26,7 @@ struct SegmentArgs {
     double seed_radius = 2.0;
     std::string init_mask, roi;
     std::optional<double> mu, epsilon, mu_raw, epsilon_raw;
-    double n = 2.0, alpha = 0.2;
+    double n = 4.0, alpha = 0.1;
     int iterations = 2000;
     std::string out_mask, out_phi, out_mesh, log;
     bool json = false, quiet = false;

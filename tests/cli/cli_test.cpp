@@ -24,8 +24,9 @@ TEST(Cli, VersionAndHelp) {
     const Result h = run_cli("--help");
     EXPECT_EQ(h.rc, 0);
     EXPECT_NE(h.out.find("demo"), std::string::npos);
+    EXPECT_NE(h.out.find("segment"), std::string::npos);
     EXPECT_NE(h.out.find("flow"), std::string::npos);
-    for (const char* sub : {"demo", "flow"}) {
+    for (const char* sub : {"demo", "flow", "segment", "mesh", "eval", "phantom"}) {
         const Result s = run_cli(std::string(sub) + " --help");
         EXPECT_EQ(s.rc, 0) << sub;
         EXPECT_NE(s.out.find("--json"), std::string::npos) << sub;

@@ -233,3 +233,17 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
         EXPECT_FALSE(fs::exists(work_dir() / "x.ply")) << c.args;
     }
 }
+
+TEST(SegmentCli, DemoWritesItsOutputsAndAJsonReport) {
+    const fs::path dir = work_dir() / "demo";
+    const Result r = run_cli("demo --size 64 --json --out " + dir.string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_EQ(lines(r.out), 1);
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    for (const char* key : {"dice", "holes", "genus", "timings_ms", "segmentation", "mesh", "eval"}) EXPECT_TRUE(j.contains(key)) << key;
+    EXPECT_GE(j["dice"].get<double>(), 0.90);
+    EXPECT_EQ(j["dice"], j["eval"]["dice"]);
+    for (const char* f : {"t1.nii.gz", "truth_gm.nii.gz", "seg.nii.gz", "phi.nii.gz", "surface.ply", "report.json"})
+        EXPECT_TRUE(fs::exists(dir / f)) << f;
+    EXPECT_EQ(nlohmann::json::parse(slurp(dir / "report.json"))["dice"], j["dice"]);
+}

@@ -24,10 +24,10 @@ struct SegmentRequest {
     // µ = median of the seed-ball intensities, ε = epsilon_sigmas × their robust σ (at least
     // min_epsilon).
     std::optional<double> mu, epsilon;
-    double epsilon_sigmas = 4.0;
+    double epsilon_sigmas = 5.0;
     double min_epsilon = 0.05;
-    double n = 2.0;
-    double alpha = 0.2;
+    double n = 4.0;
+    double alpha = 0.1;
     ScaleOptions scale;
     SegmentationOptions loop;
     int layers = 2;

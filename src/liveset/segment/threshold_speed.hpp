@@ -20,8 +20,8 @@ namespace liveset {
 struct ThresholdParams {
     double mu = 0.5;       // ideal intensity, normalised units
     double epsilon = 0.1;  // acceptable error (half window), normalised units, > 0
-    double n = 2.0;        // steepness of D at the window edge, > 0
-    double alpha = 0.2;    // curvature weight in [0, 1)
+    double n = 4.0;        // steepness of D at the window edge, > 0
+    double alpha = 0.1;    // curvature weight in [0, 1)
 };
 
 // Throws std::invalid_argument with a one-line message for non-finite values, ε ≤ 0, n ≤ 0,
