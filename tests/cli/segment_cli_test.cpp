@@ -247,3 +247,20 @@ TEST(SegmentCli, DemoWritesItsOutputsAndAJsonReport) {
         EXPECT_TRUE(fs::exists(dir / f)) << f;
     EXPECT_EQ(nlohmann::json::parse(slurp(dir / "report.json"))["dice"], j["dice"]);
 }
+
+TEST(SegmentCli, SeedInMillimetresEqualsTheSameSeedInVoxels) {
+    // The phantom is centred on (0,0,0) mm with 1 mm voxels: voxel (32,32,32) of 64^3 is at
+    // (0.5, 0.5, 0.5) mm (LPS, identity direction). Radii: 2 voxels = 2 mm.
+    const PhantomFiles& ph = phantom64();
+    const std::string img = (ph.dir / "t1.nii.gz").string();
+    const fs::path a = work_dir() / "seed_vox.nii.gz", b = work_dir() / "seed_mm.nii.gz";
+    const std::string common = " --mu 0.6 --epsilon 0.2 --iterations 30 --quiet --out-phi ";
+    ASSERT_EQ(run_cli("segment " + img + " --seed 32,32,32:2" + common + a.string() + " --out-mask " + (work_dir() / "ma.nii.gz").string()).rc, 0);
+    ASSERT_EQ(run_cli("segment " + img + " --seed-mm 0.5,0.5,0.5:2" + common + b.string() + " --out-mask " + (work_dir() / "mb.nii.gz").string()).rc, 0);
+    const Grid<float> pa = read_image(a.string()), pb = read_image(b.string());
+    ASSERT_EQ(pa.size(), pb.size());
+    for (std::size_t i = 0; i < pa.size(); ++i) ASSERT_EQ(pa[static_cast<PointIndex>(i)], pb[static_cast<PointIndex>(i)]) << i;
+    const Result off = run_cli("segment " + img + " --seed-mm 500,0,0" + common + a.string() + " --out-mask " + (work_dir() / "mc.nii.gz").string());
+    EXPECT_NE(off.rc, 0);
+    EXPECT_NE(off.err.find("outside the image"), std::string::npos) << off.err;
+}
