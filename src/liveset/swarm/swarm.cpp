@@ -1,0 +1,334 @@
+// Agent swarm on the zero level set: Eq. 4 movement with a φ-scaled pull-back, Newton
+// re-projection, and Gaussian-footprint surface edits driven by population intensity statistics.
+//
+// Movement (one step, every agent i computed from the previous positions only — Jacobi):
+//   n   = ∇φ/|∇φ|, ∇φ = interpolated_gradient(φ, x) (central differences of the trilinear φ)
+//   P   = attraction·unit(target − x) + random_walk·u_i + separation·Σ_j (1 − d_ij/R)·unit(x_i − x_j)
+//         (u_i a uniform random unit vector from stream (seed, i, step); the sum over agents j with
+//          0 < d_ij < R = separation_radius; coincident agents get a hashed direction)
+//   T   = P − n(n·P), clamped to |T| ≤ max_step
+//   B   = ε·φ(x)·n/|∇φ|, clamped to |B| ≤ max_step
+//   x  ← x + T − B, clamped into the lattice box
+// Why this is Eq. 4: ∇|φ| = sign(φ)∇φ, and for a signed distance |∇φ| = 1, so Eq. 4's
+// P − ∇|φ|(∇|φ|·P) is exactly the tangential part T (the sign squares away), and its pull-back
+// ε∇|φ| = ε·sign(φ)·n is a step of fixed length ε towards φ = 0. That fixed step overshoots
+// whenever |φ| < ε, so agents chatter across the surface with amplitude ε. Scaling it by |φ|
+// (ε·|φ|·sign(φ)·n = ε·φ·n, the gradient of ε·φ²/2) keeps the direction and makes it a damped
+// projection: to first order φ ← (1 − ε)·φ per step, converging to the surface instead. Dividing
+// by |∇φ| makes it exact for a non-unit gradient (the Newton step scaled by ε).
+// Afterwards, an agent with |φ(x)| > 1 (off the zero layer, drifting towards the band's edge) is
+// projected back by up to 8 Newton steps x ← x − φ·∇φ/|∇φ|² (stop at |φ| < 1e-3).
+//
+// Surface edits (one call = one frame):
+//   population statistics: I(x_i) trilinear at every agent; the frame mean m and mean square s
+//   update exponential moving averages μ ← (1−α)μ + α·m, S ← (1−α)S + α·s (first frame: μ = m,
+//   S = s); σ = max(sqrt(max(S − μ², 0)), min_sigma).
+//   each agent acts with probability p (stream (seed, i, frame)); it samples I_out = I(x + 1.5n),
+//   I_in = I(x − 1.5n) and
+//     expands  (Δ = −A) if |I_out − μ| ≤ k·σ   (the outside looks like the population: grow into it)
+//     contracts(Δ = +A) else if |I_in − μ| > k'·σ (the inside does not look like it: retreat)
+//   Δ is spread over the zero-layer points p with |p − x| ≤ edit_radius, weighted by the
+//   unit-peak Gaussian exp(−|p − x|²/(2σ_g²)), σ_g = edit_radius/2, so A is the change under the
+//   agent whatever the zero-layer sampling density. Contributions to a point are summed in agent
+//   order and clamped to ±0.5.
+#include "liveset/swarm/swarm.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "liveset/grid/sampling.hpp"
+
+namespace liveset {
+
+namespace {
+
+constexpr std::uint64_t kMoveTag = 0x6d6f7665ull;  // "move"
+constexpr std::uint64_t kEditTag = 0x65646974ull;  // "edit"
+constexpr std::uint64_t kPairTag = 0x70616972ull;  // "pair"
+
+std::uint64_t splitmix64(std::uint64_t& state) {
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return z ^ (z >> 31);
+}
+
+std::uint64_t mix(std::uint64_t a, std::uint64_t b) {
+    std::uint64_t s = a ^ (b * 0xd1342543de82ef95ull);
+    return splitmix64(s);
+}
+
+// A small stream generator (splitmix64 sequence) keyed by (seed, agent, step, tag).
+class Stream {
+public:
+    Stream(std::uint64_t seed, std::uint64_t agent, std::uint64_t step, std::uint64_t tag)
+        : state_(mix(mix(mix(seed, tag), agent), step)) {}
+    std::uint64_t next() { return splitmix64(state_); }
+    double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }  // [0, 1)
+    Vec3d unit_vector() {
+        const double z = 2.0 * uniform() - 1.0;
+        const double a = 2.0 * std::numbers::pi * uniform();
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        return {r * std::cos(a), r * std::sin(a), z};
+    }
+
+private:
+    std::uint64_t state_;
+};
+
+Vec3d to_d(Vec3f v) { return v.cast<double>(); }
+
+Vec3d clamp_to_box(Vec3d p, Vec3i dims) {
+    return {std::clamp(p.x, 0.0, static_cast<double>(dims.x - 1)),
+            std::clamp(p.y, 0.0, static_cast<double>(dims.y - 1)),
+            std::clamp(p.z, 0.0, static_cast<double>(dims.z - 1))};
+}
+
+Vec3d clamp_length(Vec3d v, double max_len) {
+    const double l = norm(v);
+    return l > max_len && l > 0 ? v * (max_len / l) : v;
+}
+
+// Newton projection onto φ = 0 (x ← x − φ ∇φ/|∇φ|²); returns the final position.
+Vec3d project(const Grid<float>& phi, Vec3d x, int iterations) {
+    for (int k = 0; k < iterations; ++k) {
+        const double f = trilinear(phi, x);
+        if (std::abs(f) < 1e-3) break;
+        const Vec3d g = to_d(interpolated_gradient(phi, x));
+        const double g2 = dot(g, g);
+        if (!(g2 > 1e-12)) break;
+        x = clamp_to_box(x - g * (f / g2), phi.dims());
+    }
+    return x;
+}
+
+bool finite_positive(double v) { return std::isfinite(v) && v > 0; }
+
+void require(bool ok, const char* message) {
+    if (!ok) throw std::invalid_argument(message);
+}
+
+}  // namespace
+
+void validate(const SwarmOptions& o) {
+    require(o.agents >= 1 && o.agents <= 1'000'000, "swarm: agents must be in [1, 1000000]");
+    require(std::isfinite(o.pull_back) && o.pull_back >= 0 && o.pull_back < 1,
+            "swarm: pull_back (epsilon) must be in [0, 1)");
+    require(std::isfinite(o.attraction) && o.attraction >= 0, "swarm: attraction must be finite and >= 0");
+    require(std::isfinite(o.random_walk) && o.random_walk >= 0, "swarm: random_walk must be finite and >= 0");
+    require(std::isfinite(o.separation) && o.separation >= 0, "swarm: separation must be finite and >= 0");
+    require(finite_positive(o.separation_radius), "swarm: separation_radius must be finite and > 0");
+    require(finite_positive(o.max_step) && o.max_step <= 1.0, "swarm: max_step must be in (0, 1] voxels");
+    require(std::isfinite(o.act_probability) && o.act_probability >= 0 && o.act_probability <= 1,
+            "swarm: act_probability must be in [0, 1]");
+    require(finite_positive(o.edit_radius) && o.edit_radius <= 16, "swarm: edit_radius must be in (0, 16] voxels");
+    require(finite_positive(o.edit_amount) && o.edit_amount <= 0.5, "swarm: edit_amount must be in (0, 0.5]");
+    require(std::isfinite(o.expand_sigmas) && o.expand_sigmas >= 0, "swarm: expand_sigmas must be finite and >= 0");
+    require(std::isfinite(o.contract_sigmas) && o.contract_sigmas >= 0,
+            "swarm: contract_sigmas must be finite and >= 0");
+    require(finite_positive(o.min_sigma), "swarm: min_sigma must be finite and > 0");
+    require(finite_positive(o.stats_smoothing) && o.stats_smoothing <= 1, "swarm: stats_smoothing must be in (0, 1]");
+}
+
+Swarm::Swarm(const SwarmOptions& options) : options_(options) { validate(options_); }
+
+void Swarm::spawn(const SparseField& field, Vec3d near, double radius) {
+    require(all_finite(near), "swarm: spawn position must be finite");
+    require(finite_positive(radius), "swarm: spawn radius must be finite and > 0");
+    const Lattice& lat = field.lattice();
+    struct Candidate {
+        double d2;
+        PointIndex point;
+    };
+    std::vector<Candidate> candidates;
+    for (PointIndex i : field.zero_layer()) {
+        const Vec3d d = lat.coord(i).cast<double>() - near;
+        const double d2 = dot(d, d);
+        if (d2 <= radius * radius) candidates.push_back({d2, i});
+    }
+    require(!candidates.empty(), "swarm: no zero-layer point within the spawn radius");
+    std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+        return a.d2 != b.d2 ? a.d2 < b.d2 : a.point < b.point;
+    });
+    agents_.assign(options_.agents, Agent{});
+    for (std::size_t k = 0; k < agents_.size(); ++k) {
+        const PointIndex p = candidates[k % candidates.size()].point;
+        agents_[k].position = project(field.phi(), lat.coord(p).cast<double>(), 8);
+    }
+    move_steps_ = 0;
+    edit_steps_ = 0;
+    have_stats_ = false;
+    mean_ = second_ = 0.0;
+}
+
+StepReport Swarm::move(const SparseField& field) {
+    const Grid<float>& phi = field.phi();
+    const Vec3i dims = phi.dims();
+    const std::size_t n_agents = agents_.size();
+    const std::vector<Agent> previous = agents_;
+    const double radius = options_.separation_radius;
+    const std::uint64_t step = move_steps_++;
+
+    std::vector<std::uint8_t> reprojected(n_agents, 0), on_surface(n_agents, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_agents), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Vec3d x = previous[i].position;
+            Stream rng(options_.seed, i, step, kMoveTag);
+
+            Vec3d p{0, 0, 0};
+            if (target_ && options_.attraction > 0) {
+                const Vec3d d = *target_ - x;
+                const double l = norm(d);
+                if (l > 1e-9) p += d * (options_.attraction / l);
+            }
+            if (options_.random_walk > 0) p += rng.unit_vector() * options_.random_walk;
+            if (options_.separation > 0) {
+                Vec3d rep{0, 0, 0};
+                for (std::size_t j = 0; j < n_agents; ++j) {
+                    if (j == i) continue;
+                    const Vec3d d = x - previous[j].position;
+                    const double l = norm(d);
+                    if (l >= radius) continue;
+                    Vec3d dir;
+                    if (l > 1e-9) {
+                        dir = d / l;
+                    } else {  // coincident agents: antisymmetric hashed direction
+                        const std::size_t a = std::min(i, j), b = std::max(i, j);
+                        dir = Stream(options_.seed, a, b, kPairTag).unit_vector();
+                        if (i > j) dir = -dir;
+                    }
+                    rep += dir * (1.0 - l / radius);
+                }
+                p += rep * options_.separation;
+            }
+
+            const Vec3d g = to_d(interpolated_gradient(phi, x));
+            const double gl = norm(g);
+            Vec3d next = x;
+            if (gl > 1e-9) {
+                const Vec3d n = g / gl;
+                const Vec3d tangential = clamp_length(p - n * dot(n, p), options_.max_step);
+                const double f = trilinear(phi, x);
+                const Vec3d pull = clamp_length(n * (options_.pull_back * f / gl), options_.max_step);
+                next = clamp_to_box(x + tangential - pull, dims);
+            }
+            // Off the zero layer: Newton re-projection.
+            if (std::abs(trilinear(phi, next)) > 1.0) {
+                next = project(phi, next, 8);
+                reprojected[i] = 1;
+            }
+            on_surface[i] = std::abs(trilinear(phi, next)) < 0.5 ? 1 : 0;
+            agents_[i].position = next;
+            agents_[i].velocity = next - x;
+        }
+    });
+
+    StepReport report;
+    for (std::size_t i = 0; i < n_agents; ++i) {
+        report.on_surface += on_surface[i];
+        report.reprojected += reprojected[i];
+    }
+    return report;
+}
+
+std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const Grid<float>& image_unit) {
+    require(image_unit.dims() == field.lattice().dims(), "swarm: image and level set dimensions differ");
+    const std::size_t n_agents = agents_.size();
+    if (n_agents == 0) return {};
+    const Grid<float>& phi = field.phi();
+    const Lattice& lat = field.lattice();
+    const std::uint64_t frame = edit_steps_++;
+
+    // Population statistics (summed in agent order: deterministic).
+    double sum = 0.0, sum2 = 0.0;
+    for (const Agent& a : agents_) {
+        const double v = trilinear(image_unit, a.position);
+        sum += v;
+        sum2 += v * v;
+    }
+    const double m = sum / static_cast<double>(n_agents), s = sum2 / static_cast<double>(n_agents);
+    if (!have_stats_) {
+        mean_ = m;
+        second_ = s;
+        have_stats_ = true;
+    } else {
+        const double a = options_.stats_smoothing;
+        mean_ = (1 - a) * mean_ + a * m;
+        second_ = (1 - a) * second_ + a * s;
+    }
+    const double mu = mean_;
+    const double sigma = std::max(std::sqrt(std::max(second_ - mean_ * mean_, 0.0)), options_.min_sigma);
+
+    const double support = options_.edit_radius;
+    const double sg = support / 2.0;
+    const double inv_two_var = 1.0 / (2.0 * sg * sg);
+    const int reach = static_cast<int>(std::ceil(support));
+
+    std::vector<std::vector<ZeroLayerEdit>> per_agent(n_agents);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_agents), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            Stream rng(options_.seed, i, frame, kEditTag);
+            if (!(rng.uniform() < options_.act_probability)) continue;
+            const Vec3d x = agents_[i].position;
+            const Vec3d g = to_d(interpolated_gradient(phi, x));
+            const double gl = norm(g);
+            if (!(gl > 1e-9)) continue;
+            const Vec3d n = g / gl;
+            const double outside = trilinear(image_unit, x + n * 1.5);
+            const double inside = trilinear(image_unit, x - n * 1.5);
+            double amount = 0.0;
+            if (std::abs(outside - mu) <= options_.expand_sigmas * sigma)
+                amount = -options_.edit_amount;
+            else if (std::abs(inside - mu) > options_.contract_sigmas * sigma)
+                amount = options_.edit_amount;
+            if (amount == 0.0) continue;
+
+            const Vec3i c{static_cast<int>(std::lround(x.x)), static_cast<int>(std::lround(x.y)),
+                          static_cast<int>(std::lround(x.z))};
+            auto& out = per_agent[i];
+            for (int dz = -reach; dz <= reach; ++dz)
+                for (int dy = -reach; dy <= reach; ++dy)
+                    for (int dx = -reach; dx <= reach; ++dx) {
+                        const Vec3i q = c + Vec3i{dx, dy, dz};
+                        if (!lat.contains(q)) continue;
+                        const PointIndex idx = lat.index(q);
+                        if (field.status()[idx] != 0) continue;
+                        const Vec3d d = q.cast<double>() - x;
+                        const double d2 = dot(d, d);
+                        if (d2 > support * support) continue;
+                        out.push_back({idx, static_cast<float>(amount * std::exp(-d2 * inv_two_var))});
+                    }
+        }
+    });
+
+    std::vector<ZeroLayerEdit> all;
+    for (const auto& v : per_agent) all.insert(all.end(), v.begin(), v.end());
+    std::stable_sort(all.begin(), all.end(),
+                     [](const ZeroLayerEdit& a, const ZeroLayerEdit& b) { return a.point < b.point; });
+    std::vector<ZeroLayerEdit> merged;
+    for (std::size_t k = 0; k < all.size();) {
+        const PointIndex p = all[k].point;
+        double total = 0.0;
+        for (; k < all.size() && all[k].point == p; ++k) total += all[k].delta;
+        merged.push_back({p, static_cast<float>(std::clamp(total, -0.5, 0.5))});
+    }
+    return merged;
+}
+
+std::optional<double> Swarm::intensity_mean() const {
+    if (!have_stats_) return std::nullopt;
+    return mean_;
+}
+
+std::optional<double> Swarm::intensity_sigma() const {
+    if (!have_stats_) return std::nullopt;
+    return std::max(std::sqrt(std::max(second_ - mean_ * mean_, 0.0)), options_.min_sigma);
+}
+
+}  // namespace liveset

@@ -1,0 +1,89 @@
+// Agent swarms on the zero level set (Feltell & Bai, §4): agents live in index space on φ = 0,
+// move tangentially under a potential P with a pull-back onto the surface (Eq. 4), and propose
+// local zero-layer edits (raise/lower the surface with a unit-peak Gaussian footprint) from
+// population-level intensity statistics. Deterministic for any TBB thread count: every agent's
+// random numbers come from its own stream keyed by (seed, agent, step) and moves are computed
+// Jacobi-style from the previous positions.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/levelset/sparse_field.hpp"
+
+namespace liveset {
+
+struct SwarmOptions {
+    std::size_t agents = 200;
+    double pull_back = 0.1;          // ε of Eq. 4, 0 ≤ ε < 1 (0 disables the pull-back)
+    double attraction = 0.5;         // weight of unit(target − x) in P
+    double random_walk = 0.3;        // weight of a random unit vector in P
+    double separation = 0.4;         // weight of the repulsion from nearby agents in P
+    double separation_radius = 2.0;  // voxels
+    double max_step = 0.5;           // largest tangential displacement per step, voxels
+    double act_probability = 0.1;    // p: chance that an agent edits the surface in one call
+    double edit_radius = 2.0;        // support radius of an edit (Gaussian σ = radius/2), voxels
+    double edit_amount = 0.2;        // A: |Δφ| under the agent per action, ≤ 0.5
+    std::uint64_t seed = 1;
+    // Decision rule of surface_edits (population mean μ, standard deviation σ):
+    double expand_sigmas = 1.0;      // k: expand when |I_outside − μ| ≤ k·σ
+    double contract_sigmas = 2.5;    // k': contract when |I_inside − μ| > k'·σ
+    double min_sigma = 0.05;         // floor on σ (normalised intensity units)
+    double stats_smoothing = 0.2;    // α of the exponential moving averages, 0 < α ≤ 1
+};
+
+// Throws std::invalid_argument (one-line message) on an invalid option.
+void validate(const SwarmOptions& options);
+
+struct Agent {
+    Vec3d position;  // index space
+    Vec3d velocity;  // displacement of the last move (voxels per step)
+};
+
+struct StepReport {
+    std::size_t on_surface = 0;   // agents with |φ(x)| < 0.5 after the move
+    std::size_t reprojected = 0;  // agents that left |φ| ≤ 1 and were Newton-projected back
+};
+
+class Swarm {
+public:
+    explicit Swarm(const SwarmOptions& options);
+
+    // Places options.agents agents on the zero-layer points nearest `near` within `radius`
+    // (ties by point index; if there are fewer such points, they are reused cyclically), each
+    // Newton-projected onto φ = 0. Resets velocities, step counters and intensity statistics.
+    // Throws std::invalid_argument if no zero-layer point lies within `radius`.
+    void spawn(const SparseField& field, Vec3d near, double radius);
+
+    void set_target(std::optional<Vec3d> target) { target_ = target; }
+    const std::optional<Vec3d>& target() const { return target_; }
+
+    // One Eq. 4 step for every agent (see swarm.cpp for the exact rule).
+    StepReport move(const SparseField& field);
+
+    // Edits proposed by the agents this frame (sorted by point, duplicates merged, |Δ| ≤ 0.5),
+    // ready for field.apply_edits(). image_unit must have the field's dimensions.
+    std::vector<ZeroLayerEdit> surface_edits(const SparseField& field, const Grid<float>& image_unit);
+
+    const std::vector<Agent>& agents() const { return agents_; }
+    const SwarmOptions& options() const { return options_; }
+    // Population intensity statistics (exponential moving averages); nullopt before the first
+    // surface_edits call after spawn.
+    std::optional<double> intensity_mean() const;
+    std::optional<double> intensity_sigma() const;
+
+private:
+    SwarmOptions options_;
+    std::vector<Agent> agents_;
+    std::optional<Vec3d> target_;
+    std::uint64_t move_steps_ = 0;
+    std::uint64_t edit_steps_ = 0;
+    bool have_stats_ = false;
+    double mean_ = 0.0;    // EMA of the per-frame mean intensity
+    double second_ = 0.0;  // EMA of the per-frame mean squared intensity
+};
+
+}  // namespace liveset
