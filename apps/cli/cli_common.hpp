@@ -31,5 +31,6 @@ void add_bench_commands(CLI::App& app, const int& threads);
 void add_segment_commands(CLI::App& app, const int& threads);
 void add_eval_commands(CLI::App& app, const int& threads);
 void add_demo_command(CLI::App& app, const int& threads);
+void add_repair_command(CLI::App& app, const int& threads);
 
 }  // namespace liveset::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     liveset::cli::add_flow_commands(app, threads);
     liveset::cli::add_segment_commands(app, threads);
     liveset::cli::add_eval_commands(app, threads);
+    liveset::cli::add_repair_command(app, threads);
     liveset::cli::add_bench_commands(app, threads);
     liveset::cli::add_demo_command(app, threads);
 

@@ -26,7 +26,7 @@ TEST(Cli, VersionAndHelp) {
     EXPECT_NE(h.out.find("demo"), std::string::npos);
     EXPECT_NE(h.out.find("segment"), std::string::npos);
     EXPECT_NE(h.out.find("flow"), std::string::npos);
-    for (const char* sub : {"demo", "flow", "segment", "mesh", "eval", "phantom"}) {
+    for (const char* sub : {"demo", "flow", "segment", "mesh", "eval", "phantom", "repair"}) {
         const Result s = run_cli(std::string(sub) + " --help");
         EXPECT_EQ(s.rc, 0) << sub;
         EXPECT_NE(s.out.find("--json"), std::string::npos) << sub;

@@ -1,0 +1,44 @@
+// Headless hole repair (paper §4): a swarm spawned at the user's target walks the zero level set,
+// proposes local edits each step, the edits go through the sparse field's *local* update, and the
+// changed points X go to the incremental mesher — nothing else is recomputed. Targets can change
+// over time (a user moving the mouse): target k takes effect from its step on.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "liveset/mesh/fragment_mesher.hpp"
+#include "liveset/swarm/swarm.hpp"
+
+namespace liveset {
+
+struct RepairTarget {
+    Vec3d position;  // index space
+    int step = 0;    // first step at which it is the swarm's target
+};
+
+struct RepairOptions {
+    SwarmOptions swarm;
+    int steps = 300;
+    double spawn_radius = 20.0;  // agents start on the zero-layer points nearest the first target
+};
+
+struct RepairStepLog {
+    int step = 0;
+    std::size_t on_surface = 0;  // agents within |φ| < 0.5
+    std::size_t modified = 0;    // zero-layer points edited this step
+    std::size_t changed = 0;     // |X| reported by the local update
+    std::size_t fragments = 0;   // fragments re-polygonised (0 without a mesher)
+    double ms = 0.0;             // wall time of move + edits + level set + mesh
+};
+
+// Runs `options.steps` swarm steps. Edits that would grow the surface into voxels outside `roi`
+// (when given) are dropped. `mesher` (optional) must have been full_rebuild() on field.phi().
+// Stops early when `interrupt` turns true. Throws std::invalid_argument on bad targets/options.
+std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
+                                      std::span<const RepairTarget> targets, const RepairOptions& options,
+                                      FragmentMesher* mesher = nullptr, const std::atomic<bool>* interrupt = nullptr);
+
+}  // namespace liveset
