@@ -1,7 +1,9 @@
 // Mean curvature by difference of normals against analytic shapes: sphere 2/r, cylinder 1/r, plane 0.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include "liveset/levelset/shapes.hpp"
 #include "liveset/levelset/speed.hpp"
@@ -44,4 +46,43 @@ TEST(Curvature, CylinderAndPlane) {
 TEST(Curvature, SpeedRejectsBadWeight) {
     EXPECT_THROW(CurvatureSpeed(-1.0f), std::invalid_argument);
     EXPECT_THROW(CurvatureSpeed(NAN), std::invalid_argument);
+}
+
+// The difference-of-normals formula written out with clamped reads everywhere (the reference);
+// mean_curvature's unclamped interior fast path must agree with it bit for bit.
+TEST(Curvature, InteriorFastPathIsBitIdenticalToClampedFormula) {
+    const liveset::Lattice lat({9, 8, 7});
+    liveset::Grid<float> phi(lat);
+    std::uint32_t state = 99;
+    for (float& v : phi.values()) {
+        state = state * 1664525u + 1013904223u;
+        v = static_cast<float>(state >> 8) / static_cast<float>(1u << 24) * 4.0f - 2.0f;
+    }
+    const auto reference = [&](liveset::Vec3i p) {
+        float k = 0.0f;
+        for (int a = 0; a < 3; ++a) {
+            float n_dir[2] = {0.0f, 0.0f};
+            for (int dir : {+1, -1}) {
+                const int b = (a + 1) % 3, c = (a + 2) % 3;
+                liveset::Vec3i q = p, eb{0, 0, 0}, ec{0, 0, 0};
+                q[a] += dir;
+                eb[b] = 1;
+                ec[c] = 1;
+                const float ga = static_cast<float>(dir) * (phi.clamped(q) - phi.clamped(p));
+                const float gb = 0.25f * (phi.clamped(p + eb) + phi.clamped(q + eb) - phi.clamped(p - eb) - phi.clamped(q - eb));
+                const float gc = 0.25f * (phi.clamped(p + ec) + phi.clamped(q + ec) - phi.clamped(p - ec) - phi.clamped(q - ec));
+                const float len = std::sqrt(ga * ga + gb * gb + gc * gc);
+                n_dir[dir > 0 ? 0 : 1] = len > 1e-6f ? ga / len : 0.0f;
+            }
+            k += n_dir[0] - n_dir[1];
+        }
+        return k;
+    };
+    for (int z = 0; z < 7; ++z)
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 9; ++x) {
+                const liveset::Vec3i p{x, y, z};
+                const float got = liveset::mean_curvature(phi, p), want = reference(p);
+                ASSERT_EQ(std::bit_cast<std::uint32_t>(got), std::bit_cast<std::uint32_t>(want)) << x << "," << y << "," << z;
+            }
 }

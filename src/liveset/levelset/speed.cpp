@@ -23,10 +23,32 @@ float half_point_normal(const Grid<float>& phi, Vec3i p, int a, int dir) {
     return len > 1e-6f ? ga / len : 0.0f;
 }
 
+// half_point_normal() for points whose whole stencil (±2 along a, ±1 across) is inside the
+// lattice: the same arithmetic in the same order, so bit-identical, without per-read clamping.
+float half_point_normal_interior(const float* v, std::size_t i, const std::size_t stride[3], int a, int dir) {
+    const int b = (a + 1) % 3, c = (a + 2) % 3;
+    const std::size_t j = dir > 0 ? i + stride[a] : i - stride[a];
+    const std::size_t sb = stride[b], sc = stride[c];
+    const float ga = static_cast<float>(dir) * (v[j] - v[i]);
+    const float gb = 0.25f * (v[i + sb] + v[j + sb] - v[i - sb] - v[j - sb]);
+    const float gc = 0.25f * (v[i + sc] + v[j + sc] - v[i - sc] - v[j - sc]);
+    const float len = std::sqrt(ga * ga + gb * gb + gc * gc);
+    return len > 1e-6f ? ga / len : 0.0f;
+}
+
 }  // namespace
 
 float mean_curvature(const Grid<float>& phi, Vec3i p) {
+    const Vec3i d = phi.dims();
     float k = 0.0f;
+    if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x <= d.x - 2 && p.y <= d.y - 2 && p.z <= d.z - 2) {
+        const Lattice& l = phi.lattice();
+        const std::size_t stride[3] = {1, l.stride_y(), l.stride_z()};
+        const std::size_t i = l.index(p);
+        const float* v = phi.values().data();
+        for (int a = 0; a < 3; ++a) k += half_point_normal_interior(v, i, stride, a, +1) - half_point_normal_interior(v, i, stride, a, -1);
+        return k;
+    }
     for (int a = 0; a < 3; ++a) k += half_point_normal(phi, p, a, +1) - half_point_normal(phi, p, a, -1);
     return k;
 }
