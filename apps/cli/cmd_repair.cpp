@@ -148,6 +148,10 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--p", ra.options.swarm.act_probability, "probability that an agent edits per step")->check(finite_number())->capture_default_str();
     r->add_option("--radius", ra.options.swarm.edit_radius, "edit radius, voxels")->check(finite_number())->capture_default_str();
     r->add_option("--seed", ra.options.swarm.seed, "random seed")->capture_default_str();
+    r->add_option("--amount", ra.options.swarm.edit_amount, "|dphi| under an acting agent (<= 0.5)")->check(finite_number())->capture_default_str();
+    r->add_option("--expand-sigmas", ra.options.swarm.expand_sigmas, "expand where the outside intensity is within this many population sigmas")->check(finite_number())->capture_default_str();
+    r->add_option("--contract-sigmas", ra.options.swarm.contract_sigmas, "contract where the inside intensity is beyond this many sigmas")->check(finite_number())->capture_default_str();
+    r->add_option("--sample-depth", ra.options.swarm.sample_depth, "population samples this many voxels inside the surface (0: at the agents)")->check(finite_number())->capture_default_str();
     r->add_option("--out-phi", ra.out_phi, "repaired phi");
     r->add_option("--out-mask", ra.out_mask, "repaired mask");
     r->add_option("--out-mesh", ra.out_mesh, "repaired surface (.ply/.obj/.stl)");

@@ -307,6 +307,8 @@ TEST(Swarm, BadOptionsAndInputsThrow) {
     bad([](SwarmOptions& o) { o.edit_amount = 0; });
     bad([](SwarmOptions& o) { o.min_sigma = 0; });
     bad([](SwarmOptions& o) { o.stats_smoothing = 0; });
+    bad([](SwarmOptions& o) { o.sample_depth = -1; });
+    bad([](SwarmOptions& o) { o.sample_depth = std::nan(""); });
 
     const SparseField f = sphere_field();
     Swarm s(SwarmOptions{});
@@ -314,4 +316,27 @@ TEST(Swarm, BadOptionsAndInputsThrow) {
     EXPECT_THROW(s.spawn(f, kCentre, -1.0), std::invalid_argument);
     s.spawn(f, kCentre, 100.0);
     EXPECT_THROW(s.surface_edits(f, Grid<float>(Lattice({10, 10, 10}))), std::invalid_argument);
+}
+
+// With sample_depth the population samples the tissue inside the surface: on a sphere whose image
+// is 1 inside and 0 outside (a one-voxel ramp at the surface), the mean is ≈ 0.5 at the agents and
+// 1 two voxels inside.
+TEST(Swarm, SampleDepthMovesThePopulationSamplesInside) {
+    const SparseField f = sphere_field();
+    const Grid<float> img = bright_ball(kR);
+    for (double depth : {0.0, 2.0}) {
+        SwarmOptions o;
+        o.agents = 50;
+        o.act_probability = 0.0;
+        o.sample_depth = depth;
+        Swarm s(o);
+        s.spawn(f, kCentre + Vec3d{kR, 0, 0}, 30.0);
+        s.surface_edits(f, img);
+        ASSERT_TRUE(s.intensity_mean().has_value());
+        if (depth == 0.0) {
+            EXPECT_NEAR(*s.intensity_mean(), 0.5, 0.1);
+        } else {
+            EXPECT_NEAR(*s.intensity_mean(), 1.0, 1e-6);
+        }
+    }
 }

@@ -134,6 +134,7 @@ void validate(const SwarmOptions& o) {
             "swarm: contract_sigmas must be finite and >= 0");
     require(finite_positive(o.min_sigma), "swarm: min_sigma must be finite and > 0");
     require(finite_positive(o.stats_smoothing) && o.stats_smoothing <= 1, "swarm: stats_smoothing must be in (0, 1]");
+    require(std::isfinite(o.sample_depth) && o.sample_depth >= 0 && o.sample_depth <= 8, "swarm: sample_depth must be in [0, 8]");
 }
 
 Swarm::Swarm(const SwarmOptions& options) : options_(options) { validate(options_); }
@@ -248,7 +249,13 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
     // Population statistics (summed in agent order: deterministic).
     double sum = 0.0, sum2 = 0.0;
     for (const Agent& a : agents_) {
-        const double v = trilinear(image_unit, a.position);
+        Vec3d where = a.position;
+        if (options_.sample_depth > 0.0) {  // inside the segmented tissue, along -n
+            const Vec3d g = to_d(interpolated_gradient(phi, a.position));
+            const double gl = norm(g);
+            if (gl > 1e-9) where = where - g * (options_.sample_depth / gl);
+        }
+        const double v = trilinear(image_unit, where);
         sum += v;
         sum2 += v * v;
     }

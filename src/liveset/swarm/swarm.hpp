@@ -33,6 +33,9 @@ struct SwarmOptions {
     double contract_sigmas = 2.5;    // k': contract when |I_inside − μ| > k'·σ
     double min_sigma = 0.05;         // floor on σ (normalised intensity units)
     double stats_smoothing = 0.2;    // α of the exponential moving averages, 0 < α ≤ 1
+    // Where the population samples the intensity: at the agent (0) or this many voxels inside
+    // the surface along −n (the tissue already segmented around the agents).
+    double sample_depth = 0.0;
 };
 
 // Throws std::invalid_argument (one-line message) on an invalid option.
