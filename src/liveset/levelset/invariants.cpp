@@ -100,7 +100,7 @@ InvariantReport check_invariants(const SparseField& field) {
                 bad.add(lat, i, "layer " + std::to_string(st) + " point has no neighbour in the next-inner layer");
             } else {
                 const auto is_inner = [&](std::int8_t s) { return s == inner; };
-                const float expect = detail::layer_value(phi, status, i, st > 0, is_inner);
+                const float expect = detail::layer_value(phi, status, i, phi.lattice().coord(i), st > 0, is_inner);
                 if (expect != v)
                     bad.add(lat, i, "outer-layer value " + std::to_string(v) + " differs from " + std::to_string(expect));
             }

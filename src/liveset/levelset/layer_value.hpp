@@ -17,12 +17,12 @@
 
 namespace liveset::detail {
 
-// Returns ±inf when the point has no neighbour for which is_inner(status) holds.
+// Returns ±inf when the point has no neighbour for which is_inner(status) holds. `c` is the
+// lattice coordinate of i (callers in hot loops decode it without division).
 template <class IsInner>
-float layer_value(const Grid<float>& phi, const Grid<std::int8_t>& status, PointIndex i, bool outside,
+float layer_value(const Grid<float>& phi, const Grid<std::int8_t>& status, PointIndex i, Vec3i c, bool outside,
                   const IsInner& is_inner) {
     const Lattice& lat = phi.lattice();
-    const Vec3i c = lat.coord(i);
     const Vec3i d = lat.dims();
     const PointIndex stride[3] = {1, static_cast<PointIndex>(lat.stride_y()), static_cast<PointIndex>(lat.stride_z())};
     float best = outside ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();

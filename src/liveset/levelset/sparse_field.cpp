@@ -31,8 +31,8 @@ constexpr std::size_t kParallelMin = 4096;  // below this, loops run serially
 bool is_temp(std::int8_t s) { return s >= kPendPos || s <= kPendNeg; }
 
 template <class F>
-void for_each_neighbor6(const Lattice& lat, PointIndex i, F&& f) {
-    const Vec3i c = lat.coord(i);
+void for_each_neighbor6(const Lattice& lat, const IndexDecoder& decode, PointIndex i, F&& f) {
+    const Vec3i c = decode.coord(i);
     const Vec3i d = lat.dims();
     const auto sy = static_cast<PointIndex>(lat.stride_y());
     const auto sz = static_cast<PointIndex>(lat.stride_z());
@@ -71,6 +71,7 @@ SparseField::SparseField(const Lattice& lattice, int layers) : layers_(layers) {
     phi_ = Grid<float>(lattice, static_cast<float>(layers + 1));
     status_ = Grid<std::int8_t>(lattice, far_outside());
     slot_ = Grid<std::uint32_t>(lattice, kNoSlot);
+    decoder_ = IndexDecoder(lattice);
     lists_.assign(2 * static_cast<std::size_t>(layers) + 1, {});
     for (int z = -layers; z <= layers; ++z)
         for (int y = -layers; y <= layers; ++y)
@@ -142,7 +143,7 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {
         const float v = phi_[i];
         if (std::abs(v) <= 0.5f) continue;
         bool opposite = false;
-        for_each_neighbor6(lattice(), i, [&](PointIndex q) {
+        for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
             if (std::abs(phi_[q]) > 0.5f && ((phi_[q] < 0) != (v < 0))) opposite = true;
         });
         if (opposite) steep.push_back(i);
@@ -180,7 +181,7 @@ void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
         const PointIndex i = lat.index(p.cast<int>());
         const bool inside = mask[i] != 0;
         bool boundary = false;
-        for_each_neighbor6(lat, i, [&](PointIndex q) { boundary = boundary || ((mask[q] != 0) != inside); });
+        for_each_neighbor6(lat, decoder_, i, [&](PointIndex q) { boundary = boundary || ((mask[q] != 0) != inside); });
         const double far = layers_ + 1;
         if (boundary) return inside ? -0.5 : 0.5;
         return inside ? -far : far;
@@ -199,7 +200,7 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
     const auto zero = zero_layer();
     std::vector<double> rate(zero.size());
     parallel_range(zero.size(), [&](std::size_t n) {
-        const Vec3i p = lattice().coord(zero[n]);
+        const Vec3i p = decoder_.coord(zero[n]);
         const SpeedSample s = speed.at(phi_, p);
         double r = 0.0;
         if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi_, p, s.propagation);
@@ -308,7 +309,7 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
         if (std::abs(v) <= 0.5f) return;
         const bool up = v > 0.5f;
         bool blocked = false;
-        for_each_neighbor6(lattice(), i, [&](PointIndex q) {
+        for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
             if (status_[q] == 0 && (up ? phi_[q] < -0.5f : phi_[q] > 0.5f)) blocked = true;
         });
         move[k] = blocked ? static_cast<std::int8_t>(up ? 2 : -2) : static_cast<std::int8_t>(up ? 1 : -1);
@@ -325,10 +326,10 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
     for (std::size_t k = 0; k < n; ++k) {
         if (move[k] == 0) continue;
         const std::int8_t from = move[k] > 0 ? std::int8_t{-1} : std::int8_t{1};
-        for_each_neighbor6(lattice(), edits[k].point, [&](PointIndex q) {
+        for_each_neighbor6(lattice(), decoder_, edits[k].point, [&](PointIndex q) {
             if (status_[q] != from) return;
             float w = from > 0 ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
-            for_each_neighbor6(lattice(), q, [&](PointIndex r) {
+            for_each_neighbor6(lattice(), decoder_, q, [&](PointIndex r) {
                 if (status_[r] != 0) return;
                 w = from > 0 ? std::min(w, phi_[r] + 1.0f) : std::max(w, phi_[r] - 1.0f);
             });
@@ -386,7 +387,7 @@ void SparseField::collect_band(std::vector<RegionPoint>& region) {
     for (int side : {-layers_, layers_}) {
         const std::int8_t far = side > 0 ? far_outside() : far_inside();
         for (PointIndex i : layer(side))
-            for_each_neighbor6(lattice(), i, [&](PointIndex q) {
+            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
                 if (status_[q] == far) mark_pending(q, region);
             });
     }
@@ -395,7 +396,7 @@ void SparseField::collect_band(std::vector<RegionPoint>& region) {
 float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
     const std::int8_t inner = static_cast<std::int8_t>(outside ? k - 1 : -(k - 1));
     const auto is_inner = [&](std::int8_t s) { return k == 1 ? (s == 0 || s == kPendZero) : s == inner; };
-    return detail::layer_value(phi_, status_, i, outside, is_inner);
+    return detail::layer_value(phi_, status_, i, decoder_.coord(i), outside, is_inner);
 }
 
 void SparseField::sweep_layers(std::span<const RegionPoint> region) {

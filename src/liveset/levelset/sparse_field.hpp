@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
+#include "liveset/grid/index_decoder.hpp"
 #include "liveset/levelset/speed.hpp"
 
 namespace liveset {
@@ -122,6 +123,7 @@ private:
     std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
     int steps_since_sort_ = 0;
+    IndexDecoder decoder_;  // division-free index -> coordinate for the hot loops
 };
 
 }  // namespace liveset
