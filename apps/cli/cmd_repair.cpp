@@ -51,24 +51,17 @@ SparseField load_level_set(const std::string& path, const Lattice& reference) {
     const Grid<float> g = read_image(path);
     if (!(g.dims() == reference.dims()))
         throw UsageError(fmt::format("{} ({}x{}x{}) does not match the image's size", path, g.dims().x, g.dims().y, g.dims().z));
-    bool mask = true;
+    const bool mask = is_binary_mask(g);
     std::size_t inside = 0;
-    for (float v : g.values()) {
-        mask = mask && (v == 0.0f || v == 1.0f);
-        inside += v < 0.0f || v == 1.0f;
-    }
+    for (float v : g.values()) inside += mask ? v == 1.0f : v < 0.0f;
     SparseField field(reference, 2);
     if (mask) {
-        Grid<std::uint8_t> m(reference);
-        for (std::size_t i = 0; i < g.size(); ++i) m[static_cast<PointIndex>(i)] = g[static_cast<PointIndex>(i)] != 0.0f;
-        field.init_from_mask(m);
+        field.init_from_mask(to_mask(g));
     } else {
-        const Lattice& l = g.lattice();
         field.init_from_sdf([&](Vec3d p) {
             const Vec3i q{static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)), static_cast<int>(std::lround(p.z))};
             return static_cast<double>(g(q));
         });
-        (void)l;
     }
     if (inside == 0 || field.zero_layer().empty()) throw UsageError(fmt::format("{} holds no surface to repair", path));
     return field;

@@ -65,11 +65,8 @@ int run_segment(const SegmentArgs& a, int threads) {
     req.loop.max_iterations = a.iterations;
     req.mu = a.mu;
     req.epsilon = a.epsilon;
-    if (a.mu_raw || a.epsilon_raw) {
-        const IntensityScale scale = robust_scale(image, req.roi, req.scale);
-        if (a.mu_raw) req.mu = (*a.mu_raw - scale.low) / (scale.high - scale.low);
-        if (a.epsilon_raw) req.epsilon = scale.unit_length(*a.epsilon_raw);
-    }
+    req.mu_raw = a.mu_raw;
+    req.epsilon_raw = a.epsilon_raw;
 
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {
@@ -114,21 +111,11 @@ int run_mesh(const MeshArgs& a, int threads) {
     const auto guard = limit_threads(threads);
     check_output_path(a.out, OutputKind::kMesh, "--out");
     const Grid<float> input = read_image(a.input);
-    bool is_mask = a.kind == "mask";
-    if (a.kind == "auto") {
-        is_mask = true;
-        for (float v : input.values())
-            if (v != 0.0f && v != 1.0f) {
-                is_mask = false;
-                break;
-            }
-    }
+    const bool is_mask = a.kind == "mask" || (a.kind == "auto" && is_binary_mask(input));
     Grid<float> phi = input;
     if (is_mask) {  // a 0/1 mask: φ from the sparse field's mask initialisation (±0.5 at the border)
-        Grid<std::uint8_t> mask(input.lattice());
-        for (std::size_t i = 0; i < input.size(); ++i) mask[static_cast<PointIndex>(i)] = input[static_cast<PointIndex>(i)] != 0.0f;
         SparseField f(input.lattice(), 2);
-        f.init_from_mask(mask);
+        f.init_from_mask(to_mask(input));
         phi = f.phi();
     }
     Mesh mesh;

@@ -22,6 +22,18 @@ Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& refere
     return m;
 }
 
+bool is_binary_mask(const Grid<float>& image) {
+    for (float v : image.values())
+        if (v != 0.0f && v != 1.0f) return false;
+    return true;
+}
+
+Grid<std::uint8_t> to_mask(const Grid<float>& image) {
+    Grid<std::uint8_t> m(image.lattice());
+    for (std::size_t i = 0; i < image.size(); ++i) m[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != 0.0f;
+    return m;
+}
+
 SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest& request, bool quiet,
                                  const std::string& log_path) {
     InterruptGuard interrupt;

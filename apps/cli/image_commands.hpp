@@ -16,6 +16,11 @@ namespace liveset::cli {
 // and direction within tolerance); UsageError naming `option` otherwise. Non-zero -> 1.
 Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& reference, const std::string& option);
 
+// True when every voxel is exactly 0 or 1 (a mask stored as a float image).
+bool is_binary_mask(const Grid<float>& image);
+// Non-zero -> 1, on the image's lattice.
+Grid<std::uint8_t> to_mask(const Grid<float>& image);
+
 struct SegmentRun {
     SegmentOutcome outcome;
     bool interrupted = false;  // Ctrl-C (nothing must be written)

@@ -49,9 +49,8 @@ TEST(BrainWeb, GreyMatterDiceInsideTheBrainMask) {
     ASSERT_GE(req.seeds.size(), 10u);
     req.roi = &brain;
     // The documented BrainWeb window: 94 ± 22 in the T1's units (inside-mask percentiles map it).
-    const IntensityScale scale = robust_scale(t1, &brain);
-    req.mu = scale.to_unit(94.0);
-    req.epsilon = scale.unit_length(22.0);
+    req.mu_raw = 94.0;
+    req.epsilon_raw = 22.0;
     req.alpha = 0.1;
     req.n = 4.0;
     const SegmentOutcome out = segment_image(t1, req);

@@ -19,23 +19,29 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
         req.min_epsilon <= 0)
         throw std::invalid_argument("the epsilon estimate needs positive sigmas and floor");
     validate(req.loop);
+    if ((req.mu && req.mu_raw) || (req.epsilon && req.epsilon_raw))
+        throw std::invalid_argument("give the window in normalised or raw units, not both");
 
     SegmentOutcome out;
     out.scale = robust_scale(image, req.roi, req.scale);
     const Grid<float> unit = normalise(image, out.scale);
 
+    std::optional<double> mu = req.mu, epsilon = req.epsilon;
+    if (req.mu_raw) mu = (*req.mu_raw - out.scale.low) / (out.scale.high - out.scale.low);
+    if (req.epsilon_raw) epsilon = out.scale.unit_length(*req.epsilon_raw);
+
     ThresholdParams p;
     p.n = req.n;
     p.alpha = req.alpha;
-    if (!req.mu || !req.epsilon) {
+    if (!mu || !epsilon) {
         if (req.seeds.empty())
             throw std::invalid_argument("mu and epsilon must be given when starting from a mask (no seeds to estimate them)");
         out.seed_stats = seed_statistics(unit, req.seeds, req.roi);
         p.mu = out.seed_stats->median;
         p.epsilon = std::max(req.min_epsilon, req.epsilon_sigmas * out.seed_stats->mad_sigma);
     }
-    if (req.mu) p.mu = *req.mu;
-    if (req.epsilon) p.epsilon = *req.epsilon;
+    if (mu) p.mu = *mu;
+    if (epsilon) p.epsilon = *epsilon;
     validate(p);
     out.params = p;
 

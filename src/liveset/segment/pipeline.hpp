@@ -24,6 +24,8 @@ struct SegmentRequest {
     // µ = median of the seed-ball intensities, ε = epsilon_sigmas × their robust σ (at least
     // min_epsilon).
     std::optional<double> mu, epsilon;
+    // The same in the image's own units (mapped through the intensity scale; not with mu/epsilon).
+    std::optional<double> mu_raw, epsilon_raw;
     double epsilon_sigmas = 5.0;
     double min_epsilon = 0.05;
     double n = 4.0;

@@ -28,7 +28,7 @@ double threshold_term(double intensity, const ThresholdParams& p) {
 }
 
 ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi)
-    : params_(params), propagation_(unit_image.lattice()), curvature_(unit_image.lattice(), 1) {
+    : params_(params), propagation_(unit_image.lattice()), roi_(roi) {
     validate(params);
     if (roi && !(roi->dims() == unit_image.dims())) {
         std::ostringstream os;
@@ -42,7 +42,6 @@ ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdPar
             const auto pi = static_cast<PointIndex>(i);
             if (roi && (*roi)[pi] == 0) {
                 propagation_[pi] = 0.5f;
-                curvature_[pi] = 0;
                 continue;
             }
             const float v = img[i];
@@ -54,7 +53,7 @@ ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdPar
 
 SpeedSample ThresholdSpeed::at(const Grid<float>& phi, Vec3i p) const {
     const PointIndex i = phi.lattice().index(p);
-    if (!curvature_[i]) return {propagation_[i], 0.0f};
+    if (roi_ && (*roi_)[i] == 0) return {propagation_[i], 0.0f};
     return {propagation_[i], curvature_weight() * mean_curvature(phi, p)};
 }
 

@@ -46,8 +46,8 @@ public:
 
 private:
     ThresholdParams params_;
-    Grid<float> propagation_;       // ½(1 − α) D(p), or +½ outside the ROI
-    Grid<std::uint8_t> curvature_;  // 1 where the curvature term applies (inside the ROI)
+    Grid<float> propagation_;             // ½(1 − α) D(p), or +½ outside the ROI
+    const Grid<std::uint8_t>* roi_;       // curvature applies only inside (null: everywhere)
 };
 
 }  // namespace liveset
