@@ -3,6 +3,7 @@
 // Every voxel is a pure function of the options and its index, so parallel loops are bit-identical
 // for any thread count.
 #include "liveset/phantom/phantom.hpp"
+#include "liveset/phantom/topology_growth.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -441,8 +442,128 @@ Phantom make_phantom(const PhantomOptions& options) {
         owner.swap(next);
     }
 
-    // 4. Labels and the noise-free partial-volume image from the signed distance d to the WM
-    //    surface, the local GM thickness t and the skull ellipsoid.
+    // Signed distance d to the WM surface and GM thickness t at a voxel (d = ±"far" beyond the band).
+    const auto wm_distance = [&](PointIndex i, Vec3d p, double& t) {
+        t = model.t_max;
+        if (owner[i] == kNone) return inside[i] ? -1e9 : 1e9;
+        t = feet_thickness[owner[i]];
+        return (inside[i] ? -1.0 : 1.0) * std::sqrt(dist2(p, owner[i]));
+    };
+
+    // 4. Radial closure of the pial body {d < t}: where two GM banks meet across a narrow sulcus
+    //    they would enclose CSF pockets and form bridges (cavities and handles of the GM truth, so
+    //    `holes` would count the anatomy instead of the segmentation's perforations). A voxel
+    //    outside the body whose outward ray from the centre meets the body again lies under such a
+    //    bridge: it becomes GM. The WM is star-shaped (its radius is a function of direction), so
+    //    the closed body is too, and the GM truth is one closed shell around the WM (euler 4).
+    std::vector<std::uint8_t> body(lattice.size(), 0), filled(lattice.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& zr) {
+        for (int z = zr.begin(); z != zr.end(); ++z)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    const PointIndex i = lattice.index({x, y, z});
+                    double t;
+                    body[i] = inside[i] || wm_distance(i, position({x, y, z}), t) < t;
+                }
+    });
+    const double body_top = f_hi + (model.t_max + 2.0 * h) / kMinAspect;  // no body voxel lies beyond
+    // Passes until nothing changes; each reads the closed body of the previous pass only (Jacobi,
+    // thread-independent), so pockets under freshly filled voxels are caught by the next pass.
+    std::vector<std::uint8_t> closed = body;
+    for (int pass = 0; pass < 16; ++pass) {
+        std::vector<std::uint8_t> hits(lattice.size(), 0);
+        tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& zr) {
+            for (int z = zr.begin(); z != zr.end(); ++z)
+                for (int y = 0; y < n; ++y)
+                    for (int x = 0; x < n; ++x) {
+                        const PointIndex i = lattice.index({x, y, z});
+                        const Vec3d p = position({x, y, z});
+                        if (closed[i] || radius(p) > body_top) continue;
+                        const Vec3d u = p / norm(p);
+                        for (double s = 0.5 * h;; s += 0.5 * h) {
+                            const Vec3d q = p + u * s;
+                            if (radius(q) > body_top) break;
+                            const Vec3i c{static_cast<int>(std::floor((q.x - o) / h)), static_cast<int>(std::floor((q.y - o) / h)),
+                                          static_cast<int>(std::floor((q.z - o) / h))};
+                            if (!lattice.contains(c) || !lattice.contains(c + Vec3i{1, 1, 1})) break;
+                            bool hit = false;
+                            for (int k = 0; k < 8 && !hit; ++k) hit = closed[lattice.index(c + Vec3i{k & 1, (k >> 1) & 1, k >> 2})];
+                            if (hit) {
+                                hits[i] = 1;
+                                break;
+                            }
+                        }
+                    }
+        });
+        std::size_t added = 0;
+        for (std::size_t i = 0; i < lattice.size(); ++i)
+            if (hits[i]) {
+                closed[i] = filled[i] = 1;
+                ++added;
+            }
+        if (added == 0) break;
+    }
+
+    // Pockets the rays missed (enclosed by filled voxels): everything outside the closed body not
+    // 6-connected to the lattice border becomes GM too (breadth-first flood from the border).
+    {
+        std::vector<std::uint8_t> open(lattice.size(), 0);
+        std::vector<PointIndex> queue;
+        for (int z = 0; z < n; ++z)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    if (x != 0 && y != 0 && z != 0 && x != n - 1 && y != n - 1 && z != n - 1) continue;
+                    const PointIndex i = lattice.index({x, y, z});
+                    if (!body[i] && !filled[i]) {
+                        open[i] = 1;
+                        queue.push_back(i);
+                    }
+                }
+        for (std::size_t head = 0; head < queue.size(); ++head) {
+            const Vec3i c = lattice.coord(queue[head]);
+            for (const Vec3i& e : face) {
+                const Vec3i q = c + e;
+                if (!lattice.contains(q)) continue;
+                const PointIndex j = lattice.index(q);
+                if (open[j] || body[j] || filled[j]) continue;
+                open[j] = 1;
+                queue.push_back(j);
+            }
+        }
+        for (std::size_t i = 0; i < lattice.size(); ++i)
+            if (!open[i] && !body[i]) filled[i] = 1;
+    }
+
+    // Voxel sampling of thin blades and of banks that meet can still leave handles: grow the pial
+    // body from the centre voxel within the closed body, then the WM from the centre within its
+    // voxels whose 26 neighbours all lie in the grown body, adding only simple points (closest to
+    // the centre first). Both are then digital balls and the WM never touches the CSF, so the GM
+    // between them is one shell. The few voxels refused take the label (and a crisp intensity) of
+    // the tissue outside: WM -> GM, GM -> CSF.
+    const auto centre_distance = [&](Vec3i c) { return radius(position(c)); };
+    const PointIndex centre = lattice.index({n / 2, n / 2, n / 2});
+    std::vector<std::uint8_t> pial_body(lattice.size(), 0), wm(lattice.size(), 0), wm_allowed(lattice.size(), 0);
+    pial_body[centre] = 1;
+    grow_preserving_topology(lattice, pial_body, closed, centre_distance);
+    tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& zr) {
+        for (int z = zr.begin(); z != zr.end(); ++z)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    const PointIndex i = lattice.index({x, y, z});
+                    if (!inside[i]) continue;
+                    bool collar = true;
+                    for (int k = 0; k < 27 && collar; ++k) {
+                        const Vec3i q{x + k % 3 - 1, y + (k / 3) % 3 - 1, z + k / 9 - 1};
+                        collar = lattice.contains(q) && pial_body[lattice.index(q)];
+                    }
+                    wm_allowed[i] = collar;
+                }
+    });
+    wm[centre] = 1;
+    grow_preserving_topology(lattice, wm, wm_allowed, centre_distance, 6);
+
+    // 5. Labels and the noise-free partial-volume image from the signed distance d to the WM
+    //    surface, the local GM thickness t and the skull ellipsoid (filled voxels: pure GM).
     Phantom ph;
     ph.wm_intensity = kWmValue;
     ph.gm_intensity = kGmValue;
@@ -459,23 +580,31 @@ Phantom make_phantom(const PhantomOptions& options) {
                     const PointIndex i = lattice.index({x, y, z});
                     const Vec3d p = position({x, y, z});
                     ph.bias_field[i] = static_cast<float>(model.bias_at(p));
-                    const double far = 1e9;
-                    double d = inside[i] ? -far : far, t = model.t_max;
-                    if (owner[i] != kNone) {
-                        d = (inside[i] ? -1.0 : 1.0) * std::sqrt(dist2(p, owner[i]));
-                        t = feet_thickness[owner[i]];
+                    double t;
+                    double d = wm_distance(i, p, t);
+                    double pial = filled[i] ? -h : d - t;
+                    if (inside[i] && !wm[i]) d = h, pial = -h;  // refused WM: pure GM
+                    if (!pial_body[i] && pial < 0) pial = h;      // refused GM: pure CSF
+                    // Next to a filled or refused voxel the pial surface d = t is no longer the
+                    // GM/CSF border: crisp there, so no voxel keeps a CSF fraction inside the GM.
+                    bool changed_nearby = false;
+                    for (int k = 0; k < 27 && !changed_nearby; ++k) {
+                        const Vec3i q{x + k % 3 - 1, y + (k / 3) % 3 - 1, z + k / 9 - 1};
+                        if (!lattice.contains(q)) continue;
+                        const PointIndex j = lattice.index(q);
+                        changed_nearby = filled[j] || (closed[j] && !pial_body[j]);
                     }
-                    const double pial = d - t;
+                    if (changed_nearby) pial = pial_body[i] ? -h : std::max(pial, h);
                     const double outside = std::min(pial - model.csf, model.skull(p));
                     const double f_wm = ramp(d, h), f_in_pial = ramp(pial, h), f_in_csf = ramp(outside, h);
                     clean[i] = static_cast<float>(kWmValue * f_wm + kGmValue * (f_in_pial - f_wm) +
                                                   kCsfValue * (f_in_csf - f_in_pial) + kBgValue * (1.0 - f_in_csf));
                     std::uint8_t label = kBackground;
-                    if (inside[i]) {
+                    if (wm[i]) {
                         label = kWhiteMatter;
-                    } else if (pial < 0) {
+                    } else if (pial_body[i]) {
                         label = kGreyMatter;
-                        depth[i] = static_cast<float>(std::min(d, -pial) / h);
+                        depth[i] = filled[i] ? 0.0f : static_cast<float>(std::min(d, -pial) / h);
                     } else if (outside < 0) {
                         label = kCsf;
                     }
