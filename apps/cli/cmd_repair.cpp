@@ -145,6 +145,8 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--expand-sigmas", ra.options.swarm.expand_sigmas, "expand where the outside intensity is within this many population sigmas")->check(finite_number())->capture_default_str();
     r->add_option("--contract-sigmas", ra.options.swarm.contract_sigmas, "contract where the inside intensity is beyond this many sigmas")->check(finite_number())->capture_default_str();
     r->add_option("--sample-depth", ra.options.swarm.sample_depth, "population samples this many voxels inside the surface (0: at the agents)")->check(finite_number())->capture_default_str();
+    r->add_option("--edit-range", ra.options.swarm.edit_range, "only agents within this many voxels of the target edit (0: all)")->check(finite_number())->capture_default_str();
+    r->add_flag("--no-topology-guard{false}", ra.options.topology_guard, "let edits bridge pieces or open tunnels (by default they cannot)");
     r->add_option("--out-phi", ra.out_phi, "repaired phi");
     r->add_option("--out-mask", ra.out_mask, "repaired mask");
     r->add_option("--out-mesh", ra.out_mesh, "repaired surface (.ply/.obj/.stl)");

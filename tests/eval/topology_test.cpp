@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "eval/mask_shapes.hpp"
+#include "liveset/eval/perforations.hpp"
 #include "liveset/eval/topology.hpp"
 
 using namespace liveset;
@@ -279,4 +280,32 @@ TEST(LabelComponents, RejectsUnsupportedConnectivity) {
     const Mask m(Lattice({3, 3, 3}));
     EXPECT_THROW(label_components(m, 18, nullptr), std::invalid_argument);
     EXPECT_THROW(label_components(m, 4, nullptr), std::invalid_argument);
+}
+
+// find_perforations: the drilled tunnels of a shell, located; a dent that does not go through is
+// not one.
+TEST(Perforations, FindsEachDrilledTunnelAndNotADent) {
+    const Mask truth = thick_shell();
+    Mask inner(truth.lattice(), 0);
+    paint(inner, [](Vec3d p) { return norm(p - Vec3d{13.5, 13.5, 13.5}) <= 6.0; });
+    Mask mask = truth;
+    drill(mask, 0);  // +x
+    drill(mask, 3);  // -y
+    // A dent from outside along +z that stops half way through the wall.
+    paint(mask, [](Vec3d p) {
+        const Vec3d q = p - Vec3d{13.5, 13.5, 13.5};
+        return q.z > 8.5 && q.x * q.x + q.y * q.y <= 4.0;
+    }, 0);
+    const auto found = find_perforations(mask, truth, inner);
+    ASSERT_EQ(found.size(), 2u);
+    for (const Perforation& p : found) {
+        EXPECT_GT(p.voxels, 10u);
+        EXPECT_TRUE(truth(p.nearest) && !mask(p.nearest));
+        const Vec3d d = p.centroid - Vec3d{13.5, 13.5, 13.5};
+        const bool along_x = d.x > 5 && std::abs(d.y) < 1.5 && std::abs(d.z) < 1.5;
+        const bool along_minus_y = d.y < -5 && std::abs(d.x) < 1.5 && std::abs(d.z) < 1.5;
+        EXPECT_TRUE(along_x || along_minus_y) << d.x << "," << d.y << "," << d.z;
+    }
+    EXPECT_TRUE(find_perforations(truth, truth, inner).empty());
+    EXPECT_THROW(find_perforations(mask, truth, Mask(Lattice({4, 4, 4}), 0)), std::invalid_argument);
 }

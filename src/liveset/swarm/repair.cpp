@@ -4,8 +4,79 @@
 #include <algorithm>
 #include <chrono>
 #include <stdexcept>
+#include <unordered_map>
+
+#include "liveset/grid/digital_topology.hpp"
 
 namespace liveset {
+
+namespace {
+
+constexpr std::size_t kPocketLimit = 32768;
+
+// Breadth-first flood of the outside (6-connected) from `start`: true when it ends within
+// kPocketLimit voxels without reaching the lattice border.
+template <class Inside>
+bool encloses_small_pocket(const Lattice& lat, Inside& inside, Vec3i start) {
+    std::vector<Vec3i> queue{start};
+    std::unordered_map<PointIndex, char> seen{{lat.index(start), 1}};
+    const Vec3i dims = lat.dims();
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+        if (queue.size() > kPocketLimit) return false;
+        const Vec3i p = queue[head];
+        if (p.x == 0 || p.y == 0 || p.z == 0 || p.x == dims.x - 1 || p.y == dims.y - 1 || p.z == dims.z - 1) return false;
+        for (int k = 0; k < 6; ++k) {
+            Vec3i q = p;
+            q[k / 2] += (k % 2) ? 1 : -1;
+            if (inside(q) || !seen.emplace(lat.index(q), 1).second) continue;
+            queue.push_back(q);
+        }
+    }
+    return true;
+}
+
+}  // namespace
+
+std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits) {
+    const Lattice& lat = field.lattice();
+    const Grid<float>& phi = field.phi();
+    std::unordered_map<PointIndex, bool> flipped;  // accepted flips of this batch: point -> inside
+    const auto inside = [&](Vec3i q) {
+        if (!lat.contains(q)) return false;
+        const PointIndex i = lat.index(q);
+        if (const auto it = flipped.find(i); it != flipped.end()) return it->second;
+        return phi[i] < 0.0f;
+    };
+    std::size_t dropped = 0;
+    std::erase_if(edits, [&](const ZeroLayerEdit& e) {
+        const float before = phi[e.point];
+        const float after = before + std::clamp(e.delta, -0.5f, 0.5f);
+        const bool was_in = before < 0.0f, is_in = after < 0.0f;
+        if (was_in == is_in) return false;
+        const Vec3i c = lat.coord(e.point);
+        const TopologicalNumbers t = topological_numbers(inside, c);
+        bool ok = is_in ? t.foreground == 1 : (t.background == 1 && t.foreground <= 1);
+        // Growth that splits the local background either closes a tunnel (good) or seals a small
+        // pocket off (a spurious cavity): refuse it when some face neighbour's outside region,
+        // with the point filled, is enclosed within kPocketLimit voxels.
+        if (ok && is_in && t.background >= 2) {
+            flipped[e.point] = true;
+            for (int k = 0; k < 6 && ok; ++k) {
+                Vec3i q = c;
+                q[k / 2] += (k % 2) ? 1 : -1;
+                if (lat.contains(q) && !inside(q)) ok = !encloses_small_pocket(lat, inside, q);
+            }
+            flipped.erase(e.point);
+        }
+        if (!ok) {
+            ++dropped;
+            return true;
+        }
+        flipped[e.point] = is_in;
+        return false;
+    });
+    return dropped;
+}
 
 std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                                       std::span<const RepairTarget> targets, const RepairOptions& options,
@@ -58,6 +129,7 @@ std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& ima
                     return false;
                 });
             }
+            if (options.topology_guard) rec.guarded = guard_topology(field, edits);
             rec.modified = edits.size();
             if (!edits.empty()) {
                 const ChangedPoints x = field.apply_edits(edits, RepairScope::kLocal);

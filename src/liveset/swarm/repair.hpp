@@ -23,16 +23,28 @@ struct RepairOptions {
     SwarmOptions swarm;
     int steps = 300;
     double spawn_radius = 20.0;  // agents start on the zero-layer points nearest the first target
+    // Topology guard: an edit that would move a voxel across the surface in a way that bridges two
+    // pieces, starts a new piece, opens a tunnel, seals a cavity by removal or splits a piece is
+    // dropped (see guard_topology), so the swarm can close holes but never make new ones.
+    bool topology_guard = true;
 };
 
 struct RepairStepLog {
     int step = 0;
     std::size_t on_surface = 0;  // agents within |φ| < 0.5
     std::size_t modified = 0;    // zero-layer points edited this step
+    std::size_t guarded = 0;     // edits dropped by the topology guard
     std::size_t changed = 0;     // |X| reported by the local update
     std::size_t fragments = 0;   // fragments re-polygonised (0 without a mesher)
     double ms = 0.0;             // wall time of move + edits + level set + mesh
 };
+
+// Drops, in point order, every edit that would flip the inside/outside state (φ < 0) of its point
+// non-simply: growth is kept only when the point's inside neighbours form one 26-connected piece
+// (no bridge, no new piece); shrinking only when the point is simple (no tunnel opened, no cavity
+// made, nothing split) or an isolated inside voxel. Growth that closes a tunnel or fills a
+// cavity is kept. Flips already accepted count for the later points. Returns the number dropped.
+std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits);
 
 // Runs `options.steps` swarm steps. Edits that would grow the surface into voxels outside `roi`
 // (when given) are dropped. `mesher` (optional) must have been full_rebuild() on field.phi().

@@ -23,7 +23,8 @@
 //   population statistics: I(x_i) trilinear at every agent; the frame mean m and mean square s
 //   update exponential moving averages μ ← (1−α)μ + α·m, S ← (1−α)S + α·s (first frame: μ = m,
 //   S = s); σ = max(sqrt(max(S − μ², 0)), min_sigma).
-//   each agent acts with probability p (stream (seed, i, frame)); it samples I_out = I(x + 1.5n),
+//   each agent acts with probability p (stream (seed, i, frame)) — and, with edit_range > 0, only
+//   within that distance of the target; it samples I_out = I(x + 1.5n),
 //   I_in = I(x − 1.5n) and
 //     expands  (Δ = −A) if |I_out − μ| ≤ k·σ   (the outside looks like the population: grow into it)
 //     contracts(Δ = +A) else if |I_in − μ| > k'·σ (the inside does not look like it: retreat)
@@ -135,6 +136,7 @@ void validate(const SwarmOptions& o) {
     require(finite_positive(o.min_sigma), "swarm: min_sigma must be finite and > 0");
     require(finite_positive(o.stats_smoothing) && o.stats_smoothing <= 1, "swarm: stats_smoothing must be in (0, 1]");
     require(std::isfinite(o.sample_depth) && o.sample_depth >= 0 && o.sample_depth <= 8, "swarm: sample_depth must be in [0, 8]");
+    require(std::isfinite(o.edit_range) && o.edit_range >= 0, "swarm: edit_range must be finite and >= 0");
 }
 
 Swarm::Swarm(const SwarmOptions& options) : options_(options) { validate(options_); }
@@ -283,6 +285,7 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
             Stream rng(options_.seed, i, frame, kEditTag);
             if (!(rng.uniform() < options_.act_probability)) continue;
             const Vec3d x = agents_[i].position;
+            if (options_.edit_range > 0.0 && target_ && norm(*target_ - x) > options_.edit_range) continue;
             const Vec3d g = to_d(interpolated_gradient(phi, x));
             const double gl = norm(g);
             if (!(gl > 1e-9)) continue;

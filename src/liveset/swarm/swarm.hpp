@@ -36,6 +36,9 @@ struct SwarmOptions {
     // Where the population samples the intensity: at the agent (0) or this many voxels inside
     // the surface along −n (the tissue already segmented around the agents).
     double sample_depth = 0.0;
+    // Only agents within this distance (voxels) of the target edit — the "brush" around the point
+    // the user designates; 0: no limit (and always none without a target).
+    double edit_range = 0.0;
 };
 
 // Throws std::invalid_argument (one-line message) on an invalid option.

@@ -1,0 +1,27 @@
+// Where a segmented shell is perforated: the places to point a repair at. A perforation is a
+// 6-connected region of missed truth (truth and not mask) that touches, through voxels outside the
+// mask, both the tissue the shell should enclose (`inner`, e.g. white matter under grey matter) and
+// the tissue outside it (neither truth nor inner, e.g. CSF) — a tunnel of the mask's outside
+// through the shell. Used by the demo and tests to place swarm targets "at the holes" as a user
+// would, from the ground truth.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+
+namespace liveset {
+
+struct Perforation {
+    std::size_t voxels = 0;  // missed truth voxels in the region
+    Vec3d centroid;          // index space
+    Vec3i nearest;           // the region's voxel nearest the centroid (lies in the region)
+};
+
+// Largest first (ties by centroid). All grids must share dimensions (std::invalid_argument).
+std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth,
+                                           const Grid<std::uint8_t>& inner);
+
+}  // namespace liveset
