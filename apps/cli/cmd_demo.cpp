@@ -97,9 +97,8 @@ int run_demo(const DemoArgs& a, int threads) {
     std::size_t steps = 0, fragments = 0, modified = 0;
     double repair_ms = 0.0;
     Grid<std::uint8_t> repaired = o.mask;
-    for (int r = 0; r < a.rounds; ++r) {
-        const std::vector<Perforation> holes = find_perforations(repaired, ph.truth, white);
-        if (holes.empty()) break;
+    std::vector<Perforation> holes = find_perforations(repaired, ph.truth, white);
+    for (int r = 0; r < a.rounds && !holes.empty(); ++r) {
         const Vec3d t = holes.front().centroid;
         ro.swarm.seed = a.seed + static_cast<std::uint64_t>(r);
         const RepairTarget target{t, 0};
@@ -110,10 +109,11 @@ int run_demo(const DemoArgs& a, int threads) {
             repair_ms += l.ms;
         }
         steps += log.size();
-        repaired = inside_mask(o.field->phi());
         rounds.push_back({{"target", {t.x, t.y, t.z}}, {"perforation_voxels", holes.front().voxels}, {"perforations", holes.size()}});
+        repaired = inside_mask(o.field->phi());
+        holes = find_perforations(repaired, ph.truth, white);
     }
-    const std::size_t left = find_perforations(repaired, ph.truth, white).size();
+    const std::size_t left = holes.size();
     nlohmann::json after = evaluation_report(repaired, ph.truth);
     const Mesh repaired_surface = weld_vertices(mesher.merged().view());
 

@@ -12,16 +12,11 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/pipeline.hpp"
+#include "liveset/segment/segmentation.hpp"
 #include "liveset/swarm/repair.hpp"
 
 namespace liveset {
 namespace {
-
-Grid<std::uint8_t> inside_of(const SparseField& f) {
-    Grid<std::uint8_t> m(f.lattice(), 0);
-    for (PointIndex i = 0; i < m.size(); ++i) m[i] = f.phi()[i] < 0.0f;
-    return m;
-}
 
 // Random ±0.3 edits on two touching-prone spheres: without the guard the topology changes, with
 // it never (every flip is checked against the voxels already flipped in the same batch). Known
@@ -37,7 +32,7 @@ TEST(Repair, TopologyGuardKeepsTheTopologyUnderRandomEdits) {
             const double a = norm(p - Vec3d{13, 20, 20}) - 6.0, b = norm(p - Vec3d{26.5, 20, 20}) - 6.0;
             return std::min(a, b);
         });
-        const Topology start = mask_topology(inside_of(f));
+        const Topology start = mask_topology(inside_mask(f.phi()));
         ASSERT_EQ(start.components, 2u);
         bool changed = false;
         std::uint64_t s = 12345;
@@ -51,7 +46,7 @@ TEST(Repair, TopologyGuardKeepsTheTopologyUnderRandomEdits) {
             std::sort(edits.begin(), edits.end(), [](auto& a, auto& b) { return a.point < b.point; });
             if (guard) guard_topology(f, edits);
             f.apply_edits(edits);
-            const Topology now = mask_topology(inside_of(f));
+            const Topology now = mask_topology(inside_mask(f.phi()));
             changed = now.components != start.components || now.cavities != start.cavities || now.genus != start.genus;
             if (guard) {
                 ASSERT_FALSE(changed) << "step " << step << ": " << now.components << " " << now.cavities << " " << now.genus;
@@ -89,7 +84,7 @@ TEST(Repair, SwarmClosesThePhantomPerforations) {
         ro.swarm.seed = 1 + static_cast<std::uint64_t>(round);
         const RepairTarget t{left.front().centroid, 0};
         run_repair(*o.field, unit, nullptr, {&t, 1}, ro);
-        mask = inside_of(*o.field);
+        mask = inside_mask(o.field->phi());
     }
     EXPECT_TRUE(find_perforations(mask, ph.truth, white).empty());
     const Topology after = mask_topology(mask);

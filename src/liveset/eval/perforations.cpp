@@ -2,6 +2,7 @@
 #include "liveset/eval/perforations.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <stdexcept>
 
 #include "liveset/eval/topology.hpp"
@@ -41,18 +42,16 @@ std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const
         }
     }
     std::vector<Perforation> out;
-    std::vector<std::uint32_t> ids;
+    std::vector<std::size_t> slot(count + 1, SIZE_MAX);  // component label -> index in out
     for (std::uint32_t k = 1; k <= count; ++k)
         if (touches_inner[k] && touches_outer[k]) {
+            slot[k] = out.size();
             out.push_back({size[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
-            ids.push_back(k);
         }
     std::vector<double> best(out.size(), 1e300);
     for (PointIndex i = 0; i < lat.size(); ++i) {
-        if (!label[i]) continue;
-        const auto it = std::find(ids.begin(), ids.end(), label[i]);
-        if (it == ids.end()) continue;
-        const std::size_t j = static_cast<std::size_t>(it - ids.begin());
+        const std::size_t j = slot[label[i]];
+        if (j == SIZE_MAX) continue;
         const Vec3d d = lat.coord(i).cast<double>() - out[j].centroid;
         if (dot(d, d) < best[j]) {
             best[j] = dot(d, d);

@@ -252,6 +252,17 @@ struct Model {
     }
 };
 
+// True when pred holds for a voxel of the 3x3x3 cube around c (c included); a voxel outside the
+// lattice counts as `outside`.
+template <class Pred>
+bool any_in_cube(const Lattice& lattice, Vec3i c, Pred pred, bool outside) {
+    for (int k = 0; k < 27; ++k) {
+        const Vec3i q{c.x + k % 3 - 1, c.y + (k / 3) % 3 - 1, c.z + k / 9 - 1};
+        if (!lattice.contains(q) ? outside : pred(lattice.index(q))) return true;
+    }
+    return false;
+}
+
 // Runs body(z) for every slice z in parallel and concatenates the per-slice outputs in z order,
 // so the result does not depend on the thread count.
 template <class T, class Body>
@@ -505,7 +516,7 @@ Phantom make_phantom(const PhantomOptions& options) {
     }
 
     // Pockets the rays missed (enclosed by filled voxels): everything outside the closed body not
-    // 6-connected to the lattice border becomes GM too (breadth-first flood from the border).
+    // 6-connected to the lattice border joins it as GM (breadth-first flood from the border).
     {
         std::vector<std::uint8_t> open(lattice.size(), 0);
         std::vector<PointIndex> queue;
@@ -514,7 +525,7 @@ Phantom make_phantom(const PhantomOptions& options) {
                 for (int x = 0; x < n; ++x) {
                     if (x != 0 && y != 0 && z != 0 && x != n - 1 && y != n - 1 && z != n - 1) continue;
                     const PointIndex i = lattice.index({x, y, z});
-                    if (!body[i] && !filled[i]) {
+                    if (!closed[i]) {
                         open[i] = 1;
                         queue.push_back(i);
                     }
@@ -525,13 +536,13 @@ Phantom make_phantom(const PhantomOptions& options) {
                 const Vec3i q = c + e;
                 if (!lattice.contains(q)) continue;
                 const PointIndex j = lattice.index(q);
-                if (open[j] || body[j] || filled[j]) continue;
+                if (open[j] || closed[j]) continue;
                 open[j] = 1;
                 queue.push_back(j);
             }
         }
         for (std::size_t i = 0; i < lattice.size(); ++i)
-            if (!open[i] && !body[i]) filled[i] = 1;
+            if (!open[i] && !closed[i]) closed[i] = filled[i] = 1;
     }
 
     // Voxel sampling of thin blades and of banks that meet can still leave handles: grow the pial
@@ -550,13 +561,7 @@ Phantom make_phantom(const PhantomOptions& options) {
             for (int y = 0; y < n; ++y)
                 for (int x = 0; x < n; ++x) {
                     const PointIndex i = lattice.index({x, y, z});
-                    if (!inside[i]) continue;
-                    bool collar = true;
-                    for (int k = 0; k < 27 && collar; ++k) {
-                        const Vec3i q{x + k % 3 - 1, y + (k / 3) % 3 - 1, z + k / 9 - 1};
-                        collar = lattice.contains(q) && pial_body[lattice.index(q)];
-                    }
-                    wm_allowed[i] = collar;
+                    wm_allowed[i] = inside[i] && !any_in_cube(lattice, {x, y, z}, [&](PointIndex j) { return !pial_body[j]; }, true);
                 }
     });
     wm[centre] = 1;
@@ -587,13 +592,9 @@ Phantom make_phantom(const PhantomOptions& options) {
                     if (!pial_body[i] && pial < 0) pial = h;      // refused GM: pure CSF
                     // Next to a filled or refused voxel the pial surface d = t is no longer the
                     // GM/CSF border: crisp there, so no voxel keeps a CSF fraction inside the GM.
-                    bool changed_nearby = false;
-                    for (int k = 0; k < 27 && !changed_nearby; ++k) {
-                        const Vec3i q{x + k % 3 - 1, y + (k / 3) % 3 - 1, z + k / 9 - 1};
-                        if (!lattice.contains(q)) continue;
-                        const PointIndex j = lattice.index(q);
-                        changed_nearby = filled[j] || (closed[j] && !pial_body[j]);
-                    }
+                    const bool changed_nearby = any_in_cube(lattice, {x, y, z}, [&](PointIndex j) {
+                        return filled[j] || (closed[j] && !pial_body[j]);
+                    }, false);
                     if (changed_nearby) pial = pial_body[i] ? -h : std::max(pial, h);
                     const double outside = std::min(pial - model.csf, model.skull(p));
                     const double f_wm = ramp(d, h), f_in_pial = ramp(pial, h), f_in_csf = ramp(outside, h);
