@@ -78,14 +78,74 @@ std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>&
     return dropped;
 }
 
+RepairLoop::RepairLoop(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
+                       const RepairOptions& options, FragmentMesher* mesher)
+    : field_(field), image_unit_(image_unit), roi_(roi), options_(options), mesher_(mesher), swarm_(options.swarm) {
+    if (!(image_unit.dims() == field.lattice().dims())) throw std::invalid_argument("image and level set differ in size");
+    if (roi && !(roi->dims() == field.lattice().dims())) throw std::invalid_argument("region of interest and level set differ in size");
+    if (mesher && !(mesher->lattice().dims() == field.lattice().dims())) throw std::invalid_argument("mesher and level set differ in size");
+}
+
+void RepairLoop::set_target(Vec3d target) {
+    if (!field_.lattice().contains(target)) throw std::invalid_argument("a repair target lies outside the image");
+    if (!spawned_) {
+        respawn(target);
+        return;
+    }
+    swarm_.set_target(target);
+}
+
+void RepairLoop::respawn(Vec3d target) {
+    if (!field_.lattice().contains(target)) throw std::invalid_argument("a repair target lies outside the image");
+    swarm_.spawn(field_, target, options_.spawn_radius);
+    swarm_.set_target(target);
+    spawned_ = true;
+}
+
+RepairStep RepairLoop::step() {
+    using clock = std::chrono::steady_clock;
+    const auto t0 = clock::now();
+    RepairStep out;
+    out.log.step = steps_++;
+    if (spawned_) {
+        out.log.on_surface = swarm_.move(field_).on_surface;
+        std::vector<ZeroLayerEdit> edits = swarm_.surface_edits(field_, image_unit_);
+        if (roi_) {
+            // A lowered φ (growth) at a zero-layer point next to the ROI border could carry the
+            // front out of the ROI: drop growth at points whose 6-neighbourhood leaves the ROI.
+            const Lattice& l = field_.lattice();
+            std::erase_if(edits, [&](const ZeroLayerEdit& e) {
+                if (e.delta >= 0.0f) return false;
+                const Vec3i p = l.coord(e.point);
+                for (int k = 0; k < 7; ++k) {
+                    Vec3i q = p;
+                    if (k > 0) q[(k - 1) / 2] += (k % 2) ? 1 : -1;
+                    if (!l.contains(q) || (*roi_)(q) == 0) return true;
+                }
+                return false;
+            });
+        }
+        if (options_.topology_guard) out.log.guarded = guard_topology(field_, edits);
+        out.log.modified = edits.size();
+        if (!edits.empty()) {
+            out.changed = field_.apply_edits(edits, RepairScope::kLocal);
+            out.log.changed = out.changed.size();
+            if (mesher_) {
+                out.fragments = mesher_->update(field_.phi(), out.changed.points);
+                out.log.fragments = out.fragments.size();
+            }
+        }
+    }
+    out.log.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
+    return out;
+}
+
 std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                                       std::span<const RepairTarget> targets, const RepairOptions& options,
                                       FragmentMesher* mesher, const std::atomic<bool>* interrupt) {
     validate(options.swarm);
     if (options.steps < 0) throw std::invalid_argument("the number of repair steps must not be negative");
     if (targets.empty()) throw std::invalid_argument("repair needs at least one target");
-    if (!(image_unit.dims() == field.lattice().dims())) throw std::invalid_argument("image and level set differ in size");
-    if (roi && !(roi->dims() == field.lattice().dims())) throw std::invalid_argument("region of interest and level set differ in size");
     std::vector<RepairTarget> order(targets.begin(), targets.end());
     for (const RepairTarget& t : order) {
         if (!field.lattice().contains(t.position)) throw std::invalid_argument("a repair target lies outside the image");
@@ -93,51 +153,15 @@ std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& ima
     }
     std::stable_sort(order.begin(), order.end(), [](const RepairTarget& a, const RepairTarget& b) { return a.step < b.step; });
 
-    Swarm swarm(options.swarm);
-    bool spawned = false;
+    RepairLoop loop(field, image_unit, roi, options, mesher);
     std::size_t next = 0;
     std::vector<RepairStepLog> log;
-    using clock = std::chrono::steady_clock;
     for (int step = 0; step < options.steps; ++step) {
         if (interrupt && interrupt->load(std::memory_order_relaxed)) break;
-        const auto t0 = clock::now();
-        while (next < order.size() && order[next].step <= step) {
-            if (!spawned) {
-                swarm.spawn(field, order[next].position, options.spawn_radius);
-                spawned = true;
-            }
-            swarm.set_target(order[next].position);
-            ++next;
-        }
-        RepairStepLog rec;
-        rec.step = step;
-        if (spawned) {
-            rec.on_surface = swarm.move(field).on_surface;
-            std::vector<ZeroLayerEdit> edits = swarm.surface_edits(field, image_unit);
-            if (roi) {
-                // A lowered φ (growth) at a zero-layer point next to the ROI border could carry the
-                // front out of the ROI: drop growth at points whose 6-neighbourhood leaves the ROI.
-                const Lattice& l = field.lattice();
-                std::erase_if(edits, [&](const ZeroLayerEdit& e) {
-                    if (e.delta >= 0.0f) return false;
-                    const Vec3i p = l.coord(e.point);
-                    for (int k = 0; k < 7; ++k) {
-                        Vec3i q = p;
-                        if (k > 0) q[(k - 1) / 2] += (k % 2) ? 1 : -1;
-                        if (!l.contains(q) || (*roi)(q) == 0) return true;
-                    }
-                    return false;
-                });
-            }
-            if (options.topology_guard) rec.guarded = guard_topology(field, edits);
-            rec.modified = edits.size();
-            if (!edits.empty()) {
-                const ChangedPoints x = field.apply_edits(edits, RepairScope::kLocal);
-                rec.changed = x.size();
-                if (mesher) rec.fragments = mesher->update(field.phi(), x.points).size();
-            }
-        }
-        rec.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
+        const auto t0 = std::chrono::steady_clock::now();
+        while (next < order.size() && order[next].step <= step) loop.set_target(order[next++].position);
+        RepairStepLog rec = loop.step().log;
+        rec.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
         log.push_back(rec);
     }
     return log;

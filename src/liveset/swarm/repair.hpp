@@ -46,8 +46,50 @@ struct RepairStepLog {
 // cavity is kept. Flips already accepted count for the later points. Returns the number dropped.
 std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits);
 
-// Runs `options.steps` swarm steps. Edits that would grow the surface into voxels outside `roi`
-// (when given) are dropped. `mesher` (optional) must have been full_rebuild() on field.phi().
+// One repair step's outcome: the log line plus what a renderer needs (the changed points X and the
+// fragments the mesher rebuilt for them, sorted).
+struct RepairStep {
+    RepairStepLog log;
+    ChangedPoints changed;
+    std::vector<FragmentId> fragments;
+};
+
+// The interactive repair loop, one step at a time (the viewer calls step() once per frame, the CLI
+// in a loop): swarm move -> surface edits (ROI and topology guard applied) -> local level-set
+// update -> incremental mesh. The swarm is spawned on the surface nearest the first target; later
+// targets re-aim it (respawn() moves it at once, as a click far from the swarm would).
+class RepairLoop {
+public:
+    // `field`, `image_unit`, `roi` and `mesher` must outlive the loop; `mesher` (optional) must have
+    // been full_rebuild() on field.phi(). Throws std::invalid_argument on bad options or sizes.
+    RepairLoop(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
+               const RepairOptions& options, FragmentMesher* mesher = nullptr);
+
+    // Aims the swarm at `target` (index space, inside the lattice); spawns it there first if it
+    // has no agents yet. Throws std::invalid_argument outside the lattice or when no surface lies
+    // within options.spawn_radius of a first target.
+    void set_target(Vec3d target);
+    // Spawns the swarm afresh on the surface nearest `target` and aims it there.
+    void respawn(Vec3d target);
+    bool spawned() const { return spawned_; }
+    const Swarm& swarm() const { return swarm_; }
+    Swarm& swarm() { return swarm_; }
+
+    // One step (a no-op step with zero counts before the first target).
+    RepairStep step();
+
+private:
+    SparseField& field_;
+    const Grid<float>& image_unit_;
+    const Grid<std::uint8_t>* roi_;
+    RepairOptions options_;
+    FragmentMesher* mesher_;
+    Swarm swarm_;
+    bool spawned_ = false;
+    int steps_ = 0;
+};
+
+// Runs `options.steps` swarm steps of a RepairLoop, target k taking effect from its step on.
 // Stops early when `interrupt` turns true. Throws std::invalid_argument on bad targets/options.
 std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                                       std::span<const RepairTarget> targets, const RepairOptions& options,
