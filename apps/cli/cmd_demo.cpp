@@ -18,6 +18,7 @@
 #include "liveset/eval/perforations.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/intensity.hpp"
+#include "liveset/session/repair_presets.hpp"
 #include "liveset/swarm/repair.hpp"
 
 namespace liveset::cli {
@@ -32,17 +33,6 @@ struct DemoArgs {
     int round_steps = 100;  // swarm steps per round
     bool json = false, quiet = false;
 };
-
-// The swarm settings of the demo's repair (documented in docs/BENCHMARKS.md).
-RepairOptions demo_repair_options() {
-    RepairOptions ro;
-    ro.swarm.agents = 200;
-    ro.swarm.act_probability = 0.3;
-    ro.swarm.expand_sigmas = 2.0;  // grow where the outside is within 2 population sigmas
-    ro.swarm.edit_radius = 3.0;
-    ro.swarm.edit_range = 8.0;     // only agents within 8 voxels of the target edit
-    return ro;
-}
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -290,6 +291,13 @@ ChangedPoints SparseField::apply_in_box(Vec3i lo, Vec3i hi, const std::function<
 // The shared repair
 
 ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
+    const auto start = std::chrono::steady_clock::now();
+    ChangedPoints changed = repair_band(edits, scope);
+    last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return changed;
+}
+
+ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
     const std::size_t n = edits.size();
     if (n == 0) return {};
 
@@ -357,6 +365,32 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
     // 5. Outer layers from the new zero layer; 6. bookkeeping and the change report.
     sweep_layers(region);
     return finish(region);
+}
+
+ChangedPoints SparseField::restore(std::span<const PointState> states) {
+    const auto start = std::chrono::steady_clock::now();
+    for (const PointState& s : states) {
+        if (s.point >= phi_.size()) throw std::invalid_argument("restored point outside the lattice");
+        if (s.status < far_inside() || s.status > far_outside())
+            throw std::invalid_argument("restored status at " + point_text(lattice(), s.point) + " is out of range");
+        if (!std::isfinite(s.phi)) throw std::invalid_argument("restored value at " + point_text(lattice(), s.point) + " is not finite");
+    }
+    ChangedPoints changed;
+    for (const PointState& s : states) {
+        const PointIndex i = s.point;
+        const std::int8_t old = status_[i];
+        const bool value_changed = std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(s.phi);
+        if (old == s.status && !value_changed) continue;
+        if (old != s.status) {
+            if (old >= -layers_ && old <= layers_) list_remove(i, old);
+            if (s.status >= -layers_ && s.status <= layers_) list_add(i, s.status);
+            status_[i] = s.status;
+        }
+        phi_[i] = s.phi;
+        changed.points.push_back(i);
+    }
+    last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return changed;
 }
 
 void SparseField::mark_pending(PointIndex i, std::vector<RegionPoint>& region) {

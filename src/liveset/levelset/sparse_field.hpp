@@ -50,6 +50,13 @@ struct StepOptions {
     float max_dt = 1.0e9f;   // optional cap on the time step
 };
 
+// One point's complete level-set state (φ and status), as recorded for undo and redo.
+struct PointState {
+    PointIndex point;
+    float phi;
+    std::int8_t status;
+};
+
 struct StepResult {
     double dt = 0.0;               // time step taken
     std::size_t zero_layer = 0;    // zero-layer size before the step
@@ -97,6 +104,20 @@ public:
     // lattice): delta(p, φ(p)) gives each point's Δ. Cost grows with the box, not the band.
     ChangedPoints apply_in_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta);
 
+    // Writes back φ and status at the given points and moves them to the lists of their restored
+    // layers (undo / redo). The states must be ones recorded earlier for *every* point that changed
+    // since (e.g. the first-touched old state of each point of every X of an action): together
+    // with the untouched points they then form that earlier, valid state again, bit for bit (the
+    // lists hold the same points; only their order may differ, which no update depends on).
+    // Returns the points whose φ (bitwise) or status changed, for the mesher. Throws
+    // std::invalid_argument, before changing anything, on a point outside the lattice, a status
+    // outside [-(N+1), N+1] or a non-finite φ.
+    ChangedPoints restore(std::span<const PointState> states);
+
+    // Wall time of the last update's level-set work (step, apply_edits, apply_in_box or restore),
+    // for the viewer's per-frame breakdown; not part of the state.
+    double last_update_ms() const { return last_update_ms_; }
+
 private:
     struct RegionPoint {
         PointIndex point;
@@ -105,7 +126,8 @@ private:
     };
 
     void evaluate_sdf(const std::function<double(Vec3d)>& sdf);
-    ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);
+    ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);  // timed repair_band
+    ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope);
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     void collect_band(std::vector<RegionPoint>& region);
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
@@ -123,6 +145,7 @@ private:
     std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
     int steps_since_sort_ = 0;
+    double last_update_ms_ = 0.0;
     IndexDecoder decoder_;  // division-free index -> coordinate for the hot loops
 };
 

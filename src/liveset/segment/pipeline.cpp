@@ -1,11 +1,17 @@
 // segment_image(): normalise, estimate the window, initialise, evolve.
 #include "liveset/segment/pipeline.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 namespace liveset {
+
+void estimate_window(const SeedStatistics& stats, double epsilon_sigmas, double min_epsilon, ThresholdParams& params) {
+    params.mu = stats.median;
+    params.epsilon = std::max(min_epsilon, epsilon_sigmas * stats.mad_sigma);
+}
 
 SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req, const SegmentationHook& hook,
                              const std::atomic<bool>* interrupt) {
@@ -37,8 +43,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
         if (req.seeds.empty())
             throw std::invalid_argument("mu and epsilon must be given when starting from a mask (no seeds to estimate them)");
         out.seed_stats = seed_statistics(unit, req.seeds, req.roi);
-        p.mu = out.seed_stats->median;
-        p.epsilon = std::max(req.min_epsilon, req.epsilon_sigmas * out.seed_stats->mad_sigma);
+        estimate_window(*out.seed_stats, req.epsilon_sigmas, req.min_epsilon, p);
     }
     if (mu) p.mu = *mu;
     if (epsilon) p.epsilon = *epsilon;

@@ -44,6 +44,10 @@ struct SegmentOutcome {
     Grid<std::uint8_t> mask;  // φ < 0 within the ROI
 };
 
+// The window estimated from the seed balls' statistics (normalised units), as segment_image does
+// it: µ = median, ε = max(min_epsilon, epsilon_sigmas × robust σ). Sets params.mu and params.epsilon.
+void estimate_window(const SeedStatistics& stats, double epsilon_sigmas, double min_epsilon, ThresholdParams& params);
+
 // Throws std::invalid_argument with a one-line message on bad requests (no seeds and no initial
 // mask, seeds outside the image, masks of other dimensions, bad parameters, empty initial mask).
 SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& request, const SegmentationHook& hook = {},

@@ -3,7 +3,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <stdexcept>
 
 #include "liveset/levelset/shapes.hpp"
@@ -26,18 +25,43 @@ std::string to_string(StopReason reason) {
     return "unknown";
 }
 
+FrontConvergence::FrontConvergence(const Grid<float>& phi, const SegmentationOptions& options)
+    : window_(options.window), tolerance_(options.tolerance) {
+    validate(options);
+    const std::span<const float> values = phi.values();
+    inside_.resize(values.size());
+    for (std::size_t i = 0; i < values.size(); ++i) inside_count_ += inside_[i] = values[i] < 0.0f;
+}
+
+std::size_t FrontConvergence::record_step(const Grid<float>& phi, const ChangedPoints& changed) {
+    std::size_t flips = 0;
+    for (PointIndex x : changed.points) {
+        const std::uint8_t in = phi[x] < 0.0f;
+        if (in != inside_[x]) {
+            ++flips;
+            inside_count_ = in ? inside_count_ + 1 : inside_count_ - 1;
+            inside_[x] = in;
+        }
+    }
+    return flips;
+}
+
+bool FrontConvergence::converged(std::size_t zero_layer) {
+    recent_.push_back(inside_count_);
+    if (recent_.size() > static_cast<std::size_t>(window_) + 1) recent_.pop_front();
+    if (recent_.size() < static_cast<std::size_t>(window_) + 1) return false;
+    const double net = std::abs(static_cast<double>(recent_.back()) - static_cast<double>(recent_.front()));
+    return net < std::max(1.0, tolerance_ * static_cast<double>(zero_layer));
+}
+
 SegmentationResult run_segmentation(SparseField& field, const Speed& speed, const SegmentationOptions& options,
                                     const SegmentationHook& hook, const std::atomic<bool>* interrupt) {
     validate(options);
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
-    const std::span<const float> phi = field.phi().values();
-    std::vector<std::uint8_t> inside(phi.size());
-    std::size_t inside_count = 0;
-    for (std::size_t i = 0; i < phi.size(); ++i) inside_count += inside[i] = phi[i] < 0.0f;
+    FrontConvergence convergence(field.phi(), options);
 
     SegmentationResult result;
-    std::deque<std::size_t> recent;
     for (int it = 1; it <= options.max_iterations; ++it) {
         if (interrupt && interrupt->load(std::memory_order_relaxed)) {
             result.reason = StopReason::kInterrupted;
@@ -53,38 +77,23 @@ SegmentationResult run_segmentation(SparseField& field, const Speed& speed, cons
         pr.iteration = it;
         pr.dt = step.dt;
         pr.changed = step.changed.size();
-        const std::span<const float> now = field.phi().values();
-        for (PointIndex x : step.changed.points) {
-            const std::uint8_t in = now[x] < 0.0f;
-            if (in != inside[x]) {
-                ++pr.flips;
-                inside_count = in ? inside_count + 1 : inside_count - 1;
-                inside[x] = in;
-            }
-        }
+        pr.flips = convergence.record_step(field.phi(), step.changed);
         pr.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
         pr.zero_layer = field.zero_layer().size();
         pr.band = field.band_size();
-        pr.inside = inside_count;
+        pr.inside = convergence.inside();
         result.iterations = it;
         if (hook && !hook(pr, step.changed)) {
             result.reason = StopReason::kInterrupted;
             break;
         }
-        // Net change of the inside count over the window: points oscillating across the front at
-        // the edge of the threshold window cancel out, a front still advancing does not.
-        recent.push_back(pr.inside);
-        if (recent.size() > static_cast<std::size_t>(options.window) + 1) recent.pop_front();
-        if (recent.size() == static_cast<std::size_t>(options.window) + 1) {
-            const double net = std::abs(static_cast<double>(recent.back()) - static_cast<double>(recent.front()));
-            if (net < std::max(1.0, options.tolerance * static_cast<double>(pr.zero_layer))) {
-                result.reason = StopReason::kConverged;
-                break;
-            }
+        if (convergence.converged(pr.zero_layer)) {
+            result.reason = StopReason::kConverged;
+            break;
         }
         if (it == options.max_iterations) result.reason = StopReason::kIterationLimit;
     }
-    result.inside = inside_count;
+    result.inside = convergence.inside();
     result.seconds = std::chrono::duration<double>(clock::now() - start).count();
     return result;
 }

@@ -5,9 +5,11 @@
 
 #include <atomic>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "liveset/grid/grid.hpp"
 #include "liveset/levelset/sparse_field.hpp"
@@ -47,6 +49,29 @@ struct SegmentationResult {
     StopReason reason = StopReason::kIterationLimit;
     double seconds = 0.0;
     std::size_t inside = 0;
+};
+
+// Convergence of a moving front as run_segmentation judges it (the viewer's session uses the same
+// rule): the inside points are counted once, then kept up to date from each step's X; the front
+// has converged when the net change of the inside count over the last `window` steps is below
+// max(1, tolerance × zero-layer size) - points flickering across the front at the edge of the
+// threshold window cancel out, a front still advancing does not.
+class FrontConvergence {
+public:
+    // Validates `options` (std::invalid_argument) and counts the inside points of `phi`.
+    FrontConvergence(const Grid<float>& phi, const SegmentationOptions& options);
+    // After a step that changed the points X of `phi`: the number of points that changed side.
+    std::size_t record_step(const Grid<float>& phi, const ChangedPoints& changed);
+    std::size_t inside() const { return inside_count_; }
+    // Adds the current inside count to the window; true when the front has converged.
+    bool converged(std::size_t zero_layer);
+
+private:
+    std::vector<std::uint8_t> inside_;
+    std::size_t inside_count_ = 0;
+    std::deque<std::size_t> recent_;
+    int window_;
+    double tolerance_;
 };
 
 // Called after every step with the progress and X; returning false interrupts the run.

@@ -1,0 +1,158 @@
+// EditHistory: per-action first-touched old states against a shadow of the level set.
+#include "liveset/session/edit_history.hpp"
+
+#include <bit>
+#include <stdexcept>
+
+namespace liveset {
+
+namespace {
+
+// Marks a shadow point whose old state is already in the open action's `before` list (a status
+// no sparse field uses: its layers are within ±(kMaxLayers + 1)).
+constexpr std::int8_t kRecorded = 127;
+
+bool same_marks(const SessionMarks& a, const SessionMarks& b) {
+    if (a.seeds.size() != b.seeds.size()) return false;
+    for (std::size_t i = 0; i < a.seeds.size(); ++i)
+        if (!(a.seeds[i].center == b.seeds[i].center) || a.seeds[i].radius != b.seeds[i].radius) return false;
+    return a.params.mu == b.params.mu && a.params.epsilon == b.params.epsilon && a.params.n == b.params.n &&
+           a.params.alpha == b.params.alpha && a.window_from_seeds == b.window_from_seeds && a.pristine == b.pristine &&
+           a.iterations == b.iterations;
+}
+
+bool same_state(const PointState& a, const PointState& b) {
+    return a.status == b.status && std::bit_cast<std::uint32_t>(a.phi) == std::bit_cast<std::uint32_t>(b.phi);
+}
+
+}  // namespace
+
+std::size_t EditAction::bytes() const {
+    return (before.capacity() + after.capacity()) * sizeof(PointState) +
+           (marks_before.seeds.capacity() + marks_after.seeds.capacity()) * sizeof(SeedBall) + sizeof(EditAction);
+}
+
+EditHistory::EditHistory(const SparseField& field, std::size_t limit) : limit_(std::max<std::size_t>(limit, 1)) {
+    reset(field);
+}
+
+void EditHistory::reset(const SparseField& field) {
+    shadow_phi_ = field.phi();
+    shadow_status_ = field.status();
+    open_ = false;
+    current_ = {};
+    undo_.clear();
+    redo_.clear();
+}
+
+void EditHistory::begin(std::string label, SessionMarks marks_before) {
+    if (open_) throw std::logic_error("an action is already open");
+    current_ = {};
+    current_.label = std::move(label);
+    current_.marks_before = std::move(marks_before);
+    open_ = true;
+}
+
+void EditHistory::record(const ChangedPoints& changed) {
+    if (!open_) throw std::logic_error("no action is open");
+    for (PointIndex x : changed.points) {
+        if (shadow_status_[x] == kRecorded) continue;
+        current_.before.push_back({x, shadow_phi_[x], shadow_status_[x]});
+        shadow_status_[x] = kRecorded;
+    }
+}
+
+ChangedPoints EditHistory::record_differences(const SparseField& field) {
+    if (!open_) throw std::logic_error("no action is open");
+    ChangedPoints changed;
+    const Grid<float>& phi = field.phi();
+    const Grid<std::int8_t>& status = field.status();
+    for (std::size_t n = 0; n < phi.size(); ++n) {
+        const auto i = static_cast<PointIndex>(n);
+        if (shadow_status_[i] == kRecorded) {
+            changed.points.push_back(i);  // changed earlier in this action: may have changed again
+            continue;
+        }
+        if (shadow_status_[i] != status[i] ||
+            std::bit_cast<std::uint32_t>(shadow_phi_[i]) != std::bit_cast<std::uint32_t>(phi[i]))
+            changed.points.push_back(i);
+    }
+    record(changed);
+    return changed;
+}
+
+bool EditHistory::commit(const SparseField& field, SessionMarks marks_after) {
+    if (!open_) return false;
+    open_ = false;
+    EditAction action = std::move(current_);
+    current_ = {};
+    action.marks_after = std::move(marks_after);
+    // New states; points that came back to their old state are left out.
+    std::vector<PointState> before;
+    before.reserve(action.before.size());
+    action.after.reserve(action.before.size());
+    for (const PointState& b : action.before) {
+        const PointState now{b.point, field.phi()[b.point], field.status()[b.point]};
+        shadow_phi_[b.point] = now.phi;
+        shadow_status_[b.point] = now.status;
+        if (same_state(b, now)) continue;
+        before.push_back(b);
+        action.after.push_back(now);
+    }
+    action.before = std::move(before);
+    action.before.shrink_to_fit();
+    action.after.shrink_to_fit();
+    if (action.before.empty() && same_marks(action.marks_before, action.marks_after)) return false;
+    undo_.push_back(std::move(action));
+    while (undo_.size() > limit_) undo_.pop_front();
+    redo_.clear();
+    return true;
+}
+
+const std::string& EditHistory::next_undo_label() const {
+    static const std::string none;
+    return undo_.empty() ? none : undo_.back().label;
+}
+
+const std::string& EditHistory::next_redo_label() const {
+    static const std::string none;
+    return redo_.empty() ? none : redo_.back().label;
+}
+
+std::size_t EditHistory::bytes() const {
+    std::size_t n = 0;
+    for (const EditAction& a : undo_) n += a.bytes();
+    for (const EditAction& a : redo_) n += a.bytes();
+    return n;
+}
+
+void EditHistory::adopt(std::span<const PointState> states) {
+    for (const PointState& s : states) {
+        shadow_phi_[s.point] = s.phi;
+        shadow_status_[s.point] = s.status;
+    }
+}
+
+HistoryStep EditHistory::undo(SparseField& field) {
+    if (open_) throw std::logic_error("close the open action before undoing");
+    if (undo_.empty()) throw std::logic_error("nothing to undo");
+    EditAction action = std::move(undo_.back());
+    undo_.pop_back();
+    HistoryStep step{field.restore(action.before), action.marks_before, action.label};
+    adopt(action.before);
+    redo_.push_back(std::move(action));
+    return step;
+}
+
+HistoryStep EditHistory::redo(SparseField& field) {
+    if (open_) throw std::logic_error("close the open action before redoing");
+    if (redo_.empty()) throw std::logic_error("nothing to redo");
+    EditAction action = std::move(redo_.back());
+    redo_.pop_back();
+    HistoryStep step{field.restore(action.after), action.marks_after, action.label};
+    adopt(action.after);
+    undo_.push_back(std::move(action));
+    return step;
+}
+
+}  // namespace liveset

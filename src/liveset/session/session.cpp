@@ -1,0 +1,356 @@
+// Session: every change of φ goes through one of these methods, then to the mesher and history.
+#include "liveset/session/session.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "liveset/levelset/shapes.hpp"
+#include "liveset/mesh/marching_cubes.hpp"
+#include "liveset/segment/pipeline.hpp"
+
+namespace liveset {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+const SessionOptions& checked(const SessionOptions& o) {
+    if (o.history < 20) throw std::invalid_argument("the undo history must keep at least 20 actions");
+    if (!std::isfinite(o.epsilon_sigmas) || o.epsilon_sigmas <= 0 || !std::isfinite(o.min_epsilon) || o.min_epsilon <= 0)
+        throw std::invalid_argument("the epsilon estimate needs positive sigmas and floor");
+    validate(o.segmentation);
+    validate(o.repair.swarm);
+    validate(o.params);
+    return o;
+}
+
+}  // namespace
+
+Session::Session(Grid<float> image, const SessionOptions& options, std::optional<Grid<std::uint8_t>> roi)
+    : options_(checked(options)),
+      image_(std::move(image)),
+      roi_(std::move(roi)),
+      scale_(robust_scale(image_, roi_ ? &*roi_ : nullptr, options.scale)),
+      unit_(normalise(image_, scale_)),
+      field_(image_.lattice(), options.layers),
+      mesher_(image_.lattice(), options.fragment_size),
+      repair_options_(options.repair),
+      history_(field_, options.history) {
+    marks_.params = options.params;
+    mesher_.full_rebuild(field_.phi(), field_.zero_layer());
+    dirty_flags_.assign(mesher_.fragment_count(), 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Initial level set
+
+void Session::load_mask(const Grid<std::uint8_t>& mask) {
+    if (!(mask.dims() == lattice().dims())) throw std::invalid_argument("the mask's size differs from the image's");
+    field_.init_from_mask(mask);
+    reset_after_load();
+}
+
+void Session::load_phi(const Grid<float>& phi) {
+    if (!(phi.dims() == lattice().dims())) throw std::invalid_argument("phi's size differs from the image's");
+    field_.init_from_sdf([&](Vec3d p) {
+        const Vec3i q{static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)), static_cast<int>(std::lround(p.z))};
+        return static_cast<double>(phi(q));
+    });
+    reset_after_load();
+}
+
+void Session::reset_after_load() {
+    mesher_.full_rebuild(field_.phi(), field_.zero_layer());
+    for (FragmentId f = 0; f < mesher_.fragment_count(); ++f)
+        if (!dirty_flags_[f]) {
+            dirty_flags_[f] = 1;
+            dirty_.push_back(f);
+        }
+    history_.reset(field_);
+    marks_.pristine = false;
+    marks_.iterations = 0;
+    segment_ = {};
+    convergence_.reset();
+    repair_.reset();
+    target_.reset();
+    ++revision_;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Seeds and parameters
+
+SessionUpdate Session::add_seed(SeedBall seed) {
+    if (!all_finite(seed.center) || !lattice().contains(seed.center))
+        throw std::invalid_argument("a seed lies outside the image");
+    if (!std::isfinite(seed.radius) || seed.radius <= 0) throw std::invalid_argument("a seed's radius must be positive");
+    end_action();
+    history_.begin("seed", marks());
+    const auto t0 = Clock::now();
+    const shapes::Sphere ball(seed.center, std::max(seed.radius, 0.5));
+    const Grid<float>& phi = field_.phi();
+    const Lattice& lat = lattice();
+    // Union with the ball: min(φ, distance to the ball). Each evaluation reads only its own point.
+    field_.init_from_sdf([&](Vec3d p) { return std::min(static_cast<double>(phi[lat.index(p.cast<int>())]), ball(p)); });
+    ChangedPoints changed = history_.record_differences(field_);
+    const double ms = ms_since(t0);
+    marks_.seeds.push_back(seed);
+    refresh_window();
+    SessionUpdate u = finish_update(std::move(changed), ms);
+    history_.commit(field_, marks());
+    return u;
+}
+
+SessionUpdate Session::remove_seed(std::size_t index) {
+    if (index >= marks_.seeds.size()) throw std::invalid_argument("no such seed");
+    end_action();
+    history_.begin("remove seed", marks());
+    marks_.seeds.erase(marks_.seeds.begin() + static_cast<std::ptrdiff_t>(index));
+    refresh_window();
+    SessionUpdate u;
+    if (marks_.pristine) {
+        const auto t0 = Clock::now();
+        if (marks_.seeds.empty()) {
+            const double far = field_.layers() + 1.0;
+            field_.init_from_sdf([far](Vec3d) { return far; });
+        } else {
+            init_from_seeds(field_, marks_.seeds);
+        }
+        ChangedPoints changed = history_.record_differences(field_);
+        u = finish_update(std::move(changed), ms_since(t0));
+    }
+    ++revision_;
+    history_.commit(field_, marks());
+    return u;
+}
+
+std::optional<std::size_t> Session::seed_at(Vec3d p, double tolerance) const {
+    std::optional<std::size_t> best;
+    double best_gap = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < marks_.seeds.size(); ++i) {
+        const double gap = norm(p - marks_.seeds[i].center) - marks_.seeds[i].radius;
+        if (gap <= tolerance && gap < best_gap) {
+            best_gap = gap;
+            best = i;
+        }
+    }
+    return best;
+}
+
+std::optional<ThresholdParams> Session::estimated_window() const {
+    if (marks_.seeds.empty()) return std::nullopt;
+    try {
+        const SeedStatistics stats = seed_statistics(unit_, marks_.seeds, roi());
+        ThresholdParams p = marks_.params;
+        estimate_window(stats, options_.epsilon_sigmas, options_.min_epsilon, p);
+        return p;
+    } catch (const std::invalid_argument&) {
+        return std::nullopt;  // e.g. no seed voxel inside the ROI
+    }
+}
+
+void Session::refresh_window() {
+    if (!marks_.window_from_seeds) return;
+    if (const auto p = estimated_window()) {
+        marks_.params.mu = p->mu;
+        marks_.params.epsilon = p->epsilon;
+    }
+    speed_.reset();
+    segment_.converged = false;
+}
+
+void Session::set_params(const ThresholdParams& params, bool window_from_seeds) {
+    ThresholdParams p = params;
+    if (window_from_seeds)
+        if (const auto w = estimated_window()) {
+            p.mu = w->mu;
+            p.epsilon = w->epsilon;
+        }
+    validate(p);
+    begin_action("parameters");
+    marks_.params = p;
+    marks_.window_from_seeds = window_from_seeds;
+    speed_.reset();
+    segment_.converged = false;
+    ++revision_;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Segmentation and repair
+
+SessionUpdate Session::segment_step() {
+    if (!has_surface()) {
+        segment_.vanished = true;
+        return {};
+    }
+    begin_action("segment");
+    if (!speed_) speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi());
+    if (!convergence_) convergence_.emplace(field_.phi(), options_.segmentation);
+    const auto t0 = Clock::now();
+    StepResult step = field_.step(*speed_, options_.segmentation.step);
+    const double ms = ms_since(t0);
+    history_.record(step.changed);
+    segment_.flips = convergence_->record_step(field_.phi(), step.changed);
+    segment_.inside = convergence_->inside();
+    segment_.dt = step.dt;
+    segment_.iterations = ++marks_.iterations;
+    segment_.converged = convergence_->converged(field_.zero_layer().size());
+    segment_.vanished = field_.zero_layer().empty();
+    marks_.pristine = false;
+    return finish_update(std::move(step.changed), ms);
+}
+
+void Session::make_repair_loop() { repair_ = std::make_unique<RepairLoop>(field_, unit_, roi(), repair_options_, nullptr); }
+
+void Session::set_repair_options(const RepairOptions& options) {
+    validate(options.swarm);
+    repair_options_ = options;
+    if (!repair_) return;
+    make_repair_loop();
+    if (target_) {
+        try {
+            repair_->respawn(*target_);
+        } catch (const std::invalid_argument&) {
+            target_.reset();  // the surface moved away from the old target (e.g. undone)
+        }
+    }
+    ++revision_;
+}
+
+void Session::set_target(Vec3d target) {
+    if (!all_finite(target) || !lattice().contains(target)) throw std::invalid_argument("the target lies outside the image");
+    end_action();  // each target's repair is its own undoable action
+    if (!repair_) make_repair_loop();
+    bool near_swarm = false;
+    if (repair_->spawned())
+        for (const Agent& a : repair_->swarm().agents())
+            if (norm(a.position - target) <= repair_options_.spawn_radius) {
+                near_swarm = true;
+                break;
+            }
+    if (near_swarm)
+        repair_->set_target(target);
+    else
+        repair_->respawn(target);
+    target_ = target;
+    ++revision_;
+}
+
+void Session::clear_target() {
+    end_action();
+    repair_.reset();
+    target_.reset();
+    ++revision_;
+}
+
+std::optional<Vec3d> Session::nearest_surface_point(Vec3d p, double radius) const {
+    std::optional<Vec3d> best;
+    double best_d = radius;
+    for (PointIndex i : field_.zero_layer()) {
+        const Vec3d q = lattice().coord(i).cast<double>();
+        const double d = norm(q - p);
+        if (d <= best_d) {
+            best_d = d;
+            best = q;
+        }
+    }
+    return best;
+}
+
+SessionUpdate Session::swarm_step() {
+    if (!repair_ || !repair_->spawned()) return {};
+    begin_action("repair");
+    RepairStep step = repair_->step();
+    const double level_set_ms = step.log.modified > 0 ? field_.last_update_ms() : 0.0;
+    history_.record(step.changed);
+    if (!step.changed.empty()) {
+        marks_.pristine = false;
+        convergence_.reset();
+    }
+    SessionUpdate u = finish_update(std::move(step.changed), level_set_ms);
+    u.agents_ms = std::max(0.0, step.log.ms - level_set_ms);
+    return u;
+}
+
+const std::vector<Agent>& Session::agents() const {
+    static const std::vector<Agent> none;
+    return repair_ ? repair_->swarm().agents() : none;
+}
+
+// ---------------------------------------------------------------------------------------------
+// History
+
+void Session::begin_action(const char* label) {
+    if (history_.action_open() && history_.open_label() == label) return;
+    end_action();
+    history_.begin(label, marks());
+}
+
+void Session::end_action() {
+    if (history_.action_open()) history_.commit(field_, marks());
+}
+
+void Session::adopt_marks(const SessionMarks& m) {
+    marks_ = m;
+    speed_.reset();
+    convergence_.reset();
+    segment_ = {};
+    segment_.iterations = m.iterations;
+}
+
+SessionUpdate Session::undo() {
+    end_action();
+    if (!history_.can_undo()) return {};
+    const auto t0 = Clock::now();
+    HistoryStep step = history_.undo(field_);
+    const double ms = ms_since(t0);
+    adopt_marks(step.marks);
+    return finish_update(std::move(step.changed), ms);
+}
+
+SessionUpdate Session::redo() {
+    end_action();
+    if (!history_.can_redo()) return {};
+    const auto t0 = Clock::now();
+    HistoryStep step = history_.redo(field_);
+    const double ms = ms_since(t0);
+    adopt_marks(step.marks);
+    return finish_update(std::move(step.changed), ms);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Renderer feed and outputs
+
+SessionUpdate Session::finish_update(ChangedPoints changed, double level_set_ms) {
+    SessionUpdate u;
+    u.level_set_ms = level_set_ms;
+    const auto t0 = Clock::now();
+    u.fragments = mesher_.update(field_.phi(), changed.points);
+    u.mesh_ms = ms_since(t0);
+    for (FragmentId f : u.fragments)
+        if (!dirty_flags_[f]) {
+            dirty_flags_[f] = 1;
+            dirty_.push_back(f);
+        }
+    u.changed = std::move(changed);
+    ++revision_;
+    return u;
+}
+
+std::vector<FragmentId> Session::take_dirty_fragments() {
+    std::vector<FragmentId> out;
+    out.swap(dirty_);
+    for (FragmentId f : out) dirty_flags_[f] = 0;
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+Grid<std::uint8_t> Session::mask() const { return inside_mask(field_.phi(), roi()); }
+
+Mesh Session::surface_mesh() const { return marching_cubes_band(field_.phi(), field_.zero_layer()); }
+
+}  // namespace liveset

@@ -1,0 +1,176 @@
+// One interactive editing session, shared by the viewer's window, its scripts and `liveset demo`:
+// the image (raw and normalised to [0, 1]), the seeds, the threshold parameters, the sparse-field
+// level set, the incremental fragment mesher, the threshold speed, the swarm repair loop and the
+// undo/redo history. Every change of φ goes through here, so every change reaches the mesher
+// (whose rebuilt fragments the renderer re-uploads) and the history:
+//
+//   segment_step() / swarm_step() / add_seed() / undo() ...  ->  X  ->  FragmentMesher::update  ->  U
+//
+// Standard library + oneTBB only (no GL, no ITK). Not thread-safe: one thread drives a session.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "liveset/mesh/fragment_mesher.hpp"
+#include "liveset/segment/intensity.hpp"
+#include "liveset/segment/segmentation.hpp"
+#include "liveset/segment/threshold_speed.hpp"
+#include "liveset/session/edit_history.hpp"
+#include "liveset/swarm/repair.hpp"
+
+namespace liveset {
+
+struct SessionOptions {
+    int layers = 2;               // sparse-field layers N
+    int fragment_size = 16;       // cells per mesh fragment edge (one GPU buffer each)
+    std::size_t history = 32;     // undoable actions kept (at least 20)
+    ScaleOptions scale;           // intensity normalisation
+    double epsilon_sigmas = 5.0;  // ε estimate from the seeds (as `liveset segment`)
+    double min_epsilon = 0.05;
+    SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
+    RepairOptions repair;              // swarm settings (steps unused: the caller steps)
+    ThresholdParams params;            // initial n and α (µ, ε too when there are no seeds)
+};
+
+// What one call changed, for the renderer and the status line.
+struct SessionUpdate {
+    ChangedPoints changed;              // X
+    std::vector<FragmentId> fragments;  // U: fragments the mesher rebuilt (sorted)
+    double level_set_ms = 0.0;          // sparse-field update (step, edits, restore, re-init)
+    double agents_ms = 0.0;             // swarm move and edit proposals
+    double mesh_ms = 0.0;               // incremental marching cubes
+};
+
+struct SegmentStatus {
+    int iterations = 0;        // steps taken since the level set was (re)initialised
+    bool converged = false;    // the last step met the convergence rule
+    bool vanished = false;     // no zero layer left (nothing to evolve)
+    std::size_t flips = 0;     // points that changed side in the last step
+    std::size_t inside = 0;    // inside points after the last step
+    double dt = 0.0;
+};
+
+class Session {
+public:
+    // `image` raw intensities; `roi` (optional, same dimensions) bounds the front and the output
+    // mask. The level set starts empty (no surface): add seeds or load a mask / φ.
+    // Throws std::invalid_argument on bad options, a flat image or a ROI of other dimensions.
+    Session(Grid<float> image, const SessionOptions& options, std::optional<Grid<std::uint8_t>> roi = {});
+    Session(const Session&) = delete;
+    Session& operator=(const Session&) = delete;
+
+    // --- data -------------------------------------------------------------------------------
+    const Lattice& lattice() const { return image_.lattice(); }
+    const Grid<float>& image() const { return image_; }
+    const Grid<float>& unit_image() const { return unit_; }
+    const IntensityScale& scale() const { return scale_; }
+    const Grid<std::uint8_t>* roi() const { return roi_ ? &*roi_ : nullptr; }
+    const SparseField& field() const { return field_; }
+    const FragmentMesher& mesher() const { return mesher_; }
+    bool has_surface() const { return !field_.zero_layer().empty(); }
+
+    // --- initial level set (each clears the history) ----------------------------------------
+    void load_mask(const Grid<std::uint8_t>& mask);  // non-zero inside; same dimensions
+    void load_phi(const Grid<float>& phi);           // < 0 inside, any scale; same dimensions
+
+    // --- seeds (undoable) -------------------------------------------------------------------
+    const std::vector<SeedBall>& seeds() const { return marks_.seeds; }
+    // Adds a seed ball (index space; centre inside the image) and unites it with the level set.
+    SessionUpdate add_seed(SeedBall seed);
+    // Removes seed `index`. While the level set is still the union of the seeds (no step taken
+    // since), it is re-initialised from the remaining ones; later, only the list (and the window
+    // estimate) changes - undo takes back grown regions.
+    SessionUpdate remove_seed(std::size_t index);
+    // The seed whose ball contains `p` (or lies within `tolerance` voxels of it), nearest first.
+    std::optional<std::size_t> seed_at(Vec3d p, double tolerance = 1.0) const;
+
+    // --- threshold speed (Eq. 2-3; µ, ε in normalised units) --------------------------------
+    const ThresholdParams& params() const { return marks_.params; }
+    bool window_from_seeds() const { return marks_.window_from_seeds; }
+    // Sets n, α and, unless `window_from_seeds`, µ and ε (then estimated from the seeds: median
+    // and epsilon_sigmas × robust σ, as `liveset segment`). Throws std::invalid_argument.
+    void set_params(const ThresholdParams& params, bool window_from_seeds);
+    // The window the seeds give (nullopt without seeds).
+    std::optional<ThresholdParams> estimated_window() const;
+
+    // --- segmentation -----------------------------------------------------------------------
+    // One global sparse-field step of the threshold speed; consecutive steps form one action.
+    SessionUpdate segment_step();
+    const SegmentStatus& segment_status() const { return segment_; }
+
+    // --- swarm repair -----------------------------------------------------------------------
+    const RepairOptions& repair_options() const { return repair_options_; }
+    // New swarm settings (agents, p, radius, ...): the swarm is re-created and, when it had a
+    // target, respawned there. Throws std::invalid_argument on invalid options.
+    void set_repair_options(const RepairOptions& options);
+    // Aims the swarm at `target` (index space). The first target, or one with no agent within
+    // the spawn radius (a click far from the swarm), spawns the swarm on the surface there.
+    // Throws std::invalid_argument outside the image or with no surface near a spawn point.
+    void set_target(Vec3d target);
+    void clear_target();
+    const std::optional<Vec3d>& target() const { return target_; }
+    // The zero-layer point nearest `p` within `radius` voxels (nullopt: none).
+    std::optional<Vec3d> nearest_surface_point(Vec3d p, double radius) const;
+    // One swarm step (move, edits, local level-set update); consecutive steps form one action.
+    // A no-op without a target.
+    SessionUpdate swarm_step();
+    const std::vector<Agent>& agents() const;
+
+    // --- history ----------------------------------------------------------------------------
+    // Closes the open action (a run paused, a script entry done, another kind of edit begins).
+    void end_action();
+    bool can_undo() const { return history_.undo_depth() > 0; }
+    bool can_redo() const { return history_.redo_depth() > 0; }
+    std::size_t undo_depth() const { return history_.undo_depth(); }
+    std::size_t redo_depth() const { return history_.redo_depth(); }
+    std::string next_undo_label() const { return history_.next_undo_label(); }
+    std::string next_redo_label() const { return history_.next_redo_label(); }
+    std::size_t history_bytes() const { return history_.bytes(); }
+    // Each closes the open action first; a no-op (empty update) when there is nothing to undo/redo.
+    SessionUpdate undo();
+    SessionUpdate redo();
+
+    // --- renderer feed ----------------------------------------------------------------------
+    // Fragments rebuilt since the last call (sorted, unique): the buffers to re-upload.
+    std::vector<FragmentId> take_dirty_fragments();
+    // Counts every change of φ, the seeds, the target or the agents (for redraw decisions).
+    std::uint64_t revision() const { return revision_; }
+
+    // --- outputs ----------------------------------------------------------------------------
+    Grid<std::uint8_t> mask() const;  // φ < 0 within the ROI
+    Mesh surface_mesh() const;        // marching cubes of the zero layer (index space)
+
+private:
+    SessionMarks marks() const { return marks_; }
+    void begin_action(const char* label);  // continues an open action of the same label
+    SessionUpdate finish_update(ChangedPoints changed, double level_set_ms);
+    void adopt_marks(const SessionMarks& marks);
+    void reset_after_load();
+    void refresh_window();
+    void make_repair_loop();
+
+    SessionOptions options_;
+    Grid<float> image_;
+    std::optional<Grid<std::uint8_t>> roi_;
+    IntensityScale scale_;
+    Grid<float> unit_;
+    SparseField field_;
+    FragmentMesher mesher_;
+    SessionMarks marks_;
+    std::unique_ptr<ThresholdSpeed> speed_;  // for marks_.params; rebuilt lazily
+    std::optional<FrontConvergence> convergence_;
+    SegmentStatus segment_;
+    RepairOptions repair_options_;
+    std::unique_ptr<RepairLoop> repair_;
+    std::optional<Vec3d> target_;
+    EditHistory history_;
+    std::vector<std::uint8_t> dirty_flags_;
+    std::vector<FragmentId> dirty_;
+    std::uint64_t revision_ = 0;
+};
+
+}  // namespace liveset

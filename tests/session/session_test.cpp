@@ -1,0 +1,241 @@
+// Session: segmenting from seeds gives bit for bit what `liveset segment` (segment_image) gives,
+// the incremental mesh after any session update equals whole-volume marching cubes, the renderer
+// feed (dirty fragments) keeps a mirror of the buffers exact, and undo/redo across seeds,
+// segmentation and swarm actions restore φ, status and seeds exactly.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <map>
+#include <vector>
+
+#include "liveset/levelset/invariants.hpp"
+#include "liveset/mesh/marching_cubes.hpp"
+#include "liveset/mesh/mesh_analysis.hpp"
+#include "liveset/phantom/phantom.hpp"
+#include "liveset/segment/pipeline.hpp"
+#include "liveset/session/repair_presets.hpp"
+#include "liveset/session/session.hpp"
+
+namespace liveset {
+namespace {
+
+const Phantom& phantom64() {
+    static const Phantom ph = [] {
+        PhantomOptions o;
+        o.size = 64;
+        return make_phantom(o);
+    }();
+    return ph;
+}
+
+struct State {
+    std::vector<std::uint32_t> phi;
+    std::vector<std::int8_t> status;
+    std::size_t seeds = 0;
+    bool operator==(const State&) const = default;
+};
+
+State state_of(const Session& s) {
+    State st;
+    for (float v : s.field().phi().values()) st.phi.push_back(std::bit_cast<std::uint32_t>(v));
+    st.status.assign(s.field().status().values().begin(), s.field().status().values().end());
+    st.seeds = s.seeds().size();
+    return st;
+}
+
+// A renderer stand-in: copies only the fragments the session reports dirty.
+struct BufferMirror {
+    std::map<FragmentId, Mesh> buffers;
+    void sync(Session& s) {
+        for (FragmentId f : s.take_dirty_fragments()) {
+            const FragmentView v = s.mesher().fragment(f);
+            buffers[f] = Mesh{{v.vertices.begin(), v.vertices.end()}, {v.indices.begin(), v.indices.end()}};
+        }
+    }
+    void expect_matches(const Session& s) const {
+        for (FragmentId f = 0; f < s.mesher().fragment_count(); ++f) {
+            const FragmentView v = s.mesher().fragment(f);
+            const auto it = buffers.find(f);
+            const std::size_t n = it == buffers.end() ? 0 : it->second.vertices.size();
+            ASSERT_EQ(n, v.vertices.size()) << "fragment " << f;
+            if (n == 0) continue;
+            ASSERT_TRUE(std::equal(v.indices.begin(), v.indices.end(), it->second.indices.begin(), it->second.indices.end()));
+            for (std::size_t k = 0; k < n; ++k)
+                for (int c = 0; c < 3; ++c) {
+                    ASSERT_EQ(v.vertices[k].position[c], it->second.vertices[k].position[c]) << "fragment " << f;
+                    ASSERT_EQ(v.vertices[k].normal[c], it->second.vertices[k].normal[c]) << "fragment " << f;
+                }
+        }
+    }
+};
+
+void expect_mesh_is_whole_volume_mesh(const Session& s) {
+    const Mesh whole = marching_cubes_band(s.field().phi(), s.field().zero_layer());
+    ASSERT_GT(whole.triangle_count(), 0u);
+    EXPECT_EQ(canonical_triangles(s.mesher().merged()), canonical_triangles(whole));
+    FragmentMesher fresh(s.lattice(), s.mesher().fragment_size());
+    fresh.full_rebuild(s.field().phi());
+    for (FragmentId f = 0; f < fresh.fragment_count(); ++f) {
+        const FragmentView a = fresh.fragment(f), b = s.mesher().fragment(f);
+        ASSERT_EQ(a.vertices.size(), b.vertices.size()) << "fragment " << f;
+        ASSERT_TRUE(std::equal(a.indices.begin(), a.indices.end(), b.indices.begin(), b.indices.end())) << "fragment " << f;
+    }
+}
+
+SessionOptions options() {
+    SessionOptions o;
+    o.repair = demo_repair_options();
+    return o;
+}
+
+TEST(Session, SegmentsFromSeedsExactlyAsLivesetSegment) {
+    const Phantom& ph = phantom64();
+    Session s(ph.image, options());
+    SegmentRequest req;
+    for (const Vec3i& c : ph.seeds) {
+        req.seeds.push_back({c.cast<double>(), 2.0});
+        s.add_seed({c.cast<double>(), 2.0});
+    }
+    int steps = 0;
+    while (!s.segment_status().converged && steps < 2000) {
+        s.segment_step();
+        ++steps;
+    }
+    const SegmentOutcome o = segment_image(ph.image, req);
+    ASSERT_EQ(o.result.reason, StopReason::kConverged);
+    EXPECT_EQ(steps, o.result.iterations);
+    EXPECT_DOUBLE_EQ(s.params().mu, o.params.mu);
+    EXPECT_DOUBLE_EQ(s.params().epsilon, o.params.epsilon);
+    for (std::size_t i = 0; i < o.field->phi().size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(s.field().phi()[p]), std::bit_cast<std::uint32_t>(o.field->phi()[p])) << i;
+        ASSERT_EQ(s.field().status()[p], o.field->status()[p]) << i;
+    }
+    const Grid<std::uint8_t> mask = s.mask();
+    EXPECT_TRUE(std::equal(mask.values().begin(), mask.values().end(), o.mask.values().begin(), o.mask.values().end()));
+    expect_mesh_is_whole_volume_mesh(s);
+}
+
+TEST(Session, UndoRedoRestoreEveryActionBitForBit) {
+    const Phantom& ph = phantom64();
+    Session s(ph.image, options());
+    BufferMirror mirror;
+    std::vector<State> states{state_of(s)};
+    const auto act = [&](auto&& f) {
+        f();
+        s.end_action();
+        mirror.sync(s);
+        states.push_back(state_of(s));
+    };
+    act([&] { s.add_seed({ph.seeds[0].cast<double>(), 2.0}); });
+    act([&] { s.add_seed({ph.seeds[1].cast<double>(), 2.0}); });
+    act([&] { s.remove_seed(0); });  // pristine: re-initialised from the remaining seed
+    act([&] { s.add_seed({ph.seeds[0].cast<double>(), 3.0}); });
+    act([&] {
+        for (int i = 0; i < 40; ++i) s.segment_step();
+    });
+    expect_mesh_is_whole_volume_mesh(s);
+    act([&] {
+        const auto t = s.nearest_surface_point(ph.seeds[0].cast<double>(), 40.0);
+        ASSERT_TRUE(t.has_value());
+        s.set_target(*t);
+        for (int i = 0; i < 30; ++i) s.swarm_step();
+    });
+    expect_mesh_is_whole_volume_mesh(s);
+    act([&] { s.add_seed({ph.seeds[2].cast<double>(), 2.0}); });  // grown: the ball is united
+    act([&] {
+        for (int i = 0; i < 10; ++i) s.segment_step();
+    });
+    mirror.expect_matches(s);
+    ASSERT_EQ(s.undo_depth(), states.size() - 1);
+
+    for (std::size_t a = states.size() - 1; a > 0; --a) {
+        s.undo();
+        mirror.sync(s);
+        ASSERT_TRUE(state_of(s) == states[a - 1]) << "undo of action " << a;
+        ASSERT_TRUE(check_invariants(s.field()).ok()) << check_invariants(s.field()).summary();
+    }
+    mirror.expect_matches(s);
+    for (std::size_t a = 1; a < states.size(); ++a) {
+        s.redo();
+        mirror.sync(s);
+        ASSERT_TRUE(state_of(s) == states[a]) << "redo of action " << a;
+    }
+    mirror.expect_matches(s);
+    expect_mesh_is_whole_volume_mesh(s);
+}
+
+TEST(Session, RemovingASeedBeforeAnyStepReinitialisesFromTheOthers) {
+    const Phantom& ph = phantom64();
+    Session s(ph.image, options());
+    s.add_seed({ph.seeds[0].cast<double>(), 2.0});
+    s.add_seed({ph.seeds[1].cast<double>(), 2.5});
+    s.remove_seed(0);
+    SparseField want(ph.image.lattice(), 2);
+    const std::vector<SeedBall> rest{{ph.seeds[1].cast<double>(), 2.5}};
+    init_from_seeds(want, rest);
+    for (std::size_t i = 0; i < want.phi().size(); ++i)
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(s.field().phi()[static_cast<PointIndex>(i)]),
+                  std::bit_cast<std::uint32_t>(want.phi()[static_cast<PointIndex>(i)]));
+    EXPECT_EQ(s.seeds().size(), 1u);
+    EXPECT_TRUE(s.seed_at(ph.seeds[1].cast<double>()).has_value());
+    EXPECT_FALSE(s.seed_at(ph.seeds[0].cast<double>(), 0.5).has_value() &&
+                 norm((ph.seeds[0] - ph.seeds[1]).cast<double>()) > 4.0);
+}
+
+TEST(Session, KeepsTwentyActionsToUndo) {
+    const Phantom& ph = phantom64();
+    Session s(ph.image, options());
+    s.add_seed({ph.seeds[0].cast<double>(), 2.0});
+    std::vector<State> states{state_of(s)};
+    for (int a = 0; a < 25; ++a) {
+        // Alternate the two kinds so each run of steps is its own action.
+        if (a % 2 == 0) {
+            for (int i = 0; i < 3; ++i) s.segment_step();
+        } else {
+            ThresholdParams p = s.params();
+            p.alpha = 0.1 + 0.01 * a;
+            s.set_params(p, true);
+        }
+        states.push_back(state_of(s));
+    }
+    s.end_action();
+    ASSERT_GE(s.undo_depth(), 20u);
+    for (int a = 0; a < 20; ++a) {
+        s.undo();
+        ASSERT_TRUE(state_of(s) == states[states.size() - 2 - static_cast<std::size_t>(a)]) << a;
+    }
+}
+
+TEST(Session, RejectsBadInputWithoutChangingAnything) {
+    const Phantom& ph = phantom64();
+    Session s(ph.image, options());
+    EXPECT_THROW(s.add_seed({{-1, 0, 0}, 2.0}), std::invalid_argument);
+    EXPECT_THROW(s.add_seed({{10, 10, 10}, 0.0}), std::invalid_argument);
+    EXPECT_THROW(s.set_target({100, 0, 0}), std::invalid_argument);
+    EXPECT_THROW(s.remove_seed(0), std::invalid_argument);
+    ThresholdParams p;
+    p.epsilon = -1;
+    EXPECT_THROW(s.set_params(p, false), std::invalid_argument);
+    EXPECT_FALSE(s.has_surface());
+    EXPECT_FALSE(s.can_undo());
+    EXPECT_TRUE(s.segment_step().changed.empty());  // nothing to evolve yet
+    EXPECT_TRUE(s.swarm_step().changed.empty());    // no target yet
+    Grid<std::uint8_t> wrong(Lattice({8, 8, 8}));
+    EXPECT_THROW(s.load_mask(wrong), std::invalid_argument);
+}
+
+TEST(Session, LoadedMaskStartsTheHistoryAfresh) {
+    const Phantom& ph = phantom64();
+    Session s(ph.image, options());
+    s.add_seed({ph.seeds[0].cast<double>(), 2.0});
+    s.end_action();
+    s.load_mask(ph.truth);
+    EXPECT_FALSE(s.can_undo());
+    EXPECT_TRUE(s.has_surface());
+    EXPECT_EQ(s.take_dirty_fragments().size(), s.mesher().fragment_count());
+    expect_mesh_is_whole_volume_mesh(s);
+}
+
+}  // namespace
+}  // namespace liveset
