@@ -1,0 +1,63 @@
+// Slice views as ITK-SNAP shows them, independent of OpenGL: which lattice axis each of the axial,
+// coronal and sagittal views cuts and which runs along the screen (chosen from the direction
+// cosines, so a sagittally stored image still shows upright), radiological orientation (axial and
+// coronal: the patient's right on the screen's left; axial: anterior up; sagittal: anterior left,
+// superior up), square millimetres on screen for anisotropic voxels, pane pixel <-> voxel mapping,
+// the slice's intensities as texels and the zero contour of φ by marching squares.
+#pragma once
+
+#include <glm/glm.hpp>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+
+namespace liveset::render {
+
+enum class SliceAxis { kAxial, kCoronal, kSagittal };
+std::string to_string(SliceAxis axis);
+
+// Slice texel space ("uv"): u runs to the screen's right, v up; texel (c, r) covers
+// [c, c+1] x [r, r+1], so a voxel centre sits at (c + 0.5, r + 0.5).
+struct SliceGeometry {
+    SliceAxis view = SliceAxis::kAxial;
+    int normal_axis = 2;           // lattice axis the slices are taken along
+    int u_axis = 0, v_axis = 1;    // lattice axes along the screen's right and up
+    bool u_flip = false;           // screen right runs towards lower lattice index
+    bool v_flip = false;
+    int width = 1, height = 1;     // texels
+    int slices = 1;
+    double u_mm = 1.0, v_mm = 1.0;  // texel size
+
+    glm::dvec2 to_uv(Vec3d index) const;             // continuous index -> slice texel space
+    Vec3d to_index(glm::dvec2 uv, int slice) const;  // and back, on slice `slice`
+    int slice_of(Vec3d index) const;                 // nearest slice, clamped
+    // Lattice point of texel (c, r) on `slice`.
+    Vec3i voxel(int column, int row, int slice) const;
+};
+
+SliceGeometry slice_geometry(const Lattice& lattice, SliceAxis view);
+
+// The slice's texel rectangle fitted into a pane (pixels, top-left origin), optionally zoomed
+// around a centre; maps between pane pixels and texel space.
+struct SliceViewport {
+    SliceGeometry geometry;
+    int pane_width = 1, pane_height = 1;
+    double zoom = 1.0;
+    glm::dvec2 centre_uv{0.0};  // texel-space point at the pane's centre (default: the slice's centre)
+
+    static SliceViewport fit(const SliceGeometry& g, int pane_width, int pane_height);
+    double pixels_per_mm() const;
+    glm::dvec2 to_pixel(glm::dvec2 uv) const;
+    glm::dvec2 to_uv(glm::dvec2 pixel) const;
+};
+
+// Grey texels (row 0 at the bottom) of `unit_image` (values in [0, 1]) on `slice`.
+std::vector<std::uint8_t> slice_texels(const Grid<float>& unit_image, const SliceGeometry& g, int slice);
+
+// Segments (pairs of end points, texel space) of φ = 0 on `slice`, by marching squares between
+// voxel centres; φ < 0 inside, as the mesher.
+std::vector<glm::dvec2> zero_contour(const Grid<float>& phi, const SliceGeometry& g, int slice);
+
+}  // namespace liveset::render

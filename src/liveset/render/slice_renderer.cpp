@@ -1,0 +1,152 @@
+// Slice pane drawing.
+#include "liveset/render/slice_renderer.hpp"
+
+#include <cmath>
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace liveset::render {
+
+namespace {
+
+constexpr const char* kImageVertex = R"(#version 330 core
+layout(location = 0) in vec2 a_pixel;
+layout(location = 1) in vec2 a_texcoord;
+uniform mat4 u_projection;
+out vec2 v_texcoord;
+void main() { v_texcoord = a_texcoord; gl_Position = u_projection * vec4(a_pixel, 0.0, 1.0); }
+)";
+
+constexpr const char* kImageFragment = R"(#version 330 core
+in vec2 v_texcoord;
+uniform sampler2D u_image;
+out vec4 colour;
+void main() { float g = texture(u_image, v_texcoord).r; colour = vec4(g, g, g, 1.0); }
+)";
+
+constexpr const char* kLineVertex = R"(#version 330 core
+layout(location = 0) in vec2 a_pixel;
+uniform mat4 u_projection;
+void main() { gl_Position = u_projection * vec4(a_pixel, 0.0, 1.0); }
+)";
+
+constexpr const char* kLineFragment = R"(#version 330 core
+uniform vec4 u_colour;
+out vec4 colour;
+void main() { colour = u_colour; }
+)";
+
+}  // namespace
+
+SliceRenderer::SliceRenderer() : image_(kImageVertex, kImageFragment), lines_(kLineVertex, kLineFragment) {
+    glGenTextures(1, &texture_);
+    glBindTexture(GL_TEXTURE_2D, texture_);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glGenVertexArrays(1, &quad_vao_);
+    glGenBuffers(1, &quad_vbo_);
+    glBindVertexArray(quad_vao_);
+    glBindBuffer(GL_ARRAY_BUFFER, quad_vbo_);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), nullptr);
+    glEnableVertexAttribArray(1);
+    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 4 * sizeof(float), reinterpret_cast<void*>(2 * sizeof(float)));
+    glGenVertexArrays(1, &line_vao_);
+    glGenBuffers(1, &line_vbo_);
+    glBindVertexArray(line_vao_);
+    glBindBuffer(GL_ARRAY_BUFFER, line_vbo_);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, sizeof(glm::vec2), nullptr);
+    glBindVertexArray(0);
+}
+
+SliceRenderer::~SliceRenderer() {
+    glDeleteTextures(1, &texture_);
+    glDeleteVertexArrays(1, &quad_vao_);
+    glDeleteBuffers(1, &quad_vbo_);
+    glDeleteVertexArrays(1, &line_vao_);
+    glDeleteBuffers(1, &line_vbo_);
+}
+
+void SliceRenderer::set_texels(int width, int height, std::span<const std::uint8_t> texels) {
+    glBindTexture(GL_TEXTURE_2D, texture_);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, width, height, 0, GL_RED, GL_UNSIGNED_BYTE, texels.data());
+}
+
+void SliceRenderer::draw_lines(std::span<const glm::vec2> pixels, const glm::vec4& colour, const glm::mat4& projection) {
+    if (pixels.empty()) return;
+    lines_.use();
+    lines_.set("u_projection", projection);
+    lines_.set("u_colour", colour);
+    glBindVertexArray(line_vao_);
+    glBindBuffer(GL_ARRAY_BUFFER, line_vbo_);
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(pixels.size_bytes()), pixels.data(), GL_STREAM_DRAW);
+    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(pixels.size()));
+    glBindVertexArray(0);
+}
+
+void SliceRenderer::render(const Framebuffer& target, const SliceViewport& vp, const SliceOverlay& overlay,
+                           const SliceStyle& style) {
+    target.bind();
+    glClearColor(style.background.r, style.background.g, style.background.b, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    // Pane pixels, top-left origin.
+    const glm::mat4 projection = glm::ortho(0.0f, static_cast<float>(vp.pane_width), static_cast<float>(vp.pane_height), 0.0f);
+    const SliceGeometry& g = vp.geometry;
+    const glm::dvec2 lo = vp.to_pixel({0.0, 0.0}), hi = vp.to_pixel({static_cast<double>(g.width), static_cast<double>(g.height)});
+    const float quad[] = {
+        float(lo.x), float(lo.y), 0.0f, 0.0f,  float(hi.x), float(lo.y), 1.0f, 0.0f, float(hi.x), float(hi.y), 1.0f, 1.0f,
+        float(lo.x), float(lo.y), 0.0f, 0.0f,  float(hi.x), float(hi.y), 1.0f, 1.0f, float(lo.x), float(hi.y), 0.0f, 1.0f,
+    };
+    image_.use();
+    image_.set("u_projection", projection);
+    image_.set("u_image", 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, texture_);
+    glBindVertexArray(quad_vao_);
+    glBindBuffer(GL_ARRAY_BUFFER, quad_vbo_);
+    glBufferData(GL_ARRAY_BUFFER, sizeof(quad), quad, GL_STREAM_DRAW);
+    glDrawArrays(GL_TRIANGLES, 0, 6);
+    glBindVertexArray(0);
+
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    std::vector<glm::vec2> px;
+    if (overlay.cursor) {  // ITK-SNAP's crosshair: full-width lines, a gap at the centre
+        const glm::dvec2 c = vp.to_pixel(*overlay.cursor);
+        const float gap = 6.0f;
+        const auto x = static_cast<float>(c.x), y = static_cast<float>(c.y);
+        px = {{0.0f, y}, {x - gap, y}, {x + gap, y}, {static_cast<float>(vp.pane_width), y},
+              {x, 0.0f}, {x, y - gap}, {x, y + gap}, {x, static_cast<float>(vp.pane_height)}};
+        draw_lines(px, style.cursor, projection);
+    }
+    px.clear();
+    for (const glm::dvec2& p : overlay.contour) px.emplace_back(vp.to_pixel(p));
+    draw_lines(px, style.contour, projection);
+
+    const auto circle = [&](glm::dvec2 centre_uv, double radius_mm, const glm::vec4& colour) {
+        std::vector<glm::vec2> ring;
+        const glm::dvec2 c = vp.to_pixel(centre_uv);
+        const double r = std::max(radius_mm * vp.pixels_per_mm(), 3.0);
+        for (int k = 0; k < 32; ++k)
+            for (int e = 0; e < 2; ++e) {
+                const double a = 2.0 * 3.14159265358979 * (k + e) / 32.0;
+                ring.emplace_back(c.x + r * std::cos(a), c.y + r * std::sin(a));
+            }
+        draw_lines(ring, colour, projection);
+    };
+    for (const SliceCircle& s : overlay.seeds) circle(s.centre_uv, s.radius_mm, style.seeds);
+    if (overlay.target) {
+        circle(*overlay.target, 2.5, style.target);
+        const glm::dvec2 c = vp.to_pixel(*overlay.target);
+        const std::vector<glm::vec2> cross{{c.x - 7, c.y}, {c.x + 7, c.y}, {c.x, c.y - 7}, {c.x, c.y + 7}};
+        draw_lines(cross, style.target, projection);
+    }
+    glDisable(GL_BLEND);
+}
+
+}  // namespace liveset::render

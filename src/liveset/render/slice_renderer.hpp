@@ -1,0 +1,57 @@
+// One slice pane: the image slice as a texture, the zero contour of φ, the crosshair linked to the
+// 3D view, the seeds (circles where their balls cut the slice) and the swarm's target, drawn into
+// the pane's framebuffer in pane pixels (SliceViewport).
+#pragma once
+
+#include <glm/glm.hpp>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "liveset/render/framebuffer.hpp"
+#include "liveset/render/shader_program.hpp"
+#include "liveset/render/slice_geometry.hpp"
+
+namespace liveset::render {
+
+struct SliceCircle {
+    glm::dvec2 centre_uv{0.0};
+    double radius_mm = 1.0;
+};
+
+struct SliceOverlay {
+    std::span<const glm::dvec2> contour;  // segment end points, texel space
+    std::optional<glm::dvec2> cursor;     // crosshair, texel space
+    std::vector<SliceCircle> seeds;
+    std::optional<glm::dvec2> target;
+};
+
+struct SliceStyle {
+    glm::vec3 background{0.0f};
+    glm::vec4 contour{1.0f, 0.25f, 0.2f, 1.0f};
+    glm::vec4 cursor{0.35f, 0.55f, 1.0f, 0.85f};
+    glm::vec4 seeds{0.2f, 1.0f, 0.3f, 1.0f};
+    glm::vec4 target{1.0f, 0.85f, 0.1f, 1.0f};
+};
+
+class SliceRenderer {
+public:
+    SliceRenderer();  // needs a current OpenGL 3.3 context
+    ~SliceRenderer();
+    SliceRenderer(const SliceRenderer&) = delete;
+    SliceRenderer& operator=(const SliceRenderer&) = delete;
+
+    // Uploads the slice's grey texels (slice_texels()).
+    void set_texels(int width, int height, std::span<const std::uint8_t> texels);
+    void render(const Framebuffer& target, const SliceViewport& viewport, const SliceOverlay& overlay, const SliceStyle& style);
+
+private:
+    void draw_lines(std::span<const glm::vec2> pixels, const glm::vec4& colour, const glm::mat4& projection);
+
+    ShaderProgram image_, lines_;
+    GLuint texture_ = 0;
+    GLuint quad_vao_ = 0, quad_vbo_ = 0;
+    GLuint line_vao_ = 0, line_vbo_ = 0;
+};
+
+}  // namespace liveset::render
