@@ -10,6 +10,7 @@
 
 #include "cli_common.hpp"
 #include "liveset/io/image_io.hpp"
+#include "view_command.hpp"
 
 int main(int argc, char** argv) {
     CLI::App app{"liveset: real-time interactive level-set segmentation of 3D medical images"};
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
     liveset::cli::add_repair_command(app, threads);
     liveset::cli::add_bench_commands(app, threads);
     liveset::cli::add_demo_command(app, threads);
+    liveset::cli::add_view_command(app, threads);
 
     try {
         app.parse(argc, argv);

@@ -1,0 +1,62 @@
+// Headless (EGL) runs: scripts, benchmarks and one-off renders.
+#include "headless_app.hpp"
+
+#include <fmt/core.h>
+
+#include "cli_common.hpp"
+#include "liveset/render/headless_context.hpp"
+#include "liveset/render/png_writer.hpp"
+#include "script_player.hpp"
+
+namespace liveset::viewer {
+
+namespace {
+
+std::unique_ptr<render::HeadlessContext> make_context() {
+    try {
+        return std::make_unique<render::HeadlessContext>();
+    } catch (const std::runtime_error& e) {
+        throw cli::UsageError(e.what());
+    }
+}
+
+}  // namespace
+
+int run_headless(std::unique_ptr<Session> session, const std::string& image_name, const ViewerConfig& config,
+                 const HeadlessOptions& options) {
+    const auto context = make_context();
+    ViewerConfig c = config;
+    c.headless = true;
+    Viewer viewer(std::move(session), image_name, c);
+    viewer.set_window_size(options.width, options.height);
+    if (options.maximised) viewer.set_maximised(options.maximised);
+    if (options.bench) return run_bench(viewer, *options.bench, options.width, options.height);
+    if (options.script) {
+        ScriptPlayer player(*options.script);
+        while (!player.done()) player.advance(viewer);
+    }
+    viewer.request_quit("script done");
+    return 0;
+}
+
+void render_surface_png(const FragmentMesher& mesher, const std::string& path, const std::string& view, int width, int height,
+                        int supersample) {
+    const auto context = make_context();
+    render::SurfaceBuffers buffers;
+    buffers.upload_all(mesher);
+    render::OrbitCamera camera;
+    render::CameraPose pose;
+    if (!render::OrbitCamera::named_pose(view, pose)) throw cli::UsageError("unknown view " + view);
+    camera.frame(render::surface_bounds(mesher), pose);
+    render::SceneRenderer renderer;
+    render::Framebuffer fb(width * supersample, height * supersample);
+    render::SceneContent content;
+    content.lattice = &mesher.lattice();
+    content.surface = &buffers;
+    render::SceneStyle style;
+    style.bounding_box = false;
+    renderer.render(fb, camera, content, style);
+    render::write_png(path, render::downsample(fb.read_color(), supersample));
+}
+
+}  // namespace liveset::viewer

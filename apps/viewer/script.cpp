@@ -1,0 +1,290 @@
+// Script parsing and validation: every problem is one line naming the entry.
+#include "script.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "cli_common.hpp"
+#include "cli_support.hpp"
+#include "liveset/session/repair_presets.hpp"
+
+namespace liveset::viewer {
+
+namespace {
+
+using nlohmann::json;
+
+class EntryError {
+public:
+    EntryError(const std::string& script, std::size_t entry, std::string name) : script_(script), entry_(entry), name_(std::move(name)) {}
+    [[noreturn]] void fail(const std::string& why) const {
+        if (name_.empty()) throw cli::UsageError(fmt::format("script {} entry {}: {}", script_, entry_, why));
+        throw cli::UsageError(fmt::format("script {} entry {} (\"{}\"): {}", script_, entry_, name_, why));
+    }
+
+private:
+    const std::string& script_;
+    std::size_t entry_;
+    std::string name_;
+};
+
+double number(const json& v, const EntryError& err, const char* what) {
+    if (!v.is_number()) err.fail(fmt::format("{} must be a number", what));
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) err.fail(fmt::format("{} must be finite", what));
+    return d;
+}
+
+int whole(const json& v, const EntryError& err, const char* what, int lo, int hi) {
+    if (!v.is_number_integer()) err.fail(fmt::format("{} must be a whole number", what));
+    const auto i = v.get<long long>();
+    if (i < lo || i > hi) err.fail(fmt::format("{} must be in [{}, {}]", what, lo, hi));
+    return static_cast<int>(i);
+}
+
+Vec3d point(const json& v, const EntryError& err, const Lattice& lattice, const char* what) {
+    if (!v.is_array() || v.size() != 3) err.fail(fmt::format("{} must be [i, j, k] (voxel indices)", what));
+    const Vec3d p{number(v[0], err, what), number(v[1], err, what), number(v[2], err, what)};
+    if (!lattice.contains(p)) err.fail(fmt::format("{} ({}, {}, {}) lies outside the {} image", what, p.x, p.y, p.z, lattice.describe()));
+    return p;
+}
+
+std::string text(const json& v, const EntryError& err, const char* what) {
+    if (!v.is_string() || v.get<std::string>().empty()) err.fail(fmt::format("{} must be a non-empty string", what));
+    return v.get<std::string>();
+}
+
+void only_keys(const json& obj, const std::set<std::string>& allowed, const EntryError& err) {
+    for (auto it = obj.begin(); it != obj.end(); ++it)
+        if (!allowed.count(it.key())) err.fail(fmt::format("unknown key \"{}\"", it.key()));
+}
+
+void output_path(const std::string& path, cli::OutputKind kind, const EntryError& err) {
+    try {
+        cli::check_output_path(path, kind, "the output");
+    } catch (const std::exception& e) {
+        err.fail(e.what());
+    }
+}
+
+const std::set<std::string> kRepairKeys = {"preset", "agents", "p", "radius", "amount", "seed", "expand_sigmas",
+                                           "contract_sigmas", "edit_range", "sample_depth"};
+
+void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
+    if (!p.is_object()) err.fail("expected an object of parameters");
+    std::set<std::string> allowed = {"mu", "epsilon", "n", "alpha", "auto_window"};
+    allowed.insert(kRepairKeys.begin(), kRepairKeys.end());
+    only_keys(p, allowed, err);
+    if (p.contains("mu")) a.mu = number(p["mu"], err, "mu");
+    if (p.contains("epsilon")) a.epsilon = number(p["epsilon"], err, "epsilon");
+    if (p.contains("n")) a.n = number(p["n"], err, "n");
+    if (p.contains("alpha")) a.alpha = number(p["alpha"], err, "alpha");
+    if (p.contains("auto_window")) {
+        if (!p["auto_window"].is_boolean()) err.fail("auto_window must be true or false");
+        a.auto_window = p["auto_window"].get<bool>();
+    }
+    a.repair_fields = json::object();
+    for (const std::string& k : kRepairKeys)
+        if (p.contains(k)) a.repair_fields[k] = p[k];
+    if (a.repair_fields.contains("preset") && a.repair_fields["preset"] != "demo") err.fail("the only preset is \"demo\"");
+    if (a.repair_fields.contains("agents")) whole(a.repair_fields["agents"], err, "agents", 1, 1'000'000);
+    if (a.repair_fields.contains("seed")) whole(a.repair_fields["seed"], err, "seed", 0, 2'000'000'000);
+    for (const char* k : {"p", "radius", "amount", "expand_sigmas", "contract_sigmas", "edit_range", "sample_depth"})
+        if (a.repair_fields.contains(k)) number(a.repair_fields[k], err, k);
+    // Check the values now, on top of the defaults: a bad value fails before anything runs.
+    try {
+        validate(apply_repair_fields(RepairOptions{}, a.repair_fields).swarm);
+        ThresholdParams t;
+        if (a.epsilon) t.epsilon = *a.epsilon;
+        if (a.mu) t.mu = *a.mu;
+        if (a.n) t.n = *a.n;
+        if (a.alpha) t.alpha = *a.alpha;
+        validate(t);
+    } catch (const std::invalid_argument& e) {
+        err.fail(e.what());
+    }
+}
+
+ScriptAction parse_entry(const json& e, std::size_t entry, const std::string& path, const Lattice& lattice) {
+    const EntryError bare(path, entry, "");
+    if (!e.is_object() || e.empty()) bare.fail("expected an object such as {\"segment\": 100}");
+    static const std::set<std::string> kActions = {"seed", "remove_seed", "params", "segment", "click", "target",
+                                                   "target_surface_near", "swarm", "camera", "cursor", "layout", "tool",
+                                                   "undo", "redo", "save_mask", "save_phi", "save_mesh", "screenshot", "eval"};
+    std::string name;
+    for (auto it = e.begin(); it != e.end(); ++it)
+        if (kActions.count(it.key())) {
+            if (!name.empty()) bare.fail(fmt::format("two actions (\"{}\" and \"{}\") in one entry", name, it.key()));
+            name = it.key();
+        }
+    if (name.empty()) bare.fail(fmt::format("no action (unknown key \"{}\")", e.begin().key()));
+    const EntryError err(path, entry, name);
+    ScriptAction a;
+    a.entry = entry;
+    a.name = name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    if (name == "seed" || name == "remove_seed") {
+        only_keys(e, {name, "radius"}, err);
+        a.kind = name == "seed" ? K::kSeed : K::kRemoveSeed;
+        a.point = point(v, err, lattice, "the seed");
+        if (e.contains("radius")) a.radius = number(e["radius"], err, "radius");
+        if (a.radius <= 0) err.fail("radius must be positive");
+    } else if (name == "params") {
+        only_keys(e, {name}, err);
+        a.kind = K::kParams;
+        parse_params(v, a, err);
+    } else if (name == "segment") {
+        only_keys(e, {name, "max"}, err);
+        a.kind = K::kSegment;
+        if (v.is_string() && v == "converge") {
+            a.until_converged = true;
+            a.count = e.contains("max") ? whole(e["max"], err, "max", 1, 10'000'000) : 2000;
+        } else {
+            if (!v.is_number_integer()) err.fail("expected a number of steps or \"converge\"");
+            a.count = whole(v, err, "the number of steps", 1, 10'000'000);
+        }
+    } else if (name == "click") {
+        only_keys(e, {name}, err);
+        a.kind = K::kClick;
+        if (!v.is_array() || v.size() != 2) err.fail("expected [x, y] (pixels of the 3D pane)");
+        a.x = number(v[0], err, "x");
+        a.y = number(v[1], err, "y");
+        if (a.x < 0 || a.y < 0) err.fail("pixel coordinates must not be negative");
+    } else if (name == "target" || name == "cursor") {
+        only_keys(e, {name}, err);
+        a.kind = name == "target" ? K::kTarget : K::kCursor;
+        a.point = point(v, err, lattice, "the point");
+    } else if (name == "target_surface_near") {
+        only_keys(e, {name, "radius"}, err);
+        a.kind = K::kTargetSurfaceNear;
+        a.point = point(v, err, lattice, "the point");
+        a.radius = e.contains("radius") ? number(e["radius"], err, "radius") : 20.0;
+        if (a.radius <= 0) err.fail("radius must be positive");
+    } else if (name == "swarm" || name == "undo" || name == "redo") {
+        only_keys(e, {name}, err);
+        a.kind = name == "swarm" ? K::kSwarm : (name == "undo" ? K::kUndo : K::kRedo);
+        a.count = whole(v, err, name == "swarm" ? "the number of steps" : "the count", 1, 10'000'000);
+    } else if (name == "camera") {
+        only_keys(e, {name}, err);
+        a.kind = K::kCamera;
+        if (!v.is_object()) err.fail("expected an object such as {\"view\": \"superior\"}");
+        only_keys(v, {"view", "yaw", "pitch", "zoom", "pan", "reset"}, err);
+        if (v.contains("view")) {
+            a.view = text(v["view"], err, "view");
+            render::CameraPose pose;
+            if (!render::OrbitCamera::named_pose(*a.view, pose))
+                err.fail("view must be superior, inferior, anterior, posterior, left, right or default");
+        }
+        if (v.contains("yaw")) a.yaw = number(v["yaw"], err, "yaw");
+        if (v.contains("pitch")) a.pitch = number(v["pitch"], err, "pitch");
+        if (v.contains("zoom")) a.zoom = number(v["zoom"], err, "zoom");
+        if (a.zoom && *a.zoom <= 0) err.fail("zoom must be positive");
+        if (v.contains("pan")) {
+            const json& p = v["pan"];
+            if (!p.is_array() || p.size() != 3) err.fail("pan must be [x, y, z] in mm");
+            a.pan = glm::dvec3(number(p[0], err, "pan"), number(p[1], err, "pan"), number(p[2], err, "pan"));
+        }
+        if (v.contains("reset")) {
+            if (!v["reset"].is_boolean()) err.fail("reset must be true or false");
+            a.reset = v["reset"].get<bool>();
+        }
+    } else if (name == "layout") {
+        only_keys(e, {name}, err);
+        a.kind = K::kLayout;
+        const std::string l = text(v, err, "layout");
+        if (l != "four") {
+            a.pane = pane_from_name(l);
+            if (!a.pane) err.fail("layout must be four, 3d, axial, sagittal or coronal");
+        }
+    } else if (name == "tool") {
+        only_keys(e, {name}, err);
+        a.kind = K::kTool;
+        const std::string t = text(v, err, "tool");
+        if (t == "crosshair") a.tool = Tool::kCrosshair;
+        else if (t == "seed") a.tool = Tool::kSeed;
+        else if (t == "target") a.tool = Tool::kTarget;
+        else err.fail("tool must be crosshair, seed or target");
+    } else if (name == "save_mask" || name == "save_phi" || name == "save_mesh") {
+        only_keys(e, {name}, err);
+        a.kind = name == "save_mask" ? K::kSaveMask : (name == "save_phi" ? K::kSavePhi : K::kSaveMesh);
+        a.path = text(v, err, "the path");
+        output_path(a.path, name == "save_mesh" ? cli::OutputKind::kMesh : cli::OutputKind::kImage, err);
+    } else if (name == "screenshot") {
+        only_keys(e, {name, "pane", "size", "supersample"}, err);
+        a.kind = K::kScreenshot;
+        a.path = text(v, err, "the path");
+        if (a.path.size() < 4 || a.path.substr(a.path.size() - 4) != ".png") err.fail("screenshots are .png files");
+        output_path(a.path, cli::OutputKind::kText, err);
+        a.pane = Pane::kView3d;
+        if (e.contains("pane")) {
+            const std::string p = text(e["pane"], err, "pane");
+            a.pane = p == "window" ? std::nullopt : pane_from_name(p);
+            if (p != "window" && !a.pane) err.fail("pane must be 3d, axial, sagittal, coronal or window");
+        }
+        if (e.contains("size")) {
+            const json& s = e["size"];
+            if (!s.is_array() || s.size() != 2) err.fail("size must be [width, height]");
+            a.width = whole(s[0], err, "width", 16, 8192);
+            a.height = whole(s[1], err, "height", 16, 8192);
+        }
+        if (e.contains("supersample")) a.supersample = whole(e["supersample"], err, "supersample", 1, 4);
+    } else if (name == "eval") {
+        only_keys(e, {name}, err);
+        a.kind = K::kEval;
+        if (!v.is_object() || !v.contains("truth")) err.fail("expected {\"truth\": path}");
+        only_keys(v, {"truth", "label"}, err);
+        a.path = text(v["truth"], err, "truth");
+        if (v.contains("label")) a.label = whole(v["label"], err, "label", 1, 255);
+    }
+    return a;
+}
+
+}  // namespace
+
+RepairOptions apply_repair_fields(RepairOptions o, const nlohmann::json& f) {
+    if (f.contains("preset")) {
+        const int steps = o.steps;
+        o = demo_repair_options();
+        o.steps = steps;
+    }
+    if (f.contains("agents")) o.swarm.agents = f["agents"].get<std::size_t>();
+    if (f.contains("p")) o.swarm.act_probability = f["p"].get<double>();
+    if (f.contains("radius")) o.swarm.edit_radius = f["radius"].get<double>();
+    if (f.contains("amount")) o.swarm.edit_amount = f["amount"].get<double>();
+    if (f.contains("seed")) o.swarm.seed = f["seed"].get<std::uint64_t>();
+    if (f.contains("expand_sigmas")) o.swarm.expand_sigmas = f["expand_sigmas"].get<double>();
+    if (f.contains("contract_sigmas")) o.swarm.contract_sigmas = f["contract_sigmas"].get<double>();
+    if (f.contains("edit_range")) o.swarm.edit_range = f["edit_range"].get<double>();
+    if (f.contains("sample_depth")) o.swarm.sample_depth = f["sample_depth"].get<double>();
+    return o;
+}
+
+Script parse_script_text(const std::string& text, const std::string& path, const Lattice& lattice) {
+    json doc;
+    try {
+        doc = json::parse(text);
+    } catch (const json::parse_error& e) {
+        // nlohmann's message ends with the byte position: enough to find the typo.
+        throw cli::UsageError(fmt::format("script {} is not valid JSON: {}", path, e.what()));
+    }
+    if (!doc.is_array()) throw cli::UsageError(fmt::format("script {} must be a JSON list of actions", path));
+    Script s;
+    s.path = path;
+    for (std::size_t i = 0; i < doc.size(); ++i) s.actions.push_back(parse_entry(doc[i], i + 1, path, lattice));
+    return s;
+}
+
+Script parse_script(const std::string& path, const Lattice& lattice) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw cli::UsageError(fmt::format("cannot read script {}", path));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return parse_script_text(ss.str(), path, lattice);
+}
+
+}  // namespace liveset::viewer

@@ -1,0 +1,116 @@
+// Script playback: one bounded piece of work per advance().
+#include "script_player.hpp"
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+#include "cli_common.hpp"
+#include "image_commands.hpp"
+#include "liveset/io/image_io.hpp"
+
+namespace liveset::viewer {
+
+void ScriptPlayer::fail(const ScriptAction& a, const std::string& why) const {
+    throw cli::UsageError(fmt::format("script {} entry {} (\"{}\"): {}", script_.path, a.entry, a.name, why));
+}
+
+void ScriptPlayer::finish_entry(Viewer& viewer) {
+    if (viewer.session()) viewer.session()->end_action();
+    ++next_;
+    steps_done_ = 0;
+}
+
+void ScriptPlayer::advance(Viewer& viewer) {
+    if (done()) return;
+    const ScriptAction& a = script_.actions[next_];
+    Session* s = viewer.session();
+    if (!s) fail(a, "no image is open");
+    using K = ScriptAction::Kind;
+    const auto check = [&](bool ok) {
+        if (!ok) fail(a, viewer.message());
+    };
+    switch (a.kind) {
+        case K::kSeed: check(viewer.add_seed(a.point, a.radius)); break;
+        case K::kRemoveSeed: check(viewer.remove_seed_at(a.point)); break;
+        case K::kParams: {
+            ThresholdParams p = s->params();
+            bool auto_window = s->window_from_seeds();
+            if (a.mu || a.epsilon) auto_window = false;
+            if (a.auto_window) auto_window = *a.auto_window;
+            if (a.mu) p.mu = *a.mu;
+            if (a.epsilon) p.epsilon = *a.epsilon;
+            if (a.n) p.n = *a.n;
+            if (a.alpha) p.alpha = *a.alpha;
+            check(viewer.apply_params(p, auto_window));
+            if (!a.repair_fields.empty()) check(viewer.apply_repair_options(apply_repair_fields(s->repair_options(), a.repair_fields)));
+            break;
+        }
+        case K::kSegment: {
+            if (steps_done_ == 0 && !s->has_surface()) fail(a, "no surface to evolve: place a seed first");
+            viewer.segment_step();
+            ++steps_done_;
+            const SegmentStatus& st = s->segment_status();
+            const bool stop = st.vanished || (a.until_converged && st.converged) || steps_done_ >= a.count;
+            if (!stop) return;  // more steps on the next call
+            break;
+        }
+        case K::kClick: {
+            const Rect r = viewer.pane_rect(Pane::kView3d);
+            if (a.x >= r.w || a.y >= r.h) fail(a, fmt::format("pixel ({}, {}) is outside the {}x{} 3D pane", a.x, a.y, r.w, r.h));
+            if (!viewer.click_3d(a.x, a.y, true)) fail(a, fmt::format("no surface under pixel ({}, {})", a.x, a.y));
+            break;
+        }
+        case K::kTarget: check(viewer.set_target(a.point)); break;
+        case K::kTargetSurfaceNear: {
+            const auto p = s->nearest_surface_point(a.point, a.radius);
+            if (!p) fail(a, fmt::format("no surface within {} voxels", a.radius));
+            check(viewer.set_target(*p));
+            break;
+        }
+        case K::kSwarm: {
+            if (!s->target()) fail(a, "no target: add a \"target\", \"target_surface_near\" or \"click\" entry first");
+            viewer.swarm_step();
+            if (++steps_done_ < a.count) return;
+            break;
+        }
+        case K::kCamera: {
+            render::OrbitCamera& c = viewer.camera();
+            if (a.reset && s) c.frame(render::surface_bounds(s->mesher()));
+            render::CameraPose pose = c.pose();
+            if (a.view) render::OrbitCamera::named_pose(*a.view, pose);
+            if (a.yaw) pose.yaw_deg = *a.yaw;
+            if (a.pitch) pose.pitch_deg = *a.pitch;
+            if (a.zoom) pose.zoom = *a.zoom;
+            if (a.pan) pose.pan = *a.pan;
+            c.set_pose(pose);
+            viewer.camera_changed();
+            break;
+        }
+        case K::kCursor:
+            viewer.set_cursor({static_cast<int>(std::lround(a.point.x)), static_cast<int>(std::lround(a.point.y)),
+                               static_cast<int>(std::lround(a.point.z))});
+            break;
+        case K::kLayout: viewer.set_maximised(a.pane); break;
+        case K::kTool: viewer.set_tool(a.tool); break;
+        case K::kUndo: viewer.undo(a.count); break;
+        case K::kRedo: viewer.redo(a.count); break;
+        case K::kSaveMask: check(viewer.save_mask(a.path)); break;
+        case K::kSavePhi: check(viewer.save_phi(a.path)); break;
+        case K::kSaveMesh: check(viewer.save_mesh(a.path)); break;
+        case K::kScreenshot: check(viewer.save_screenshot(a.path, a.pane, a.width, a.height, a.supersample)); break;
+        case K::kEval: {
+            Grid<std::uint8_t> truth = read_label_image(a.path);
+            if (!truth.lattice().same_geometry(s->lattice(), 1e-3)) fail(a, fmt::format("{} does not overlay the image", a.path));
+            for (std::uint8_t& v : truth.values()) v = a.label ? v == a.label : v != 0;
+            const nlohmann::json report = cli::evaluation_report(s->mask(), truth);
+            fmt::print("{}\n", nlohmann::json{{"entry", a.entry}, {"eval", report}}.dump());
+            std::fflush(stdout);
+            viewer.log().add("eval", {{"entry", a.entry}, {"dice", report["dice"]}, {"holes", report["holes"]}});
+            break;
+        }
+    }
+    finish_entry(viewer);
+}
+
+}  // namespace liveset::viewer

@@ -1,0 +1,197 @@
+// `liveset view` argument handling and dispatch.
+#include "view_command.hpp"
+
+#include <fmt/core.h>
+
+#include <filesystem>
+
+#include "cli_common.hpp"
+#include "cli_support.hpp"
+#include "headless_app.hpp"
+#include "image_commands.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/session/repair_presets.hpp"
+#include "window_app.hpp"
+
+namespace liveset::cli {
+
+namespace {
+
+struct ViewArgs {
+    std::string image, mask, phi, roi, script, log_events, size = "1280x720", layout = "four";
+    std::vector<std::string> seeds;
+    double seed_radius = 2.0;
+    bool headless = false, bench = false, json = false;
+    int bench_frames = 100;
+    std::size_t bench_agents = 200;
+    std::string bench_target;
+    int fragment_size = 16;
+};
+
+void parse_size(const std::string& text, int& w, int& h) {
+    const auto x = text.find('x');
+    try {
+        if (x == std::string::npos) throw std::invalid_argument(text);
+        std::size_t used = 0;
+        w = std::stoi(text.substr(0, x), &used);
+        if (used != x) throw std::invalid_argument(text);
+        h = std::stoi(text.substr(x + 1), &used);
+        if (used != text.size() - x - 1) throw std::invalid_argument(text);
+    } catch (const std::exception&) {
+        throw UsageError(fmt::format("--size {}: expected WIDTHxHEIGHT, e.g. 1280x720", text));
+    }
+    if (w < 320 || h < 240 || w > 8192 || h > 8192) throw UsageError(fmt::format("--size {}: from 320x240 to 8192x8192", text));
+}
+
+std::unique_ptr<Session> load_session(const ViewArgs& a) {
+    Grid<float> image = read_image(a.image);
+    std::optional<Grid<std::uint8_t>> roi;
+    if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
+    SessionOptions so;
+    so.fragment_size = a.fragment_size;
+    so.repair = demo_repair_options();
+    const Lattice lattice = image.lattice();
+    std::unique_ptr<Session> s;
+    try {
+        s = std::make_unique<Session>(std::move(image), so, std::move(roi));
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(fmt::format("{}: {}", a.image, e.what()));
+    }
+    if (!a.mask.empty()) {
+        s->load_mask(load_mask_like(a.mask, lattice, "--mask"));
+        if (!s->has_surface()) throw UsageError(fmt::format("--mask {} holds no surface (empty or full)", a.mask));
+    } else if (!a.phi.empty()) {
+        const Grid<float> phi = read_image(a.phi);
+        if (!phi.lattice().same_geometry(lattice, 1e-3))
+            throw UsageError(fmt::format("--phi {} ({}) does not overlay the image ({})", a.phi, phi.lattice().describe(), lattice.describe()));
+        s->load_phi(phi);
+        if (!s->has_surface()) throw UsageError(fmt::format("--phi {} holds no surface (no sign change)", a.phi));
+    }
+    for (const std::string& text : a.seeds) {
+        const SeedBall b = parse_seed_voxel(text, a.seed_radius);
+        check_seed_inside(b, lattice, "--seed " + text);
+        s->add_seed(b);
+    }
+    s->end_action();
+    return s;
+}
+
+int run_view(const ViewArgs& a, int threads) {
+    const auto guard = limit_threads(threads);
+    int width = 1280, height = 720;
+    parse_size(a.size, width, height);
+    std::optional<viewer::Pane> maximised;
+    if (a.layout != "four") {
+        maximised = viewer::pane_from_name(a.layout);
+        if (!maximised) throw UsageError("--layout must be four, 3d, axial, sagittal or coronal");
+    }
+    if (!a.log_events.empty()) check_output_path(a.log_events, OutputKind::kText, "--log-events");
+    if (a.bench && !a.headless) throw UsageError("--bench runs headless: add --headless");
+    if (a.headless && a.image.empty()) throw UsageError("--headless needs an IMAGE");
+    if (a.headless && a.script.empty() && !a.bench) throw UsageError("--headless needs --script or --bench");
+    if (!a.mask.empty() && !a.phi.empty()) throw UsageError("give --mask or --phi, not both");
+    if (a.image.empty() && (!a.mask.empty() || !a.phi.empty() || !a.seeds.empty() || !a.roi.empty() || !a.script.empty()))
+        throw UsageError("--mask, --phi, --roi, --seed and --script need an IMAGE");
+
+    std::unique_ptr<Session> session;
+    if (!a.image.empty()) session = load_session(a);
+    std::optional<viewer::Script> script;
+    if (!a.script.empty()) script = viewer::parse_script(a.script, session->lattice());
+    viewer::ViewerConfig config;
+    config.log_events = a.log_events;
+    config.session.fragment_size = a.fragment_size;
+    config.session.repair = demo_repair_options();
+    const std::string name = a.image.empty() ? std::string() : std::filesystem::path(a.image).filename().string();
+
+    if (a.headless) {
+        viewer::HeadlessOptions ho;
+        ho.width = width;
+        ho.height = height;
+        ho.maximised = maximised;
+        ho.script = script ? &*script : nullptr;
+        if (a.bench) {
+            viewer::BenchOptions bo;
+            bo.frames = a.bench_frames;
+            bo.agents = a.bench_agents;
+            bo.json = a.json;
+            if (!a.bench_target.empty()) {
+                const SeedBall t = parse_seed_voxel(a.bench_target, 1.0);
+                check_seed_inside(t, session->lattice(), "--bench-target");
+                bo.target = t.center;
+            }
+            ho.bench = bo;
+        }
+        return viewer::run_headless(std::move(session), name, config, ho);
+    }
+    if (!viewer::display_available()) throw UsageError("no display to open a window on (DISPLAY is not set); use --headless --script");
+    viewer::WindowOptions wo;
+    wo.width = width;
+    wo.height = height;
+    wo.title = name.empty() ? "liveset" : "liveset - " + name;
+    wo.maximised = maximised;
+    wo.script = script ? &*script : nullptr;
+    return viewer::run_window(std::move(session), name, config, wo);
+}
+
+}  // namespace
+
+bool viewer_display_available() { return viewer::display_available(); }
+
+int open_demo_viewer(std::unique_ptr<Session> session, Vec3d target) {
+    viewer::ViewerConfig config;
+    config.session.repair = demo_repair_options();
+    viewer::WindowOptions wo;
+    wo.title = "liveset demo - phantom repair (Ctrl+Q quits)";
+    return viewer::run_window(std::move(session), "phantom", config, wo, [target](viewer::Viewer& v) {
+        render::CameraPose superior;
+        render::OrbitCamera::named_pose("superior", superior);
+        v.camera().set_pose(superior);
+        v.camera_changed();
+        v.set_tool(viewer::Tool::kTarget);
+        if (v.set_target(target)) v.set_swarm_running(true);
+    });
+}
+
+nlohmann::json write_before_after_pictures(const std::filesystem::path& dir, const Grid<float>& phi_before,
+                                           const FragmentMesher& after) {
+    try {
+        FragmentMesher before(phi_before.lattice(), after.fragment_size());
+        before.full_rebuild(phi_before);
+        viewer::render_surface_png(before, (dir / "before.png").string(), "superior", 800, 800, 2);
+        viewer::render_surface_png(after, (dir / "after.png").string(), "superior", 800, 800, 2);
+        return {{"before", "before.png"}, {"after", "after.png"}};
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "liveset: warning: no before/after pictures: {}\n", e.what());
+        return nullptr;
+    }
+}
+
+void add_view_command(CLI::App& app, const int& threads) {
+    static ViewArgs va;
+    auto* v = app.add_subcommand("view", "interactive 3D viewer: segment, repair with agent swarms, undo, save (window or --headless)");
+    v->add_option("image", va.image, "image to open (NIfTI, MetaImage, NRRD, MINC, DICOM folder)");
+    v->add_option("--mask", va.mask, "start from this segmentation mask (non-zero inside)");
+    v->add_option("--phi", va.phi, "start from this level set (< 0 inside)");
+    v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave");
+    v->add_option("--seed", va.seeds, "seed I,J,K[:R] (voxels); repeatable");
+    v->add_option("--seed-radius", va.seed_radius, "default seed radius, voxels")->check(CLI::PositiveNumber)->capture_default_str();
+    v->add_flag("--headless", va.headless, "no window: render with EGL into an offscreen framebuffer (needs --script or --bench)");
+    v->add_option("--script", va.script, "replay a session: JSON list of actions (see README)");
+    v->add_option("--size", va.size, "window (or offscreen) size WIDTHxHEIGHT")->capture_default_str();
+    v->add_option("--layout", va.layout, "four | 3d | axial | sagittal | coronal (one pane maximised)")->capture_default_str();
+    v->add_option("--log-events", va.log_events, "write user actions as JSON lines to this file (rewritten atomically)");
+    v->add_option("--fragment-size", va.fragment_size, "cells per mesh fragment edge (one GPU buffer each)")
+        ->check(CLI::Range(2, 512))
+        ->capture_default_str();
+    v->add_flag("--bench", va.bench, "headless frame-time breakdown: static, agents moving, repairing at p = 0.1 and 0.5");
+    v->add_option("--bench-frames", va.bench_frames, "measured frames per scenario")->check(CLI::Range(1, 100000))->capture_default_str();
+    v->add_option("--bench-agents", va.bench_agents, "agents in the swarm scenarios")->check(CLI::Range(1, 100000))->capture_default_str();
+    v->add_option("--bench-target", va.bench_target, "swarm target I,J,K (default: the top of the surface)");
+    v->add_flag("--json", va.json, "benchmark results as one JSON object");
+    v->callback([&threads] {
+        const int rc = run_view(va, threads);
+        if (rc != 0) std::exit(rc);
+    });
+}
+
+}  // namespace liveset::cli

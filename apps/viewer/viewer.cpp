@@ -1,0 +1,601 @@
+// Viewer core: frames (evolve -> upload U -> redraw dirty panes -> compose), layout, actions.
+#include "viewer.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+
+#include "cli_common.hpp"
+#include "cli_support.hpp"
+#include "imgui_bridge.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/mesh/mesh_io.hpp"
+#include "liveset/render/png_writer.hpp"
+
+namespace liveset::viewer {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+nlohmann::json to_json(Vec3d v) { return {v.x, v.y, v.z}; }
+
+Vec3i rounded(Vec3d v) {
+    return {static_cast<int>(std::lround(v.x)), static_cast<int>(std::lround(v.y)), static_cast<int>(std::lround(v.z))};
+}
+
+}  // namespace
+
+const char* pane_name(Pane pane) {
+    switch (pane) {
+        case Pane::kAxial: return "axial";
+        case Pane::kSagittal: return "sagittal";
+        case Pane::kCoronal: return "coronal";
+        case Pane::kView3d: return "3d";
+    }
+    return "?";
+}
+
+std::optional<Pane> pane_from_name(std::string_view name) {
+    for (int i = 0; i < kPaneCount; ++i)
+        if (name == pane_name(static_cast<Pane>(i))) return static_cast<Pane>(i);
+    return std::nullopt;
+}
+
+const char* tool_name(Tool tool) {
+    switch (tool) {
+        case Tool::kCrosshair: return "crosshair";
+        case Tool::kSeed: return "seed";
+        case Tool::kTarget: return "target";
+    }
+    return "?";
+}
+
+Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const ViewerConfig& config)
+    : config_(config), session_(std::move(session)), image_name_(std::move(image_name)), log_(config.log_events) {
+    imgui_ = std::make_unique<ImGuiBridge>();
+    scene_renderer_ = std::make_unique<render::SceneRenderer>();
+    for (auto& r : slice_renderers_) r = std::make_unique<render::SliceRenderer>();
+    attach_session();
+}
+
+Viewer::~Viewer() = default;
+
+void Viewer::attach_session() {
+    slice_shown_ = {-1, -1, -1};
+    contour_slice_ = {-1, -1, -1};
+    segment_running_ = swarm_running_ = false;
+    if (!session_) {
+        mark_all_panes();
+        return;
+    }
+    surface_.upload_all(session_->mesher());
+    session_->take_dirty_fragments();
+    camera_.frame(render::surface_bounds(session_->mesher()));
+    const Vec3i d = session_->lattice().dims();
+    cursor_ = {d.x / 2, d.y / 2, d.z / 2};
+    ui_params_ = session_->params();
+    ui_auto_window_ = session_->window_from_seeds();
+    ui_repair_ = session_->repair_options();
+    seen_revision_ = session_->revision();
+    mark_all_panes();
+}
+
+void Viewer::request_quit(const std::string& reason) {
+    if (quit_) return;
+    quit_ = true;
+    nlohmann::json fields{{"reason", reason}, {"frames", frames_}};
+    if (session_) {
+        fields["seeds"] = session_->seeds().size();
+        fields["undo_depth"] = session_->undo_depth();
+        fields["iterations"] = session_->segment_status().iterations;
+        fields["triangles"] = surface_.triangle_count();
+        if (session_->target()) fields["target"] = to_json(*session_->target());
+    }
+    const render::CameraPose& p = camera_.pose();
+    fields["camera"] = {{"yaw", p.yaw_deg}, {"pitch", p.pitch_deg}, {"zoom", p.zoom}};
+    log_.add("exit", fields);
+}
+
+void Viewer::mark_all_panes() {
+    pane_dirty_.fill(true);
+    redraw_frames_ = std::max(redraw_frames_, 1);
+}
+
+void Viewer::camera_changed() {
+    pane_dirty_[static_cast<int>(Pane::kView3d)] = true;
+    redraw_frames_ = std::max(redraw_frames_, 1);
+}
+
+void Viewer::set_tool(Tool tool) {
+    tool_ = tool;
+    redraw_frames_ = std::max(redraw_frames_, 1);
+}
+
+void Viewer::set_cursor(Vec3i voxel) {
+    if (!session_) return;
+    const Vec3i d = session_->lattice().dims();
+    voxel = {std::clamp(voxel.x, 0, d.x - 1), std::clamp(voxel.y, 0, d.y - 1), std::clamp(voxel.z, 0, d.z - 1)};
+    if (voxel == cursor_) return;
+    cursor_ = voxel;
+    mark_all_panes();
+}
+
+void Viewer::set_maximised(std::optional<Pane> pane) {
+    maximised_ = pane;
+    if (window_width_ > 0) set_window_size(window_width_, window_height_);
+    mark_all_panes();
+}
+
+void Viewer::set_window_size(int width, int height) {
+    window_width_ = width;
+    window_height_ = height;
+    const int panel = std::min(config_.panel_width, width / 2);
+    panel_rect_ = {0, 0, panel, height};
+    const int x0 = panel, aw = std::max(width - panel, 2), h = std::max(height, 2);
+    std::array<Rect, kPaneCount> r{};
+    if (maximised_) {
+        r[static_cast<int>(*maximised_)] = {x0, 0, aw, h};
+    } else {
+        const int w1 = aw / 2, h1 = h / 2;
+        r[static_cast<int>(Pane::kAxial)] = {x0, 0, w1, h1};
+        r[static_cast<int>(Pane::kSagittal)] = {x0 + w1, 0, aw - w1, h1};
+        r[static_cast<int>(Pane::kCoronal)] = {x0, h1, w1, h - h1};
+        r[static_cast<int>(Pane::kView3d)] = {x0 + w1, h1, aw - w1, h - h1};
+    }
+    for (int i = 0; i < kPaneCount; ++i)
+        if (r[i].w != pane_rects_[i].w || r[i].h != pane_rects_[i].h) pane_dirty_[i] = true;
+    pane_rects_ = r;
+}
+
+bool Viewer::needs_frame() const {
+    return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active ||
+           (session_ && session_->revision() != seen_revision_);
+}
+
+void Viewer::push_event(const InputEvent& event) {
+    events_.push_back(event);
+    redraw_frames_ = std::max(redraw_frames_, 2);  // ImGui settles hover/active states in a frame or two
+}
+
+// ---------------------------------------------------------------------------------------------
+// Frames
+
+void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
+    const auto t0 = Clock::now();
+    set_window_size(width, height);
+    log_.set_frame(frames_);
+    current_ = {};
+    process_events();
+    advance();
+    upload();
+    render_dirty_panes();
+    compose(target, width, height);
+    current_.triangles = surface_.triangle_count();
+    last_ = current_;
+    if (!ready_logged_ && !config_.headless) {  // the window is up and laid out: tell a driving test where things are
+        ready_logged_ = true;
+        nlohmann::json rects = nlohmann::json::object();
+        for (const auto& [name, r] : button_rects_) rects[name] = {r.x, r.y, r.w, r.h};
+        nlohmann::json panes = nlohmann::json::object();
+        for (int i = 0; i < kPaneCount; ++i) {
+            const Rect& r = pane_rects_[i];
+            panes[pane_name(static_cast<Pane>(i))] = {r.x, r.y, r.w, r.h};
+        }
+        log_.add("ready", {{"width", width}, {"height", height}, {"buttons", rects}, {"panes", panes}});
+    }
+    const double wall_ms = ms_since(t0);
+    const double now_fps = 1000.0 / std::max(wall_ms, 1e-3);
+    fps_ = fps_ <= 0.0 ? now_fps : 0.8 * fps_ + 0.2 * now_fps;
+    (void)dt_seconds;
+    ++frames_;
+    if (redraw_frames_ > 0) --redraw_frames_;
+}
+
+void Viewer::account(const SessionUpdate& u) {
+    current_.level_set_ms += u.level_set_ms;
+    current_.agents_ms += u.agents_ms;
+    current_.mesh_ms += u.mesh_ms;
+    current_.fragments += u.fragments.size();
+}
+
+void Viewer::segment_step() {
+    if (!session_) return;
+    account(session_->segment_step());
+    ++current_.segment_steps;
+    const SegmentStatus& st = session_->segment_status();
+    if (st.converged || st.vanished) {
+        const bool was_running = segment_running_;
+        segment_running_ = false;
+        session_->end_action();
+        message_ = st.vanished ? "the front vanished" : fmt::format("converged after {} iterations", st.iterations);
+        message_is_error_ = st.vanished;
+        if (was_running) log_.add("segmentation", {{"running", false}, {"iterations", st.iterations}, {"converged", st.converged}});
+    }
+}
+
+void Viewer::swarm_step() {
+    if (!session_) return;
+    if (!session_->target()) {
+        swarm_running_ = false;
+        fail("set a target first: click the surface with the target tool");
+        return;
+    }
+    account(session_->swarm_step());
+    ++current_.swarm_steps;
+}
+
+void Viewer::advance() {
+    if (!session_) return;
+    if (segment_running_) {
+        const auto t0 = Clock::now();
+        do segment_step();
+        while (segment_running_ && ms_since(t0) < config_.segment_budget_ms);
+    }
+    if (swarm_running_)
+        for (int i = 0; i < swarm_steps_per_frame && swarm_running_; ++i) swarm_step();
+}
+
+void Viewer::upload() {
+    if (!session_) return;
+    const std::vector<FragmentId> ids = session_->take_dirty_fragments();
+    if (!ids.empty()) {
+        const auto t0 = Clock::now();
+        const render::UploadStats st = surface_.upload(session_->mesher(), ids);
+        current_.upload_ms += ms_since(t0);
+        current_.uploaded += st.fragments;
+    }
+    if (session_->revision() != seen_revision_) {
+        seen_revision_ = session_->revision();
+        mark_all_panes();
+    }
+}
+
+render::SliceViewport Viewer::slice_viewport(Pane pane, int width, int height) const {
+    static constexpr render::SliceAxis kAxes[3] = {render::SliceAxis::kAxial, render::SliceAxis::kSagittal,
+                                                   render::SliceAxis::kCoronal};
+    return render::SliceViewport::fit(render::slice_geometry(session_->lattice(), kAxes[static_cast<int>(pane)]), width, height);
+}
+
+render::SceneContent Viewer::scene_content() {
+    render::SceneContent c;
+    std::vector<glm::vec3>& agents = agent_points_;
+    c.lattice = &session_->lattice();
+    c.surface = &surface_;
+    agents.clear();
+    for (const Agent& a : session_->agents())
+        agents.emplace_back(static_cast<float>(a.position.x), static_cast<float>(a.position.y), static_cast<float>(a.position.z));
+    c.agents = agents;
+    if (session_->target()) {
+        const Vec3d t = *session_->target();
+        c.target = glm::vec3(static_cast<float>(t.x), static_cast<float>(t.y), static_cast<float>(t.z));
+    }
+    c.cursor = glm::vec3(static_cast<float>(cursor_.x), static_cast<float>(cursor_.y), static_cast<float>(cursor_.z));
+    return c;
+}
+
+void Viewer::render_pane(Pane pane) {
+    const int i = static_cast<int>(pane);
+    const Rect r = pane_rects_[i];
+    pane_dirty_[i] = false;
+    if (r.w <= 0 || r.h <= 0) return;
+    render::Framebuffer& fb = pane_buffers_[i];
+    fb.resize(r.w, r.h);
+    if (!session_) {
+        fb.bind();
+        glClearColor(0.05f, 0.05f, 0.06f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        return;
+    }
+    if (pane == Pane::kView3d) {
+        const auto t0 = Clock::now();
+        scene_renderer_->render(fb, camera_, scene_content(), scene_style);
+        glFinish();  // llvmpipe draws at flush time: count the drawing in this frame
+        current_.draw_ms += ms_since(t0);
+        return;
+    }
+    const render::SliceViewport vp = slice_viewport(pane, r.w, r.h);
+    const render::SliceGeometry& g = vp.geometry;
+    const int slice = g.slice_of(cursor_.cast<double>());
+    if (slice_shown_[i] != slice) {
+        const std::vector<std::uint8_t> texels = render::slice_texels(session_->unit_image(), g, slice);
+        slice_renderers_[i]->set_texels(g.width, g.height, texels);
+        slice_shown_[i] = slice;
+    }
+    if (contour_slice_[i] != slice || contour_revision_[i] != session_->revision()) {
+        contours_[i] = render::zero_contour(session_->field().phi(), g, slice);
+        contour_slice_[i] = slice;
+        contour_revision_[i] = session_->revision();
+    }
+    render::SliceOverlay overlay;
+    overlay.contour = contours_[i];
+    overlay.cursor = g.to_uv(cursor_.cast<double>());
+    const double texel_mm = std::min(g.u_mm, g.v_mm);
+    for (const SeedBall& s : session_->seeds()) {
+        const double d = std::abs(s.center[g.normal_axis] - slice);
+        if (d <= s.radius) overlay.seeds.push_back({g.to_uv(s.center), std::sqrt(s.radius * s.radius - d * d) * texel_mm});
+    }
+    if (const auto& t = session_->target(); t && std::abs((*t)[g.normal_axis] - slice) <= 2.0) overlay.target = g.to_uv(*t);
+    slice_renderers_[i]->render(fb, vp, overlay, render::SliceStyle{});
+}
+
+void Viewer::render_dirty_panes() {
+    for (int i = 0; i < kPaneCount; ++i)
+        if (pane_dirty_[i] || pane_buffers_[i].width() != pane_rects_[i].w || pane_buffers_[i].height() != pane_rects_[i].h)
+            render_pane(static_cast<Pane>(i));
+}
+
+void Viewer::ensure_3d_rendered() {
+    upload();
+    const int i = static_cast<int>(Pane::kView3d);
+    if (pane_dirty_[i] || pane_buffers_[i].width() != pane_rects_[i].w || pane_buffers_[i].height() != pane_rects_[i].h)
+        render_pane(Pane::kView3d);
+}
+
+void Viewer::compose(GLuint target, int width, int height) {
+    glBindFramebuffer(GL_FRAMEBUFFER, target);
+    glViewport(0, 0, width, height);
+    glDisable(GL_SCISSOR_TEST);
+    glClearColor(0.06f, 0.06f, 0.07f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    for (int i = 0; i < kPaneCount; ++i) {
+        const Rect& r = pane_rects_[i];
+        if (r.w > 0 && r.h > 0 && pane_buffers_[i].valid()) pane_buffers_[i].blit_to(target, r.x, height - r.y - r.h);
+    }
+    imgui_->new_frame(width, height, 1.0 / 60.0);
+    draw_panel();
+    draw_pane_labels();
+    glBindFramebuffer(GL_FRAMEBUFFER, target);
+    glViewport(0, 0, width, height);
+    imgui_->render();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Actions
+
+bool Viewer::fail(const std::string& what) {
+    message_ = what;
+    message_is_error_ = true;
+    redraw_frames_ = std::max(redraw_frames_, 1);
+    log_.add("error", {{"message", what}});
+    return false;
+}
+
+bool Viewer::open_image(const std::string& path) {
+    try {
+        Grid<float> image = read_image(path);
+        auto session = std::make_unique<Session>(std::move(image), config_.session);
+        session_ = std::move(session);
+        image_name_ = std::filesystem::path(path).filename().string();
+        attach_session();
+        message_ = "opened " + path;
+        message_is_error_ = false;
+        log_.add("open", {{"path", path}});
+        return true;
+    } catch (const std::exception& e) {
+        return fail(e.what());
+    }
+}
+
+bool Viewer::add_seed(Vec3d index, double radius) {
+    if (!session_) return fail("open an image first");
+    try {
+        account(session_->add_seed({index, radius}));
+    } catch (const std::invalid_argument& e) {
+        return fail(e.what());
+    }
+    message_ = fmt::format("seed {} at ({:.0f}, {:.0f}, {:.0f})", session_->seeds().size(), index.x, index.y, index.z);
+    message_is_error_ = false;
+    log_.add("seed", {{"index", to_json(index)}, {"radius", radius}, {"seeds", session_->seeds().size()}});
+    return true;
+}
+
+bool Viewer::remove_seed_at(Vec3d index) {
+    if (!session_) return fail("open an image first");
+    const auto k = session_->seed_at(index, 1.0);
+    if (!k) return fail("no seed there");
+    account(session_->remove_seed(*k));
+    message_ = "seed removed";
+    message_is_error_ = false;
+    log_.add("remove_seed", {{"index", to_json(index)}, {"seeds", session_->seeds().size()}});
+    return true;
+}
+
+void Viewer::set_segment_running(bool on) {
+    if (!session_ || on == segment_running_) return;
+    if (on && !session_->has_surface()) {
+        fail("place a seed first (seed tool: click in a slice)");
+        return;
+    }
+    if (on) swarm_running_ = false;
+    segment_running_ = on;
+    if (!on) session_->end_action();
+    message_ = on ? "segmenting" : "segmentation paused";
+    message_is_error_ = false;
+    log_.add("segmentation", {{"running", on}, {"iterations", session_->segment_status().iterations}});
+}
+
+void Viewer::set_swarm_running(bool on) {
+    if (!session_ || on == swarm_running_) return;
+    if (on && !session_->target()) {
+        fail("set a target first: click the surface with the target tool");
+        return;
+    }
+    if (on) segment_running_ = false;
+    swarm_running_ = on;
+    if (!on) session_->end_action();
+    message_ = on ? "swarm repairing" : "swarm stopped";
+    message_is_error_ = false;
+    log_.add("swarm", {{"running", on}});
+}
+
+bool Viewer::set_target(Vec3d index) {
+    if (!session_) return fail("open an image first");
+    try {
+        session_->set_target(index);
+    } catch (const std::invalid_argument& e) {
+        return fail(e.what());
+    }
+    set_cursor(rounded(index));
+    message_ = fmt::format("target ({:.1f}, {:.1f}, {:.1f})", index.x, index.y, index.z);
+    message_is_error_ = false;
+    log_.add("target", {{"index", to_json(index)}});
+    return true;
+}
+
+std::optional<render::Pick> Viewer::click_3d(double x, double y, bool as_target) {
+    if (!session_) return std::nullopt;
+    ensure_3d_rendered();
+    const auto p = render::pick(pane_buffers_[static_cast<int>(Pane::kView3d)], static_cast<int>(std::floor(x)),
+                                static_cast<int>(std::floor(y)), camera_, session_->lattice());
+    if (!p) {
+        fail("no surface under the pointer");
+        return std::nullopt;
+    }
+    const Vec3d index{p->index.x, p->index.y, p->index.z};
+    log_.add("pick", {{"pixel", {x, y}}, {"index", to_json(index)}, {"world", {p->world.x, p->world.y, p->world.z}}});
+    if (as_target) {
+        if (!set_target(index)) return std::nullopt;
+    } else {
+        set_cursor(rounded(index));
+    }
+    return p;
+}
+
+void Viewer::undo(int times) {
+    if (!session_) return;
+    segment_running_ = swarm_running_ = false;
+    for (int i = 0; i < times && session_->can_undo(); ++i) {
+        const std::string label = session_->next_undo_label();
+        account(session_->undo());
+        message_ = "undid " + label;
+        log_.add("undo", {{"action", label}, {"undo_depth", session_->undo_depth()}});
+    }
+    ui_params_ = session_->params();
+    ui_auto_window_ = session_->window_from_seeds();
+    message_is_error_ = false;
+}
+
+void Viewer::redo(int times) {
+    if (!session_) return;
+    segment_running_ = swarm_running_ = false;
+    for (int i = 0; i < times && session_->can_redo(); ++i) {
+        const std::string label = session_->next_redo_label();
+        account(session_->redo());
+        message_ = "redid " + label;
+        log_.add("redo", {{"action", label}, {"redo_depth", session_->redo_depth()}});
+    }
+    ui_params_ = session_->params();
+    ui_auto_window_ = session_->window_from_seeds();
+    message_is_error_ = false;
+}
+
+bool Viewer::apply_params(const ThresholdParams& params, bool window_from_seeds) {
+    if (!session_) return fail("open an image first");
+    try {
+        session_->set_params(params, window_from_seeds);
+    } catch (const std::invalid_argument& e) {
+        ui_params_ = session_->params();
+        return fail(e.what());
+    }
+    ui_params_ = session_->params();
+    ui_auto_window_ = session_->window_from_seeds();
+    return true;
+}
+
+bool Viewer::apply_repair_options(const RepairOptions& options) {
+    if (!session_) return fail("open an image first");
+    try {
+        session_->set_repair_options(options);
+    } catch (const std::invalid_argument& e) {
+        ui_repair_ = session_->repair_options();
+        return fail(e.what());
+    }
+    ui_repair_ = session_->repair_options();
+    return true;
+}
+
+bool Viewer::save_mask(const std::string& path) {
+    if (!session_) return fail("open an image first");
+    try {
+        cli::check_output_path(path, cli::OutputKind::kImage, "mask");
+        write_label_image(session_->mask(), path);
+    } catch (const std::exception& e) {
+        return fail(e.what());
+    }
+    message_ = "saved the mask to " + path;
+    message_is_error_ = false;
+    log_.add("save", {{"what", "mask"}, {"path", path}});
+    return true;
+}
+
+bool Viewer::save_phi(const std::string& path) {
+    if (!session_) return fail("open an image first");
+    try {
+        cli::check_output_path(path, cli::OutputKind::kImage, "phi");
+        write_image(session_->field().phi(), path);
+    } catch (const std::exception& e) {
+        return fail(e.what());
+    }
+    message_ = "saved phi to " + path;
+    message_is_error_ = false;
+    log_.add("save", {{"what", "phi"}, {"path", path}});
+    return true;
+}
+
+bool Viewer::save_mesh(const std::string& path) {
+    if (!session_) return fail("open an image first");
+    try {
+        cli::check_output_path(path, cli::OutputKind::kMesh, "mesh");
+        write_mesh(path, session_->surface_mesh().view(), session_->lattice());
+    } catch (const std::exception& e) {
+        return fail(e.what());
+    }
+    message_ = "saved the surface to " + path;
+    message_is_error_ = false;
+    log_.add("save", {{"what", "mesh"}, {"path", path}});
+    return true;
+}
+
+render::Image Viewer::capture_pane(Pane pane, int width, int height, int supersample) {
+    const int ss = std::clamp(supersample, 1, 4);
+    const Rect saved = pane_rects_[static_cast<int>(pane)];
+    pane_rects_[static_cast<int>(pane)] = {saved.x, saved.y, width * ss, height * ss};
+    upload();
+    render_pane(pane);  // into the pane's own buffer at the capture size
+    const render::Image img = pane_buffers_[static_cast<int>(pane)].read_color();
+    pane_rects_[static_cast<int>(pane)] = saved;
+    pane_dirty_[static_cast<int>(pane)] = true;  // back to the layout size on the next frame
+    return render::downsample(img, ss);
+}
+
+render::Image Viewer::capture_window(int width, int height) {
+    render::Framebuffer fb(width, height);
+    for (int k = 0; k < 2; ++k) frame(fb.id(), width, height, 1.0 / 60.0);  // ImGui lays out in one frame, settles in two
+    return fb.read_color();
+}
+
+bool Viewer::save_screenshot(const std::string& path, std::optional<Pane> pane, int width, int height, int supersample) {
+    try {
+        render::Image img;
+        if (pane) {
+            const Rect r = pane_rects_[static_cast<int>(*pane)];
+            img = capture_pane(*pane, width > 0 ? width : std::max(r.w, 16), height > 0 ? height : std::max(r.h, 16), supersample);
+        } else {
+            img = capture_window(width > 0 ? width : std::max(window_width_, 64), height > 0 ? height : std::max(window_height_, 64));
+        }
+        render::write_png(path, img);
+    } catch (const std::exception& e) {
+        return fail(e.what());
+    }
+    message_ = "saved a screenshot to " + path;
+    message_is_error_ = false;
+    log_.add("screenshot", {{"path", path}, {"pane", pane ? pane_name(*pane) : "window"}});
+    return true;
+}
+
+}  // namespace liveset::viewer

@@ -1,0 +1,236 @@
+// The viewer's core, shared by the GLFW window, headless (EGL) runs, scripts and benchmarks: an
+// ITK-SNAP-like layout (axial / sagittal / coronal / 3D panes and a control panel), the session it
+// edits, one framebuffer per pane (a pane is redrawn only when what it shows changed), input
+// routing (ImGui panel or panes), the actions the panel, the keyboard and the scripts share, and
+// per-frame timing (level set, agents, meshing, upload, draw).
+#pragma once
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <array>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "event_log.hpp"
+#include "liveset/render/framebuffer.hpp"
+#include "liveset/render/orbit_camera.hpp"
+#include "liveset/render/picking.hpp"
+#include "liveset/render/scene_renderer.hpp"
+#include "liveset/render/slice_renderer.hpp"
+#include "liveset/render/surface_buffers.hpp"
+#include "liveset/session/session.hpp"
+
+namespace liveset::viewer {
+
+// ITK-SNAP's default arrangement: axial top-left, sagittal top-right, coronal bottom-left, 3D
+// bottom-right.
+enum class Pane { kAxial = 0, kSagittal = 1, kCoronal = 2, kView3d = 3 };
+inline constexpr int kPaneCount = 4;
+const char* pane_name(Pane pane);  // "axial", "sagittal", "coronal", "3d"
+std::optional<Pane> pane_from_name(std::string_view name);
+
+enum class Tool { kCrosshair, kSeed, kTarget };
+const char* tool_name(Tool tool);
+
+struct Rect {
+    int x = 0, y = 0, w = 0, h = 0;  // window pixels, top-left origin
+    bool contains(double px, double py) const { return px >= x && py >= y && px < x + w && py < y + h; }
+};
+
+// Window-system input, in window pixels (top-left origin); key codes and modifiers are GLFW's.
+struct InputEvent {
+    enum class Type { kMove, kPress, kRelease, kScroll, kKey, kChar };
+    Type type = Type::kMove;
+    double x = 0.0, y = 0.0;
+    int button = 0;        // 0 left, 1 right, 2 middle
+    double scroll = 0.0;   // wheel steps, positive away from the user
+    int key = 0;
+    int mods = 0;
+    bool down = false;     // key pressed (or repeated) rather than released
+    unsigned codepoint = 0;
+};
+
+// What one frame cost (milliseconds) and did.
+struct FrameStats {
+    double level_set_ms = 0.0, agents_ms = 0.0, mesh_ms = 0.0, upload_ms = 0.0, draw_ms = 0.0;
+    std::size_t fragments = 0;       // rebuilt by the mesher this frame
+    std::size_t uploaded = 0;        // fragment buffers re-uploaded this frame
+    std::size_t triangles = 0;       // on the GPU after the frame
+    int segment_steps = 0, swarm_steps = 0;
+    double total_ms() const { return level_set_ms + agents_ms + mesh_ms + upload_ms + draw_ms; }
+};
+
+class ImGuiBridge;
+
+struct ViewerConfig {
+    bool headless = false;
+    std::string log_events;  // JSON-lines event log (rewritten atomically at every event); empty: none
+    int panel_width = 340;
+    SessionOptions session;  // for images opened from the panel
+    float segment_budget_ms = 40.0f;  // level-set time per frame while segmentation runs
+};
+
+class Viewer {
+public:
+    // Needs a current OpenGL 3.3 core context (window or headless). `session` may be null: the
+    // panel then offers to open an image. `image_name` labels the window and the panel.
+    Viewer(std::unique_ptr<Session> session, std::string image_name, const ViewerConfig& config);
+    ~Viewer();
+    Viewer(const Viewer&) = delete;
+    Viewer& operator=(const Viewer&) = delete;
+
+    // --- frames ---------------------------------------------------------------------------
+    void push_event(const InputEvent& event);
+    void request_redraw() { redraw_frames_ = std::max(redraw_frames_, 1); }
+    // True while something is to be computed or shown (events queued, evolution running, a
+    // redraw pending); the window sleeps otherwise.
+    bool needs_frame() const;
+    bool busy() const { return segment_running_ || swarm_running_; }
+    // One frame into framebuffer `target` (0: the window) of width x height pixels: input,
+    // evolution, upload of the rebuilt fragments, dirty panes, then panes + panel composed.
+    void frame(GLuint target, int width, int height, double dt_seconds);
+    const FrameStats& last_frame() const { return last_; }
+    double fps() const { return fps_; }
+    std::uint64_t frames() const { return frames_; }
+    bool quit_requested() const { return quit_; }
+    void request_quit(const std::string& reason);
+
+    // --- state ----------------------------------------------------------------------------
+    Session* session() { return session_.get(); }
+    const std::string& image_name() const { return image_name_; }
+    Tool tool() const { return tool_; }
+    void set_tool(Tool tool);
+    Vec3i cursor() const { return cursor_; }
+    void set_cursor(Vec3i voxel);
+    render::OrbitCamera& camera() { return camera_; }
+    void camera_changed();  // after changing camera() directly
+    std::optional<Pane> maximised() const { return maximised_; }
+    void set_maximised(std::optional<Pane> pane);
+    void set_window_size(int width, int height);  // lays the panes out (frame() does it too)
+    Rect pane_rect(Pane pane) const { return pane_rects_[static_cast<int>(pane)]; }
+    Rect panel_rect() const { return panel_rect_; }
+    const std::string& message() const { return message_; }
+    EventLog& log() { return log_; }
+
+    // --- actions: panel, keys and scripts share them; false + message() on failure ---------
+    bool open_image(const std::string& path);
+    bool add_seed(Vec3d index, double radius);
+    bool remove_seed_at(Vec3d index);
+    void set_segment_running(bool on);
+    bool segment_running() const { return segment_running_; }
+    void segment_step();  // one step, accounted in this frame's statistics
+    void set_swarm_running(bool on);
+    bool swarm_running() const { return swarm_running_; }
+    void swarm_step();
+    bool set_target(Vec3d index);
+    // A click at pixel (x, y) of the 3D pane (pane coordinates): the surface point under it
+    // (depth-buffer pick) becomes the cursor and, with `as_target`, the swarm's target.
+    std::optional<render::Pick> click_3d(double x, double y, bool as_target);
+    void undo(int times = 1);
+    void redo(int times = 1);
+    bool apply_params(const ThresholdParams& params, bool window_from_seeds);
+    bool apply_repair_options(const RepairOptions& options);
+    bool save_mask(const std::string& path);
+    bool save_phi(const std::string& path);
+    bool save_mesh(const std::string& path);
+    // Screenshot of a pane at its layout size (or width x height, supersampled) or of the whole
+    // window (pane = nullopt) as the last frame laid it out.
+    bool save_screenshot(const std::string& path, std::optional<Pane> pane, int width = 0, int height = 0, int supersample = 1);
+    render::Image capture_pane(Pane pane, int width, int height, int supersample = 1);
+    render::Image capture_window(int width, int height);
+
+    // Renders the 3D pane now if it is out of date (picking reads its depth buffer).
+    void ensure_3d_rendered();
+
+    // Seed radius and swarm steps per frame used by clicks and the run buttons.
+    double seed_radius = 2.0;
+    int swarm_steps_per_frame = 1;
+    render::SceneStyle scene_style;
+
+private:
+    struct Drag {
+        bool active = false;
+        Pane pane = Pane::kView3d;
+        int button = 0;
+        int mods = 0;
+        double start_x = 0, start_y = 0, last_x = 0, last_y = 0;
+        bool moved = false;
+    };
+
+    // viewer.cpp
+    void attach_session();
+    void account(const SessionUpdate& update);
+    void advance();
+    void upload();
+    void render_pane(Pane pane);
+    void render_dirty_panes();
+    void compose(GLuint target, int width, int height);
+    void mark_all_panes();
+    render::SliceViewport slice_viewport(Pane pane, int width, int height) const;
+    render::SceneContent scene_content();
+    bool fail(const std::string& what);
+    // viewer_input.cpp
+    void process_events();
+    bool routes_to_imgui(const InputEvent& e) const;
+    void handle_pane_event(const InputEvent& e);
+    void handle_key(const InputEvent& e);
+    void pane_click(Pane pane, double x, double y, int button, int mods);
+    std::optional<Pane> pane_at(double x, double y) const;
+    std::optional<Vec3i> voxel_at(Pane pane, double x, double y) const;
+    // viewer_panel.cpp
+    void draw_panel();
+    bool panel_button(const char* label, const char* name);
+    void draw_pane_labels();
+
+    ViewerConfig config_;
+    std::unique_ptr<Session> session_;
+    std::string image_name_;
+    EventLog log_;
+    std::unique_ptr<ImGuiBridge> imgui_;
+    std::unique_ptr<render::SceneRenderer> scene_renderer_;
+    std::array<std::unique_ptr<render::SliceRenderer>, 3> slice_renderers_;
+    std::array<int, 3> slice_shown_{-1, -1, -1};  // slice index in each slice renderer's texture
+    render::SurfaceBuffers surface_;
+    render::OrbitCamera camera_;
+    std::array<render::Framebuffer, kPaneCount> pane_buffers_;
+    std::array<bool, kPaneCount> pane_dirty_{true, true, true, true};
+    std::array<Rect, kPaneCount> pane_rects_{};
+    Rect panel_rect_;
+    int window_width_ = 0, window_height_ = 0;
+    std::optional<Pane> maximised_;
+    std::uint64_t seen_revision_ = ~std::uint64_t{0};
+    std::vector<glm::vec3> agent_points_;  // index space, refreshed per 3D draw
+    std::array<std::vector<glm::dvec2>, 3> contours_;
+    std::array<std::uint64_t, 3> contour_revision_{};
+    std::array<int, 3> contour_slice_{-1, -1, -1};
+    Tool tool_ = Tool::kCrosshair;
+    Vec3i cursor_{};
+    bool segment_running_ = false, swarm_running_ = false;
+    std::deque<InputEvent> events_;
+    double mouse_x_ = 0.0, mouse_y_ = 0.0;
+    std::map<std::string, Rect> button_rects_;  // panel buttons, for the event log's "ready" line
+    bool ready_logged_ = false;
+    Drag drag_;
+    int redraw_frames_ = 2;
+    bool quit_ = false;
+    std::string message_;
+    bool message_is_error_ = false;
+    FrameStats current_, last_;
+    double fps_ = 0.0, fps_clock_ = 0.0;
+    int fps_frames_ = 0;
+    std::uint64_t frames_ = 0;
+    // Panel fields (kept between frames).
+    std::string open_path_, mask_path_ = "segmentation.nii.gz", phi_path_ = "phi.nii.gz", mesh_path_ = "surface.ply",
+                                screenshot_path_ = "screenshot.png";
+    ThresholdParams ui_params_;
+    bool ui_auto_window_ = true;
+    RepairOptions ui_repair_;
+};
+
+}  // namespace liveset::viewer

@@ -1,0 +1,88 @@
+// A real window under Xvfb driven by real input events (xdotool, window_smoke.sh): the drag
+// rotates the 3D view, the click with the target tool picks a point on the surface (within half a
+// voxel of the zero level set) and aims the swarm there, T runs and stops the swarm, the panel's
+// "Reset view" button restores the home camera, Ctrl+Q quits cleanly with status 0. What the
+// viewer did is read from its --log-events file.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "liveset/grid/sampling.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/levelset/sparse_field.hpp"
+#include "liveset/phantom/phantom.hpp"
+
+namespace liveset {
+namespace {
+
+namespace fs = std::filesystem;
+
+bool have(const char* tool) { return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0; }
+
+TEST(WindowSmoke, DragClickKeysAndAButtonUnderXvfb) {
+    if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
+        GTEST_SKIP() << "xvfb-run, xauth and xdotool are needed (scripts/setup.sh installs them)";
+    const fs::path dir = fs::temp_directory_path() / ("liveset_window_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    PhantomOptions o;
+    o.size = 64;
+    const Phantom ph = make_phantom(o);
+    const std::string image = (dir / "t1.nii.gz").string(), mask = (dir / "truth.nii.gz").string(),
+                      log = (dir / "events.jsonl").string();
+    write_image(ph.image, image);
+    write_label_image(ph.truth, mask);
+
+    const std::string cmd = "cd " + dir.string() + " && timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' bash " +
+                            std::string(LIVESET_SOURCE_DIR) + "/tests/render/window_smoke.sh " + LIVESET_CLI_PATH + " " + image +
+                            " " + mask + " " + log + " > driver.out 2>&1";
+    const int status = std::system(cmd.c_str());
+    std::ifstream driver(dir / "driver.out");
+    const std::string driver_out((std::istreambuf_iterator<char>(driver)), std::istreambuf_iterator<char>());
+    ASSERT_TRUE(WIFEXITED(status)) << driver_out;
+    ASSERT_EQ(WEXITSTATUS(status), 0) << driver_out;  // the viewer's own exit status
+
+    std::vector<nlohmann::json> events;
+    std::ifstream in(log);
+    for (std::string line; std::getline(in, line);) events.push_back(nlohmann::json::parse(line));
+    const auto find = [&](const std::string& type, const std::function<bool(const nlohmann::json&)>& also = {}) {
+        for (const auto& e : events)
+            if (e["type"] == type && (!also || also(e))) return e;
+        return nlohmann::json();
+    };
+    ASSERT_FALSE(find("ready").is_null());
+
+    // The drag rotated the camera away from the home pose (yaw -30, pitch 20).
+    const auto rotate = find("camera", [](const auto& e) { return e["gesture"] == "rotate"; });
+    ASSERT_FALSE(rotate.is_null()) << driver_out;
+    EXPECT_LT(rotate["yaw"].get<double>(), -30.0 - 5.0);  // dragged right: the object turned right
+
+    // The click picked a point on the surface and made it the target.
+    const auto pick = find("pick");
+    ASSERT_FALSE(pick.is_null());
+    SparseField field(ph.image.lattice(), 2);
+    field.init_from_mask(ph.truth);
+    const Vec3d p{pick["index"][0].get<double>(), pick["index"][1].get<double>(), pick["index"][2].get<double>()};
+    EXPECT_LE(std::abs(trilinear(field.phi(), p)), 0.5) << pick.dump();
+    const auto target = find("target");
+    ASSERT_FALSE(target.is_null());
+    EXPECT_EQ(target["index"], pick["index"]);
+
+    // The swarm ran and stopped; the button reset the camera; Ctrl+Q ended the session.
+    EXPECT_FALSE(find("swarm", [](const auto& e) { return e["running"] == true; }).is_null());
+    EXPECT_FALSE(find("swarm", [](const auto& e) { return e["running"] == false; }).is_null());
+    EXPECT_FALSE(find("button", [](const auto& e) { return e["name"] == "reset_view"; }).is_null());
+    const auto exit = find("exit");
+    ASSERT_FALSE(exit.is_null());
+    EXPECT_EQ(exit["reason"], "ctrl+q");
+    EXPECT_DOUBLE_EQ(exit["camera"]["yaw"].get<double>(), -30.0);
+    EXPECT_DOUBLE_EQ(exit["camera"]["pitch"].get<double>(), 20.0);
+    ASSERT_TRUE(exit.contains("target"));
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace liveset
