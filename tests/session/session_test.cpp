@@ -239,3 +239,27 @@ TEST(Session, LoadedMaskStartsTheHistoryAfresh) {
 
 }  // namespace
 }  // namespace liveset
+
+namespace liveset {
+namespace {
+
+// A phi image cannot tell every band point's layer: a point at exactly +-0.5 may be on L0 or on
+// L+-1 (and a value of exactly +-1.5 on L+-1 or L+-2), so the far points next to them may come
+// back as L+-2. The surface - signs, zero-layer values, the mesh - comes back exactly.
+TEST(Session, ASavedPhiLoadsBackAsTheSameSurface) {
+    const Phantom& ph = phantom64();
+    Session a(ph.image, options());
+    for (const Vec3i& c : ph.seeds) a.add_seed({c.cast<double>(), 2.0});
+    for (int i = 0; i < 60; ++i) a.segment_step();
+    Session b(ph.image, options());
+    b.load_phi(a.field().phi());  // what `liveset view --phi` does with a saved phi
+    ASSERT_TRUE(check_invariants(b.field()).ok()) << check_invariants(b.field()).summary();
+    const Grid<std::uint8_t> ma = a.mask(), mb = b.mask();
+    EXPECT_TRUE(std::equal(ma.values().begin(), ma.values().end(), mb.values().begin(), mb.values().end()));
+    for (PointIndex p : a.field().zero_layer())
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(a.field().phi()[p]), std::bit_cast<std::uint32_t>(b.field().phi()[p]));
+    EXPECT_EQ(canonical_triangles(a.mesher().merged()), canonical_triangles(b.mesher().merged()));
+}
+
+}  // namespace
+}  // namespace liveset
