@@ -19,6 +19,7 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/session/repair_presets.hpp"
+#include "view_command.hpp"
 #include "liveset/swarm/repair.hpp"
 
 namespace liveset::cli {
@@ -31,7 +32,7 @@ struct DemoArgs {
     std::uint64_t seed = 1;
     int rounds = 20;        // repair rounds (one target each)
     int round_steps = 100;  // swarm steps per round
-    bool json = false, quiet = false;
+    bool json = false, quiet = false, no_view = false;
 };
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -88,6 +89,7 @@ int run_demo(const DemoArgs& a, int threads) {
     double repair_ms = 0.0;
     Grid<std::uint8_t> repaired = o.mask;
     std::vector<Perforation> holes = find_perforations(repaired, ph.truth, white);
+    const std::optional<Vec3d> first_hole = holes.empty() ? std::nullopt : std::optional<Vec3d>(holes.front().centroid);
     for (int r = 0; r < a.rounds && !holes.empty(); ++r) {
         const Vec3d t = holes.front().centroid;
         ro.swarm.seed = a.seed + static_cast<std::uint64_t>(r);
@@ -134,6 +136,7 @@ int run_demo(const DemoArgs& a, int threads) {
     j["timings_ms"] = {{"phantom", phantom_ms}, {"segment", 1000.0 * o.result.seconds}, {"mesh", mesh_ms}, {"eval", eval_ms},
                        {"repair", repair_ms}};
     j["outputs"] = a.out;
+    j["screenshots"] = write_before_after_pictures(dir, phi_before, mesher);  // superior view, headless
     write_atomically((dir / "report.json").string(), j.dump(2) + "\n");
     if (a.json) {
         fmt::print("{}\n", j.dump());
@@ -151,7 +154,13 @@ int run_demo(const DemoArgs& a, int threads) {
                    fragments, left);
         fmt::print("  before       dice {:.4f}  holes {}\n", ev["dice"].get<double>(), ev["holes"].get<long>());
         fmt::print("  after        dice {:.4f}  holes {}\n", after["dice"].get<double>(), after["holes"].get<long>());
-        fmt::print("  outputs      {}/ (t1, truth_gm, seg, phi, seg_repaired, phi_repaired .nii.gz; surface(_repaired).ply; report.json)\n", a.out);
+        fmt::print("  outputs      {}/ (t1, truth_gm, seg, phi, seg_repaired, phi_repaired .nii.gz; surface(_repaired).ply; before/after.png; report.json)\n", a.out);
+    }
+    // With a display: the viewer on the segmented phantom, the swarm repairing the first hole live.
+    if (!a.no_view && !a.json && first_hole && viewer_display_available()) {
+        auto session = std::make_unique<Session>(ph.image, SessionOptions{});
+        session->load_phi(phi_before);
+        return open_demo_viewer(std::move(session), *first_hole);
     }
     return 0;
 }
@@ -168,6 +177,7 @@ void add_demo_command(CLI::App& app, const int& threads) {
     demo->add_option("--round-steps", da.round_steps, "swarm steps per repair round")->check(CLI::Range(1, 100000))->capture_default_str();
     demo->add_flag("--json", da.json, "print the report as one JSON object on stdout");
     demo->add_flag("--quiet,-q", da.quiet, "print nothing");
+    demo->add_flag("--no-view", da.no_view, "do not open the viewer even when a display is available (--json implies it)");
     demo->callback([&threads] {
         const int rc = run_demo(da, threads);
         if (rc != 0) std::exit(rc);
