@@ -1,7 +1,8 @@
 // `liveset view --headless --bench`: the frame-time breakdown of the paper's §5 scenarios on the
 // loaded surface - static, agents moving (p = 0), agents repairing at p = 0.1 and 0.5 - with the
 // 3D view filling the window: per frame the ms in level set, agents, meshing, upload and draw, the
-// fragments rebuilt and the triangles drawn.
+// fragments rebuilt and the triangles drawn. Swarm settings: the demo's, with no edit range (all
+// agents may edit, as in the paper's timings) and p as the scenario says.
 #pragma once
 
 #include <optional>

@@ -114,7 +114,8 @@ ScriptAction parse_entry(const json& e, std::size_t entry, const std::string& pa
     if (!e.is_object() || e.empty()) bare.fail("expected an object such as {\"segment\": 100}");
     static const std::set<std::string> kActions = {"seed", "remove_seed", "params", "segment", "click", "target",
                                                    "target_surface_near", "swarm", "camera", "cursor", "layout", "tool",
-                                                   "undo", "redo", "save_mask", "save_phi", "save_mesh", "screenshot", "eval"};
+                                                   "undo", "redo", "save_mask", "save_phi", "save_mesh", "screenshot", "eval",
+                                                   "perforations", "clear_target"};
     std::string name;
     for (auto it = e.begin(); it != e.end(); ++it)
         if (kActions.count(it.key())) {
@@ -173,7 +174,8 @@ ScriptAction parse_entry(const json& e, std::size_t entry, const std::string& pa
         only_keys(e, {name}, err);
         a.kind = K::kCamera;
         if (!v.is_object()) err.fail("expected an object such as {\"view\": \"superior\"}");
-        only_keys(v, {"view", "yaw", "pitch", "zoom", "pan", "reset"}, err);
+        only_keys(v, {"view", "yaw", "pitch", "zoom", "pan", "center", "reset"}, err);
+        if (v.contains("center")) a.center = point(v["center"], err, lattice, "center");
         if (v.contains("view")) {
             a.view = text(v["view"], err, "view");
             render::CameraPose pose;
@@ -215,7 +217,11 @@ ScriptAction parse_entry(const json& e, std::size_t entry, const std::string& pa
         a.path = text(v, err, "the path");
         output_path(a.path, name == "save_mesh" ? cli::OutputKind::kMesh : cli::OutputKind::kImage, err);
     } else if (name == "screenshot") {
-        only_keys(e, {name, "pane", "size", "supersample"}, err);
+        only_keys(e, {name, "pane", "size", "supersample", "overlays"}, err);
+        if (e.contains("overlays")) {
+            if (!e["overlays"].is_boolean()) err.fail("overlays must be true or false");
+            a.overlays = e["overlays"].get<bool>();
+        }
         a.kind = K::kScreenshot;
         a.path = text(v, err, "the path");
         if (a.path.size() < 4 || a.path.substr(a.path.size() - 4) != ".png") err.fail("screenshots are .png files");
@@ -240,6 +246,20 @@ ScriptAction parse_entry(const json& e, std::size_t entry, const std::string& pa
         only_keys(v, {"truth", "label"}, err);
         a.path = text(v["truth"], err, "truth");
         if (v.contains("label")) a.label = whole(v["label"], err, "label", 1, 255);
+    } else if (name == "clear_target") {
+        only_keys(e, {name}, err);
+        a.kind = K::kClearTarget;
+        if (v != true) err.fail("expected true");
+    } else if (name == "perforations") {
+        only_keys(e, {name}, err);
+        a.kind = K::kPerforations;
+        if (!v.is_object() || !v.contains("labels")) err.fail("expected {\"labels\": path, \"truth_label\": 2, \"inner_label\": 3}");
+        only_keys(v, {"labels", "truth_label", "inner_label", "target"}, err);
+        a.path = text(v["labels"], err, "labels");
+        a.label = v.contains("truth_label") ? whole(v["truth_label"], err, "truth_label", 1, 255) : 2;
+        a.inner_label = v.contains("inner_label") ? whole(v["inner_label"], err, "inner_label", 1, 255) : 3;
+        if (a.label == a.inner_label) err.fail("truth_label and inner_label must differ");
+        if (v.contains("target")) a.rank = whole(v["target"], err, "target", 0, 1'000'000);
     }
     return a;
 }

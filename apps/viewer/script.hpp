@@ -10,13 +10,18 @@
 //   {"segment": 100} or {"segment": "converge", "max": 2000}
 //   {"click": [x, y]}                          pixel of the 3D pane: pick -> swarm target
 //   {"target": [i, j, k]}  {"target_surface_near": [i, j, k], "radius": 20}
-//   {"swarm": 300}
-//   {"camera": {"view": "superior", "yaw": 0, "pitch": 90, "zoom": 1.2, "pan": [x, y, z], "reset": true}}
+//   {"swarm": 300}  {"clear_target": true}   (the swarm goes away)
+//   {"camera": {"view": "superior", "yaw": 0, "pitch": 90, "zoom": 1.2, "pan": [x, y, z], "center": [i, j, k],
+//               "reset": true}}                 ("center": orbit around this voxel instead of the surface's centre)
 //   {"cursor": [i, j, k]}  {"layout": "four" | "3d" | "axial" | "sagittal" | "coronal"}  {"tool": "seed"}
 //   {"undo": 1}  {"redo": 1}
 //   {"save_mask": path}  {"save_phi": path}  {"save_mesh": path}
 //   {"screenshot": path, "pane": "3d" | "axial" | ... | "window", "size": [w, h], "supersample": 2}
 //   {"eval": {"truth": path, "label": 2}}      prints {"entry": k, "eval": {dice, holes, ...}}
+//   {"perforations": {"labels": path, "truth_label": 2, "inner_label": 3, "target": 0}}
+//        prints the tunnels through the segmented shell where the truth is intact (largest first,
+//        find_perforations) and, with "target": r, aims the swarm at the r-th largest - what a
+//        user sees and clicks; as the demo does
 #pragma once
 
 #include <optional>
@@ -34,7 +39,7 @@ namespace liveset::viewer {
 struct ScriptAction {
     enum class Kind {
         kSeed, kRemoveSeed, kParams, kSegment, kClick, kTarget, kTargetSurfaceNear, kSwarm, kCamera, kCursor, kLayout,
-        kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval
+        kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval, kPerforations, kClearTarget
     };
     Kind kind = Kind::kSeed;
     std::size_t entry = 0;  // 1-based position in the script
@@ -52,12 +57,16 @@ struct ScriptAction {
     std::optional<std::string> view;
     std::optional<double> yaw, pitch, zoom;
     std::optional<glm::dvec3> pan;
+    std::optional<Vec3d> center;  // voxel to orbit around
     bool reset = false;
     std::optional<Pane> pane;  // layout / screenshot (nullopt: four panes / the window)
     Tool tool = Tool::kCrosshair;
     std::string path;
     int width = 0, height = 0, supersample = 1;
-    int label = 0;  // eval: truth label (0: any non-zero)
+    int label = 0;  // eval: truth label (0: any non-zero); perforations: truth label
+    int inner_label = 0;           // perforations: the tissue the shell encloses
+    std::optional<int> rank;       // perforations: target the rank-th largest
+    bool overlays = true;          // screenshot: bounding box and crosshair
 };
 
 struct Script {

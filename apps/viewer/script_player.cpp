@@ -7,6 +7,7 @@
 
 #include "cli_common.hpp"
 #include "image_commands.hpp"
+#include "liveset/eval/perforations.hpp"
 #include "liveset/io/image_io.hpp"
 
 namespace liveset::viewer {
@@ -62,6 +63,7 @@ void ScriptPlayer::advance(Viewer& viewer) {
             break;
         }
         case K::kTarget: check(viewer.set_target(a.point)); break;
+        case K::kClearTarget: viewer.clear_target(); break;
         case K::kTargetSurfaceNear: {
             const auto p = s->nearest_surface_point(a.point, a.radius);
             if (!p) fail(a, fmt::format("no surface within {} voxels", a.radius));
@@ -83,6 +85,10 @@ void ScriptPlayer::advance(Viewer& viewer) {
             if (a.pitch) pose.pitch_deg = *a.pitch;
             if (a.zoom) pose.zoom = *a.zoom;
             if (a.pan) pose.pan = *a.pan;
+            if (a.center) {  // the orbit centre is the framed centre plus the pan
+                const Vec3d w = s->lattice().to_world(*a.center);
+                pose.pan = glm::dvec3(w.x, w.y, w.z) - (c.centre() - c.pose().pan);
+            }
             c.set_pose(pose);
             viewer.camera_changed();
             break;
@@ -98,7 +104,35 @@ void ScriptPlayer::advance(Viewer& viewer) {
         case K::kSaveMask: check(viewer.save_mask(a.path)); break;
         case K::kSavePhi: check(viewer.save_phi(a.path)); break;
         case K::kSaveMesh: check(viewer.save_mesh(a.path)); break;
-        case K::kScreenshot: check(viewer.save_screenshot(a.path, a.pane, a.width, a.height, a.supersample)); break;
+        case K::kScreenshot: {
+            const render::SceneStyle saved = viewer.scene_style;
+            if (!a.overlays) viewer.scene_style.bounding_box = viewer.scene_style.cursor = false;
+            const bool ok = viewer.save_screenshot(a.path, a.pane, a.width, a.height, a.supersample);
+            viewer.scene_style = saved;
+            viewer.camera_changed();
+            check(ok);
+            break;
+        }
+        case K::kPerforations: {
+            const Grid<std::uint8_t> labels = read_label_image(a.path);
+            if (!labels.lattice().same_geometry(s->lattice(), 1e-3)) fail(a, fmt::format("{} does not overlay the image", a.path));
+            Grid<std::uint8_t> truth(labels.lattice()), inner(labels.lattice());
+            for (PointIndex i = 0; i < labels.size(); ++i) {
+                truth[i] = labels[i] == a.label;
+                inner[i] = labels[i] == a.inner_label;
+            }
+            const std::vector<Perforation> found = find_perforations(s->mask(), truth, inner);
+            nlohmann::json list = nlohmann::json::array();
+            for (std::size_t k = 0; k < found.size() && k < 20; ++k)
+                list.push_back({{"voxels", found[k].voxels}, {"centroid", {found[k].centroid.x, found[k].centroid.y, found[k].centroid.z}}});
+            fmt::print("{}\n", nlohmann::json{{"entry", a.entry}, {"perforations", found.size()}, {"largest", list}}.dump());
+            std::fflush(stdout);
+            if (a.rank) {
+                if (*a.rank >= static_cast<int>(found.size())) fail(a, fmt::format("only {} perforations", found.size()));
+                check(viewer.set_target(found[static_cast<std::size_t>(*a.rank)].centroid));
+            }
+            break;
+        }
         case K::kEval: {
             Grid<std::uint8_t> truth = read_label_image(a.path);
             if (!truth.lattice().same_geometry(s->lattice(), 1e-3)) fail(a, fmt::format("{} does not overlay the image", a.path));

@@ -169,14 +169,14 @@ void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     const auto t0 = Clock::now();
     set_window_size(width, height);
     log_.set_frame(frames_);
-    current_ = {};
-    process_events();
+    process_events();  // current_ already holds what scripts or the bench did since the last frame
     advance();
     upload();
     render_dirty_panes();
     compose(target, width, height);
     current_.triangles = surface_.triangle_count();
     last_ = current_;
+    current_ = {};
     if (!ready_logged_ && !config_.headless) {  // the window is up and laid out: tell a driving test where things are
         ready_logged_ = true;
         nlohmann::json rects = nlohmann::json::object();
@@ -445,6 +445,13 @@ bool Viewer::set_target(Vec3d index) {
     message_is_error_ = false;
     log_.add("target", {{"index", to_json(index)}});
     return true;
+}
+
+void Viewer::clear_target() {
+    if (!session_) return;
+    swarm_running_ = false;
+    session_->clear_target();
+    log_.add("clear_target");
 }
 
 std::optional<render::Pick> Viewer::click_3d(double x, double y, bool as_target) {

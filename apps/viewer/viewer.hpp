@@ -129,6 +129,7 @@ public:
     bool swarm_running() const { return swarm_running_; }
     void swarm_step();
     bool set_target(Vec3d index);
+    void clear_target();  // the swarm goes away
     // A click at pixel (x, y) of the 3D pane (pane coordinates): the surface point under it
     // (depth-buffer pick) becomes the cursor and, with `as_target`, the swarm's target.
     std::optional<render::Pick> click_3d(double x, double y, bool as_target);

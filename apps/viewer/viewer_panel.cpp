@@ -129,10 +129,7 @@ void Viewer::draw_panel() {
             session_->end_action();
         }
         ImGui::SameLine();
-        if (panel_button("Clear target", "clear_target")) {
-            swarm_running_ = false;
-            session_->clear_target();
-        }
+        if (panel_button("Clear target", "clear_target")) clear_target();
     }
 
     if (session_ && ImGui::CollapsingHeader("History", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -86,6 +86,12 @@ glm::dvec3 OrbitCamera::up() const {
     return up;
 }
 
+glm::dvec2 OrbitCamera::depth_range() const {
+    const double d = glm::length(eye() - bounds_.centre);
+    const double r = 0.75 * bounds_.radius;  // the object, not its box's corners
+    return {std::max(d - r, 0.0), d + r};
+}
+
 glm::mat4 OrbitCamera::view() const { return glm::mat4(glm::lookAt(eye(), centre(), up())); }
 
 glm::mat4 OrbitCamera::projection(double aspect) const {

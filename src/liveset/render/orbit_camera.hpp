@@ -43,6 +43,8 @@ public:
     double distance() const;
     glm::dvec3 eye() const;
     glm::dvec3 up() const;
+    // Eye-space distances from the eye to the near and far side of the framed object's sphere.
+    glm::dvec2 depth_range() const;
     glm::mat4 view() const;                    // world -> eye
     glm::mat4 projection(double aspect) const;  // eye -> clip
 

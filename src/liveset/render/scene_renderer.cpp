@@ -23,13 +23,15 @@ void main() {
 }
 )";
 
-// Phong: a headlight plus a key light from the upper left, specular on the outside only.
+// Phong: a headlight plus a key light from the upper left, a soft specular on the outside only,
+// and a mild darkening with depth across the object (a depth cue for folded surfaces).
 constexpr const char* kSurfaceFragment = R"(#version 330 core
 in vec3 v_normal;
 in vec3 v_eye;
 uniform vec3 u_outside;
 uniform vec3 u_inside;
 uniform bool u_front_is_ccw;
+uniform vec2 u_depth_range;
 out vec4 colour;
 void main() {
     vec3 n = normalize(v_normal);
@@ -38,11 +40,10 @@ void main() {
     vec3 v = normalize(-v_eye);
     vec3 key = normalize(vec3(-0.45, 0.6, 0.65));
     vec3 base = outside ? u_outside : u_inside;
-    float head = max(dot(n, v), 0.0);
-    float diffuse = 0.55 * head + 0.35 * max(dot(n, key), 0.0);
-    vec3 h = normalize(key + v);
-    float specular = outside ? 0.25 * pow(max(dot(n, h), 0.0), 40.0) + 0.15 * pow(head, 60.0) : 0.0;
-    colour = vec4(base * (0.18 + diffuse) + vec3(specular), 1.0);
+    float diffuse = 0.55 * max(dot(n, v), 0.0) + 0.35 * max(dot(n, key), 0.0);
+    float specular = outside ? 0.12 * pow(max(dot(n, normalize(key + v)), 0.0), 20.0) : 0.0;
+    float depth = clamp((-v_eye.z - u_depth_range.x) / max(u_depth_range.y - u_depth_range.x, 1e-3), 0.0, 1.0);
+    colour = vec4((base * (0.25 + diffuse) + vec3(specular)) * (1.0 - 0.25 * depth), 1.0);
 }
 )";
 
@@ -163,6 +164,8 @@ void SceneRenderer::render(const Framebuffer& target, const OrbitCamera& camera,
         surface_.set("u_normal_matrix", glm::mat3(glm::transpose(glm::inverse(model_view))));
         surface_.set("u_outside", style.outside);
         surface_.set("u_inside", style.inside);
+        const glm::dvec2 range = camera.depth_range();
+        surface_.set("u_depth_range", glm::vec2(range));
         // Triangles are counter-clockwise seen from outside in index space; a mirroring
         // index -> world map (negative determinant) turns them clockwise.
         surface_.set("u_front_is_ccw", glm::determinant(glm::dmat3(model_d)) > 0.0 ? 1 : 0);

@@ -18,11 +18,11 @@ namespace liveset::render {
 
 struct SceneStyle {
     glm::vec3 background{0.10f, 0.11f, 0.13f};
-    glm::vec3 outside{0.91f, 0.80f, 0.70f};  // cortex-like
+    glm::vec3 outside{0.93f, 0.82f, 0.72f};  // cortex-like
     glm::vec3 inside{0.62f, 0.22f, 0.20f};   // back faces: seen through holes
     glm::vec3 agents{0.15f, 0.75f, 0.95f};
     glm::vec3 target{1.00f, 0.85f, 0.10f};
-    float agent_radius_mm = 0.9f;
+    float agent_radius_mm = 0.6f;
     float target_radius_mm = 2.5f;
     bool bounding_box = true;
     bool cursor = true;
