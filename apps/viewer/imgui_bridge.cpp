@@ -43,7 +43,8 @@ ImGuiBridge::ImGuiBridge() {
     ImGuiStyle& style = ImGui::GetStyle();
     style.WindowRounding = 0.0f;
     style.FrameRounding = 2.0f;
-    style.ItemSpacing.y = 5.0f;
+    style.ItemSpacing.y = 3.0f;
+    style.FramePadding.y = 2.0f;
     ImGui_ImplOpenGL3_Init("#version 330 core");
 }
 

@@ -10,6 +10,7 @@
 
 #include "imgui_bridge.hpp"
 #include "liveset/io/image_io.hpp"
+#include "liveset/render/png_writer.hpp"
 
 namespace liveset::viewer {
 
@@ -53,6 +54,9 @@ const char* tool_name(Tool tool) {
 
 Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const ViewerConfig& config)
     : config_(config), session_(std::move(session)), image_name_(std::move(image_name)), log_(config.log_events) {
+    const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    renderer_ = renderer ? renderer : "unknown renderer";
+    if (const auto cut = renderer_.find(" ("); cut != std::string::npos) renderer_.resize(cut);
     imgui_ = std::make_unique<ImGuiBridge>();
     scene_renderer_ = std::make_unique<render::SceneRenderer>();
     for (auto& r : slice_renderers_) r = std::make_unique<render::SliceRenderer>();
@@ -170,6 +174,19 @@ void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     upload();
     render_dirty_panes();
     compose(target, width, height);
+    if (window_shot_pending_) {
+        window_shot_pending_ = false;
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, target);
+        if (target == 0) glReadBuffer(GL_BACK);
+        try {
+            render::write_png(screenshot_path_, render::read_bound_color(width, height));
+            message_ = "saved the window to " + screenshot_path_;
+            message_is_error_ = false;
+            log_.add("screenshot", {{"path", screenshot_path_}, {"pane", "window"}});
+        } catch (const std::exception& e) {
+            fail(e.what());
+        }
+    }
     current_.triangles = surface_.triangle_count();
     last_ = current_;
     current_ = {};

@@ -145,6 +145,9 @@ public:
     bool save_screenshot(const std::string& path, std::optional<Pane> pane, int width = 0, int height = 0, int supersample = 1);
     render::Image capture_pane(Pane pane, int width, int height, int supersample = 1);
     render::Image capture_window(int width, int height);
+    // Saves exactly what the window shows (its back buffer after the next frame) to the panel's
+    // screenshot path.
+    void request_window_screenshot() { window_shot_pending_ = true; request_redraw(); }
 
     // Renders the 3D pane now if it is out of date (picking reads its depth buffer).
     void ensure_3d_rendered();
@@ -217,10 +220,12 @@ private:
     double mouse_x_ = 0.0, mouse_y_ = 0.0;
     std::map<std::string, Rect> button_rects_;  // panel buttons, for the event log's "ready" line
     bool ready_logged_ = false;
+    bool window_shot_pending_ = false;  // F12: save what the window shows after this frame
     Drag drag_;
     int redraw_frames_ = 2;
     bool quit_ = false;
     std::string message_;
+    std::string renderer_;  // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
     bool message_is_error_ = false;
     FrameStats current_, last_;
     double fps_ = 0.0, fps_clock_ = 0.0;

@@ -208,6 +208,9 @@ void Viewer::handle_key(const InputEvent& e) {
         key_log("reset view");
         if (session_) camera_.frame(render::surface_bounds(session_->mesher()));
         camera_changed();
+    } else if (e.key == GLFW_KEY_F12) {
+        key_log("window screenshot");
+        request_window_screenshot();
     } else if (e.key == GLFW_KEY_F) {
         key_log("maximise 3d");
         set_maximised(maximised_ ? std::nullopt : std::optional<Pane>(Pane::kView3d));

@@ -132,6 +132,15 @@ void Viewer::draw_panel() {
         if (panel_button("Clear target", "clear_target")) clear_target();
     }
 
+    if (ImGui::CollapsingHeader("Status", ImGuiTreeNodeFlags_DefaultOpen)) {
+        const FrameStats& f = last_;
+        ImGui::Text("%.1f FPS, frame %.1f ms (%s)", fps_, f.total_ms(), renderer_.c_str());
+        ImGui::Text("level set %.2f  agents %.2f  mesh %.2f ms", f.level_set_ms, f.agents_ms, f.mesh_ms);
+        ImGui::Text("upload %.2f  draw %.2f ms", f.upload_ms, f.draw_ms);
+        ImGui::Text("fragments rebuilt %zu, uploaded %zu", f.fragments, f.uploaded);
+        ImGui::Text("triangles %zu", surface_.triangle_count());
+        if (f.segment_steps || f.swarm_steps) ImGui::TextDisabled("%d level-set / %d swarm steps this frame", f.segment_steps, f.swarm_steps);
+    }
     if (session_ && ImGui::CollapsingHeader("History", ImGuiTreeNodeFlags_DefaultOpen)) {
         ImGui::BeginDisabled(!session_->can_undo());
         if (panel_button("Undo (Ctrl+Z)", "undo")) undo();
@@ -179,15 +188,6 @@ void Viewer::draw_panel() {
         }
     }
 
-    if (ImGui::CollapsingHeader("Status", ImGuiTreeNodeFlags_DefaultOpen)) {
-        const FrameStats& f = last_;
-        ImGui::Text("%.1f FPS, frame %.1f ms (llvmpipe: software)", fps_, f.total_ms());
-        ImGui::Text("level set %.2f  agents %.2f  mesh %.2f ms", f.level_set_ms, f.agents_ms, f.mesh_ms);
-        ImGui::Text("upload %.2f  draw %.2f ms", f.upload_ms, f.draw_ms);
-        ImGui::Text("fragments rebuilt %zu, uploaded %zu", f.fragments, f.uploaded);
-        ImGui::Text("triangles %zu", surface_.triangle_count());
-        if (f.segment_steps || f.swarm_steps) ImGui::TextDisabled("%d level-set / %d swarm steps this frame", f.segment_steps, f.swarm_steps);
-    }
     if (!message_.empty()) {
         ImGui::Separator();
         ImGui::PushStyleColor(ImGuiCol_Text, message_is_error_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f));
