@@ -96,15 +96,39 @@ Vec3d clamp_length(Vec3d v, double max_len) {
     return l > max_len && l > 0 ? v * (max_len / l) : v;
 }
 
-// Newton projection onto φ = 0 (x ← x − φ ∇φ/|∇φ|²); returns the final position.
+// Projection onto φ = 0 by safeguarded Newton steps x ← x − φ ∇φ/|∇φ|², each at most half a
+// voxel long; a step that crosses the surface brackets it and bisection along that step finishes
+// (plain Newton overshoots where ∇φ is small). Where ∇φ vanishes (the centre of a one-voxel bubble
+// or pinch, a local extremum of φ) it first steps a tenth of a voxel along a fixed diagonal.
 Vec3d project(const Grid<float>& phi, Vec3d x, int iterations) {
+    constexpr double kTolerance = 1e-3;
+    bool nudged = false;
     for (int k = 0; k < iterations; ++k) {
-        const double f = trilinear(phi, x);
-        if (std::abs(f) < 1e-3) break;
-        const Vec3d g = to_d(interpolated_gradient(phi, x));
+        double f = trilinear(phi, x);
+        if (std::abs(f) < kTolerance) break;
+        Vec3d g = to_d(interpolated_gradient(phi, x));
+        if (!(dot(g, g) > 1e-12) && !nudged) {
+            nudged = true;
+            x = clamp_to_box(x + Vec3d{1, 1, 1} * (0.1 / std::sqrt(3.0)), phi.dims());
+            f = trilinear(phi, x);
+            g = to_d(interpolated_gradient(phi, x));
+        }
         const double g2 = dot(g, g);
         if (!(g2 > 1e-12)) break;
-        x = clamp_to_box(x - g * (f / g2), phi.dims());
+        const Vec3d y = clamp_to_box(x - clamp_length(g * (f / g2), 0.5), phi.dims());
+        const double fy = trilinear(phi, y);
+        if ((f < 0) == (fy < 0)) {
+            x = y;
+            continue;
+        }
+        Vec3d a = x, b = y;  // φ(a) and φ(b) have opposite signs
+        for (int j = 0; j < 24; ++j) {
+            const Vec3d m = (a + b) * 0.5;
+            const double fm = trilinear(phi, m);
+            if (std::abs(fm) < kTolerance) return m;
+            ((fm < 0) == (f < 0) ? a : b) = m;
+        }
+        return (a + b) * 0.5;
     }
     return x;
 }
