@@ -58,6 +58,42 @@ TEST(Repair, TopologyGuardKeepsTheTopologyUnderRandomEdits) {
     }
 }
 
+// A target far from the swarm respawns it there (a click elsewhere on the surface); a near one
+// only re-aims it.
+TEST(Repair, AFarTargetRespawnsTheSwarm) {
+    const Lattice lat({48, 48, 48});
+    SparseField f(lat, 2);
+    f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{23.5, 23.5, 23.5}) - 18.0; });
+    const Grid<float> image(lat, 0.5f);
+    RepairOptions ro;
+    ro.swarm.agents = 30;
+    ro.swarm.act_probability = 0.0;
+    RepairLoop loop(f, image, nullptr, ro);
+    const auto centroid = [&] {
+        Vec3d c{0, 0, 0};
+        for (const Agent& a : loop.swarm().agents()) c += a.position;
+        return c / static_cast<double>(loop.swarm().agents().size());
+    };
+    const Vec3d east{41.5, 23.5, 23.5}, north{23.5, 41.5, 23.5}, near_east{41.0, 26.5, 23.5};
+    loop.set_target(east);
+    EXPECT_LT(norm(centroid() - east), 4.0);
+    for (int k = 0; k < 5; ++k) loop.step();
+    const Vec3d before = centroid();
+    loop.set_target(near_east);  // within respawn_distance: re-aimed, not moved
+    EXPECT_EQ(norm(centroid() - before), 0.0);
+    loop.set_target(north);      // 25 voxels away: respawned there
+    EXPECT_LT(norm(centroid() - north), 4.0);
+    ro.respawn_distance = 0.0;   // never respawn: the swarm stays where it was
+    RepairLoop stay(f, image, nullptr, ro);
+    stay.set_target(east);
+    stay.set_target(north);
+    Vec3d c{0, 0, 0};
+    for (const Agent& a : stay.swarm().agents()) c += a.position;
+    EXPECT_LT(norm(c / 30.0 - east), 4.0);
+    ro.respawn_distance = -1.0;
+    EXPECT_THROW(RepairLoop(f, image, nullptr, ro), std::invalid_argument);
+}
+
 // The decisive check on the phantom: segmenting leaves one perforation per weak spot (and a
 // one-voxel bubble); repair rounds aimed at the largest hole left (as the demo does) close them all.
 TEST(Repair, SwarmClosesThePhantomPerforations) {

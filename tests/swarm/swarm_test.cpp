@@ -266,6 +266,32 @@ TEST(Swarm, ContractsWhereTheInsideIsUnlikeThePopulation) {
     for (const ZeroLayerEdit& e : edits) EXPECT_GT(e.delta, 0.0f);
 }
 
+// The paper's speed experiment: acting agents raise or lower at random whatever the image says.
+// On a flat image the intensity rule expands everywhere; the random rule does both, about evenly.
+TEST(Swarm, RandomDecisionRaisesAndLowers) {
+    const SparseField f = sphere_field();
+    const Grid<float> flat(f.lattice(), 0.5f);
+    SwarmOptions o;
+    o.agents = 200;
+    o.act_probability = 1.0;
+    o.edit_radius = 0.5;  // each agent edits only the zero-layer points right under it
+    for (EditDecision d : {EditDecision::kIntensity, EditDecision::kRandom}) {
+        o.decision = d;
+        Swarm s(o);
+        s.spawn(f, kCentre + Vec3d{kR, 0, 0}, 30.0);
+        for (int k = 0; k < 5; ++k) s.move(f);
+        std::size_t raise = 0, lower = 0;
+        for (const ZeroLayerEdit& e : s.surface_edits(f, flat)) (e.delta > 0 ? raise : lower) += 1;
+        if (d == EditDecision::kIntensity) {
+            EXPECT_EQ(raise, 0u);
+            EXPECT_GT(lower, 50u);
+        } else {
+            EXPECT_GT(raise, 30u);
+            EXPECT_GT(lower, 30u);
+        }
+    }
+}
+
 TEST(Swarm, BitIdenticalForOneAndTwoThreads) {
     auto run = [](int threads) {
         tbb::global_control c(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));

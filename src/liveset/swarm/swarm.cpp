@@ -28,6 +28,8 @@
 //   I_in = I(x − 1.5n) and
 //     expands  (Δ = −A) if |I_out − μ| ≤ k·σ   (the outside looks like the population: grow into it)
 //     contracts(Δ = +A) else if |I_in − μ| > k'·σ (the inside does not look like it: retreat)
+//   (decision kRandom, the paper's speed benchmark: an acting agent raises or lowers the surface
+//   with equal probability instead, from the same stream)
 //   Δ is spread over the zero-layer points p with |p − x| ≤ edit_radius, weighted by the
 //   unit-peak Gaussian exp(−|p − x|²/(2σ_g²)), σ_g = edit_radius/2, so A is the change under the
 //   agent whatever the zero-layer sampling density. Contributions to a point are summed in agent
@@ -317,7 +319,9 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
             const double outside = trilinear(image_unit, x + n * 1.5);
             const double inside = trilinear(image_unit, x - n * 1.5);
             double amount = 0.0;
-            if (std::abs(outside - mu) <= options_.expand_sigmas * sigma)
+            if (options_.decision == EditDecision::kRandom)
+                amount = rng.uniform() < 0.5 ? -options_.edit_amount : options_.edit_amount;
+            else if (std::abs(outside - mu) <= options_.expand_sigmas * sigma)
                 amount = -options_.edit_amount;
             else if (std::abs(inside - mu) > options_.contract_sigmas * sigma)
                 amount = options_.edit_amount;
