@@ -104,6 +104,7 @@ Vec3d clamp_length(Vec3d v, double max_len) {
 // or pinch, a local extremum of φ) it first steps a tenth of a voxel along a fixed diagonal.
 Vec3d project(const Grid<float>& phi, Vec3d x, int iterations) {
     constexpr double kTolerance = 1e-3;
+    constexpr double kMaxStep = 0.5;  // voxels: a step cannot skip the surface
     bool nudged = false;
     for (int k = 0; k < iterations; ++k) {
         double f = trilinear(phi, x);
@@ -117,7 +118,7 @@ Vec3d project(const Grid<float>& phi, Vec3d x, int iterations) {
         }
         const double g2 = dot(g, g);
         if (!(g2 > 1e-12)) break;
-        const Vec3d y = clamp_to_box(x - clamp_length(g * (f / g2), 0.5), phi.dims());
+        const Vec3d y = clamp_to_box(x - clamp_length(g * (f / g2), kMaxStep), phi.dims());
         const double fy = trilinear(phi, y);
         if ((f < 0) == (fy < 0)) {
             x = y;
