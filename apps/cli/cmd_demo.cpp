@@ -88,7 +88,12 @@ int run_demo(const DemoArgs& a, int threads) {
     std::size_t steps = 0, fragments = 0, modified = 0;
     double repair_ms = 0.0;
     Grid<std::uint8_t> repaired = o.mask;
-    std::vector<Perforation> holes = find_perforations(repaired, ph.truth, white);
+    // The holes a user would point at: perforations first, then spurious cavities (bubbles).
+    const auto holes_left = [&] {
+        std::vector<Perforation> h = find_perforations(repaired, ph.truth, white);
+        return h.empty() ? find_cavities(repaired, white) : h;
+    };
+    std::vector<Perforation> holes = holes_left();
     const std::optional<Vec3d> first_hole = holes.empty() ? std::nullopt : std::optional<Vec3d>(holes.front().centroid);
     for (int r = 0; r < a.rounds && !holes.empty(); ++r) {
         const Vec3d t = holes.front().centroid;
@@ -101,9 +106,9 @@ int run_demo(const DemoArgs& a, int threads) {
             repair_ms += l.ms;
         }
         steps += log.size();
-        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"perforation_voxels", holes.front().voxels}, {"perforations", holes.size()}});
+        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", holes.front().voxels}, {"holes", holes.size()}});
         repaired = inside_mask(o.field->phi());
-        holes = find_perforations(repaired, ph.truth, white);
+        holes = holes_left();
     }
     const std::size_t left = holes.size();
     nlohmann::json after = evaluation_report(repaired, ph.truth);
@@ -130,7 +135,7 @@ int run_demo(const DemoArgs& a, int threads) {
     j["dice"] = after["dice"];
     j["holes"] = after["holes"];
     j["repair"] = {{"agents", ro.swarm.agents}, {"p", ro.swarm.act_probability}, {"rounds", rounds}, {"steps", steps},
-                   {"perforations_left", left}, {"points_modified", modified}, {"fragments_rebuilt", fragments},
+                   {"holes_left", left}, {"points_modified", modified}, {"fragments_rebuilt", fragments},
                    {"ms_per_step", steps ? repair_ms / static_cast<double>(steps) : 0.0},
                    {"triangles", repaired_surface.triangle_count()}};
     j["timings_ms"] = {{"phantom", phantom_ms}, {"segment", 1000.0 * o.result.seconds}, {"mesh", mesh_ms}, {"eval", eval_ms},
@@ -149,7 +154,7 @@ int run_demo(const DemoArgs& a, int threads) {
         fmt::print("  evaluation   against the phantom's ground truth ({:.0f} ms):\n", eval_ms);
         print_evaluation(ev, "               ");
         fmt::print("  repair       {} rounds, each {} agents for {} steps at the largest hole left (p = {}): {} steps, {:.3f} ms/step,\n"
-                   "               {} fragment rebuilds; perforations left {}\n",
+                   "               {} fragment rebuilds; perforations/cavities left {}\n",
                    rounds.size(), ro.swarm.agents, a.round_steps, ro.swarm.act_probability, steps, j["repair"]["ms_per_step"].get<double>(),
                    fragments, left);
         fmt::print("  before       dice {:.4f}  holes {}\n", ev["dice"].get<double>(), ev["holes"].get<long>());

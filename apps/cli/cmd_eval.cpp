@@ -8,6 +8,7 @@
 #include "cli_common.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
+#include "liveset/eval/perforations.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
 
@@ -17,9 +18,21 @@ namespace {
 
 struct EvalArgs {
     std::string mask, truth;
-    int label = -1, mask_label = -1;
+    int label = -1, mask_label = -1, inner_label = -1;
+    int max_sites = 20;
     bool json = false;
 };
+
+// Hole sites as JSON: index-space centroid, the voxel nearest it (a ready --target) and the size.
+nlohmann::json sites_json(const std::vector<Perforation>& sites, int limit) {
+    nlohmann::json a = nlohmann::json::array();
+    for (std::size_t k = 0; k < sites.size() && static_cast<int>(k) < limit; ++k) {
+        const Perforation& p = sites[k];
+        a.push_back({{"voxels", p.voxels}, {"centroid", {p.centroid.x, p.centroid.y, p.centroid.z}},
+                     {"target", {p.nearest.x, p.nearest.y, p.nearest.z}}});
+    }
+    return a;
+}
 
 Grid<std::uint8_t> select_label(Grid<std::uint8_t> g, int label) {
     for (std::uint8_t& v : g.values()) v = label < 0 ? v != 0 : v == label;
@@ -28,7 +41,10 @@ Grid<std::uint8_t> select_label(Grid<std::uint8_t> g, int label) {
 
 void run_eval(const EvalArgs& a, int threads) {
     const auto guard = limit_threads(threads);
-    const Grid<std::uint8_t> truth = select_label(read_label_image(a.truth), a.label);
+    if (a.inner_label >= 0 && a.label < 0) throw UsageError("--inner-label needs --label (both index the truth's label image)");
+    if (a.inner_label >= 0 && a.inner_label == a.label) throw UsageError("--inner-label must differ from --label");
+    const Grid<std::uint8_t> labels = read_label_image(a.truth);
+    const Grid<std::uint8_t> truth = select_label(labels, a.label);
     const Grid<std::uint8_t> mask = select_label(read_label_image(a.mask), a.mask_label);
     try {
         require_same_geometry(mask.lattice(), truth.lattice(), "eval");
@@ -44,11 +60,30 @@ void run_eval(const EvalArgs& a, int threads) {
     j["mask"] = a.mask;
     j["truth"]["path"] = a.truth;
     if (a.label >= 0) j["truth"]["label"] = a.label;
+    std::vector<Perforation> perforations, cavities;
+    if (a.inner_label >= 0) {  // where to point a repair: tunnels through the structure, bubbles in it
+        const Grid<std::uint8_t> inner = select_label(labels, a.inner_label);
+        perforations = find_perforations(mask, truth, inner);
+        cavities = find_cavities(mask, inner);
+        j["perforations"] = perforations.size();
+        j["cavities_spurious"] = cavities.size();
+        j["sites"] = {{"perforations", sites_json(perforations, a.max_sites)}, {"cavities", sites_json(cavities, a.max_sites)}};
+    }
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else {
         fmt::print("liveset eval: {} against {}{}\n", a.mask, a.truth, a.label >= 0 ? fmt::format(" (label {})", a.label) : "");
         print_evaluation(j);
+        if (a.inner_label >= 0) {
+            fmt::print("  hole sites: {} perforation(s) through the structure to label {}, {} spurious cavity(ies); largest:\n",
+                       perforations.size(), a.inner_label, cavities.size());
+            for (const auto* list : {&perforations, &cavities})
+                for (std::size_t k = 0; k < list->size() && static_cast<int>(k) < std::min(a.max_sites, 5); ++k) {
+                    const Perforation& p = (*list)[k];
+                    fmt::print("    {:<11} {:>6} voxels  --target {},{},{}\n", list == &perforations ? "perforation" : "cavity", p.voxels,
+                               p.nearest.x, p.nearest.y, p.nearest.z);
+                }
+        }
     }
 }
 
@@ -116,6 +151,8 @@ void add_eval_commands(CLI::App& app, const int& threads) {
     ev->add_option("--truth", ea.truth, "ground-truth mask or label image")->required();
     ev->add_option("--label", ea.label, "use truth == LABEL (e.g. 2 = grey matter in BrainWeb labels)")->check(CLI::Range(0, 255));
     ev->add_option("--mask-label", ea.mask_label, "use mask == LABEL")->check(CLI::Range(0, 255));
+    ev->add_option("--inner-label", ea.inner_label, "also locate the holes to repair: perforations through the structure to truth == LABEL (e.g. 3 = white matter under grey matter) and spurious cavities")->check(CLI::Range(0, 255));
+    ev->add_option("--max-sites", ea.max_sites, "hole sites listed per kind in the JSON report")->check(CLI::Range(0, 100000))->capture_default_str();
     ev->add_flag("--json", ea.json, "print one JSON object (dice, jaccard, volume_difference, hausdorff95_mm, components, euler, genus, holes)");
     ev->callback([&threads] { run_eval(ea, threads); });
 

@@ -22,6 +22,7 @@ struct RepairArgs {
     std::vector<std::string> targets, targets_mm;
     RepairOptions options;
     std::string out_phi, out_mask, out_mesh, log;
+    std::string decision = "intensity";
     bool json = false, quiet = false;
 };
 
@@ -75,6 +76,7 @@ int run_repair_command(RepairArgs a, int threads) {
     if (!a.out_mask.empty()) check_output_path(a.out_mask, OutputKind::kImage, "--out-mask");
     if (!a.out_mesh.empty()) check_output_path(a.out_mesh, OutputKind::kMesh, "--out-mesh");
     if (!a.log.empty()) check_output_path(a.log, OutputKind::kText, "--log");
+    a.options.swarm.decision = a.decision == "random" ? EditDecision::kRandom : EditDecision::kIntensity;
     if (a.targets.empty() && a.targets_mm.empty()) throw UsageError("give at least one --target I,J,K[@STEP] (or --target-mm)");
     try {
         validate(a.options.swarm);
@@ -140,12 +142,16 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--steps", ra.options.steps, "swarm steps")->check(CLI::Range(0, 10'000'000))->capture_default_str();
     r->add_option("--p", ra.options.swarm.act_probability, "probability that an agent edits per step")->check(finite_number())->capture_default_str();
     r->add_option("--radius", ra.options.swarm.edit_radius, "edit radius, voxels")->check(finite_number())->capture_default_str();
+    r->add_option("--respawn-distance", ra.options.respawn_distance, "a target farther than this (voxels) from the swarm respawns it there (0: never)")->check(CLI::Range(0.0, 1e6))->capture_default_str();
     r->add_option("--seed", ra.options.swarm.seed, "random seed")->capture_default_str();
     r->add_option("--amount", ra.options.swarm.edit_amount, "|dphi| under an acting agent (<= 0.5)")->check(finite_number())->capture_default_str();
     r->add_option("--expand-sigmas", ra.options.swarm.expand_sigmas, "expand where the outside intensity is within this many population sigmas")->check(finite_number())->capture_default_str();
     r->add_option("--contract-sigmas", ra.options.swarm.contract_sigmas, "contract where the inside intensity is beyond this many sigmas")->check(finite_number())->capture_default_str();
     r->add_option("--sample-depth", ra.options.swarm.sample_depth, "population samples this many voxels inside the surface (0: at the agents)")->check(finite_number())->capture_default_str();
     r->add_option("--edit-range", ra.options.swarm.edit_range, "only agents within this many voxels of the target edit (0: all)")->check(finite_number())->capture_default_str();
+    r->add_option("--decision", ra.decision, "how acting agents edit: intensity (the repair rule) or random (raise/lower at random, the paper's speed test)")
+        ->check(CLI::IsMember({"intensity", "random"}))
+        ->capture_default_str();
     r->add_flag("--no-topology-guard{false}", ra.options.topology_guard, "let edits bridge pieces or open tunnels (by default they cannot)");
     r->add_option("--out-phi", ra.out_phi, "repaired phi");
     r->add_option("--out-mask", ra.out_mask, "repaired mask");

@@ -66,7 +66,8 @@ int run_bench(Viewer& viewer, const BenchOptions& o, int width, int height) {
             RepairOptions ro = demo_repair_options();
             ro.swarm.agents = o.agents;
             ro.swarm.act_probability = sc.p;
-            ro.swarm.edit_range = 0.0;  // as in the paper's timing: every agent may edit, wherever it is
+            ro.swarm.edit_range = 0.0;  // as in the paper's timing: every agent may edit, wherever it is,
+            ro.swarm.decision = EditDecision::kRandom;  // raising or lowering the surface at random
             viewer.apply_repair_options(ro);
             if (!viewer.set_target(target)) throw cli::UsageError("bench target: " + viewer.message());
         } else {

@@ -1,8 +1,9 @@
 // `liveset view --headless --bench`: the frame-time breakdown of the paper's §5 scenarios on the
 // loaded surface - static, agents moving (p = 0), agents repairing at p = 0.1 and 0.5 - with the
 // 3D view filling the window: per frame the ms in level set, agents, meshing, upload and draw, the
-// fragments rebuilt and the triangles drawn. Swarm settings: the demo's, with no edit range (all
-// agents may edit, as in the paper's timings) and p as the scenario says.
+// fragments rebuilt and the triangles drawn. Swarm: the demo's settings, but as in the paper's
+// timing experiment every agent may edit (no edit range) and raises or lowers the surface at random
+// with probability p per step.
 #pragma once
 
 #include <optional>

@@ -309,3 +309,25 @@ TEST(Perforations, FindsEachDrilledTunnelAndNotADent) {
     EXPECT_TRUE(find_perforations(truth, truth, inner).empty());
     EXPECT_THROW(find_perforations(mask, truth, Mask(Lattice({4, 4, 4}), 0)), std::invalid_argument);
 }
+
+// find_cavities: bubbles carved inside the shell's wall are found and located, largest first; the
+// shell's own core (the inner tissue) and a perforation (open to the outside) are not cavities.
+TEST(Perforations, FindsBubblesInTheWallButNotTheCore) {
+    const Mask truth = thick_shell();
+    Mask inner(truth.lattice(), 0);
+    paint(inner, [](Vec3d p) { return norm(p - Vec3d{13.5, 13.5, 13.5}) <= 6.0; });
+    Mask mask = truth;
+    EXPECT_TRUE(find_cavities(mask, inner).empty());  // the core is the shell's legitimate cavity
+    const Vec3i one{13, 13, 22};                        // a one-voxel bubble in the +z wall (r = 8.5)
+    mask(one) = 0;
+    paint(mask, [](Vec3d p) { return norm(p - Vec3d{13, 22, 13}) <= 1.0; }, 0);  // a 7-voxel bubble in +y
+    drill(mask, 0);                                     // a perforation along +x: open, not a cavity
+    ASSERT_EQ(mask_topology(mask).cavities, 2u);        // the core joined the outside through the tunnel
+    const auto found = find_cavities(mask, inner);
+    ASSERT_EQ(found.size(), 2u);
+    EXPECT_EQ(found[0].voxels, 7u);
+    EXPECT_LT(norm(found[0].centroid - Vec3d{13, 22, 13}), 1e-9);
+    EXPECT_EQ(found[1].voxels, 1u);
+    EXPECT_EQ(found[1].nearest, one);
+    EXPECT_THROW(find_cavities(mask, Mask(Lattice({4, 4, 4}), 0)), std::invalid_argument);
+}

@@ -58,8 +58,44 @@ TEST(Repair, TopologyGuardKeepsTheTopologyUnderRandomEdits) {
     }
 }
 
-// The decisive check on the phantom: segmenting leaves one perforation per weak spot; repair
-// rounds aimed at the largest perforation left (as the demo does) close them all.
+// A target far from the swarm respawns it there (a click elsewhere on the surface); a near one
+// only re-aims it.
+TEST(Repair, AFarTargetRespawnsTheSwarm) {
+    const Lattice lat({48, 48, 48});
+    SparseField f(lat, 2);
+    f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{23.5, 23.5, 23.5}) - 18.0; });
+    const Grid<float> image(lat, 0.5f);
+    RepairOptions ro;
+    ro.swarm.agents = 30;
+    ro.swarm.act_probability = 0.0;
+    RepairLoop loop(f, image, nullptr, ro);
+    const auto centroid = [&] {
+        Vec3d c{0, 0, 0};
+        for (const Agent& a : loop.swarm().agents()) c += a.position;
+        return c / static_cast<double>(loop.swarm().agents().size());
+    };
+    const Vec3d east{41.5, 23.5, 23.5}, north{23.5, 41.5, 23.5}, near_east{41.0, 26.5, 23.5};
+    loop.set_target(east);
+    EXPECT_LT(norm(centroid() - east), 4.0);
+    for (int k = 0; k < 5; ++k) loop.step();
+    const Vec3d before = centroid();
+    loop.set_target(near_east);  // within respawn_distance: re-aimed, not moved
+    EXPECT_EQ(norm(centroid() - before), 0.0);
+    loop.set_target(north);      // 25 voxels away: respawned there
+    EXPECT_LT(norm(centroid() - north), 4.0);
+    ro.respawn_distance = 0.0;   // never respawn: the swarm stays where it was
+    RepairLoop stay(f, image, nullptr, ro);
+    stay.set_target(east);
+    stay.set_target(north);
+    Vec3d c{0, 0, 0};
+    for (const Agent& a : stay.swarm().agents()) c += a.position;
+    EXPECT_LT(norm(c / 30.0 - east), 4.0);
+    ro.respawn_distance = -1.0;
+    EXPECT_THROW(RepairLoop(f, image, nullptr, ro), std::invalid_argument);
+}
+
+// The decisive check on the phantom: segmenting leaves one perforation per weak spot (and a
+// one-voxel bubble); repair rounds aimed at the largest hole left (as the demo does) close them all.
 TEST(Repair, SwarmClosesThePhantomPerforations) {
     const Phantom ph = make_phantom();
     SegmentRequest req;
@@ -78,25 +114,35 @@ TEST(Repair, SwarmClosesThePhantomPerforations) {
     ro.swarm.edit_radius = 3.0;
     ro.swarm.edit_range = 8.0;
     Grid<std::uint8_t> mask = o.mask;
+    const auto holes_left = [&] {  // perforations first, then bubbles, as the demo targets them
+        std::vector<Perforation> h = find_perforations(mask, ph.truth, white);
+        return h.empty() ? find_cavities(mask, white) : h;
+    };
+    std::vector<Vec3d> targets;
     for (int round = 0; round < 20; ++round) {
-        const auto left = find_perforations(mask, ph.truth, white);
+        const auto left = holes_left();
         if (left.empty()) break;
         ro.swarm.seed = 1 + static_cast<std::uint64_t>(round);
         const RepairTarget t{left.front().centroid, 0};
+        targets.push_back(t.position);
         run_repair(*o.field, unit, nullptr, {&t, 1}, ro);
         mask = inside_mask(o.field->phi());
     }
-    EXPECT_TRUE(find_perforations(mask, ph.truth, white).empty());
+    EXPECT_TRUE(holes_left().empty());
     const Topology after = mask_topology(mask);
     EXPECT_EQ(after.genus, 0);  // both tunnels closed, none made
-    // Overlap: within 0.005 of the segmentation's (measured: 0.9741 -> 0.9713; see BENCHMARKS).
+    EXPECT_EQ(holes_between(mask_topology(ph.truth), after), 0);  // the check: `holes` drops to 0
+    // Overlap: within 0.005 of the segmentation's (measured: 0.9741 -> 0.9707, over-growth into biased
+    // CSF and white matter around the holes; see BENCHMARKS).
     EXPECT_GE(compare_overlap(mask, ph.truth).dice, dice_before - 0.005);
-    // Nothing far from the weak spots changed.
+    // Nothing far from the targets changed: agents edit only within edit_range of the target, each
+    // edit reaches edit_radius further and the band repair two voxels more.
+    const double reach = ro.swarm.edit_range + ro.swarm.edit_radius + 2.0;
     for (PointIndex i = 0; i < mask.size(); ++i) {
         if (mask[i] == o.mask[i]) continue;
         double nearest = 1e9;
-        for (const Vec3i& w : ph.weak_spots) nearest = std::min(nearest, norm((mask.lattice().coord(i) - w).cast<double>()));
-        ASSERT_LT(nearest, 30.0);
+        for (const Vec3d& t : targets) nearest = std::min(nearest, norm(mask.lattice().coord(i).cast<double>() - t));
+        ASSERT_LE(nearest, reach);
     }
 }
 

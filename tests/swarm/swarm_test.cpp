@@ -165,6 +165,27 @@ TEST(Swarm, AgentsOffTheBandAreNewtonProjectedBack) {
     }
 }
 
+// A one-voxel bubble inside the tissue (a noisy voxel a segmentation left out): φ peaks at its
+// centre, where ∇φ = 0, so a plain Newton step from the lattice point jumps voxels away. The
+// spawned agent must land on the bubble's own tiny surface, and the bubble can then be filled.
+TEST(Swarm, AgentsLandOnAOneVoxelBubble) {
+    Grid<std::uint8_t> mask(Lattice({kN, kN, kN}), 0);
+    for (PointIndex i = 0; i < mask.size(); ++i) mask[i] = norm(mask.lattice().coord(i).cast<double>() - kCentre) <= 12.0;
+    const Vec3i bubble{23, 23, 23};
+    mask(bubble) = 0;
+    SparseField f(mask.lattice(), 2);
+    f.init_from_mask(mask);
+    ASSERT_GT(f.phi()(bubble), 0.0f);
+    ASSERT_EQ(f.status()(bubble), 0);  // the bubble is a zero-layer point of its own
+    SwarmOptions o;
+    o.agents = 1;
+    Swarm s(o);
+    s.spawn(f, bubble.cast<double>(), 3.0);
+    const Vec3d x = s.agents()[0].position;
+    EXPECT_LT(norm(x - bubble.cast<double>()), 1.0);
+    EXPECT_LT(std::abs(trilinear(f.phi(), x)), 0.01);
+}
+
 TEST(Swarm, EditsExpandTowardsTheBrightRegionLocally) {
     SparseField f = sphere_field();
     const Grid<float> image = bright_ball(20.0);
@@ -243,6 +264,32 @@ TEST(Swarm, ContractsWhereTheInsideIsUnlikeThePopulation) {
     const auto edits = s.surface_edits(f, odd);
     ASSERT_FALSE(edits.empty());
     for (const ZeroLayerEdit& e : edits) EXPECT_GT(e.delta, 0.0f);
+}
+
+// The paper's speed experiment: acting agents raise or lower at random whatever the image says.
+// On a flat image the intensity rule expands everywhere; the random rule does both, about evenly.
+TEST(Swarm, RandomDecisionRaisesAndLowers) {
+    const SparseField f = sphere_field();
+    const Grid<float> flat(f.lattice(), 0.5f);
+    SwarmOptions o;
+    o.agents = 200;
+    o.act_probability = 1.0;
+    o.edit_radius = 0.5;  // each agent edits only the zero-layer points right under it
+    for (EditDecision d : {EditDecision::kIntensity, EditDecision::kRandom}) {
+        o.decision = d;
+        Swarm s(o);
+        s.spawn(f, kCentre + Vec3d{kR, 0, 0}, 30.0);
+        for (int k = 0; k < 5; ++k) s.move(f);
+        std::size_t raise = 0, lower = 0;
+        for (const ZeroLayerEdit& e : s.surface_edits(f, flat)) (e.delta > 0 ? raise : lower) += 1;
+        if (d == EditDecision::kIntensity) {
+            EXPECT_EQ(raise, 0u);
+            EXPECT_GT(lower, 50u);
+        } else {
+            EXPECT_GT(raise, 30u);
+            EXPECT_GT(lower, 30u);
+        }
+    }
 }
 
 TEST(Swarm, BitIdenticalForOneAndTwoThreads) {

@@ -9,6 +9,32 @@
 
 namespace liveset {
 
+namespace {
+
+// Fills each region's `nearest` (its voxel nearest its centroid; slot maps a component label to
+// its index in `out`) and sorts the regions largest first, ties by centroid (deterministic).
+void locate_nearest(const Lattice& lat, const std::vector<std::uint32_t>& label, const std::vector<std::size_t>& slot,
+                    std::vector<Perforation>& out) {
+    std::vector<double> best(out.size(), 1e300);
+    for (PointIndex i = 0; i < lat.size(); ++i) {
+        const std::size_t j = slot[label[i]];
+        if (j == SIZE_MAX) continue;
+        const Vec3d d = lat.coord(i).cast<double>() - out[j].centroid;
+        if (dot(d, d) < best[j]) {
+            best[j] = dot(d, d);
+            out[j].nearest = lat.coord(i);
+        }
+    }
+    std::stable_sort(out.begin(), out.end(), [](const Perforation& a, const Perforation& b) {
+        if (a.voxels != b.voxels) return a.voxels > b.voxels;
+        if (a.centroid.z != b.centroid.z) return a.centroid.z < b.centroid.z;
+        if (a.centroid.y != b.centroid.y) return a.centroid.y < b.centroid.y;
+        return a.centroid.x < b.centroid.x;
+    });
+}
+
+}  // namespace
+
 std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth,
                                            const Grid<std::uint8_t>& inner) {
     if (!(mask.dims() == truth.dims()) || !(mask.dims() == inner.dims()))
@@ -48,17 +74,37 @@ std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const
             slot[k] = out.size();
             out.push_back({size[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
         }
-    std::vector<double> best(out.size(), 1e300);
+    locate_nearest(lat, label, slot, out);
+    return out;
+}
+
+std::vector<Perforation> find_cavities(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& inner) {
+    if (!(mask.dims() == inner.dims())) throw std::invalid_argument("find_cavities: mask and inner differ in size");
+    const Lattice& lat = mask.lattice();
+    const Vec3i d = lat.dims();
+    Grid<std::uint8_t> outside(lat, 0);
+    for (PointIndex i = 0; i < lat.size(); ++i) outside[i] = !mask[i];
+    std::size_t count = 0;
+    const std::vector<std::uint32_t> label = label_components(outside, 6, &count);
+    std::vector<std::size_t> size(count + 1, 0);
+    std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
+    std::vector<std::uint8_t> open(count + 1, 0);  // touches the border or the inner core
     for (PointIndex i = 0; i < lat.size(); ++i) {
-        const std::size_t j = slot[label[i]];
-        if (j == SIZE_MAX) continue;
-        const Vec3d d = lat.coord(i).cast<double>() - out[j].centroid;
-        if (dot(d, d) < best[j]) {
-            best[j] = dot(d, d);
-            out[j].nearest = lat.coord(i);
-        }
+        const std::uint32_t k = label[i];
+        if (!k) continue;
+        const Vec3i c = lat.coord(i);
+        ++size[k];
+        sum[k] += c.cast<double>();
+        if (inner[i] || c.x == 0 || c.y == 0 || c.z == 0 || c.x == d.x - 1 || c.y == d.y - 1 || c.z == d.z - 1) open[k] = 1;
     }
-    std::stable_sort(out.begin(), out.end(), [](const Perforation& a, const Perforation& b) { return a.voxels > b.voxels; });
+    std::vector<Perforation> out;
+    std::vector<std::size_t> slot(count + 1, SIZE_MAX);
+    for (std::uint32_t k = 1; k <= count; ++k)
+        if (!open[k]) {
+            slot[k] = out.size();
+            out.push_back({size[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
+        }
+    locate_nearest(lat, label, slot, out);
     return out;
 }
 

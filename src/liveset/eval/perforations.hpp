@@ -1,4 +1,4 @@
-// Where a segmented shell is perforated: the places to point a repair at. A perforation is a
+// Where a segmented shell is perforated or has spurious cavities: the places to point a repair at. A perforation is a
 // 6-connected region of missed truth (truth and not mask) that touches, through voxels outside the
 // mask, both the tissue the shell should enclose (`inner`, e.g. white matter under grey matter) and
 // the tissue outside it (neither truth nor inner, e.g. CSF) — a tunnel of the mask's outside
@@ -23,5 +23,12 @@ struct Perforation {
 // Largest first (ties by centroid). All grids must share dimensions (std::invalid_argument).
 std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth,
                                            const Grid<std::uint8_t>& inner);
+
+// Spurious cavities: 6-connected components of the mask's outside that are enclosed (touch
+// neither the image border nor any `inner` voxel), e.g. a one-voxel bubble a noisy voxel left in
+// the tissue. They are holes as `holes_between` counts them (each adds one to the mask's b2) but no
+// perforation. The shell's legitimate cavity (its `inner` core) is never reported. Largest first
+// (ties by centroid); `nearest` is the cavity voxel nearest its centroid. Same dimensions required.
+std::vector<Perforation> find_cavities(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& inner);
 
 }  // namespace liveset

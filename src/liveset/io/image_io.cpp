@@ -467,7 +467,10 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
     try {
         out.create();  // a clear reason (permissions, read-only file system) before ITK tries
         io->SetFileName(tmp);
-        io->Write(data);
+        {
+            const io_detail::SilencedStderr quiet;  // niftilib/teem print their own error first
+            io->Write(data);
+        }
         // Read the temporary back: catches writers that do not report short writes (disk full).
         auto check = itk::ImageIOFactory::CreateImageIO(tmp.c_str(), itk::IOFileModeEnum::ReadMode);
         if (!check) fail_write(path, "the written file cannot be read back (disk full?)");

@@ -1,11 +1,32 @@
 // Pieces of liveset_io's error messages (see messages.hpp).
 #include "liveset/io/messages.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cstdio>
+
 #include <cstring>
 #include <filesystem>
 #include <sstream>
 
 namespace liveset::io_detail {
+
+SilencedStderr::SilencedStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+    if (null >= 0) ::close(null);
+}
+
+SilencedStderr::~SilencedStderr() {
+    if (saved_ < 0) return;
+    std::fflush(stderr);
+    ::dup2(saved_, 2);
+    ::close(saved_);
+}
+
 
 std::string quoted(const std::string& s) { return "\"" + s + "\""; }
 

@@ -18,4 +18,19 @@ std::string voxels_are_non_finite(std::uint64_t n);              // "3 voxels ar
 // and caps the length.
 std::string condense(const std::string& text, const std::string& path);
 
+// While alive, the process's stderr (file descriptor 2) goes to /dev/null: the C libraries under
+// ITK (niftilib, teem, libminc) print their own diagnostics there ("** ERROR: NWAD: wrote only 0 of
+// ... bytes") before ITK throws, and liveset reports each failure in one line of its own. Not for
+// concurrent use from several threads (the descriptor is process-wide).
+class SilencedStderr {
+public:
+    SilencedStderr();
+    ~SilencedStderr();
+    SilencedStderr(const SilencedStderr&) = delete;
+    SilencedStderr& operator=(const SilencedStderr&) = delete;
+
+private:
+    int saved_ = -1;
+};
+
 }  // namespace liveset::io_detail

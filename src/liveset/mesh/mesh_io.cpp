@@ -185,7 +185,7 @@ void write_mesh(const fs::path& path, MeshView mesh, const Lattice& lattice, Mes
                 case MeshFormat::stl: write_stl_body(os, world, mesh); break;
             }
             os.flush();
-            if (!os) fail(path, "write error");
+            if (!os) fail(path, "write error (disk full?)");
             os.close();
             if (os.fail()) fail(path, "error closing the file");
         }

@@ -225,17 +225,7 @@ void Session::set_target(Vec3d target) {
     if (!all_finite(target) || !lattice().contains(target)) throw std::invalid_argument("the target lies outside the image");
     end_action();  // each target's repair is its own undoable action
     if (!repair_) make_repair_loop();
-    bool near_swarm = false;
-    if (repair_->spawned())
-        for (const Agent& a : repair_->swarm().agents())
-            if (norm(a.position - target) <= repair_options_.spawn_radius) {
-                near_swarm = true;
-                break;
-            }
-    if (near_swarm)
-        repair_->set_target(target);
-    else
-        repair_->respawn(target);
+    repair_->set_target(target);  // spawns the swarm there first, or again when the target is far from it
     target_ = target;
     ++revision_;
 }

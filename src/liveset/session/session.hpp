@@ -107,8 +107,8 @@ public:
     // New swarm settings (agents, p, radius, ...): the swarm is re-created and, when it had a
     // target, respawned there. Throws std::invalid_argument on invalid options.
     void set_repair_options(const RepairOptions& options);
-    // Aims the swarm at `target` (index space). The first target, or one with no agent within
-    // the spawn radius (a click far from the swarm), spawns the swarm on the surface there.
+    // Aims the swarm at `target` (index space). The first target, or one farther than the
+    // options' respawn distance from the swarm (a click elsewhere), spawns it on the surface there.
     // Throws std::invalid_argument outside the image or with no surface near a spawn point.
     void set_target(Vec3d target);
     void clear_target();

@@ -81,6 +81,8 @@ std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>&
 RepairLoop::RepairLoop(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                        const RepairOptions& options, FragmentMesher* mesher)
     : field_(field), image_unit_(image_unit), roi_(roi), options_(options), mesher_(mesher), swarm_(options.swarm) {
+    if (!(options.respawn_distance >= 0)) throw std::invalid_argument("the respawn distance must be >= 0");
+    if (!(options.spawn_radius > 0)) throw std::invalid_argument("the spawn radius must be > 0");
     if (!(image_unit.dims() == field.lattice().dims())) throw std::invalid_argument("image and level set differ in size");
     if (roi && !(roi->dims() == field.lattice().dims())) throw std::invalid_argument("region of interest and level set differ in size");
     if (mesher && !(mesher->lattice().dims() == field.lattice().dims())) throw std::invalid_argument("mesher and level set differ in size");
@@ -88,7 +90,14 @@ RepairLoop::RepairLoop(SparseField& field, const Grid<float>& image_unit, const 
 
 void RepairLoop::set_target(Vec3d target) {
     if (!field_.lattice().contains(target)) throw std::invalid_argument("a repair target lies outside the image");
-    if (!spawned_) {
+    bool far = false;
+    if (spawned_ && options_.respawn_distance > 0) {
+        Vec3d centroid{0, 0, 0};
+        for (const Agent& a : swarm_.agents()) centroid += a.position;
+        centroid = centroid / static_cast<double>(swarm_.agents().size());
+        far = norm(target - centroid) > options_.respawn_distance;
+    }
+    if (!spawned_ || far) {
         respawn(target);
         return;
     }

@@ -23,6 +23,9 @@ struct RepairOptions {
     SwarmOptions swarm;
     int steps = 300;
     double spawn_radius = 20.0;  // agents start on the zero-layer points nearest the first target
+    // A new target farther than this (voxels) from the swarm's centroid respawns the swarm there,
+    // as a click on another part of the surface would, instead of walking it across (0: never).
+    double respawn_distance = 20.0;
     // Topology guard: an edit that would move a voxel across the surface in a way that bridges two
     // pieces, starts a new piece, opens a tunnel, seals a cavity by removal or splits a piece is
     // dropped (see guard_topology), so the swarm can close holes but never make new ones.
@@ -66,7 +69,7 @@ public:
                const RepairOptions& options, FragmentMesher* mesher = nullptr);
 
     // Aims the swarm at `target` (index space, inside the lattice); spawns it there first if it
-    // has no agents yet. Throws std::invalid_argument outside the lattice or when no surface lies
+    // has no agents yet or the target is farther than options.respawn_distance from its centroid. Throws std::invalid_argument outside the lattice or when no surface lies
     // within options.spawn_radius of a first target.
     void set_target(Vec3d target);
     // Spawns the swarm afresh on the surface nearest `target` and aims it there.

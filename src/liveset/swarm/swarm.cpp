@@ -28,6 +28,8 @@
 //   I_in = I(x − 1.5n) and
 //     expands  (Δ = −A) if |I_out − μ| ≤ k·σ   (the outside looks like the population: grow into it)
 //     contracts(Δ = +A) else if |I_in − μ| > k'·σ (the inside does not look like it: retreat)
+//   (decision kRandom, the paper's speed benchmark: an acting agent raises or lowers the surface
+//   with equal probability instead, from the same stream)
 //   Δ is spread over the zero-layer points p with |p − x| ≤ edit_radius, weighted by the
 //   unit-peak Gaussian exp(−|p − x|²/(2σ_g²)), σ_g = edit_radius/2, so A is the change under the
 //   agent whatever the zero-layer sampling density. Contributions to a point are summed in agent
@@ -96,15 +98,40 @@ Vec3d clamp_length(Vec3d v, double max_len) {
     return l > max_len && l > 0 ? v * (max_len / l) : v;
 }
 
-// Newton projection onto φ = 0 (x ← x − φ ∇φ/|∇φ|²); returns the final position.
+// Projection onto φ = 0 by safeguarded Newton steps x ← x − φ ∇φ/|∇φ|², each at most half a
+// voxel long; a step that crosses the surface brackets it and bisection along that step finishes
+// (plain Newton overshoots where ∇φ is small). Where ∇φ vanishes (the centre of a one-voxel bubble
+// or pinch, a local extremum of φ) it first steps a tenth of a voxel along a fixed diagonal.
 Vec3d project(const Grid<float>& phi, Vec3d x, int iterations) {
+    constexpr double kTolerance = 1e-3;
+    constexpr double kMaxStep = 0.5;  // voxels: a step cannot skip the surface
+    bool nudged = false;
     for (int k = 0; k < iterations; ++k) {
-        const double f = trilinear(phi, x);
-        if (std::abs(f) < 1e-3) break;
-        const Vec3d g = to_d(interpolated_gradient(phi, x));
+        double f = trilinear(phi, x);
+        if (std::abs(f) < kTolerance) break;
+        Vec3d g = to_d(interpolated_gradient(phi, x));
+        if (!(dot(g, g) > 1e-12) && !nudged) {
+            nudged = true;
+            x = clamp_to_box(x + Vec3d{1, 1, 1} * (0.1 / std::sqrt(3.0)), phi.dims());
+            f = trilinear(phi, x);
+            g = to_d(interpolated_gradient(phi, x));
+        }
         const double g2 = dot(g, g);
         if (!(g2 > 1e-12)) break;
-        x = clamp_to_box(x - g * (f / g2), phi.dims());
+        const Vec3d y = clamp_to_box(x - clamp_length(g * (f / g2), kMaxStep), phi.dims());
+        const double fy = trilinear(phi, y);
+        if ((f < 0) == (fy < 0)) {
+            x = y;
+            continue;
+        }
+        Vec3d a = x, b = y;  // φ(a) and φ(b) have opposite signs
+        for (int j = 0; j < 24; ++j) {
+            const Vec3d m = (a + b) * 0.5;
+            const double fm = trilinear(phi, m);
+            if (std::abs(fm) < kTolerance) return m;
+            ((fm < 0) == (f < 0) ? a : b) = m;
+        }
+        return (a + b) * 0.5;
     }
     return x;
 }
@@ -293,7 +320,9 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
             const double outside = trilinear(image_unit, x + n * 1.5);
             const double inside = trilinear(image_unit, x - n * 1.5);
             double amount = 0.0;
-            if (std::abs(outside - mu) <= options_.expand_sigmas * sigma)
+            if (options_.decision == EditDecision::kRandom)
+                amount = rng.uniform() < 0.5 ? -options_.edit_amount : options_.edit_amount;
+            else if (std::abs(outside - mu) <= options_.expand_sigmas * sigma)
                 amount = -options_.edit_amount;
             else if (std::abs(inside - mu) > options_.contract_sigmas * sigma)
                 amount = options_.edit_amount;

@@ -16,6 +16,12 @@
 
 namespace liveset {
 
+// How an acting agent chooses to raise or lower the surface.
+enum class EditDecision {
+    kIntensity,  // population intensity statistics (the repair rule, see swarm.cpp)
+    kRandom,     // raise or lower at random (the paper's frame-rate experiment, §4)
+};
+
 struct SwarmOptions {
     std::size_t agents = 200;
     double pull_back = 0.1;          // ε of Eq. 4, 0 ≤ ε < 1 (0 disables the pull-back)
@@ -39,6 +45,7 @@ struct SwarmOptions {
     // Only agents within this distance (voxels) of the target edit — the "brush" around the point
     // the user designates; 0: no limit (and always none without a target).
     double edit_range = 0.0;
+    EditDecision decision = EditDecision::kIntensity;
 };
 
 // Throws std::invalid_argument (one-line message) on an invalid option.

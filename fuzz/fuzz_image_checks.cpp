@@ -1,0 +1,24 @@
+// libFuzzer target: the project's own byte-level image checks (liveset_io's file_checks: NIfTI-1/-2
+// headers and data size, gzip streams, NaN counting; MetaImage headers and their data files).
+// The first input byte picks the check; the rest is the file. The checks must answer (possibly
+// "truncated") or throw std::runtime_error, never crash or read out of bounds.
+#include <cstdint>
+#include <stdexcept>
+
+#include "fuzz_input_file.hpp"
+#include "liveset/io/file_checks.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    if (size == 0) return 0;
+    static const char* const kExtensions[] = {".nii", ".nii.gz", ".mha", ".mhd"};
+    const int which = data[0] % 4;
+    const liveset::fuzz::InputFile file(data + 1, size - 1, kExtensions[which]);
+    try {
+        if (which < 2)
+            (void)liveset::io_detail::check_nifti_data(file.path().string(), true);
+        else
+            (void)liveset::io_detail::check_metaimage_data(file.path().string(), 4096);
+    } catch (const std::runtime_error&) {
+    }
+    return 0;
+}

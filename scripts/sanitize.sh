@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Sanitizer and fuzzing runs (docs/RELIABILITY.md). Installs what it needs (Debian packages),
+# builds the preset into its own folder and runs it:
+#   bash scripts/sanitize.sh asan            # whole suite under ASan + UBSan (minus the whole-brain runs)
+#   bash scripts/sanitize.sh tsan            # the multithreaded parts under ThreadSanitizer
+#   bash scripts/sanitize.sh fuzz [SECONDS]  # each libFuzzer target for SECONDS (default 60)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+mode=${1:-asan}
+
+need=()
+case "$mode" in
+  fuzz) need=(clang libclang-rt-14-dev) ;;
+esac
+missing=()
+for p in "${need[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+fi
+
+jobs=$(nproc 2>/dev/null || echo 2)
+case "$mode" in
+  asan|tsan)
+    cmake --preset "$mode" >/dev/null
+    cmake --build --preset "$mode" -j "$jobs"
+    ctest --preset "$mode"
+    ;;
+  fuzz)
+    seconds=${2:-60}
+    cmake --preset fuzz >/dev/null
+    cmake --build --preset fuzz -j "$jobs"
+    mkdir -p build-fuzz/findings
+    for target in mesh_readers image_checks; do
+      corpus="build-fuzz/corpus/$target"
+      mkdir -p "$corpus"
+      log="build-fuzz/fuzz_$target.log"
+      rc=0
+      "build-fuzz/fuzz/fuzz_$target" -max_total_time="$seconds" -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
+        -artifact_prefix="build-fuzz/findings/$target-" "$corpus" "fuzz/corpus/${target%%_*}" >"$log" 2>&1 || rc=$?
+      runs=$(grep -m1 '^stat::number_of_executed_units' "$log" | awk '{print $2}')
+      echo "fuzz_$target: ${seconds} s, ${runs:-?} executions, exit $rc" >&2
+      if [ "$rc" -ne 0 ]; then
+        grep -E "ERROR|SUMMARY|Test unit written" "$log" >&2 || tail -20 "$log" >&2
+        exit 1
+      fi
+    done
+    ;;
+  *) echo "usage: scripts/sanitize.sh asan|tsan|fuzz [SECONDS]" >&2; exit 2 ;;
+esac
