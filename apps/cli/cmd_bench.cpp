@@ -352,6 +352,7 @@ void add_bench_commands(CLI::App& app, const int& threads) {
         ->capture_default_str();
     fig3->add_flag("--no-plot", fig3_args.no_plot, "write only the CSV (no gnuplot needed)");
     fig3->callback([&threads] { run_fig3(fig3_args, threads); });
+    add_soak_command(bench, threads);
 }
 
 }  // namespace liveset::cli

@@ -47,27 +47,6 @@ RepairTarget parse_target(const std::string& text, const Lattice& lattice, bool 
     return {b.center, step};
 }
 
-// φ image or 0/1 mask -> sparse field on the image's lattice.
-SparseField load_level_set(const std::string& path, const Lattice& reference) {
-    const Grid<float> g = read_image(path);
-    if (!(g.dims() == reference.dims()))
-        throw UsageError(fmt::format("{} ({}x{}x{}) does not match the image's size", path, g.dims().x, g.dims().y, g.dims().z));
-    const bool mask = is_binary_mask(g);
-    std::size_t inside = 0;
-    for (float v : g.values()) inside += mask ? v == 1.0f : v < 0.0f;
-    SparseField field(reference, 2);
-    if (mask) {
-        field.init_from_mask(to_mask(g));
-    } else {
-        field.init_from_sdf([&](Vec3d p) {
-            const Vec3i q{static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)), static_cast<int>(std::lround(p.z))};
-            return static_cast<double>(g(q));
-        });
-    }
-    if (inside == 0 || field.zero_layer().empty()) throw UsageError(fmt::format("{} holds no surface to repair", path));
-    return field;
-}
-
 int run_repair_command(RepairArgs a, int threads) {
     const auto guard = limit_threads(threads);
     const InterruptGuard interrupt;

@@ -128,4 +128,25 @@ void print_evaluation(const nlohmann::json& j, const std::string& in) {
                j["genus"].get<long>(), j["holes"].get<long>(), j["truth"]["euler"].get<long>(), j["truth"]["genus"].get<long>());
 }
 
+// φ image or 0/1 mask -> sparse field on the image's lattice.
+SparseField load_level_set(const std::string& path, const Lattice& reference) {
+    const Grid<float> g = read_image(path);
+    if (!(g.dims() == reference.dims()))
+        throw UsageError(fmt::format("{} ({}x{}x{}) does not match the image's size", path, g.dims().x, g.dims().y, g.dims().z));
+    const bool mask = is_binary_mask(g);
+    std::size_t inside = 0;
+    for (float v : g.values()) inside += mask ? v == 1.0f : v < 0.0f;
+    SparseField field(reference, 2);
+    if (mask) {
+        field.init_from_mask(to_mask(g));
+    } else {
+        field.init_from_sdf([&](Vec3d p) {
+            const Vec3i q{static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)), static_cast<int>(std::lround(p.z))};
+            return static_cast<double>(g(q));
+        });
+    }
+    if (inside == 0 || field.zero_layer().empty()) throw UsageError(fmt::format("{} holds no surface (nothing inside, or no voxel changes sign)", path));
+    return field;
+}
+
 }  // namespace liveset::cli

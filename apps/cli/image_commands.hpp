@@ -1,5 +1,5 @@
-// Pieces shared by the image commands (segment, eval, repair, demo): loading masks that must
-// overlay an image, the segmentation run with its progress line, and the JSON reports.
+// Pieces shared by the image commands (segment, eval, repair, demo, bench soak): loading masks
+// and level sets that must overlay an image, the segmentation run with its progress line, and the JSON reports.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -20,6 +20,10 @@ Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& refere
 bool is_binary_mask(const Grid<float>& image);
 // Non-zero -> 1, on the image's lattice.
 Grid<std::uint8_t> to_mask(const Grid<float>& image);
+
+// A φ image (< 0 inside) or a 0/1 mask (stored as any pixel type) as a 2-layer sparse field on
+// `reference`'s lattice; UsageError when the sizes differ or it holds no surface.
+SparseField load_level_set(const std::string& path, const Lattice& reference);
 
 struct SegmentRun {
     SegmentOutcome outcome;

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_run.hpp"
 
 namespace {
@@ -91,4 +93,31 @@ TEST(BenchCli, Fig3RefusesBadArgumentsWithOneLine) {
     }
     EXPECT_FALSE(fs::exists(base / "out" / "fig3.csv"));
     fs::remove_all(base);
+}
+
+// bench soak: a short run on a small phantom passes every invariant and mesh check and logs one
+// line per check; a broken input is refused in one line.
+TEST(BenchCli, SoakChecksTheLevelSetAndTheMeshesAndLogsMemory) {
+    const fs::path dir = scratch_dir("soak");
+    ASSERT_EQ(run_cli("phantom --size 48 --quiet --out " + (dir / "ph").string()).rc, 0);
+    const std::string common = (dir / "ph" / "truth_gm.nii.gz").string() + " --image " + (dir / "ph" / "t1.nii.gz").string();
+    const Result r = run_cli("bench soak " + common + " --iterations 1200 --check-every 400 --json --log " + (dir / "soak.jsonl").string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const nlohmann::json s = nlohmann::json::parse(r.out);
+    EXPECT_EQ(s["checks"], 3);
+    EXPECT_GT(s["rss_peak_mb"].get<double>(), 0.0);
+    std::istringstream log(slurp(dir / "soak.jsonl"));
+    std::string line;
+    int n = 0;
+    while (std::getline(log, line)) {
+        const nlohmann::json j = nlohmann::json::parse(line);
+        EXPECT_TRUE(j["invariants_ok"].get<bool>());
+        EXPECT_TRUE(j["mesh_equal"].get<bool>());
+        EXPECT_EQ(j["iteration"], 400 * ++n);
+    }
+    EXPECT_EQ(n, 3);
+    const Result bad = run_cli("bench soak " + (dir / "missing.nii.gz").string() + " --image " + (dir / "ph" / "t1.nii.gz").string());
+    EXPECT_NE(bad.rc, 0);
+    EXPECT_LE(lines(bad.err), 1) << bad.err;
+    fs::remove_all(dir);
 }
