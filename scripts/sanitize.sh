@@ -35,13 +35,15 @@ case "$mode" in
     cmake --preset fuzz >/dev/null
     cmake --build --preset fuzz -j "$jobs"
     mkdir -p build-fuzz/findings
-    for target in mesh_readers image_checks; do
+    for entry in mesh_readers:mesh image_checks:image recovery_file:recovery session_script:script; do
+      target=${entry%%:*}
+      seeds=${entry#*:}
       corpus="build-fuzz/corpus/$target"
       mkdir -p "$corpus"
       log="build-fuzz/fuzz_$target.log"
       rc=0
       "build-fuzz/fuzz/fuzz_$target" -max_total_time="$seconds" -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
-        -artifact_prefix="build-fuzz/findings/$target-" "$corpus" "fuzz/corpus/${target%%_*}" >"$log" 2>&1 || rc=$?
+        -artifact_prefix="build-fuzz/findings/$target-" "$corpus" "fuzz/corpus/$seeds" >"$log" 2>&1 || rc=$?
       runs=$(grep -m1 '^stat::number_of_executed_units' "$log" | awk '{print $2}')
       echo "fuzz_$target: ${seconds} s, ${runs:-?} executions, exit $rc" >&2
       if [ "$rc" -ne 0 ]; then

@@ -33,7 +33,10 @@ int run_headless(std::unique_ptr<Session> session, const std::string& image_name
     if (options.bench) return run_bench(viewer, *options.bench, options.width, options.height);
     if (options.script) {
         ScriptPlayer player(*options.script);
-        while (!player.done()) player.advance(viewer);
+        while (!player.done()) {
+            player.advance(viewer);
+            viewer.autosave().tick();  // no frames here: keep the crash copy and autosaves current
+        }
     }
     viewer.request_quit("script done");
     return 0;

@@ -26,6 +26,9 @@ struct ViewArgs {
     std::size_t bench_agents = 200;
     std::string bench_target;
     int fragment_size = 16;
+    bool recover = false, no_autosave = false;
+    double autosave_every = 120.0;
+    std::string recovery_dir;
 };
 
 void parse_size(const std::string& text, int& w, int& h) {
@@ -90,6 +93,9 @@ int run_view(const ViewArgs& a, int threads) {
     if (a.headless && a.image.empty()) throw UsageError("--headless needs an IMAGE");
     if (a.headless && a.script.empty() && !a.bench) throw UsageError("--headless needs --script or --bench");
     if (!a.mask.empty() && !a.phi.empty()) throw UsageError("give --mask or --phi, not both");
+    if (a.recover && (a.no_autosave || (a.headless && a.recovery_dir.empty())))
+        throw UsageError("--recover needs autosave (a --recovery-dir, or a window without --no-autosave)");
+    if (a.recover && a.image.empty()) throw UsageError("--recover needs an IMAGE");
     if (a.image.empty() && (!a.mask.empty() || !a.phi.empty() || !a.seeds.empty() || !a.roi.empty() || !a.script.empty()))
         throw UsageError("--mask, --phi, --roi, --seed and --script need an IMAGE");
 
@@ -101,6 +107,12 @@ int run_view(const ViewArgs& a, int threads) {
     config.log_events = a.log_events;
     config.session.fragment_size = a.fragment_size;
     config.session.repair = demo_repair_options();
+    config.image_path = a.image;
+    // Windows autosave by default; headless runs (scripts, tests) only into an explicit --recovery-dir.
+    if (!a.no_autosave) config.autosave.dir = !a.recovery_dir.empty() ? std::filesystem::path(a.recovery_dir)
+                                                : (a.headless ? std::filesystem::path() : viewer::default_recovery_dir());
+    config.autosave.interval_seconds = a.autosave_every;
+    config.autosave.recover = a.recover;
     const std::string name = a.image.empty() ? std::string() : std::filesystem::path(a.image).filename().string();
 
     if (a.headless) {
@@ -188,6 +200,14 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--bench-agents", va.bench_agents, "agents in the swarm scenarios")->check(CLI::Range(1, 100000))->capture_default_str();
     v->add_option("--bench-target", va.bench_target, "swarm target I,J,K (default: the top of the surface)");
     v->add_flag("--json", va.json, "benchmark results as one JSON object");
+    v->add_option("--autosave-every", va.autosave_every, "seconds between autosaves of unsaved work (0: at every change)")
+        ->check(CLI::Range(0.0, 86400.0))
+        ->capture_default_str();
+    v->add_option("--recovery-dir", va.recovery_dir,
+                  "folder of the recovery files (default $XDG_STATE_HOME/liveset/recovery or ~/.local/state/liveset/recovery; "
+                  "headless runs autosave only when it is given)");
+    v->add_flag("--no-autosave", va.no_autosave, "no autosave, no recovery offer");
+    v->add_flag("--recover", va.recover, "restore the image's recovery file (unsaved work of an earlier run) without asking");
     v->callback([&threads] {
         const int rc = run_view(va, threads);
         if (rc != 0) std::exit(rc);

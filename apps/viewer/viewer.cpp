@@ -53,7 +53,12 @@ const char* tool_name(Tool tool) {
 }
 
 Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const ViewerConfig& config)
-    : config_(config), session_(std::move(session)), image_name_(std::move(image_name)), log_(config.log_events) {
+    : config_(config),
+      session_(std::move(session)),
+      image_name_(std::move(image_name)),
+      image_path_(config.image_path),
+      log_(config.log_events),
+      autosave_(std::make_unique<Autosave>(config.autosave)) {
     const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
     renderer_ = renderer ? renderer : "unknown renderer";
     if (const auto cut = renderer_.find(" ("); cut != std::string::npos) renderer_.resize(cut);
@@ -63,9 +68,32 @@ Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const V
     attach_session();
 }
 
-Viewer::~Viewer() = default;
+Viewer::~Viewer() {
+    autosave_->at_exit();
+    report_autosave();
+}
 
 void Viewer::attach_session() {
+    autosave_->attach(session_.get(), image_path_);
+    show_session();
+    report_autosave();
+    if (autosave_->restored()) log_.add("restore", {{"file", autosave_->file().string()}});
+    if (autosave_->offer_pending() && config_.headless)
+        fmt::print(stderr, "liveset: note: found {}; --recover restores it\n", autosave_->offer_summary());
+}
+
+// Autosave's news goes to the status line, and to stderr when no one watches the window.
+void Viewer::report_autosave() {
+    bool routine = false;
+    const std::string note = autosave_->take_message(&routine);
+    if (note.empty()) return;
+    if ((config_.headless || quit_) && !routine) fmt::print(stderr, "liveset: note: {}\n", note);
+    message_ = note;
+    message_is_error_ = false;
+    redraw_frames_ = std::max(redraw_frames_, 1);
+}
+
+void Viewer::show_session() {
     slice_shown_ = {-1, -1, -1};
     contour_slice_ = {-1, -1, -1};
     segment_running_ = swarm_running_ = false;
@@ -88,6 +116,8 @@ void Viewer::attach_session() {
 void Viewer::request_quit(const std::string& reason) {
     if (quit_) return;
     quit_ = true;
+    autosave_->at_exit();
+    report_autosave();
     nlohmann::json fields{{"reason", reason}, {"frames", frames_}};
     if (session_) {
         fields["seeds"] = session_->seeds().size();
@@ -171,6 +201,8 @@ void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     log_.set_frame(frames_);
     process_events();  // current_ already holds what scripts or the bench did since the last frame
     advance();
+    autosave_->tick();
+    report_autosave();
     upload();
     render_dirty_panes();
     compose(target, width, height);
@@ -362,6 +394,7 @@ void Viewer::compose(GLuint target, int width, int height) {
     imgui_->new_frame(width, height, 1.0 / 60.0);
     draw_panel();
     draw_pane_labels();
+    if (!config_.headless) draw_recovery_offer();
     glBindFramebuffer(GL_FRAMEBUFFER, target);
     glViewport(0, 0, width, height);
     imgui_->render();
@@ -382,7 +415,10 @@ bool Viewer::open_image(const std::string& path) {
     try {
         Grid<float> image = read_image(path);
         auto session = std::make_unique<Session>(std::move(image), config_.session);
+        autosave_->at_exit();  // the previous image's unsaved work
+        report_autosave();
         session_ = std::move(session);
+        image_path_ = path;
         image_name_ = std::filesystem::path(path).filename().string();
         attach_session();
         message_ = "opened " + path;

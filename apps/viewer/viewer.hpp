@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "autosave.hpp"
 #include "event_log.hpp"
 #include "liveset/render/framebuffer.hpp"
 #include "liveset/render/orbit_camera.hpp"
@@ -74,6 +75,8 @@ struct ViewerConfig {
     int panel_width = 340;
     SessionOptions session;  // for images opened from the panel
     float segment_budget_ms = 40.0f;  // level-set time per frame while segmentation runs
+    std::string image_path;  // the session's image as given (the key of its recovery file)
+    AutosaveConfig autosave;  // recovery files (dir empty: none)
 };
 
 class Viewer {
@@ -117,6 +120,7 @@ public:
     Rect panel_rect() const { return panel_rect_; }
     const std::string& message() const { return message_; }
     EventLog& log() { return log_; }
+    Autosave& autosave() { return *autosave_; }
 
     // --- actions: panel, keys and scripts share them; false + message() on failure ---------
     bool open_image(const std::string& path);
@@ -169,6 +173,8 @@ private:
 
     // viewer.cpp
     void attach_session();
+    void show_session();  // renderer state for the session's current surface
+    void report_autosave();
     void account(const SessionUpdate& update);
     void advance();
     void upload();
@@ -191,11 +197,14 @@ private:
     void draw_panel();
     bool panel_button(const char* label, const char* name);
     void draw_pane_labels();
+    void draw_recovery_offer();
 
     ViewerConfig config_;
     std::unique_ptr<Session> session_;
     std::string image_name_;
+    std::string image_path_;
     EventLog log_;
+    std::unique_ptr<Autosave> autosave_;
     std::unique_ptr<ImGuiBridge> imgui_;
     std::unique_ptr<render::SceneRenderer> scene_renderer_;
     std::array<std::unique_ptr<render::SliceRenderer>, 3> slice_renderers_;
@@ -220,7 +229,8 @@ private:
     double mouse_x_ = 0.0, mouse_y_ = 0.0;
     std::map<std::string, Rect> button_rects_;  // panel buttons, for the event log's "ready" line
     bool ready_logged_ = false;
-    bool window_shot_pending_ = false;  // F12: save what the window shows after this frame
+    bool window_shot_pending_ = false;
+    int offer_frames_ = 0;  // frames the recovery dialog has been shown  // F12: save what the window shows after this frame
     Drag drag_;
     int redraw_frames_ = 2;
     bool quit_ = false;

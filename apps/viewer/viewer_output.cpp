@@ -21,6 +21,7 @@ bool Viewer::save_mask(const std::string& path) {
     message_ = "saved the mask to " + path;
     message_is_error_ = false;
     log_.add("save", {{"what", "mask"}, {"path", path}});
+    autosave_->mark_saved();
     return true;
 }
 
@@ -35,6 +36,7 @@ bool Viewer::save_phi(const std::string& path) {
     message_ = "saved phi to " + path;
     message_is_error_ = false;
     log_.add("save", {{"what", "phi"}, {"path", path}});
+    autosave_->mark_saved();
     return true;
 }
 

@@ -198,6 +198,50 @@ void Viewer::draw_panel() {
     ImGui::End();
 }
 
+// A recovery file was found for the image: ask (modal) whether to restore it.
+void Viewer::draw_recovery_offer() {
+    if (!autosave_->offer_pending()) return;
+    const char* title = "Restore unsaved work?";
+    if (!ImGui::IsPopupOpen(title)) ImGui::OpenPopup(title);
+    ImGui::SetNextWindowPos(ImVec2(static_cast<float>(window_width_) * 0.5f, static_cast<float>(window_height_) * 0.5f), ImGuiCond_Always,
+                            ImVec2(0.5f, 0.5f));
+    ImGui::SetNextWindowSize(ImVec2(480.0f, 0.0f));
+    if (offer_frames_ < 3) redraw_frames_ = std::max(redraw_frames_, 2);  // until the dialog settles and is logged
+    if (!ImGui::BeginPopupModal(title, nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize)) return;
+    ImGui::TextWrapped("liveset found %s.", autosave_->offer_summary().c_str());
+    ImGui::TextWrapped("Restore replaces the current surface with it; Discard deletes it.");
+    bool done = false;
+    const bool pressed_restore = panel_button("Restore", "restore");
+    ImGui::SameLine();
+    const bool pressed_discard = panel_button("Discard", "discard");
+    // Tell a driving test where the buttons are once the dialog has its final size and place.
+    if (++offer_frames_ == 3) {
+        nlohmann::json rects = nlohmann::json::object();
+        for (const char* name : {"restore", "discard"}) {
+            const Rect& r = button_rects_[name];
+            rects[name] = {r.x, r.y, r.w, r.h};
+        }
+        log_.add("recovery_offer", {{"file", autosave_->file().string()}, {"buttons", rects}});
+    }
+    if (pressed_restore) {
+        if (autosave_->restore()) {
+            show_session();
+            log_.add("restore", {{"file", autosave_->file().string()}});
+        }
+        done = true;
+    }
+    if (pressed_discard) {
+        autosave_->discard();
+        done = true;
+    }
+    if (done) {
+        report_autosave();
+        mark_all_panes();
+        ImGui::CloseCurrentPopup();
+    }
+    ImGui::EndPopup();
+}
+
 void Viewer::draw_pane_labels() {
     ImDrawList* draw = ImGui::GetBackgroundDrawList();
     for (int i = 0; i < kPaneCount; ++i) {

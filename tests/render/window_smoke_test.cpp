@@ -15,6 +15,7 @@
 #include "liveset/io/image_io.hpp"
 #include "liveset/levelset/sparse_field.hpp"
 #include "liveset/phantom/phantom.hpp"
+#include "liveset/session/recovery.hpp"
 
 namespace liveset {
 namespace {
@@ -81,6 +82,59 @@ TEST(WindowSmoke, DragClickKeysAndAButtonUnderXvfb) {
     EXPECT_DOUBLE_EQ(exit["camera"]["yaw"].get<double>(), -30.0);
     EXPECT_DOUBLE_EQ(exit["camera"]["pitch"].get<double>(), 20.0);
     ASSERT_TRUE(exit.contains("target"));
+    // The swarm's edits were never saved: they wait in a recovery file for the next start.
+    const fs::path kept = recovery_path(dir / "recovery", image);
+    ASSERT_TRUE(fs::exists(kept)) << driver_out;
+    EXPECT_EQ(read_recovery(kept).signal, 0);
+    fs::remove_all(dir);
+}
+
+// The image has a recovery file (unsaved work of a headless run): the window opens with the
+// restore dialog, a real click on "Restore" restores it, Ctrl+Q quits with status 0.
+TEST(WindowSmoke, TheRestoreDialogRestoresUnsavedWorkUnderXvfb) {
+    if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
+        GTEST_SKIP() << "xvfb-run, xauth and xdotool are needed (scripts/setup.sh installs them)";
+    const fs::path dir = fs::temp_directory_path() / ("liveset_window_recovery_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    PhantomOptions o;
+    o.size = 48;
+    const Phantom ph = make_phantom(o);
+    const std::string image = (dir / "t1.nii.gz").string(), log = (dir / "events.jsonl").string();
+    write_image(ph.image, image);
+    std::string script = "[";
+    for (const Vec3i& s : ph.seeds) script += "{\"seed\": [" + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + "]}, ";
+    script += "{\"segment\": 30}]";
+    std::ofstream(dir / "work.json") << script;
+    const fs::path recovery = dir / "recovery";
+    const std::string work = std::string(LIVESET_CLI_PATH) + " view " + image + " --headless --recovery-dir " + recovery.string() +
+                             " --script " + (dir / "work.json").string() + " > " + (dir / "work.out").string() + " 2>&1";
+    ASSERT_EQ(std::system(work.c_str()), 0);
+    ASSERT_TRUE(fs::exists(recovery_path(recovery, image)));
+
+    const std::string cmd = "cd " + dir.string() + " && timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' bash " +
+                            std::string(LIVESET_SOURCE_DIR) + "/tests/render/window_recovery.sh " + LIVESET_CLI_PATH + " " + image +
+                            " " + recovery.string() + " " + log + " > driver.out 2>&1";
+    const int status = std::system(cmd.c_str());
+    std::ifstream driver(dir / "driver.out");
+    const std::string driver_out((std::istreambuf_iterator<char>(driver)), std::istreambuf_iterator<char>());
+    ASSERT_TRUE(WIFEXITED(status)) << driver_out;
+    ASSERT_EQ(WEXITSTATUS(status), 0) << driver_out;
+
+    std::vector<nlohmann::json> events;
+    std::ifstream in(log);
+    for (std::string line; std::getline(in, line);) events.push_back(nlohmann::json::parse(line));
+    const auto count = [&](const std::string& type) {
+        return std::count_if(events.begin(), events.end(), [&](const nlohmann::json& e) { return e["type"] == type; });
+    };
+    EXPECT_EQ(count("recovery_offer"), 1);
+    EXPECT_EQ(count("restore"), 1) << driver_out;
+    const auto exit = std::find_if(events.begin(), events.end(), [](const nlohmann::json& e) { return e["type"] == "exit"; });
+    ASSERT_NE(exit, events.end());
+    EXPECT_EQ((*exit)["seeds"], ph.seeds.size()) << "the restored seeds";
+    EXPECT_EQ((*exit)["iterations"], 30);
+    // Still unsaved after the restore: the file is kept for the next start.
+    EXPECT_EQ(read_recovery(recovery_path(recovery, image)).marks.iterations, 30);
     fs::remove_all(dir);
 }
 

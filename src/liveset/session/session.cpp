@@ -2,11 +2,13 @@
 #include "liveset/session/session.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
+#include "liveset/levelset/invariants.hpp"
 #include "liveset/levelset/shapes.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/segment/pipeline.hpp"
@@ -62,6 +64,37 @@ void Session::load_phi(const Grid<float>& phi) {
         return static_cast<double>(phi(q));
     });
     reset_after_load();
+}
+
+bool Session::load_recovered(const Grid<float>& phi, const Grid<std::int8_t>& status, const SessionMarks& marks) {
+    if (!(phi.dims() == lattice().dims()) || !(status.dims() == lattice().dims()))
+        throw std::invalid_argument("the recovered level set's size differs from the image's");
+    for (const SeedBall& b : marks.seeds)
+        if (!lattice().contains(b.center)) throw std::invalid_argument("a recovered seed lies outside the image");
+    validate(marks.params);
+    // Write back every point that differs from the current state: the saved state, bit for bit.
+    std::vector<PointState> states;
+    const auto& cur_phi = field_.phi();
+    const auto& cur_status = field_.status();
+    for (std::size_t i = 0; i < phi.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if (std::bit_cast<std::uint32_t>(phi[p]) != std::bit_cast<std::uint32_t>(cur_phi[p]) || status[p] != cur_status[p])
+            states.push_back({p, phi[p], status[p]});
+    }
+    bool exact = false;
+    try {
+        field_.restore(states);
+        exact = check_invariants(field_).ok();
+    } catch (const std::invalid_argument&) {
+    }
+    if (exact)
+        reset_after_load();
+    else
+        load_phi(phi);
+    SessionMarks m = marks;
+    m.pristine = false;
+    adopt_marks(m);
+    return exact;
 }
 
 void Session::reset_after_load() {

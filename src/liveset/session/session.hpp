@@ -76,6 +76,11 @@ public:
     // --- initial level set (each clears the history) ----------------------------------------
     void load_mask(const Grid<std::uint8_t>& mask);  // non-zero inside; same dimensions
     void load_phi(const Grid<float>& phi);           // < 0 inside, any scale; same dimensions
+    // φ, status and the small state saved in a recovery file (seeds, parameters, iterations).
+    // Returns true when the sparse field was restored bit for bit; false when the saved status was
+    // not a consistent sparse field and φ's signs were used instead (as load_phi). Throws
+    // std::invalid_argument (changing nothing) on other dimensions, seeds outside, bad parameters.
+    bool load_recovered(const Grid<float>& phi, const Grid<std::int8_t>& status, const SessionMarks& marks);
 
     // --- seeds (undoable) -------------------------------------------------------------------
     const std::vector<SeedBall>& seeds() const { return marks_.seeds; }
@@ -134,6 +139,9 @@ public:
     SessionUpdate undo();
     SessionUpdate redo();
 
+    // The seeds, parameters and iteration count (what a recovery file keeps besides φ).
+    const SessionMarks& marks() const { return marks_; }
+
     // --- renderer feed ----------------------------------------------------------------------
     // Fragments rebuilt since the last call (sorted, unique): the buffers to re-upload.
     std::vector<FragmentId> take_dirty_fragments();
@@ -145,7 +153,6 @@ public:
     Mesh surface_mesh() const;        // marching cubes of the zero layer (index space)
 
 private:
-    SessionMarks marks() const { return marks_; }
     void begin_action(const char* label);  // continues an open action of the same label
     SessionUpdate finish_update(ChangedPoints changed, double level_set_ms);
     void adopt_marks(const SessionMarks& marks);

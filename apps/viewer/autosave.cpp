@@ -1,0 +1,192 @@
+// Autosave and recovery of the viewer's unsaved work.
+#include "autosave.hpp"
+
+#include <fmt/core.h>
+
+#include <cstdlib>
+#include <ctime>
+#include <system_error>
+#include <utility>
+
+namespace liveset::viewer {
+
+namespace {
+
+std::string local_time(std::int64_t unix_time) {
+    const std::time_t t = static_cast<std::time_t>(unix_time);
+    std::tm tm{};
+    if (!localtime_r(&t, &tm)) return "an unknown time";
+    char text[32];
+    std::strftime(text, sizeof text, "%Y-%m-%d %H:%M", &tm);
+    return text;
+}
+
+const char* signal_name(int sig) {
+    switch (sig) {
+        case 0: return nullptr;
+        case 1: return "SIGHUP";
+        case 2: return "SIGINT";
+        case 4: return "SIGILL";
+        case 6: return "SIGABRT";
+        case 7: return "SIGBUS";
+        case 8: return "SIGFPE";
+        case 11: return "SIGSEGV";
+        case 15: return "SIGTERM";
+        default: return "a signal";
+    }
+}
+
+}  // namespace
+
+std::filesystem::path default_recovery_dir() {
+    if (const char* state = std::getenv("XDG_STATE_HOME"); state && *state) return std::filesystem::path(state) / "liveset" / "recovery";
+    if (const char* home = std::getenv("HOME"); home && *home) return std::filesystem::path(home) / ".local" / "state" / "liveset" / "recovery";
+    return {};
+}
+
+void Autosave::attach(Session* session, const std::string& image_path) {
+    crash_.reset();
+    offer_.reset();
+    session_ = nullptr;
+    image_ = image_path;
+    exited_ = restored_ = false;
+    file_.clear();
+    if (!enabled() || !session || image_.empty()) return;
+    session_ = session;
+    std::error_code ec;
+    std::filesystem::create_directories(config_.dir, ec);
+    if (ec) {
+        message_ = fmt::format("autosave is off: cannot create {} ({})", config_.dir.string(), ec.message());
+        session_ = nullptr;
+        return;
+    }
+    file_ = recovery_path(config_.dir, image_);
+    clean_revision_ = written_revision_ = session_->revision();
+    tracked_revision_ = ~std::uint64_t{0};
+    last_write_ = std::chrono::steady_clock::now();
+    if (std::filesystem::exists(file_, ec)) {
+        try {
+            RecoveryState state = read_recovery(file_);
+            if (!state.phi.lattice().same_geometry(session_->lattice(), 1e-3))
+                message_ = fmt::format("ignoring the recovery file {}: its geometry ({}) is not the image's", file_.string(),
+                                       state.phi.lattice().describe());
+            else
+                offer_ = std::move(state);
+        } catch (const std::exception& e) {
+            message_ = fmt::format("ignoring a damaged recovery file: {}", e.what());
+        }
+    }
+    if (offer_ && config_.recover) restore();
+    if (!offer_) crash_.emplace(file_);
+}
+
+std::string Autosave::offer_summary() const {
+    if (!offer_) return {};
+    const SessionMarks& m = offer_->marks;
+    std::string how = offer_->signal ? fmt::format(", saved when the viewer received {}", signal_name(offer_->signal)) : "";
+    return fmt::format("unsaved work from {} ({} seed(s), {} iteration(s){}) in {}", local_time(offer_->unix_time), m.seeds.size(),
+                       m.iterations, how, file_.string());
+}
+
+bool Autosave::restore() {
+    if (!offer_ || !session_) return false;
+    message_.clear();
+    try {
+        if (!session_->load_recovered(offer_->phi, offer_->status, offer_->marks))
+            message_ = "the recovery file's sparse field was inconsistent: restored from the signs of its phi";
+    } catch (const std::exception& e) {
+        message_ = fmt::format("cannot restore {}: {}", file_.string(), e.what());
+        offer_.reset();
+        crash_.emplace(file_);
+        return false;
+    }
+    message_ = fmt::format("restored {}{}", offer_summary(), message_.empty() ? "" : " (" + message_ + ")");
+    offer_.reset();
+    restored_ = true;
+    // The restored work is still unsaved: keep the file until the user saves.
+    clean_revision_ = ~std::uint64_t{0};
+    written_revision_ = session_->revision();
+    crash_.emplace(file_);
+    return true;
+}
+
+void Autosave::discard() {
+    if (!offer_) return;
+    offer_.reset();
+    remove_file();
+    message_ = "discarded the recovery file";
+    crash_.emplace(file_);
+}
+
+bool Autosave::dirty() const { return session_ && session_->revision() != clean_revision_; }
+
+void Autosave::tick() {
+    if (!session_ || offer_ || exited_ || !crash_) return;
+    const std::uint64_t revision = session_->revision();
+    if (!dirty()) {
+        if (tracked_revision_ != revision) crash_->untrack();
+        tracked_revision_ = revision;
+        return;
+    }
+    if (tracked_revision_ != revision) {
+        try {
+            crash_->track(image_, session_->marks(), session_->field().phi(), session_->field().status());
+        } catch (const std::exception& e) {
+            message_ = e.what();
+        }
+        tracked_revision_ = revision;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (revision != written_revision_ && std::chrono::duration<double>(now - last_write_).count() >= config_.interval_seconds)
+        write("autosaved");
+}
+
+void Autosave::write(const char* why) {
+    RecoveryState s;
+    s.image = image_;
+    s.unix_time = static_cast<std::int64_t>(std::time(nullptr));
+    s.marks = session_->marks();
+    s.phi = session_->field().phi();
+    s.status = session_->field().status();
+    try {
+        write_recovery(file_, s);
+        message_ = fmt::format("{} unsaved work in {}", why, file_.string());
+        routine_ = !exited_;
+    } catch (const std::exception& e) {
+        message_ = fmt::format("autosave failed: {}", e.what());
+    }
+    written_revision_ = session_->revision();
+    last_write_ = std::chrono::steady_clock::now();
+}
+
+void Autosave::remove_file() {
+    std::error_code ec;
+    if (!file_.empty()) std::filesystem::remove(file_, ec);
+}
+
+void Autosave::mark_saved() {
+    if (!session_ || offer_) return;
+    clean_revision_ = session_->revision();
+    remove_file();
+    if (crash_) crash_->untrack();
+    tracked_revision_ = clean_revision_;
+}
+
+void Autosave::at_exit() {
+    if (!session_ || exited_) return;
+    exited_ = true;
+    if (crash_) crash_->untrack();
+    if (offer_) return;  // the user did not choose: the file stays for next time
+    if (dirty())
+        write("kept the");
+    else
+        remove_file();
+}
+
+std::string Autosave::take_message(bool* routine) {
+    if (routine) *routine = routine_;
+    routine_ = false;
+    return std::exchange(message_, {});
+}
+
+}  // namespace liveset::viewer

@@ -1,0 +1,389 @@
+// Recovery files: encoding, strict decoding, atomic writes, and the crash-signal writer.
+#include "liveset/session/recovery.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+#include <system_error>
+
+#include "liveset/segment/threshold_speed.hpp"
+
+namespace liveset {
+
+static_assert(std::endian::native == std::endian::little, "recovery files are written in the host's byte order (little-endian)");
+
+namespace {
+
+constexpr char kMagic[8] = {'L', 'S', 'R', 'E', 'C', 'O', 'V', '1'};
+constexpr std::uint32_t kVersion = 1;
+constexpr std::size_t kSignalOffset = 12;  // u32 signal, then i64 time
+constexpr std::size_t kTimeOffset = 16;
+constexpr std::size_t kFixedHead = 24;
+constexpr std::uint32_t kMaxPath = 4096;
+constexpr std::uint32_t kMaxSeeds = 100000;
+constexpr int kMaxStatus = 9;  // SparseField::kMaxLayers + 1
+
+struct Fnv {
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    void add(const void* data, std::size_t n) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < n; ++i) {
+            h ^= p[i];
+            h *= 0x100000001b3ull;
+        }
+    }
+};
+
+template <class T>
+void put(std::vector<std::uint8_t>& out, T value) {
+    const std::size_t at = out.size();
+    out.resize(at + sizeof(T));
+    std::memcpy(out.data() + at, &value, sizeof(T));
+}
+
+// The file up to and including the voxel count, with signal 0 and time 0.
+std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, const Lattice& lattice) {
+    if (image.size() > kMaxPath) throw std::runtime_error("recovery: the image path is too long");
+    if (marks.seeds.size() > kMaxSeeds) throw std::runtime_error("recovery: too many seeds");
+    std::vector<std::uint8_t> out;
+    out.reserve(256 + image.size() + 32 * marks.seeds.size());
+    for (char c : kMagic) out.push_back(static_cast<std::uint8_t>(c));
+    put(out, kVersion);
+    put(out, std::uint32_t{0});
+    put(out, std::int64_t{0});
+    put(out, static_cast<std::uint32_t>(image.size()));
+    for (char c : image) out.push_back(static_cast<std::uint8_t>(c));
+    const Vec3i d = lattice.dims();
+    for (int v : {d.x, d.y, d.z}) put(out, static_cast<std::int32_t>(v));
+    const Vec3d s = lattice.spacing(), o = lattice.origin();
+    for (double v : {s.x, s.y, s.z, o.x, o.y, o.z}) put(out, v);
+    for (double v : lattice.direction()) put(out, v);
+    const ThresholdParams& p = marks.params;
+    for (double v : {p.mu, p.epsilon, p.n, p.alpha}) put(out, v);
+    put(out, static_cast<std::uint8_t>(marks.window_from_seeds ? 1 : 0));
+    put(out, static_cast<std::int32_t>(marks.iterations));
+    put(out, static_cast<std::uint32_t>(marks.seeds.size()));
+    for (const SeedBall& b : marks.seeds)
+        for (double v : {b.center.x, b.center.y, b.center.z, b.radius}) put(out, v);
+    put(out, static_cast<std::uint64_t>(lattice.size()));
+    return out;
+}
+
+class Reader {
+public:
+    Reader(const std::uint8_t* data, std::size_t size) : data_(data), size_(size) {}
+    template <class T>
+    T get(const char* what) {
+        need(sizeof(T), what);
+        T v;
+        std::memcpy(&v, data_ + pos_, sizeof(T));
+        pos_ += sizeof(T);
+        return v;
+    }
+    double finite(const char* what) {
+        const double v = get<double>(what);
+        if (!std::isfinite(v)) throw std::runtime_error(std::string("non-finite ") + what);
+        return v;
+    }
+    const std::uint8_t* take(std::size_t n, const char* what) {
+        need(n, what);
+        const std::uint8_t* p = data_ + pos_;
+        pos_ += n;
+        return p;
+    }
+    std::size_t remaining() const { return size_ - pos_; }
+
+private:
+    void need(std::size_t n, const char* what) const {
+        if (n > size_ - pos_) throw std::runtime_error(std::string("truncated (in the ") + what + ")");
+    }
+    const std::uint8_t* data_;
+    std::size_t size_;
+    std::size_t pos_ = 0;
+};
+
+void write_all_or_throw(std::ofstream& out, const std::vector<std::uint8_t>& bytes, const std::filesystem::path& path) {
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    out.flush();
+    if (!out) throw std::runtime_error(path.string() + ": write error (disk full?)");
+}
+
+// --- crash path: static storage only, read by the signal handler ----------------------------
+
+struct TrackedState {
+    std::unique_ptr<std::uint8_t[]> header;
+    std::size_t header_size = 0;
+    const float* phi = nullptr;
+    const std::int8_t* status = nullptr;
+    std::size_t voxels = 0;
+};
+
+constexpr std::array<int, 8> kSignals{SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTERM, SIGINT, SIGHUP};
+std::array<TrackedState, 2> g_slots;
+std::atomic<int> g_active{-1};
+std::atomic<bool> g_installed{false};
+std::atomic<bool> g_writing{false};
+std::array<char, 4200> g_path{};
+std::array<char, 4210> g_temp{};
+std::array<struct sigaction, kSignals.size()> g_previous{};
+
+bool write_fd(int fd, const void* data, std::size_t n, Fnv& hash) {
+    hash.add(data, n);
+    const auto* p = static_cast<const char*>(data);
+    while (n > 0) {
+        const ssize_t w = ::write(fd, p, n);
+        if (w < 0) {
+            if (errno == EINTR) continue;
+            return false;
+        }
+        p += w;
+        n -= static_cast<std::size_t>(w);
+    }
+    return true;
+}
+
+void write_from_handler(int sig) {
+    const int slot = g_active.load();
+    if (slot < 0 || g_writing.exchange(true)) return;
+    const TrackedState& s = g_slots[static_cast<std::size_t>(slot)];
+    const int fd = ::open(g_temp.data(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
+    if (fd < 0) return;
+    Fnv hash;
+    const auto signal_number = static_cast<std::uint32_t>(sig);
+    const auto now = static_cast<std::int64_t>(::time(nullptr));
+    bool ok = write_fd(fd, s.header.get(), kSignalOffset, hash) && write_fd(fd, &signal_number, sizeof signal_number, hash) &&
+              write_fd(fd, &now, sizeof now, hash) &&
+              write_fd(fd, s.header.get() + kFixedHead, s.header_size - kFixedHead, hash) &&
+              write_fd(fd, s.phi, s.voxels * sizeof(float), hash) && write_fd(fd, s.status, s.voxels, hash);
+    const std::uint64_t sum = hash.h;
+    Fnv ignored;
+    ok = ok && write_fd(fd, &sum, sizeof sum, ignored) && ::fsync(fd) == 0;
+    ::close(fd);
+    if (ok)
+        ::rename(g_temp.data(), g_path.data());
+    else
+        ::unlink(g_temp.data());
+}
+
+extern "C" void liveset_recovery_signal(int sig) {
+    write_from_handler(sig);
+    // SA_RESETHAND restored the default action: deliver the signal again to take it (a fault
+    // re-raises itself when the handler returns).
+    ::raise(sig);
+}
+
+}  // namespace
+
+std::filesystem::path recovery_path(const std::filesystem::path& dir, const std::string& image) {
+    std::error_code ec;
+    std::filesystem::path full = std::filesystem::weakly_canonical(std::filesystem::absolute(image, ec), ec);
+    if (ec) full = std::filesystem::path(image).lexically_normal();
+    Fnv h;
+    const std::string key = full.string();
+    h.add(key.data(), key.size());
+    std::string name = std::filesystem::path(image).filename().string();
+    if (name.empty()) name = "image";
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.h));
+    return dir / (name + "-" + hex + ".lsrecovery");
+}
+
+std::vector<std::uint8_t> encode_recovery(const RecoveryState& state) {
+    std::vector<std::uint8_t> out = encode_header(state.image, state.marks, state.phi.lattice());
+    const auto sig = static_cast<std::uint32_t>(state.signal);
+    std::memcpy(out.data() + kSignalOffset, &sig, sizeof sig);
+    std::memcpy(out.data() + kTimeOffset, &state.unix_time, sizeof state.unix_time);
+    const std::span<const float> phi = state.phi.values();
+    const std::size_t at = out.size();
+    out.resize(at + phi.size_bytes());
+    std::memcpy(out.data() + at, phi.data(), phi.size_bytes());
+    if (state.status.size() != phi.size()) throw std::runtime_error("recovery: status and phi differ in size");
+    const std::span<const std::int8_t> status = state.status.values();
+    const std::size_t at2 = out.size();
+    out.resize(at2 + status.size());
+    std::memcpy(out.data() + at2, status.data(), status.size());
+    Fnv hash;
+    hash.add(out.data(), out.size());
+    put(out, hash.h);
+    return out;
+}
+
+RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
+    Reader r(data, size);
+    if (std::memcmp(r.take(8, "magic"), kMagic, 8) != 0) throw std::runtime_error("not a liveset recovery file (wrong magic)");
+    if (size < 8 + sizeof(std::uint64_t)) throw std::runtime_error("truncated");
+    Fnv hash;
+    hash.add(data, size - sizeof(std::uint64_t));
+    std::uint64_t stored;
+    std::memcpy(&stored, data + size - sizeof stored, sizeof stored);
+    const std::uint32_t version = r.get<std::uint32_t>("version");
+    if (version != kVersion) throw std::runtime_error("unsupported recovery file version " + std::to_string(version));
+    if (hash.h != stored) throw std::runtime_error("damaged (checksum mismatch)");
+
+    RecoveryState s;
+    const std::uint32_t sig = r.get<std::uint32_t>("signal");
+    if (sig > 64) throw std::runtime_error("invalid signal number");
+    s.signal = static_cast<int>(sig);
+    s.unix_time = r.get<std::int64_t>("time");
+    const std::uint32_t path_size = r.get<std::uint32_t>("image path");
+    if (path_size > kMaxPath) throw std::runtime_error("image path too long");
+    const std::uint8_t* path = r.take(path_size, "image path");
+    s.image.assign(reinterpret_cast<const char*>(path), path_size);
+    Vec3i dims;
+    dims.x = r.get<std::int32_t>("dimensions");
+    dims.y = r.get<std::int32_t>("dimensions");
+    dims.z = r.get<std::int32_t>("dimensions");
+    Vec3d spacing, origin;
+    spacing.x = r.finite("spacing");
+    spacing.y = r.finite("spacing");
+    spacing.z = r.finite("spacing");
+    origin.x = r.finite("origin");
+    origin.y = r.finite("origin");
+    origin.z = r.finite("origin");
+    Mat3d direction;
+    for (double& v : direction) v = r.finite("direction");
+    Lattice lattice;
+    try {
+        lattice = Lattice(dims, spacing, origin, direction);
+    } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(std::string("invalid geometry: ") + e.what());
+    }
+    ThresholdParams& p = s.marks.params;
+    p.mu = r.finite("parameters");
+    p.epsilon = r.finite("parameters");
+    p.n = r.finite("parameters");
+    p.alpha = r.finite("parameters");
+    try {
+        validate(p);
+    } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(std::string("invalid parameters: ") + e.what());
+    }
+    const std::uint8_t window = r.get<std::uint8_t>("parameters");
+    if (window > 1) throw std::runtime_error("invalid flag");
+    s.marks.window_from_seeds = window == 1;
+    s.marks.pristine = false;
+    s.marks.iterations = r.get<std::int32_t>("iterations");
+    if (s.marks.iterations < 0) throw std::runtime_error("negative iteration count");
+    const std::uint32_t seeds = r.get<std::uint32_t>("seed count");
+    if (seeds > kMaxSeeds || seeds * 32ull > r.remaining()) throw std::runtime_error("invalid seed count");
+    for (std::uint32_t i = 0; i < seeds; ++i) {
+        SeedBall b;
+        b.center.x = r.finite("seeds");
+        b.center.y = r.finite("seeds");
+        b.center.z = r.finite("seeds");
+        b.radius = r.finite("seeds");
+        if (b.radius <= 0) throw std::runtime_error("a seed with a non-positive radius");
+        s.marks.seeds.push_back(b);
+    }
+    const std::uint64_t voxels = r.get<std::uint64_t>("voxel count");
+    if (voxels != lattice.size()) throw std::runtime_error("the voxel count does not match the dimensions");
+    const std::uint64_t payload = voxels * (sizeof(float) + 1) + sizeof(std::uint64_t);
+    if (r.remaining() != payload) throw std::runtime_error(r.remaining() < payload ? "truncated (in phi)" : "trailing bytes after phi");
+    const std::uint8_t* values = r.take(voxels * sizeof(float), "phi");
+    s.phi = Grid<float>(lattice);
+    std::memcpy(s.phi.values().data(), values, voxels * sizeof(float));
+    for (float v : s.phi.values())
+        if (!std::isfinite(v)) throw std::runtime_error("phi holds NaN or infinite values");
+    const std::uint8_t* status = r.take(voxels, "status");
+    s.status = Grid<std::int8_t>(lattice);
+    std::memcpy(s.status.values().data(), status, voxels);
+    for (std::int8_t v : s.status.values())
+        if (v < -(kMaxStatus) || v > kMaxStatus) throw std::runtime_error("invalid sparse-field status");
+    return s;
+}
+
+void write_recovery(const std::filesystem::path& path, const RecoveryState& state) {
+    const std::vector<std::uint8_t> bytes = encode_recovery(state);
+    std::filesystem::path temp = path;
+    temp += ".part";
+    {
+        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+        if (!out) throw std::runtime_error(path.string() + ": cannot write (" + std::strerror(errno) + ")");
+        try {
+            write_all_or_throw(out, bytes, path);
+        } catch (...) {
+            out.close();
+            std::error_code ec;
+            std::filesystem::remove(temp, ec);
+            throw;
+        }
+    }
+    std::error_code ec;
+    std::filesystem::rename(temp, path, ec);
+    if (ec) {
+        std::filesystem::remove(temp, ec);
+        throw std::runtime_error(path.string() + ": cannot write (" + ec.message() + ")");
+    }
+}
+
+RecoveryState read_recovery(const std::filesystem::path& path) {
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    if (ec) throw std::runtime_error(path.string() + ": " + ec.message());
+    if (size > kMaxLatticePoints * sizeof(float) + (std::uint64_t{1} << 24)) throw std::runtime_error(path.string() + ": too large for a recovery file");
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
+    std::ifstream in(path, std::ios::binary);
+    if (!in || !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size())))
+        throw std::runtime_error(path.string() + ": cannot read");
+    try {
+        return decode_recovery(bytes.data(), bytes.size());
+    } catch (const std::runtime_error& e) {
+        throw std::runtime_error(path.string() + ": " + e.what());
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+
+CrashRecovery::CrashRecovery(std::filesystem::path path) : path_(std::move(path)) {
+    if (g_installed.exchange(true)) throw std::logic_error("CrashRecovery: one instance at a time");
+    // Its own temporary name: an autosave may be writing "<file>.part" when the signal comes.
+    const std::string p = path_.string(), t = p + ".crash.part";
+    if (t.size() >= g_temp.size()) {
+        g_installed = false;
+        throw std::runtime_error(p + ": path too long for a recovery file");
+    }
+    std::memcpy(g_path.data(), p.c_str(), p.size() + 1);
+    std::memcpy(g_temp.data(), t.c_str(), t.size() + 1);
+    struct sigaction action {};
+    action.sa_handler = liveset_recovery_signal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;
+    for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &action, &g_previous[i]);
+}
+
+CrashRecovery::~CrashRecovery() {
+    for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &g_previous[i], nullptr);
+    g_active = -1;
+    for (TrackedState& s : g_slots) s = {};
+    g_installed = false;
+}
+
+void CrashRecovery::track(const std::string& image, const SessionMarks& marks, const Grid<float>& phi, const Grid<std::int8_t>& status) {
+    if (status.size() != phi.size()) throw std::invalid_argument("CrashRecovery::track: status and phi differ in size");
+    const std::vector<std::uint8_t> header = encode_header(image, marks, phi.lattice());
+    const int slot = g_active.load() == 0 ? 1 : 0;
+    TrackedState& s = g_slots[static_cast<std::size_t>(slot)];
+    s.header = std::make_unique<std::uint8_t[]>(header.size());
+    std::memcpy(s.header.get(), header.data(), header.size());
+    s.header_size = header.size();
+    s.phi = phi.values().data();
+    s.status = status.values().data();
+    s.voxels = phi.size();
+    g_active = slot;
+}
+
+void CrashRecovery::untrack() { g_active = -1; }
+
+}  // namespace liveset

@@ -1,0 +1,175 @@
+// No lost work, end to end through `liveset view --headless`: unsaved work is kept in a recovery
+// file at exit and restored (same evaluation) with --recover; saving removes the file; a
+// termination signal in the middle of a segmentation writes the state it had; a damaged recovery
+// file is reported in one line and replaced, never fatal.
+#include <gtest/gtest.h>
+#include <fcntl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fmt/core.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "cli/cli_run.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/phantom/phantom.hpp"
+#include "liveset/session/recovery.hpp"
+
+namespace liveset {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CliResult;
+using testing::run_cli;
+
+struct Fixture {
+    fs::path dir, recovery;
+    std::string image, truth, seeds;
+};
+
+const Fixture& fixture() {
+    static const Fixture f = [] {
+        Fixture x;
+        x.dir = fs::temp_directory_path() / ("liveset_autosave_test_" + std::to_string(::getpid()));
+        fs::remove_all(x.dir);
+        fs::create_directories(x.dir);
+        PhantomOptions o;
+        o.size = 64;
+        const Phantom ph = make_phantom(o);
+        x.image = (x.dir / "t1.nii.gz").string();
+        x.truth = (x.dir / "truth.nii.gz").string();
+        write_image(ph.image, x.image);
+        write_label_image(ph.truth, x.truth);
+        for (const Vec3i& s : ph.seeds) x.seeds += fmt::format("{{\"seed\": [{}, {}, {}]}}, ", s.x, s.y, s.z);
+        return x;
+    }();
+    return f;
+}
+
+fs::path script(const fs::path& dir, const std::string& name, const std::string& body) {
+    const fs::path p = dir / name;
+    std::ofstream(p) << body;
+    return p;
+}
+
+std::vector<fs::path> recovery_files(const fs::path& dir) {
+    std::vector<fs::path> r;
+    if (fs::exists(dir))
+        for (const auto& e : fs::directory_iterator(dir))
+            if (e.path().extension() == ".lsrecovery") r.push_back(e.path());
+    return r;
+}
+
+nlohmann::json first_eval(const std::string& out) {
+    std::istringstream in(out);
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty() && line.front() == '{') return nlohmann::json::parse(line)["eval"];
+    return nullptr;
+}
+
+std::string view(const Fixture& f, const fs::path& rec, const fs::path& s, const std::string& extra = "") {
+    return "view " + f.image + " --headless --recovery-dir " + rec.string() + " --script " + s.string() + " " + extra;
+}
+
+TEST(Autosave, UnsavedWorkIsKeptAtExitRestoredWithRecoverAndGoneOnceSaved) {
+    const Fixture& f = fixture();
+    const fs::path rec = f.dir / "rec1";
+    const std::string eval = R"({"eval": {"truth": ")" + f.truth + R"("}})";
+    const CliResult first = run_cli(view(f, rec, script(f.dir, "work.json", "[" + f.seeds + R"({"segment": 40}, )" + eval + "]")));
+    ASSERT_EQ(first.rc, 0) << first.err;
+    EXPECT_NE(first.err.find("kept the unsaved work"), std::string::npos) << first.err;
+    const auto files = recovery_files(rec);
+    ASSERT_EQ(files.size(), 1u);
+    const RecoveryState kept = read_recovery(files[0]);
+    EXPECT_EQ(kept.image, f.image);
+    EXPECT_EQ(kept.signal, 0);
+    EXPECT_EQ(kept.marks.iterations, 40);
+    EXPECT_EQ(kept.marks.seeds.size(), 5u);
+
+    // Without --recover: one note, the file stays for a later choice.
+    const CliResult ignored = run_cli(view(f, rec, script(f.dir, "idle.json", R"([{"layout": "four"}])")));
+    ASSERT_EQ(ignored.rc, 0) << ignored.err;
+    EXPECT_NE(ignored.err.find("--recover restores it"), std::string::npos) << ignored.err;
+    EXPECT_EQ(recovery_files(rec).size(), 1u);
+
+    // --recover: the same surface as before the exit; saving the mask then removes the file.
+    const fs::path mask = f.dir / "restored_mask.nii.gz";
+    const CliResult restored =
+        run_cli(view(f, rec, script(f.dir, "save.json", "[" + eval + R"(, {"save_mask": ")" + mask.string() + R"("}])"), "--recover"));
+    ASSERT_EQ(restored.rc, 0) << restored.err;
+    EXPECT_NE(restored.err.find("restored unsaved work"), std::string::npos) << restored.err;
+    const nlohmann::json before = first_eval(first.out), after = first_eval(restored.out);
+    ASSERT_FALSE(before.is_null());
+    ASSERT_FALSE(after.is_null()) << restored.out;
+    EXPECT_EQ(before["dice"], after["dice"]);
+    EXPECT_EQ(before["holes"], after["holes"]);
+    EXPECT_EQ(before["genus"], after["genus"]);
+    EXPECT_EQ(before["jaccard"], after["jaccard"]);
+    EXPECT_TRUE(fs::exists(mask));
+    EXPECT_TRUE(recovery_files(rec).empty()) << "the work was saved: its recovery file should be gone";
+}
+
+TEST(Autosave, ATerminationSignalMidSegmentationWritesTheStateItHad) {
+    const Fixture& f = fixture();
+    const fs::path rec = f.dir / "rec2";
+    const fs::path s = script(f.dir, "long.json", "[" + f.seeds + R"({"segment": 1000000}])");
+    const fs::path err = f.dir / "long.err";
+    const std::string err_path = err.string();
+    const pid_t pid = ::fork();
+    if (pid == 0) {  // only async-signal-safe calls until exec
+        const int e = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644), n = ::open("/dev/null", O_WRONLY);
+        if (e < 0 || n < 0 || ::dup2(e, 2) < 0 || ::dup2(n, 1) < 0) ::_exit(120);
+        ::execl(LIVESET_CLI_PATH, LIVESET_CLI_PATH, "view", f.image.c_str(), "--headless", "--recovery-dir", rec.c_str(),
+                "--autosave-every", "0", "--script", s.c_str(), static_cast<char*>(nullptr));
+        ::_exit(121);
+    }
+    // --autosave-every 0 writes at every change: the file's appearance says the segmentation runs.
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (recovery_files(rec).empty() && std::chrono::steady_clock::now() < deadline)
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    ASSERT_FALSE(recovery_files(rec).empty()) << "no autosave within 2 minutes";
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    ::kill(pid, SIGTERM);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFSIGNALED(status)) << "exit status " << WEXITSTATUS(status) << ": " << testing::slurp(err);
+    EXPECT_EQ(WTERMSIG(status), SIGTERM);
+    const auto files = recovery_files(rec);
+    ASSERT_EQ(files.size(), 1u);
+    const RecoveryState got = read_recovery(files[0]);
+    EXPECT_EQ(got.signal, SIGTERM) << "the file is the last autosave, not the signal's";
+    EXPECT_GT(got.marks.iterations, 0);
+    EXPECT_EQ(got.marks.seeds.size(), 5u);
+
+    const CliResult restored = run_cli(view(f, rec, script(f.dir, "eval.json", R"([{"eval": {"truth": ")" + f.truth + R"("}}])"), "--recover"));
+    ASSERT_EQ(restored.rc, 0) << restored.err;
+    EXPECT_NE(restored.err.find("SIGTERM"), std::string::npos) << restored.err;
+    const nlohmann::json e = first_eval(restored.out);
+    ASSERT_FALSE(e.is_null());
+    EXPECT_GT(e["dice"].get<double>(), 0.0);
+}
+
+TEST(Autosave, ADamagedRecoveryFileIsReportedAndReplaced) {
+    const Fixture& f = fixture();
+    const fs::path rec = f.dir / "rec3";
+    fs::create_directories(rec);
+    const fs::path file = recovery_path(rec, f.image);
+    std::ofstream(file) << "LSRECOV1 but nothing after it";
+    const CliResult r = run_cli(view(f, rec, script(f.dir, "short.json", "[" + f.seeds + R"({"segment": 5}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("ignoring a damaged recovery file"), std::string::npos) << r.err;
+    EXPECT_EQ(read_recovery(file).marks.iterations, 5);
+
+    const CliResult no_dir = run_cli("view " + f.image + " --headless --recover --script " + (f.dir / "short.json").string());
+    EXPECT_NE(no_dir.rc, 0);
+    EXPECT_NE(no_dir.err.find("--recover needs"), std::string::npos) << no_dir.err;
+}
+
+}  // namespace
+}  // namespace liveset

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Drives `liveset view` in a real X window (run under xvfb-run): the image has a recovery file, so
+# the viewer opens with its "Restore unsaved work?" dialog; a real click on "Restore" (xdotool)
+# restores it; Ctrl+Q quits. Each step waits until the viewer's event log shows the reaction.
+# Usage: window_recovery.sh LIVESET IMAGE RECOVERY_DIR LOG  (exit status: the viewer's, or 90+)
+set -u
+liveset=$1 image=$2 recovery=$3 log=$4
+rm -f "$log"
+"$liveset" view "$image" --recovery-dir "$recovery" --log-events "$log" &
+app=$!
+
+wait_for() {  # wait_for PATTERN SECONDS: until the log has a line matching PATTERN
+    for _ in $(seq 1 $(($2 * 10))); do
+        grep -q "$1" "$log" 2>/dev/null && return 0
+        kill -0 "$app" 2>/dev/null || { echo "viewer exited early" >&2; exit 91; }
+        sleep 0.1
+    done
+    echo "timed out waiting for $1" >&2
+    kill "$app" 2>/dev/null
+    exit 90
+}
+
+wait_for '"type":"recovery_offer"' 60
+window=$(xdotool search --sync --name '^liveset' | head -1)
+read -r bx by bw bh <<<"$(grep '"recovery_offer"' "$log" | grep -o '"restore":\[[0-9,]*\]' | head -1 | sed 's/.*\[//; s/\]//; s/,/ /g')"
+xdotool mousemove --window "$window" $((bx + bw / 2)) $((by + bh / 2))
+sleep 0.3
+xdotool click 1
+wait_for '"type":"restore"' 30
+xdotool key ctrl+q
+wait "$app"

@@ -1,0 +1,310 @@
+// Recovery files: a written state reads back bit for bit; every damaged file (each truncation, a
+// flipped byte, a wrong magic or version, bad geometry, NaN φ, a wrong voxel count) is refused
+// with a reason; a crash or termination signal writes the tracked state before the process dies;
+// and a session restored from a recovery file has the surface, seeds and parameters it had.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <bit>
+#include <csignal>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include "liveset/mesh/mesh_analysis.hpp"
+#include "liveset/phantom/phantom.hpp"
+#include "liveset/session/recovery.hpp"
+#include "liveset/session/repair_presets.hpp"
+#include "liveset/session/session.hpp"
+
+namespace liveset {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path fresh_dir(const std::string& name) {
+    const fs::path d = fs::temp_directory_path() / ("liveset_recovery_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d);
+    return d;
+}
+
+RecoveryState sample_state() {
+    const Mat3d flip{-1, 0, 0, 0, 0, 1, 0, 1, 0};
+    const Lattice lattice({7, 5, 4}, {0.9, 1.1, 2.5}, {-12.5, 30.0, 4.25}, flip);
+    RecoveryState s;
+    s.image = "/data/subject 01/t1.nii.gz";
+    s.unix_time = 1795000000;
+    s.marks.seeds = {{{1.5, 2.0, 3.0}, 2.0}, {{4.0, 1.0, 0.0}, 0.75}};
+    s.marks.params = {0.42, 0.07, 3.0, 0.2};
+    s.marks.window_from_seeds = false;
+    s.marks.pristine = false;
+    s.marks.iterations = 137;
+    s.phi = Grid<float>(lattice);
+    int k = 0;
+    for (float& v : s.phi.values()) v = static_cast<float>(k++ % 11) * 0.37f - 1.5f;
+    s.status = Grid<std::int8_t>(lattice);
+    k = 0;
+    for (std::int8_t& v : s.status.values()) v = static_cast<std::int8_t>(k++ % 7 - 3);
+    return s;
+}
+
+void expect_same(const RecoveryState& a, const RecoveryState& b) {
+    EXPECT_EQ(a.image, b.image);
+    EXPECT_EQ(a.signal, b.signal);
+    EXPECT_EQ(a.unix_time, b.unix_time);
+    ASSERT_EQ(a.marks.seeds.size(), b.marks.seeds.size());
+    for (std::size_t i = 0; i < a.marks.seeds.size(); ++i) {
+        EXPECT_EQ(a.marks.seeds[i].center, b.marks.seeds[i].center);
+        EXPECT_EQ(a.marks.seeds[i].radius, b.marks.seeds[i].radius);
+    }
+    EXPECT_EQ(a.marks.params.mu, b.marks.params.mu);
+    EXPECT_EQ(a.marks.params.epsilon, b.marks.params.epsilon);
+    EXPECT_EQ(a.marks.params.n, b.marks.params.n);
+    EXPECT_EQ(a.marks.params.alpha, b.marks.params.alpha);
+    EXPECT_EQ(a.marks.window_from_seeds, b.marks.window_from_seeds);
+    EXPECT_EQ(a.marks.iterations, b.marks.iterations);
+    EXPECT_TRUE(a.phi.lattice().same_geometry(b.phi.lattice(), 0.0));
+    ASSERT_EQ(a.phi.size(), b.phi.size());
+    for (std::size_t i = 0; i < a.phi.size(); ++i)
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(a.phi.values()[i]), std::bit_cast<std::uint32_t>(b.phi.values()[i])) << i;
+    ASSERT_EQ(a.status.size(), b.status.size());
+    EXPECT_TRUE(std::equal(a.status.values().begin(), a.status.values().end(), b.status.values().begin()));
+}
+
+// Recomputes the trailing checksum after a deliberate edit, so the field checks are reached.
+void reseal(std::vector<std::uint8_t>& bytes) {
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    for (std::size_t i = 0; i < bytes.size() - 8; ++i) {
+        h ^= bytes[i];
+        h *= 0x100000001b3ull;
+    }
+    std::memcpy(bytes.data() + bytes.size() - 8, &h, 8);
+}
+
+std::string refusal(const std::vector<std::uint8_t>& bytes) {
+    try {
+        decode_recovery(bytes.data(), bytes.size());
+    } catch (const std::runtime_error& e) {
+        return e.what();
+    }
+    return "(accepted)";
+}
+
+// Byte offsets of the sample's fields (see the format in recovery.hpp).
+constexpr std::size_t kPathLength = 24;
+std::size_t dims_offset(const RecoveryState& s) { return kPathLength + 4 + s.image.size(); }
+std::size_t spacing_offset(const RecoveryState& s) { return dims_offset(s) + 12; }
+std::size_t params_offset(const RecoveryState& s) { return spacing_offset(s) + 15 * 8; }
+std::size_t voxels_offset(const RecoveryState& s) { return params_offset(s) + 4 * 8 + 1 + 4 + 4 + s.marks.seeds.size() * 32; }
+
+TEST(Recovery, EncodedStateDecodesBitForBit) {
+    RecoveryState s = sample_state();
+    s.signal = 11;
+    const std::vector<std::uint8_t> bytes = encode_recovery(s);
+    EXPECT_EQ(bytes.size(), voxels_offset(s) + 8 + s.phi.size() * 5 + 8);
+    expect_same(s, decode_recovery(bytes.data(), bytes.size()));
+}
+
+TEST(Recovery, TheFuzzingSeedIsAValidFile) {
+    const RecoveryState s = read_recovery(fs::path(LIVESET_SOURCE_DIR) / "fuzz/corpus/recovery/small.lsrecovery");
+    EXPECT_EQ(s.phi.lattice().dims(), (Vec3i{4, 3, 2}));
+    EXPECT_EQ(s.marks.seeds.size(), 1u);
+    EXPECT_EQ(s.marks.iterations, 12);
+}
+
+TEST(Recovery, EveryTruncationAndEveryFlippedByteIsRefused) {
+    const RecoveryState s = sample_state();
+    const std::vector<std::uint8_t> bytes = encode_recovery(s);
+    for (std::size_t n = 0; n < bytes.size(); ++n) {
+        const std::vector<std::uint8_t> cut(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(n));
+        ASSERT_NE(refusal(cut), "(accepted)") << "a file cut to " << n << " bytes was accepted";
+    }
+    for (std::size_t i = 0; i < bytes.size(); ++i) {
+        std::vector<std::uint8_t> flipped = bytes;
+        flipped[i] ^= 0x10;
+        ASSERT_NE(refusal(flipped), "(accepted)") << "byte " << i << " flipped was accepted";
+    }
+    std::vector<std::uint8_t> longer = bytes;
+    longer.push_back(0);
+    EXPECT_NE(refusal(longer), "(accepted)");
+}
+
+TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
+    const RecoveryState s = sample_state();
+    const std::vector<std::uint8_t> good = encode_recovery(s);
+    struct Case {
+        const char* name;
+        std::size_t offset;
+        std::vector<std::uint8_t> value;
+        const char* phrase;
+    };
+    auto i32 = [](std::int32_t v) { std::vector<std::uint8_t> b(4); std::memcpy(b.data(), &v, 4); return b; };
+    auto u32 = [](std::uint32_t v) { std::vector<std::uint8_t> b(4); std::memcpy(b.data(), &v, 4); return b; };
+    auto f64 = [](double v) { std::vector<std::uint8_t> b(8); std::memcpy(b.data(), &v, 8); return b; };
+    auto u64 = [](std::uint64_t v) { std::vector<std::uint8_t> b(8); std::memcpy(b.data(), &v, 8); return b; };
+    auto f32 = [](float v) { std::vector<std::uint8_t> b(4); std::memcpy(b.data(), &v, 4); return b; };
+    const std::vector<Case> cases{
+        {"wrong magic", 0, {'N', 'I', 'F', 'T'}, "wrong magic"},
+        {"version 2", 8, u32(2), "version 2"},
+        {"path length beyond the file", kPathLength, u32(1000000), "too long"},
+        {"zero dimension", dims_offset(s), i32(0), "invalid geometry"},
+        {"negative dimension", dims_offset(s) + 4, i32(-5), "invalid geometry"},
+        {"negative spacing", spacing_offset(s), f64(-1.0), "invalid geometry"},
+        {"NaN spacing", spacing_offset(s) + 8, f64(std::numeric_limits<double>::quiet_NaN()), "non-finite spacing"},
+        {"epsilon 0", params_offset(s) + 8, f64(0.0), "invalid parameters"},
+        {"alpha 1", params_offset(s) + 24, f64(1.0), "invalid parameters"},
+        {"flag 7", params_offset(s) + 32, {7}, "invalid flag"},
+        {"negative iterations", params_offset(s) + 33, i32(-1), "negative iteration"},
+        {"four billion seeds", params_offset(s) + 37, u32(0xFFFFFFFFu), "seed count"},
+        {"seed radius 0", params_offset(s) + 41 + 24, f64(0.0), "non-positive radius"},
+        {"voxel count off by one", voxels_offset(s), u64(s.phi.size() + 1), "voxel count"},
+        {"NaN in phi", voxels_offset(s) + 8 + 4 * 17, f32(std::numeric_limits<float>::quiet_NaN()), "NaN"},
+        {"infinity in phi", voxels_offset(s) + 8, f32(std::numeric_limits<float>::infinity()), "NaN or infinite"},
+        {"status 12", voxels_offset(s) + 8 + 4 * s.phi.size() + 3, {12}, "invalid sparse-field status"},
+    };
+    for (const Case& c : cases) {
+        std::vector<std::uint8_t> bytes = good;
+        ASSERT_LE(c.offset + c.value.size(), bytes.size() - 8) << c.name;
+        std::copy(c.value.begin(), c.value.end(), bytes.begin() + static_cast<std::ptrdiff_t>(c.offset));
+        reseal(bytes);
+        EXPECT_NE(refusal(bytes).find(c.phrase), std::string::npos) << c.name << ": " << refusal(bytes);
+    }
+    std::vector<std::uint8_t> flipped = good;
+    flipped[good.size() / 2] ^= 1;
+    EXPECT_NE(refusal(flipped).find("checksum"), std::string::npos) << refusal(flipped);
+}
+
+TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {
+    const fs::path dir = fresh_dir("files");
+    const RecoveryState s = sample_state();
+    const fs::path path = recovery_path(dir, s.image);
+    EXPECT_EQ(path.parent_path(), dir);
+    EXPECT_EQ(path.extension(), ".lsrecovery");
+    EXPECT_NE(recovery_path(dir, "/other/t1.nii.gz"), path) << "two images with one file name share a recovery file";
+    write_recovery(path, s);
+    expect_same(s, read_recovery(path));
+    EXPECT_FALSE(fs::exists(path.string() + ".part"));
+    // Unwritable place: an exception naming the file, nothing left behind.
+    const fs::path blocked = dir / "not_a_folder";
+    std::ofstream(blocked) << "x";
+    EXPECT_THROW(write_recovery(blocked / "r.lsrecovery", s), std::runtime_error);
+    // Missing and empty files: one-line refusals naming the file.
+    try {
+        read_recovery(dir / "missing.lsrecovery");
+        ADD_FAILURE() << "a missing file was read";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("missing.lsrecovery"), std::string::npos) << e.what();
+    }
+    std::ofstream(dir / "empty.lsrecovery");
+    EXPECT_THROW(read_recovery(dir / "empty.lsrecovery"), std::runtime_error);
+    fs::remove_all(dir);
+}
+
+// The child process dies by `sig` after the tracking was set up in the parent (no allocation after
+// fork); the parent then reads what the handler wrote.
+int die_by(int sig) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        ::raise(sig);
+        ::_exit(99);  // not reached: the signal's default action ends the process
+    }
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return WIFSIGNALED(status) ? WTERMSIG(status) : -WEXITSTATUS(status);
+}
+
+TEST(Recovery, ACrashOrTerminationSignalWritesTheTrackedState) {
+    const fs::path dir = fresh_dir("crash");
+    const RecoveryState s = sample_state();
+    for (int sig : {SIGSEGV, SIGABRT, SIGTERM, SIGINT}) {
+        const fs::path path = dir / ("crash" + std::to_string(sig) + ".lsrecovery");
+        CrashRecovery crash(path);
+        crash.track(s.image, s.marks, s.phi, s.status);
+        ASSERT_EQ(die_by(sig), sig) << "signal " << sig;
+        ASSERT_TRUE(fs::exists(path)) << "signal " << sig << " wrote no recovery file";
+        EXPECT_FALSE(fs::exists(path.string() + ".part"));
+        const RecoveryState got = read_recovery(path);
+        EXPECT_EQ(got.signal, sig);
+        EXPECT_GT(got.unix_time, 1700000000);
+        RecoveryState expected = s;
+        expected.signal = sig;
+        expected.unix_time = got.unix_time;
+        expect_same(expected, got);
+    }
+    {  // untracked (the work was saved): the signal writes nothing
+        const fs::path path = dir / "untracked.lsrecovery";
+        CrashRecovery crash(path);
+        crash.track(s.image, s.marks, s.phi, s.status);
+        crash.untrack();
+        ASSERT_EQ(die_by(SIGTERM), SIGTERM);
+        EXPECT_FALSE(fs::exists(path));
+    }
+    EXPECT_THROW(
+        {
+            CrashRecovery a(dir / "a");
+            CrashRecovery b(dir / "b");
+        },
+        std::logic_error);
+    fs::remove_all(dir);
+}
+
+TEST(Recovery, ARestoredSessionHasTheSurfaceSeedsAndParametersItHad) {
+    PhantomOptions po;
+    po.size = 48;
+    const Phantom ph = make_phantom(po);
+    SessionOptions o;
+    o.repair = demo_repair_options();
+    Session a(ph.image, o);
+    for (const Vec3i& c : ph.seeds) a.add_seed({c.cast<double>(), 2.0});
+    for (int i = 0; i < 40; ++i) a.segment_step();
+    a.end_action();
+
+    RecoveryState saved;
+    saved.image = "phantom";
+    saved.marks = a.marks();
+    saved.phi = a.field().phi();
+    saved.status = a.field().status();
+    const std::vector<std::uint8_t> bytes = encode_recovery(saved);
+    const RecoveryState back = decode_recovery(bytes.data(), bytes.size());
+
+    Session b(ph.image, o);
+    EXPECT_TRUE(b.load_recovered(back.phi, back.status, back.marks)) << "the saved sparse field was not taken as it is";
+    for (std::size_t i = 0; i < a.field().phi().size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(a.field().phi()[p]), std::bit_cast<std::uint32_t>(b.field().phi()[p])) << i;
+        ASSERT_EQ(a.field().status()[p], b.field().status()[p]) << i;
+    }
+    EXPECT_EQ(b.seeds().size(), a.seeds().size());
+    EXPECT_EQ(b.params().mu, a.params().mu);
+    EXPECT_EQ(b.params().epsilon, a.params().epsilon);
+    EXPECT_EQ(b.segment_status().iterations, 40);
+    EXPECT_FALSE(b.can_undo()) << "the history starts afresh from the restored state";
+    const Grid<std::uint8_t> ma = a.mask(), mb = b.mask();
+    EXPECT_TRUE(std::equal(ma.values().begin(), ma.values().end(), mb.values().begin(), mb.values().end()));
+    EXPECT_EQ(canonical_triangles(a.mesher().merged()), canonical_triangles(b.mesher().merged()));
+    // The restored session goes on segmenting as the original does.
+    for (int i = 0; i < 20; ++i) {
+        a.segment_step();
+        b.segment_step();
+    }
+    const Grid<std::uint8_t> ma2 = a.mask(), mb2 = b.mask();
+    EXPECT_TRUE(std::equal(ma2.values().begin(), ma2.values().end(), mb2.values().begin(), mb2.values().end()));
+
+    // A status that is no sparse field (a far point marked as zero layer): φ's signs are used.
+    Grid<std::int8_t> broken = back.status;
+    broken[0] = 0;
+    Session c(ph.image, o);
+    EXPECT_FALSE(c.load_recovered(back.phi, broken, back.marks));
+    const Grid<std::uint8_t> mc = c.mask();
+    EXPECT_TRUE(std::equal(ma.values().begin(), ma.values().end(), mc.values().begin(), mc.values().end()));
+
+    SessionMarks outside = back.marks;
+    outside.seeds.push_back({{1000.0, 0.0, 0.0}, 2.0});
+    EXPECT_THROW(b.load_recovered(back.phi, back.status, outside), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace liveset
