@@ -288,8 +288,9 @@ Script parse_script_text(const std::string& text, const std::string& path, const
     json doc;
     try {
         doc = json::parse(text);
-    } catch (const json::parse_error& e) {
-        // nlohmann's message ends with the byte position: enough to find the typo.
+    } catch (const json::exception& e) {
+        // parse_error, or out_of_range for a number beyond a double ("1e999"); nlohmann's message
+        // names the byte position or the number: enough to find the typo.
         throw cli::UsageError(fmt::format("script {} is not valid JSON: {}", path, e.what()));
     }
     if (!doc.is_array()) throw cli::UsageError(fmt::format("script {} must be a JSON list of actions", path));

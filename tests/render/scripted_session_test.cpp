@@ -132,6 +132,7 @@ TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
     };
     const Case cases[] = {
         {"[{\"segment\": 10}", "not valid JSON"},
+        {"[{\"segment\": 1e999}]", "not valid JSON"},  // a number beyond a double (found by fuzz_session_script)
         {"{\"segment\": 10}", "must be a JSON list"},
         {"[{\"seed\": [1, 2, 3]}, {\"segmnet\": 5}]", "entry 2: no action (unknown key \"segmnet\")"},
         {"[{\"seed\": [1, 2, 300]}]", "entry 1 (\"seed\"): the seed (1, 2, 300) lies outside"},
