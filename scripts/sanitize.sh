@@ -35,16 +35,47 @@ case "$mode" in
     cmake --build --preset asan -j "$jobs" --target "${core[@]/%/_tests}"
     export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
     export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+    export LSAN_OPTIONS=suppressions=$PWD/tests/sanitizer/lsan.supp
     for t in "${core[@]}"; do
       start=$(date +%s)
       "build-asan/tests/$t/${t}_tests" --gtest_filter='-BrainWebRepair.*' --gtest_brief=1
       echo "asan-core: ${t}_tests passed in $(( $(date +%s) - start )) s" >&2
     done
     ;;
-  asan|tsan)
-    cmake --preset "$mode" >/dev/null
-    cmake --build --preset "$mode" -j "$jobs"
-    ctest --preset "$mode"
+  asan)
+    cmake --preset asan >/dev/null
+    cmake --build --preset asan -j "$jobs"
+    ctest --preset asan
+    ;;
+  tsan)
+    # Debian's libtbb is not built with ThreadSanitizer, so TSan cannot see the scheduler's
+    # synchronisation (every parallel_for would be reported). Build the same oneTBB from Debian's
+    # source package with -fsanitize=thread, once, into build-tsan-deps, and link the tests to it.
+    deps=$PWD/build-tsan-deps
+    tbb=$deps/onetbb-tsan
+    if [ ! -f "$tbb/lib/cmake/TBB/TBBConfig.cmake" ]; then
+      sudo_cmd=()
+      [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+      if ! apt-get source --print-uris onetbb >/dev/null 2>&1; then
+        printf 'Types: deb-src\nURIs: http://deb.debian.org/debian\nSuites: bookworm\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' |
+          "${sudo_cmd[@]}" tee /etc/apt/sources.list.d/liveset-deb-src.sources >/dev/null
+        "${sudo_cmd[@]}" apt-get update -qq
+      fi
+      dpkg-query -W -f='${Status}' dpkg-dev 2>/dev/null | grep -q "install ok installed" ||
+        DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends dpkg-dev >/dev/null
+      mkdir -p "$deps"
+      (cd "$deps" && rm -rf onetbb-*/ && apt-get source -qq onetbb >/dev/null 2>&1)
+      src=$(find "$deps" -maxdepth 1 -type d -name 'onetbb-[0-9]*' | head -1)
+      cmake -S "$src" -B "$deps/tbb-build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTBB_TEST=OFF -DTBB_EXAMPLES=OFF \
+        -DTBBMALLOC_BUILD=OFF -DTBB_STRICT=OFF -DCMAKE_CXX_FLAGS=-fsanitize=thread -DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread \
+        -DCMAKE_INSTALL_PREFIX="$tbb" >/dev/null
+      cmake --build "$deps/tbb-build" -j "$jobs" >/dev/null
+      cmake --install "$deps/tbb-build" >/dev/null
+    fi
+    # Only the test programs holding the multithreaded parts (the ctest preset's filter).
+    cmake --preset tsan -DTBB_DIR="$tbb/lib/cmake/TBB" >/dev/null
+    cmake --build --preset tsan -j "$jobs" --target levelset_tests mesh_tests segment_tests swarm_tests
+    ctest --preset tsan
     ;;
   fuzz)
     seconds=${2:-60}

@@ -11,6 +11,7 @@
 #include <cstdlib>
 
 #include "cli_common.hpp"
+#include "liveset/render/driver_allocations.hpp"
 #include "script_player.hpp"
 
 namespace liveset::viewer {
@@ -83,6 +84,7 @@ bool display_available() {
 int run_window(std::unique_ptr<Session> session, const std::string& image_name, const ViewerConfig& config,
                const WindowOptions& options, const std::function<void(Viewer&)>& prepare) {
     glfwSetErrorCallback(on_glfw_error);
+    render::keep_driver_mapped();
     if (!glfwInit()) throw cli::UsageError("cannot open a window: " + g_glfw_error + " (use --headless without a display)");
     struct Terminate {
         ~Terminate() { glfwTerminate(); }

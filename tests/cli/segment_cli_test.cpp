@@ -237,7 +237,8 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
 
 TEST(SegmentCli, DemoWritesItsOutputsAndAJsonReport) {
     const fs::path dir = work_dir() / "demo";
-    const Result r = run_cli("demo --size 64 --json --out " + dir.string());
+    // Two short rounds: the report is what is tested here (and the test stays quick sanitized).
+    const Result r = run_cli("demo --size 64 --rounds 2 --round-steps 50 --json --out " + dir.string());
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_EQ(lines(r.out), 1);
     const nlohmann::json j = nlohmann::json::parse(r.out);

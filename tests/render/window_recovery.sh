@@ -4,12 +4,9 @@
 # restores it; Ctrl+Q quits. Each step waits until the viewer's event log shows the reaction.
 # Usage: window_recovery.sh LIVESET IMAGE RECOVERY_DIR LOG  (exit status: the viewer's, or 90+)
 set -u
-# Under AddressSanitizer the window runs with LeakSanitizer off: Mesa's GLX driver, loaded and
-# unloaded by GLFW, leaves two 56-byte blocks LSan cannot attribute (the driver is gone by then);
-# memory errors are still checked, and the headless (EGL) viewer is leak-checked in the other tests.
 liveset=$1 image=$2 recovery=$3 log=$4
 rm -f "$log"
-ASAN_OPTIONS="${ASAN_OPTIONS:-}:detect_leaks=0" "$liveset" view "$image" --recovery-dir "$recovery" --log-events "$log" &
+"$liveset" view "$image" --recovery-dir "$recovery" --log-events "$log" &
 app=$!
 
 wait_for() {  # wait_for PATTERN SECONDS: until the log has a line matching PATTERN

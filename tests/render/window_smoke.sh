@@ -6,12 +6,9 @@
 # viewer's event log shows the reaction, so a slow software renderer only makes it slower.
 # Usage: window_smoke.sh LIVESET IMAGE MASK LOG  (exit status: the viewer's, or 90+ on a timeout)
 set -u
-# Under AddressSanitizer the window runs with LeakSanitizer off: Mesa's GLX driver, loaded and
-# unloaded by GLFW, leaves two 56-byte blocks LSan cannot attribute (the driver is gone by then);
-# memory errors are still checked, and the headless (EGL) viewer is leak-checked in the other tests.
 liveset=$1 image=$2 mask=$3 log=$4
 rm -f "$log"
-ASAN_OPTIONS="${ASAN_OPTIONS:-}:detect_leaks=0" "$liveset" view "$image" --mask "$mask" --log-events "$log" --recovery-dir "$(dirname "$log")/recovery" &
+"$liveset" view "$image" --mask "$mask" --log-events "$log" --recovery-dir "$(dirname "$log")/recovery" &
 app=$!
 
 wait_for() {  # wait_for PATTERN SECONDS: until the log has a line matching PATTERN

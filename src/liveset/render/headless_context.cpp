@@ -1,6 +1,8 @@
 // EGL surfaceless context creation.
 #include "liveset/render/headless_context.hpp"
 
+#include "liveset/render/driver_allocations.hpp"
+
 #include <epoxy/egl.h>
 #include <epoxy/gl.h>
 
@@ -25,6 +27,7 @@ bool has_client_extension(const char* name) {
 }  // namespace
 
 HeadlessContext::HeadlessContext() {
+    keep_driver_mapped();
     if (!has_client_extension("EGL_MESA_platform_surfaceless") || !has_client_extension("EGL_EXT_platform_base"))
         fail("EGL lacks the surfaceless platform (install Mesa: libegl1, libgl1-mesa-dri)");
     // The EXT entry point: eglGetPlatformDisplay through epoxy aborts before any display exists.
