@@ -80,6 +80,7 @@ std::string view(const Fixture& f, const fs::path& rec, const fs::path& s, const
 TEST(Autosave, UnsavedWorkIsKeptAtExitRestoredWithRecoverAndGoneOnceSaved) {
     const Fixture& f = fixture();
     const fs::path rec = f.dir / "rec1";
+    fs::remove_all(rec);
     const std::string eval = R"({"eval": {"truth": ")" + f.truth + R"("}})";
     const CliResult first = run_cli(view(f, rec, script(f.dir, "work.json", "[" + f.seeds + R"({"segment": 40}, )" + eval + "]")));
     ASSERT_EQ(first.rc, 0) << first.err;
@@ -118,6 +119,7 @@ TEST(Autosave, UnsavedWorkIsKeptAtExitRestoredWithRecoverAndGoneOnceSaved) {
 TEST(Autosave, ATerminationSignalMidSegmentationWritesTheStateItHad) {
     const Fixture& f = fixture();
     const fs::path rec = f.dir / "rec2";
+    fs::remove_all(rec);
     const fs::path s = script(f.dir, "long.json", "[" + f.seeds + R"({"segment": 1000000}])");
     const fs::path err = f.dir / "long.err";
     const std::string err_path = err.string();
@@ -158,6 +160,7 @@ TEST(Autosave, ATerminationSignalMidSegmentationWritesTheStateItHad) {
 TEST(Autosave, ADamagedRecoveryFileIsReportedAndReplaced) {
     const Fixture& f = fixture();
     const fs::path rec = f.dir / "rec3";
+    fs::remove_all(rec);
     fs::create_directories(rec);
     const fs::path file = recovery_path(rec, f.image);
     std::ofstream(file) << "LSRECOV1 but nothing after it";
