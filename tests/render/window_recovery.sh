@@ -9,16 +9,7 @@ rm -f "$log"
 "$liveset" view "$image" --recovery-dir "$recovery" --log-events "$log" &
 app=$!
 
-wait_for() {  # wait_for PATTERN SECONDS: until the log has a line matching PATTERN
-    for _ in $(seq 1 $(($2 * 10))); do
-        grep -q "$1" "$log" 2>/dev/null && return 0
-        kill -0 "$app" 2>/dev/null || { echo "viewer exited early" >&2; exit 91; }
-        sleep 0.1
-    done
-    echo "timed out waiting for $1" >&2
-    kill "$app" 2>/dev/null
-    exit 90
-}
+. "$(dirname "$0")/window_driver.sh"
 
 wait_for '"type":"recovery_offer"' 60
 window=$(xdotool search --sync --name '^liveset' | head -1)

@@ -11,16 +11,7 @@ rm -f "$log"
 "$liveset" view "$image" --mask "$mask" --log-events "$log" --recovery-dir "$(dirname "$log")/recovery" &
 app=$!
 
-wait_for() {  # wait_for PATTERN SECONDS: until the log has a line matching PATTERN
-    for _ in $(seq 1 $(($2 * 10))); do
-        grep -q "$1" "$log" 2>/dev/null && return 0
-        kill -0 "$app" 2>/dev/null || { echo "viewer exited early" >&2; exit 91; }
-        sleep 0.1
-    done
-    echo "timed out waiting for $1" >&2
-    kill "$app" 2>/dev/null
-    exit 90
-}
+. "$(dirname "$0")/window_driver.sh"
 rect() {  # rect NAME: "x y w h" of a pane or button from the ready line
     grep '"ready"' "$log" | grep -o "\"$1\":\[[0-9,]*\]" | head -1 | sed 's/.*\[//; s/\]//; s/,/ /g'
 }
