@@ -78,7 +78,8 @@ int run_demo(const DemoArgs& a, int threads) {
     const double eval_ms = ms_since(t0);
 
     // Repair: each round points the swarm at the largest perforation left (found from the truth,
-    // as a user would see it), runs round_steps swarm steps through the incremental mesher.
+    // as a user would see it) with the brush (edit range) sized to that hole, and runs round_steps
+    // swarm steps through the incremental mesher.
     Grid<std::uint8_t> white(ph.labels.lattice(), 0);
     for (PointIndex i = 0; i < white.size(); ++i) white[i] = ph.labels[i] == kWhiteMatter;
     const Grid<float> unit = normalise(ph.image, o.scale);
@@ -98,6 +99,7 @@ int run_demo(const DemoArgs& a, int threads) {
     for (int r = 0; r < a.rounds && !holes.empty(); ++r) {
         const Vec3d t = holes.front().centroid;
         ro.swarm.seed = a.seed + static_cast<std::uint64_t>(r);
+        ro.swarm.edit_range = hole_brush_range(holes.front().voxels);  // the brush sized to the hole
         const RepairTarget target{t, 0};
         const std::vector<RepairStepLog> log = run_repair(*o.field, unit, nullptr, {&target, 1}, ro, &mesher);
         for (const RepairStepLog& l : log) {
@@ -106,7 +108,8 @@ int run_demo(const DemoArgs& a, int threads) {
             repair_ms += l.ms;
         }
         steps += log.size();
-        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", holes.front().voxels}, {"holes", holes.size()}});
+        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", holes.front().voxels}, {"holes", holes.size()},
+                          {"edit_range", ro.swarm.edit_range}});
         repaired = inside_mask(o.field->phi());
         holes = holes_left();
     }

@@ -118,6 +118,11 @@ TEST(ScriptedSession, SegmentsThePhantomThenTheSwarmRepairsItToNoHoles) {
     EXPECT_EQ(run.holes_left, 0u) << "after " << run.rounds << " rounds";
     EXPECT_EQ(run.after["holes"].get<long>(), 0) << run.after.dump();
     EXPECT_EQ(run.after["genus"].get<long>(), 0) << run.after.dump();  // both tunnels closed, none made
+    // With the demo's fixed 8-voxel brush the viewer's path closes both holes but Dice falls a little
+    // (0.9741 -> ~0.971; the demo now sizes its brush to each hole and Dice rises, see
+    // Repair.SwarmClosesThePhantomPerforations). Replayed here round by round through saved phi files
+    // (re-initialised each round), the sized brush stalls with one tunnel left after 20 rounds
+    // (Dice 0.9786): closing the last tunnel is sensitive to the trajectory (docs/BENCHMARKS.md).
     EXPECT_GE(run.after["dice"].get<double>(), run.before["dice"].get<double>() - 0.005);
 }
 

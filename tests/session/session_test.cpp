@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cmath>
 #include <map>
 #include <vector>
 
@@ -259,6 +260,22 @@ TEST(Session, ASavedPhiLoadsBackAsTheSameSurface) {
     for (PointIndex p : a.field().zero_layer())
         ASSERT_EQ(std::bit_cast<std::uint32_t>(a.field().phi()[p]), std::bit_cast<std::uint32_t>(b.field().phi()[p]));
     EXPECT_EQ(canonical_triangles(a.mesher().merged()), canonical_triangles(b.mesher().merged()));
+}
+
+// The brush sized to a hole: a disc of r² π t voxels through a shell t thick has radius r, and the
+// brush reaches one voxel past it, within [3, max_range].
+TEST(RepairPresets, HoleBrushIsTheHoleRadiusPlusOneVoxel) {
+    constexpr double kPi = 3.14159265358979323846;
+    EXPECT_NEAR(hole_brush_range(static_cast<std::size_t>(std::lround(25 * kPi * 3))), 6.0, 0.01);
+    EXPECT_NEAR(hole_brush_range(static_cast<std::size_t>(std::lround(16 * kPi * 4)), 4.0), 5.0, 0.01);
+    EXPECT_DOUBLE_EQ(hole_brush_range(1), 3.0);           // a tiny hole: the smallest brush
+    EXPECT_DOUBLE_EQ(hole_brush_range(0), 3.0);
+    EXPECT_DOUBLE_EQ(hole_brush_range(100000), 8.0);      // a huge one: the demo's widest brush
+    EXPECT_DOUBLE_EQ(hole_brush_range(100000, 3.0, 12.0), 12.0);
+    EXPECT_LT(hole_brush_range(200), hole_brush_range(400));
+    EXPECT_THROW(hole_brush_range(10, 0.0), std::invalid_argument);
+    EXPECT_THROW(hole_brush_range(10, std::nan("")), std::invalid_argument);
+    EXPECT_THROW(hole_brush_range(10, 3.0, 2.0), std::invalid_argument);
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/pipeline.hpp"
 #include "liveset/segment/segmentation.hpp"
+#include "liveset/session/repair_presets.hpp"
 #include "liveset/swarm/repair.hpp"
 
 namespace liveset {
@@ -119,11 +120,14 @@ TEST(Repair, SwarmClosesThePhantomPerforations) {
         return h.empty() ? find_cavities(mask, white) : h;
     };
     std::vector<Vec3d> targets;
+    std::vector<double> ranges;
     for (int round = 0; round < 20; ++round) {
         const auto left = holes_left();
         if (left.empty()) break;
         ro.swarm.seed = 1 + static_cast<std::uint64_t>(round);
+        ro.swarm.edit_range = hole_brush_range(left.front().voxels);  // as the demo sizes its brush
         const RepairTarget t{left.front().centroid, 0};
+        ranges.push_back(ro.swarm.edit_range);
         targets.push_back(t.position);
         run_repair(*o.field, unit, nullptr, {&t, 1}, ro);
         mask = inside_mask(o.field->phi());
@@ -132,17 +136,17 @@ TEST(Repair, SwarmClosesThePhantomPerforations) {
     const Topology after = mask_topology(mask);
     EXPECT_EQ(after.genus, 0);  // both tunnels closed, none made
     EXPECT_EQ(holes_between(mask_topology(ph.truth), after), 0);  // the check: `holes` drops to 0
-    // Overlap: within 0.005 of the segmentation's (measured: 0.9741 -> 0.9707, over-growth into biased
-    // CSF and white matter around the holes; see BENCHMARKS).
-    EXPECT_GE(compare_overlap(mask, ph.truth).dice, dice_before - 0.005);
+    // Overlap: the check, Dice must not fall (measured: 0.9741 -> 0.9769; with a fixed
+    // 8-voxel brush it fell to 0.9707, see BENCHMARKS).
+    EXPECT_GE(compare_overlap(mask, ph.truth).dice, dice_before);
     // Nothing far from the targets changed: agents edit only within edit_range of the target, each
     // edit reaches edit_radius further and the band repair two voxels more.
-    const double reach = ro.swarm.edit_range + ro.swarm.edit_radius + 2.0;
     for (PointIndex i = 0; i < mask.size(); ++i) {
         if (mask[i] == o.mask[i]) continue;
         double nearest = 1e9;
-        for (const Vec3d& t : targets) nearest = std::min(nearest, norm(mask.lattice().coord(i).cast<double>() - t));
-        ASSERT_LE(nearest, reach);
+        for (std::size_t k = 0; k < targets.size(); ++k)
+            nearest = std::min(nearest, norm(mask.lattice().coord(i).cast<double>() - targets[k]) - ranges[k]);
+        ASSERT_LE(nearest, ro.swarm.edit_radius + 2.0);
     }
 }
 
