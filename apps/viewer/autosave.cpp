@@ -142,14 +142,9 @@ void Autosave::tick() {
 }
 
 void Autosave::write(const char* why) {
-    RecoveryState s;
-    s.image = image_;
-    s.unix_time = static_cast<std::int64_t>(std::time(nullptr));
-    s.marks = session_->marks();
-    s.phi = session_->field().phi();
-    s.status = session_->field().status();
     try {
-        write_recovery(file_, s);
+        write_recovery(file_, RecoveryView(image_, 0, static_cast<std::int64_t>(std::time(nullptr)), session_->marks(),
+                                           session_->field().phi(), session_->field().status()));
         message_ = fmt::format("{} unsaved work in {}", why, file_.string());
         routine_ = !exited_;
     } catch (const std::exception& e) {

@@ -229,8 +229,8 @@ private:
     double mouse_x_ = 0.0, mouse_y_ = 0.0;
     std::map<std::string, Rect> button_rects_;  // panel buttons, for the event log's "ready" line
     bool ready_logged_ = false;
-    bool window_shot_pending_ = false;
-    int offer_frames_ = 0;  // frames the recovery dialog has been shown  // F12: save what the window shows after this frame
+    bool window_shot_pending_ = false;  // F12: save what the window shows after this frame
+    int offer_frames_ = 0;              // frames the recovery dialog has been shown
     Drag drag_;
     int redraw_frames_ = 2;
     bool quit_ = false;

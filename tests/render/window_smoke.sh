@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Drives `liveset view` in a real X window (run under xvfb-run) with real input events from
 # xdotool: rotate the 3D view by dragging, pick the surface with the target tool, run and stop
-# the swarm, press the panel's "Reset view" button, quit with Ctrl+Q (the swarm's unsaved edits go to
-# a recovery file next to the log). Each step waits until the
-# viewer's event log shows the reaction, so a slow software renderer only makes it slower.
+# the swarm, press the panel's "Reset view" button, quit with Ctrl+Q (the swarm's unsaved edits go
+# to a recovery file next to the log). Each step waits until the viewer's event log shows the
+# reaction, so a slow software renderer only makes it slower.
 # Usage: window_smoke.sh LIVESET IMAGE MASK LOG  (exit status: the viewer's, or 90+ on a timeout)
 set -u
 liveset=$1 image=$2 mask=$3 log=$4

@@ -199,7 +199,8 @@ std::filesystem::path recovery_path(const std::filesystem::path& dir, const std:
     return dir / (name + "-" + hex + ".lsrecovery");
 }
 
-std::vector<std::uint8_t> encode_recovery(const RecoveryState& state) {
+std::vector<std::uint8_t> encode_recovery(const RecoveryView& state) {
+    if (state.status.size() != state.phi.size()) throw std::runtime_error("recovery: status and phi differ in size");
     std::vector<std::uint8_t> out = encode_header(state.image, state.marks, state.phi.lattice());
     const auto sig = static_cast<std::uint32_t>(state.signal);
     std::memcpy(out.data() + kSignalOffset, &sig, sizeof sig);
@@ -208,7 +209,6 @@ std::vector<std::uint8_t> encode_recovery(const RecoveryState& state) {
     const std::size_t at = out.size();
     out.resize(at + phi.size_bytes());
     std::memcpy(out.data() + at, phi.data(), phi.size_bytes());
-    if (state.status.size() != phi.size()) throw std::runtime_error("recovery: status and phi differ in size");
     const std::span<const std::int8_t> status = state.status.values();
     const std::size_t at2 = out.size();
     out.resize(at2 + status.size());
@@ -303,7 +303,7 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
     return s;
 }
 
-void write_recovery(const std::filesystem::path& path, const RecoveryState& state) {
+void write_recovery(const std::filesystem::path& path, const RecoveryView& state) {
     const std::vector<std::uint8_t> bytes = encode_recovery(state);
     std::filesystem::path temp = path;
     temp += ".part";

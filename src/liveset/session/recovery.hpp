@@ -32,16 +32,32 @@ struct RecoveryState {
     Grid<std::int8_t> status;    // the sparse field's layer of each point (same lattice)
 };
 
+// What encode_recovery and write_recovery read: a state's parts where they live, so an autosave
+// serialises the session's grids without copying them first. A RecoveryState converts to it.
+struct RecoveryView {
+    RecoveryView(const std::string& image_, int signal_, std::int64_t unix_time_, const SessionMarks& marks_,
+                 const Grid<float>& phi_, const Grid<std::int8_t>& status_)
+        : image(image_), signal(signal_), unix_time(unix_time_), marks(marks_), phi(phi_), status(status_) {}
+    RecoveryView(const RecoveryState& s)  // implicit on purpose
+        : RecoveryView(s.image, s.signal, s.unix_time, s.marks, s.phi, s.status) {}
+    const std::string& image;
+    int signal;
+    std::int64_t unix_time;
+    const SessionMarks& marks;
+    const Grid<float>& phi;
+    const Grid<std::int8_t>& status;
+};
+
 // The recovery file for `image` in `dir`: "<file name>-<hash of the absolute path>.lsrecovery".
 std::filesystem::path recovery_path(const std::filesystem::path& dir, const std::string& image);
 
 // The serialised file (what write_recovery writes).
-std::vector<std::uint8_t> encode_recovery(const RecoveryState& state);
+std::vector<std::uint8_t> encode_recovery(const RecoveryView& state);
 // Parses a whole file; throws std::runtime_error with a one-line reason for anything malformed.
 RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size);
 
 // Writes atomically (a temporary file next to `path`, then rename). Throws std::runtime_error.
-void write_recovery(const std::filesystem::path& path, const RecoveryState& state);
+void write_recovery(const std::filesystem::path& path, const RecoveryView& state);
 // Throws std::runtime_error (one line naming the file) when missing, unreadable or malformed.
 RecoveryState read_recovery(const std::filesystem::path& path);
 
