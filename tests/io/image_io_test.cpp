@@ -506,11 +506,11 @@ TEST_F(ImageIo, WriteOnFullDiskLeavesNothing) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Real data: BrainWeb (skipped when ../shared/data is absent)
+// Real data: BrainWeb (bundled in data/brainweb)
 
 TEST(ImageIoData, BrainWeb) {
-    const std::string base = std::string(LIVESET_SHARED_DATA) + "/brainweb/";
-    if (!fs::exists(base + "t1.mha")) GTEST_SKIP() << "no BrainWeb data in " << base;
+    const std::string base = std::string(LIVESET_DATA_DIR) + "/brainweb/";
+    ASSERT_TRUE(fs::exists(base + "t1.mha")) << "no BrainWeb data in " << base;
     const Grid<float> t1 = read_image(base + "t1.mha");
     const Grid<std::uint8_t> labels = read_label_image(base + "labels_crisp.nii.gz");
     const Grid<std::uint8_t> mask = read_label_image(base + "brain_mask.nii.gz");

@@ -1,4 +1,4 @@
-// Real data: grey matter of the BrainWeb T1 (../shared/data/brainweb) segmented with the paper's
+// Real data: grey matter of the BrainWeb T1 (data/brainweb) segmented with the paper's
 // threshold speed inside the brain mask, on a cortical sub-volume so the test stays short (the
 // whole-volume figures are in docs/BENCHMARKS.md). Skips when the data is absent.
 #include <gtest/gtest.h>
@@ -28,8 +28,8 @@ Grid<T> crop(const Grid<T>& g, Vec3i lo, Vec3i size) {
 }  // namespace
 
 TEST(BrainWeb, GreyMatterDiceInsideTheBrainMask) {
-    const std::filesystem::path dir = std::filesystem::path(LIVESET_SHARED_DATA) / "brainweb";
-    if (!std::filesystem::exists(dir / "t1.mha")) GTEST_SKIP() << "BrainWeb data not found in " << dir;
+    const std::filesystem::path dir = std::filesystem::path(LIVESET_DATA_DIR) / "brainweb";
+    ASSERT_TRUE(std::filesystem::exists(dir / "t1.mha")) << "BrainWeb data (bundled in data/brainweb) not found in " << dir;
     const Vec3i lo{40, 50, 70}, size{100, 120, 48};  // a slab through the middle of the brain
     const Grid<float> t1 = crop(read_image((dir / "t1.mha").string()), lo, size);
     const Grid<std::uint8_t> brain = crop(read_label_image((dir / "brain_mask.nii.gz").string()), lo, size);

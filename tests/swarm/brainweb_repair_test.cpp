@@ -1,5 +1,5 @@
 // Real data: the swarm repairs holes of the BrainWeb grey-matter segmentation of README.md
-// (whole volume, ../shared/data/brainweb; ≈ 3 min on 2 cores). Targets are the hole-sized
+// (whole volume, data/brainweb; ≈ 3 min on 2 cores). Targets are the hole-sized
 // perforations the segmentation left (missed grey matter joining white matter to the outside), as
 // `liveset eval --inner-label 3` lists them, clicked one after another; the `holes` count must
 // fall and Dice must not fall. Skips when the data is absent.
@@ -27,8 +27,8 @@ Grid<std::uint8_t> select(Grid<std::uint8_t> labels, int value) {
 }  // namespace
 
 TEST(BrainWebRepair, TargetedPerforationsLowerTheHoleCountWithoutLosingDice) {
-    const std::filesystem::path dir = std::filesystem::path(LIVESET_SHARED_DATA) / "brainweb";
-    if (!std::filesystem::exists(dir / "t1.mha")) GTEST_SKIP() << "BrainWeb data not found in " << dir;
+    const std::filesystem::path dir = std::filesystem::path(LIVESET_DATA_DIR) / "brainweb";
+    ASSERT_TRUE(std::filesystem::exists(dir / "t1.mha")) << "BrainWeb data (bundled in data/brainweb) not found in " << dir;
     const Grid<float> t1 = read_image((dir / "t1.mha").string());
     const Grid<std::uint8_t> brain = read_label_image((dir / "brain_mask.nii.gz").string());
     const Grid<std::uint8_t> labels = read_label_image((dir / "labels_crisp.nii.gz").string());
