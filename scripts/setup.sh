@@ -11,6 +11,7 @@ packages=(
   libcli11-dev libfmt-dev nlohmann-json3-dev  # command line, formatting, JSON reports
   gnuplot-nox                                 # plots of the Figure 3 experiment
   libinsighttoolkit5-dev zlib1g-dev           # image IO (NIfTI, MetaImage, NRRD, MINC, DICOM)
+  minc-tools                                  # tests: MINC geometry checked with nii2mnc, mincinfo, worldtovoxel
   libglfw3-dev libepoxy-dev libimgui-dev      # viewer: window, OpenGL 3.3 loader, Dear ImGui
   libglm-dev libstb-dev                       # viewer: matrices, PNG screenshots
   libegl-dev libgl-dev libgl1-mesa-dri        # OpenGL / EGL (Mesa llvmpipe without a GPU; headless runs)

@@ -25,6 +25,7 @@
 #include <itkImageIOBase.h>
 #include <itkImageIOFactory.h>
 #include <itkImageSeriesReader.h>
+#include <itkMINCImageIO.h>
 #include <itkMINCImageIOFactory.h>
 #include <itkMetaImageIOFactory.h>
 #include <itkNiftiImageIOFactory.h>
@@ -33,6 +34,7 @@
 #include "liveset/io/atomic_output.hpp"
 #include "liveset/io/file_checks.hpp"
 #include "liveset/io/messages.hpp"
+#include "liveset/io/minc_world.hpp"
 
 namespace liveset {
 
@@ -42,6 +44,7 @@ namespace fs = std::filesystem;
 using Component = itk::IOComponentEnum;
 using io_detail::bytes_text;
 using io_detail::dims_text;
+using io_detail::flip_ras_lps;
 using io_detail::quoted;
 using io_detail::voxels_are_non_finite;
 
@@ -86,6 +89,22 @@ std::string format_name(const itk::ImageIOBase& io) {
 
 const char* kFormatsHint =
     "liveset reads .nii/.nii.gz, .mha/.mhd, .nrrd/.nhdr, .mnc and folders of DICOM slices";
+
+// ---------------------------------------------------------------------------------------------
+// MINC: its RAS world is converted to LPS on read and back on write (minc_world.hpp says why)
+
+bool is_minc(const itk::ImageIOBase& io) { return std::string(io.GetNameOfClass()) == "MINCImageIO"; }
+
+// Later ITK releases can convert MINC's RAS to LPS themselves (SetRAStoLPS): switched off where
+// it exists, so that flip_ras_lps below is the one conversion.
+template <class MincIO>
+void keep_minc_world_as_stored(MincIO& io) {
+    if constexpr (requires { io.SetRAStoLPS(false); }) io.SetRAStoLPS(false);
+}
+
+void prepare_minc_io(itk::ImageIOBase& io) {
+    if (auto* minc = dynamic_cast<itk::MINCImageIO*>(&io)) keep_minc_world_as_stored(*minc);
+}
 
 // ---------------------------------------------------------------------------------------------
 // Opening: header of a file or of a DICOM series folder
@@ -156,6 +175,7 @@ void open_file(Source& src) {
     }
     if (!io) fail_read(path, std::string("unknown image format or damaged header (") + kFormatsHint + ")");
     try {
+        prepare_minc_io(*io);
         io->SetFileName(path);
         io->ReadImageInformation();
     } catch (const itk::ExceptionObject& e) {
@@ -173,6 +193,7 @@ void open_file(Source& src) {
         origin[a] = io->GetOrigin(a);
         axes[a] = io->GetDirection(a);
     }
+    if (is_minc(*io)) flip_ras_lps(origin, axes);  // MINC's RAS -> LPS
     fill_geometry(src, n, spacing, origin, axes);
     src.header.components = static_cast<int>(io->GetNumberOfComponents());
     src.scalar = io->GetPixelType() == itk::IOPixelEnum::SCALAR && io->GetNumberOfComponents() == 1;
@@ -399,6 +420,32 @@ void verify_data(const Source& src) {
 // ---------------------------------------------------------------------------------------------
 // Writing
 
+// Hands the lattice's geometry to a writer (MINC: converted to RAS) and sets the whole image as the region.
+void set_geometry(itk::ImageIOBase& io, const Lattice& lattice) {
+    io.SetNumberOfDimensions(3);
+    const Vec3i d = lattice.dims();
+    const Vec3d s = lattice.spacing(), o = lattice.origin();
+    const Mat3d& m = lattice.direction();
+    std::vector<double> origin{o.x, o.y, o.z};
+    std::vector<std::vector<double>> axes;
+    for (unsigned a = 0; a < 3; ++a) axes.push_back({m[a], m[3 + a], m[6 + a]});
+    if (is_minc(io)) {
+        prepare_minc_io(io);
+        flip_ras_lps(origin, axes);  // LPS -> MINC's RAS
+    }
+    itk::ImageIORegion region(3);
+    for (unsigned a = 0; a < 3; ++a) {
+        const int ai = static_cast<int>(a);
+        io.SetDimensions(a, static_cast<itk::SizeValueType>(d[ai]));
+        io.SetSpacing(a, s[ai]);
+        io.SetOrigin(a, origin[a]);
+        io.SetDirection(a, axes[a]);
+        region.SetIndex(a, 0);
+        region.SetSize(a, static_cast<itk::SizeValueType>(d[ai]));
+    }
+    io.SetIORegion(region);
+}
+
 void write_grid(const void* data, Component component, const Lattice& lattice, const std::string& path) {
     if (path.empty()) throw ImageIoError("cannot write an image: the path is empty");
     if (lattice.size() == 0) fail_write(path, "the image is empty");
@@ -425,20 +472,8 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
     const std::string cls = io->GetNameOfClass();
     if (cls == "GDCMImageIO") fail_write(path, std::string("writing DICOM is not supported (") + formats + ")");
 
-    io->SetNumberOfDimensions(3);
+    set_geometry(*io, lattice);
     const Vec3i d = lattice.dims();
-    const Vec3d s = lattice.spacing(), o = lattice.origin();
-    const Mat3d& m = lattice.direction();
-    itk::ImageIORegion region(3);
-    for (unsigned a = 0; a < 3; ++a) {
-        const int ai = static_cast<int>(a);
-        io->SetDimensions(a, static_cast<itk::SizeValueType>(d[ai]));
-        io->SetSpacing(a, s[ai]);
-        io->SetOrigin(a, o[ai]);
-        io->SetDirection(a, std::vector<double>{m[a], m[3 + a], m[6 + a]});
-        region.SetIndex(a, 0);
-        region.SetSize(a, static_cast<itk::SizeValueType>(d[ai]));
-    }
     io->SetPixelType(itk::IOPixelEnum::SCALAR);
     io->SetComponentType(component);
     io->SetNumberOfComponents(1);
@@ -446,7 +481,6 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
     // where the format allows it (.nii vs .nii.gz is decided by the extension itself).
     const bool two_file = cls == "MetaImageIO" ? ext != ".mha" : (cls == "NrrdImageIO" && ext != ".nrrd");
     io->SetUseCompression(!two_file);
-    io->SetIORegion(region);
 
     // Uncompressed output must fit, known before writing. Checked up front because some writers
     // do not clean up after a failed write: teem keeps a detached .raw open (its disk space stays
