@@ -10,6 +10,7 @@
 
 #include "cli_common.hpp"
 #include "cli_support.hpp"
+#include "demo_brain.hpp"
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/fragment_mesher.hpp"
@@ -33,6 +34,8 @@ struct DemoArgs {
     int rounds = 20;        // repair rounds (one target each)
     int round_steps = 100;  // swarm steps per round
     bool json = false, quiet = false, no_view = false;
+    bool brain = false;  // the real-brain demo instead (demo_brain.hpp)
+    BrainDemoArgs brain_args;
 };
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -178,7 +181,7 @@ int run_demo(const DemoArgs& a, int threads) {
 void add_demo_command(CLI::App& app, const int& threads) {
     static DemoArgs da;
     auto* demo = app.add_subcommand("demo", "the main job: phantom -> segment -> mesh -> eval, with a report");
-    demo->add_option("--out", da.out, "output folder")->capture_default_str();
+    CLI::Option* out = demo->add_option("--out", da.out, "output folder (liveset-demo; liveset-demo-brain with --brain)")->capture_default_str();
     demo->add_option("--size", da.size, "phantom voxels per axis")->check(CLI::Range(48, 256))->capture_default_str();
     demo->add_option("--seed", da.seed, "phantom noise seed")->capture_default_str();
     demo->add_option("--rounds", da.rounds, "repair rounds (one target, the largest hole left, each)")->check(CLI::Range(0, 1000))->capture_default_str();
@@ -186,7 +189,17 @@ void add_demo_command(CLI::App& app, const int& threads) {
     demo->add_flag("--json", da.json, "print the report as one JSON object on stdout");
     demo->add_flag("--quiet,-q", da.quiet, "print nothing");
     demo->add_flag("--no-view", da.no_view, "do not open the viewer even when a display is available (--json implies it)");
-    demo->callback([&threads] {
+    demo->add_flag("--brain", da.brain, "the real-brain path instead: BrainWeb T1 (bundled in data/brainweb), seeds only -> segment -> mesh -> eval");
+    demo->add_option("--data", da.brain_args.data, "with --brain: the folder holding t1.mha, labels_crisp.nii.gz and brain_mask.nii.gz")->capture_default_str();
+    demo->callback([&threads, out] {
+        if (da.brain) {
+            da.brain_args.json = da.json;
+            da.brain_args.quiet = da.quiet;
+            if (out->count() > 0) da.brain_args.out = da.out;
+            const int rc = run_brain_demo(da.brain_args, threads);
+            if (rc != 0) std::exit(rc);
+            return;
+        }
         const int rc = run_demo(da, threads);
         if (rc != 0) std::exit(rc);
     });

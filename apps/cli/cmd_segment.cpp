@@ -27,6 +27,8 @@ struct SegmentArgs {
     std::string init_mask, roi;
     std::optional<double> mu, epsilon, mu_raw, epsilon_raw;
     double n = 4.0, alpha = 0.1;
+    std::string window_from = "model";
+    int classes = 3;
     int iterations = 2000;
     std::string out_mask, out_phi, out_mesh, log;
     bool json = false, quiet = false;
@@ -67,6 +69,9 @@ int run_segment(const SegmentArgs& a, int threads) {
     req.epsilon = a.epsilon;
     req.mu_raw = a.mu_raw;
     req.epsilon_raw = a.epsilon_raw;
+    req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
+    req.window.model.classes = a.classes;
+    if (std::getenv("LIVESET_EXP_NOPV")) req.window.model.partial_volume = false;  // EXPERIMENT-ONLY
 
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {
@@ -155,10 +160,12 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--seed-radius", sa.seed_radius, "default seed radius")->check(finite_number() & CLI::Range(0.5, 100.0))->capture_default_str();
     seg->add_option("--init-mask", sa.init_mask, "start from this mask instead of seeds (needs --mu/--epsilon)");
     seg->add_option("--roi", sa.roi, "region-of-interest mask the front may not leave (e.g. a brain mask)");
-    seg->add_option("--mu", sa.mu, "ideal intensity, normalised to [0,1] (default: estimated from the seeds)")->check(finite_number());
-    seg->add_option("--epsilon", sa.epsilon, "half window, normalised units (default: estimated from the seeds)")->check(finite_number());
+    seg->add_option("--mu", sa.mu, "ideal intensity, normalised to [0,1] (default: the tissue model's window for the seeds' class)")->check(finite_number());
+    seg->add_option("--epsilon", sa.epsilon, "half window, normalised units (default: from the tissue model)")->check(finite_number());
     seg->add_option("--mu-raw", sa.mu_raw, "ideal intensity in the image's own units")->check(finite_number());
     seg->add_option("--epsilon-raw", sa.epsilon_raw, "half window in the image's own units")->check(finite_number());
+    seg->add_option("--window-from", sa.window_from, "estimate the window from the tissue model of the image (the seeds pick the class) or from the seeds' statistics")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
+    seg->add_option("--classes", sa.classes, "tissue classes of the model (T1 brain: CSF, GM, WM)")->check(CLI::Range(2, 6))->capture_default_str();
     seg->add_option("--n", sa.n, "steepness of the threshold term")->check(finite_number())->capture_default_str();
     seg->add_option("--alpha", sa.alpha, "curvature weight in [0,1)")->check(finite_number())->capture_default_str();
     seg->add_option("--iterations", sa.iterations, "iteration limit")->check(CLI::Range(1, 10'000'000))->capture_default_str();

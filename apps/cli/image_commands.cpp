@@ -50,6 +50,8 @@ SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest&
     };
     SegmentRun run{segment_image(image, request, hook, &interrupt.flag()), false};
     progress.finish();
+    if (!quiet)
+        for (const std::string& w : run.outcome.warnings) fmt::print(stderr, "liveset: warning: {}\n", w);
     run.interrupted = run.outcome.result.reason == StopReason::kInterrupted;
     if (!log_path.empty() && !run.interrupted) write_atomically(log_path, log);
     return run;
@@ -71,7 +73,14 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
     j["epsilon_raw"] = o.scale.raw_length(o.params.epsilon);
     j["n"] = o.params.n;
     j["alpha"] = o.params.alpha;
-    j["window_estimated"] = o.seed_stats.has_value();
+    j["window_estimated"] = o.window_source != WindowSource::kUser;
+    j["window"] = {{"mu_raw", o.scale.to_raw(o.params.mu)},
+                   {"epsilon_raw", o.scale.raw_length(o.params.epsilon)},
+                   {"lower_raw", o.scale.to_raw(o.params.mu - o.params.epsilon)},
+                   {"upper_raw", o.scale.to_raw(o.params.mu + o.params.epsilon)},
+                   {"source", to_string(o.window_source)}};
+    if (o.model) j["tissue_model"] = tissue_model_report(*o.model, o.model_window ? &*o.model_window : nullptr);
+    j["warnings"] = o.warnings;
     j["intensity_scale"] = {{"low", o.scale.low}, {"high", o.scale.high}};
     j["voxels"] = inside;
     j["volume_mm3"] = static_cast<double>(inside) * voxel_mm3;
@@ -79,13 +88,40 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
     return j;
 }
 
+nlohmann::json tissue_model_report(const TissueModel& m, const ModelWindow* w) {
+    nlohmann::json classes = nlohmann::json::array();
+    for (std::size_t c = 0; c < m.classes.size(); ++c)
+        classes.push_back({{"name", tissue_class_name(m, static_cast<int>(c))}, {"mean", m.classes[c].mean},
+                           {"sigma", m.classes[c].sigma}, {"weight", m.classes[c].weight}});
+    nlohmann::json j{{"classes", classes}, {"partial_volume", m.mixed}, {"voxels", m.voxels},
+                     {"iterations", m.iterations}, {"converged", m.converged}, {"usable", m.usable()}};
+    if (!m.usable()) j["degenerate"] = m.degenerate;
+    if (w) j["seed_class"] = {{"name", tissue_class_name(m, w->seed_class)}, {"index", w->seed_class}, {"share", w->seed_class_share}};
+    return j;
+}
+
 void print_segmentation_summary(const nlohmann::json& j) {
     fmt::print("  segmentation {} iterations ({}), {:.2f} s, {:.2f} ms/iteration\n", j["iterations"].get<int>(),
                j["stop"].get<std::string>(), j["seconds"].get<double>(), j["ms_per_iteration"].get<double>());
-    fmt::print("  window       mu {:.4f} epsilon {:.4f} (raw {:.1f} +- {:.1f}{}), n {}, alpha {}\n", j["mu"].get<double>(),
-               j["epsilon"].get<double>(), j["mu_raw"].get<double>(), j["epsilon_raw"].get<double>(),
-               j["window_estimated"].get<bool>() ? ", estimated from the seeds" : "", j["n"].get<double>(),
-               j["alpha"].get<double>());
+    if (j.contains("tissue_model")) {
+        const nlohmann::json& m = j["tissue_model"];
+        std::string line;
+        for (const auto& c : m["classes"])
+            line += fmt::format("{}{} {:.1f} ± {:.1f} ({:.0f} %)", line.empty() ? "" : ", ", c["name"].get<std::string>(),
+                                c["mean"].get<double>(), c["sigma"].get<double>(), 100.0 * c["weight"].get<double>());
+        double pv = 0;
+        for (const auto& v : m["partial_volume"]) pv += v.get<double>();
+        fmt::print("  tissues      {}; partial volume {:.0f} %{}\n", line, 100.0 * pv, m["usable"].get<bool>() ? "" : " (not usable)");
+    }
+    const nlohmann::json& w = j["window"];
+    const std::string source = w["source"].get<std::string>();
+    std::string from = source == "user" ? "given" : source == "seeds" ? "from the seeds' statistics" : "from the tissue model";
+    if (source == "model")
+        from += fmt::format(": {}, {:.0f} % of the seed voxels", j["tissue_model"]["seed_class"]["name"].get<std::string>(),
+                            100.0 * j["tissue_model"]["seed_class"]["share"].get<double>());
+    fmt::print("  window       {:.1f} .. {:.1f} raw (mu {:.1f} ± {:.1f}; {}), n {}, alpha {}\n", w["lower_raw"].get<double>(),
+               w["upper_raw"].get<double>(), w["mu_raw"].get<double>(), w["epsilon_raw"].get<double>(), from,
+               j["n"].get<double>(), j["alpha"].get<double>());
     fmt::print("  volume       {} voxels, {:.1f} ml\n", j["voxels"].get<std::size_t>(), j["volume_mm3"].get<double>() / 1000.0);
 }
 

@@ -35,7 +35,12 @@ struct SegmentRun {
 SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest& request, bool quiet,
                                  const std::string& log_path = {});
 
-// Parameters, iterations, timing and volume of a segmentation.
+// The tissue model (classes with names, means, spreads, weights; partial-volume weights) and the
+// seeds' class when the window came from it.
+nlohmann::json tissue_model_report(const TissueModel& model, const ModelWindow* window);
+
+// Parameters, window (raw, with its source), tissue model, warnings, iterations, timing and
+// volume of a segmentation.
 nlohmann::json segmentation_report(const SegmentOutcome& outcome, const Lattice& lattice);
 void print_segmentation_summary(const nlohmann::json& report);
 

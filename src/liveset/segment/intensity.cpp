@@ -72,7 +72,7 @@ Grid<float> normalise(const Grid<float>& image, const IntensityScale& scale) {
     return out;
 }
 
-SeedStatistics seed_statistics(const Grid<float>& image, std::span<const SeedBall> seeds, const Grid<std::uint8_t>* roi) {
+std::vector<float> seed_values(const Grid<float>& image, std::span<const SeedBall> seeds, const Grid<std::uint8_t>* roi) {
     check_roi(image, roi);
     const Lattice& l = image.lattice();
     std::vector<float> v;
@@ -100,6 +100,15 @@ SeedStatistics seed_statistics(const Grid<float>& image, std::span<const SeedBal
                 }
     }
     if (v.empty()) throw std::invalid_argument("the seeds cover no voxel (inside the region of interest)");
+    return v;
+}
+
+SeedStatistics seed_statistics(const Grid<float>& image, std::span<const SeedBall> seeds, const Grid<std::uint8_t>* roi) {
+    return seed_statistics_of(seed_values(image, seeds, roi));
+}
+
+SeedStatistics seed_statistics_of(std::vector<float> v) {
+    if (v.empty()) throw std::invalid_argument("no seed voxel to take statistics of");
     SeedStatistics st;
     st.voxels = v.size();
     double sum = 0, sum2 = 0;

@@ -51,9 +51,16 @@ struct SeedStatistics {
     double mad_sigma = 0.0;  // 1.4826 × median absolute deviation (robust σ)
 };
 
-// Statistics of `image` over the lattice points inside the seed balls (inside `roi` when given).
-// Throws std::invalid_argument when a seed centre lies outside the lattice or no voxel is covered.
+// Values of `image` at the lattice points inside the seed balls (inside `roi` when given), seed by
+// seed. Throws std::invalid_argument when a seed centre lies outside the lattice, a radius is bad
+// or no voxel is covered.
+std::vector<float> seed_values(const Grid<float>& image, std::span<const SeedBall> seeds,
+                               const Grid<std::uint8_t>* roi = nullptr);
+
+// Statistics of seed_values().
 SeedStatistics seed_statistics(const Grid<float>& image, std::span<const SeedBall> seeds,
                                const Grid<std::uint8_t>* roi = nullptr);
+// Statistics of a sample (not empty).
+SeedStatistics seed_statistics_of(std::vector<float> values);
 
 }  // namespace liveset

@@ -8,10 +8,38 @@
 
 namespace liveset {
 
-void estimate_window(const SeedStatistics& stats, double epsilon_sigmas, double min_epsilon, ThresholdParams& params) {
-    params.mu = stats.median;
-    params.epsilon = std::max(min_epsilon, epsilon_sigmas * stats.mad_sigma);
+namespace {
+
+// µ and ε for the request: the user's where given, the rest estimated (window.hpp). Fills the
+// outcome's window source, model, statistics and warnings.
+void choose_window(const Grid<float>& image, const SegmentRequest& req, SegmentOutcome& out, ThresholdParams& p) {
+    std::optional<double> mu = req.mu, epsilon = req.epsilon;
+    if (req.mu_raw) mu = (*req.mu_raw - out.scale.low) / (out.scale.high - out.scale.low);
+    if (req.epsilon_raw) epsilon = out.scale.unit_length(*req.epsilon_raw);
+    if (!req.seeds.empty()) {  // the model: for the window, or to check the user's window
+        const Grid<std::uint8_t> region = model_region(image, req.model_region, req.roi, req.window.model.classes);
+        out.model = fit_window_model(image, region, req.window.model, out.warnings);
+    }
+    if (!mu || !epsilon) {
+        if (req.seeds.empty())
+            throw std::invalid_argument("mu and epsilon must be given when starting from a mask (no seeds to estimate them)");
+        const WindowEstimate w = estimate_window(image, out.scale, req.seeds, req.roi, out.model ? &*out.model : nullptr, req.window);
+        out.window_source = w.source;
+        out.seed_stats = w.seed_stats;
+        out.model_window = w.model_window;
+        out.warnings.insert(out.warnings.end(), w.warnings.begin(), w.warnings.end());
+        p.mu = w.mu;
+        p.epsilon = w.epsilon;
+    }
+    if (mu) p.mu = *mu;
+    if (epsilon) p.epsilon = *epsilon;
+    if (mu && epsilon && out.model && out.model->usable()) {
+        const auto more = window_warnings(*out.model, out.scale.to_raw(p.mu - p.epsilon), out.scale.to_raw(p.mu + p.epsilon));
+        out.warnings.insert(out.warnings.end(), more.begin(), more.end());
+    }
 }
+
+}  // namespace
 
 SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req, const SegmentationHook& hook,
                              const std::atomic<bool>* interrupt) {
@@ -21,9 +49,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
         os << "initial mask " << req.initial_mask->dims() << " does not match the image " << image.dims();
         throw std::invalid_argument(os.str());
     }
-    if (!std::isfinite(req.epsilon_sigmas) || req.epsilon_sigmas <= 0 || !std::isfinite(req.min_epsilon) ||
-        req.min_epsilon <= 0)
-        throw std::invalid_argument("the epsilon estimate needs positive sigmas and floor");
+    req.window.validate();
     validate(req.loop);
     if ((req.mu && req.mu_raw) || (req.epsilon && req.epsilon_raw))
         throw std::invalid_argument("give the window in normalised or raw units, not both");
@@ -32,21 +58,11 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     out.scale = robust_scale(image, req.roi, req.scale);
     const Grid<float> unit = normalise(image, out.scale);
 
-    std::optional<double> mu = req.mu, epsilon = req.epsilon;
-    if (req.mu_raw) mu = (*req.mu_raw - out.scale.low) / (out.scale.high - out.scale.low);
-    if (req.epsilon_raw) epsilon = out.scale.unit_length(*req.epsilon_raw);
-
     ThresholdParams p;
     p.n = req.n;
     p.alpha = req.alpha;
-    if (!mu || !epsilon) {
-        if (req.seeds.empty())
-            throw std::invalid_argument("mu and epsilon must be given when starting from a mask (no seeds to estimate them)");
-        out.seed_stats = seed_statistics(unit, req.seeds, req.roi);
-        estimate_window(*out.seed_stats, req.epsilon_sigmas, req.min_epsilon, p);
-    }
-    if (mu) p.mu = *mu;
-    if (epsilon) p.epsilon = *epsilon;
+    choose_window(image, req, out, p);
+    if (!req.mu && !req.mu_raw) p.mu = std::clamp(p.mu, 0.0, 1.0);  // an estimate beyond the scale's range
     validate(p);
     out.params = p;
 

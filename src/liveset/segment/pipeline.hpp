@@ -13,6 +13,7 @@
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
+#include "liveset/segment/window.hpp"
 
 namespace liveset {
 
@@ -20,14 +21,17 @@ struct SegmentRequest {
     std::vector<SeedBall> seeds;                   // index space; or
     const Grid<std::uint8_t>* initial_mask = nullptr;  // an initial region (non-zero inside)
     const Grid<std::uint8_t>* roi = nullptr;       // region the front may not leave
-    // Threshold window in normalised units; estimated from the seeds when absent:
-    // µ = median of the seed-ball intensities, ε = epsilon_sigmas × their robust σ (at least
-    // min_epsilon).
+    // Threshold window in normalised units. When absent it is estimated: by default the tissue
+    // model's window for the seeds' class; with estimate = kSeeds (or when the model is not
+    // usable, with a warning) µ = median of the seed-ball intensities, ε = epsilon_sigmas × their
+    // robust σ (at least min_epsilon).
     std::optional<double> mu, epsilon;
     // The same in the image's own units (mapped through the intensity scale; not with mu/epsilon).
     std::optional<double> mu_raw, epsilon_raw;
-    double epsilon_sigmas = 5.0;
-    double min_epsilon = 0.05;
+    WindowOptions window;  // how the window is estimated (window.hpp)
+    // Where the tissue model is fitted: this region, else the ROI, else the image's foreground
+    // (voxels above the Otsu threshold between background and the rest).
+    const Grid<std::uint8_t>* model_region = nullptr;
     double n = 4.0;
     double alpha = 0.1;
     ScaleOptions scale;
@@ -38,15 +42,15 @@ struct SegmentRequest {
 struct SegmentOutcome {
     IntensityScale scale;
     ThresholdParams params;
+    WindowSource window_source = WindowSource::kUser;
     std::optional<SeedStatistics> seed_stats;  // when the window was estimated
+    std::optional<TissueModel> model;          // when it could be fitted (seeds given)
+    std::optional<ModelWindow> model_window;   // when the window came from the model
+    std::vector<std::string> warnings;         // one line each: model fallback, seeds in two classes, ...
     SegmentationResult result;
     std::unique_ptr<SparseField> field;
     Grid<std::uint8_t> mask;  // φ < 0 within the ROI
 };
-
-// The window estimated from the seed balls' statistics (normalised units), as segment_image does
-// it: µ = median, ε = max(min_epsilon, epsilon_sigmas × robust σ). Sets params.mu and params.epsilon.
-void estimate_window(const SeedStatistics& stats, double epsilon_sigmas, double min_epsilon, ThresholdParams& params);
 
 // Throws std::invalid_argument with a one-line message on bad requests (no seeds and no initial
 // mask, seeds outside the image, masks of other dimensions, bad parameters, empty initial mask).

@@ -23,8 +23,7 @@ double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std
 
 const SessionOptions& checked(const SessionOptions& o) {
     if (o.history < 20) throw std::invalid_argument("the undo history must keep at least 20 actions");
-    if (!std::isfinite(o.epsilon_sigmas) || o.epsilon_sigmas <= 0 || !std::isfinite(o.min_epsilon) || o.min_epsilon <= 0)
-        throw std::invalid_argument("the epsilon estimate needs positive sigmas and floor");
+    o.window.validate();
     validate(o.segmentation);
     validate(o.repair.swarm);
     validate(o.params);
@@ -174,16 +173,31 @@ std::optional<std::size_t> Session::seed_at(Vec3d p, double tolerance) const {
     return best;
 }
 
-std::optional<ThresholdParams> Session::estimated_window() const {
+const std::optional<TissueModel>& Session::tissue_model() const {
+    if (!model_) {
+        std::vector<std::string> ignored;  // window_estimate() reports an unusable model
+        model_ = fit_window_model(image_, model_region(image_, nullptr, roi(), options_.window.model.classes), options_.window.model, ignored);
+    }
+    return *model_;
+}
+
+std::optional<WindowEstimate> Session::window_estimate() const {
     if (marks_.seeds.empty()) return std::nullopt;
     try {
-        const SeedStatistics stats = seed_statistics(unit_, marks_.seeds, roi());
-        ThresholdParams p = marks_.params;
-        estimate_window(stats, options_.epsilon_sigmas, options_.min_epsilon, p);
-        return p;
+        const auto& model = tissue_model();
+        return estimate_window(image_, scale_, marks_.seeds, roi(), model ? &*model : nullptr, options_.window);
     } catch (const std::invalid_argument&) {
         return std::nullopt;  // e.g. no seed voxel inside the ROI
     }
+}
+
+std::optional<ThresholdParams> Session::estimated_window() const {
+    const std::optional<WindowEstimate> w = window_estimate();
+    if (!w) return std::nullopt;
+    ThresholdParams p = marks_.params;
+    p.mu = std::clamp(w->mu, 0.0, 1.0);
+    p.epsilon = w->epsilon;
+    return p;
 }
 
 void Session::refresh_window() {

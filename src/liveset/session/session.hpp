@@ -19,6 +19,7 @@
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
+#include "liveset/segment/window.hpp"
 #include "liveset/session/edit_history.hpp"
 #include "liveset/swarm/repair.hpp"
 
@@ -29,8 +30,7 @@ struct SessionOptions {
     int fragment_size = 16;       // cells per mesh fragment edge (one GPU buffer each)
     std::size_t history = 32;     // undoable actions kept (at least 20)
     ScaleOptions scale;           // intensity normalisation
-    double epsilon_sigmas = 5.0;  // ε estimate from the seeds (as `liveset segment`)
-    double min_epsilon = 0.05;
+    WindowOptions window;         // how µ, ε are estimated from the seeds (as `liveset segment`)
     SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
     RepairOptions repair;              // swarm settings (steps unused: the caller steps)
     ThresholdParams params;            // initial n and α (µ, ε too when there are no seeds)
@@ -96,11 +96,16 @@ public:
     // --- threshold speed (Eq. 2-3; µ, ε in normalised units) --------------------------------
     const ThresholdParams& params() const { return marks_.params; }
     bool window_from_seeds() const { return marks_.window_from_seeds; }
-    // Sets n, α and, unless `window_from_seeds`, µ and ε (then estimated from the seeds: median
-    // and epsilon_sigmas × robust σ, as `liveset segment`). Throws std::invalid_argument.
+    // Sets n, α and, unless `window_from_seeds`, µ and ε (then estimated from the seeds as
+    // `liveset segment` does: the tissue model's window for the seeds' class, window.hpp).
+    // Throws std::invalid_argument.
     void set_params(const ThresholdParams& params, bool window_from_seeds);
     // The window the seeds give (nullopt without seeds).
     std::optional<ThresholdParams> estimated_window() const;
+    // The same with where it came from and its warnings (nullopt without seeds).
+    std::optional<WindowEstimate> window_estimate() const;
+    // The tissue model of the image (inside the ROI, else its foreground), fitted on first use.
+    const std::optional<TissueModel>& tissue_model() const;
 
     // --- segmentation -----------------------------------------------------------------------
     // One global sparse-field step of the threshold speed; consecutive steps form one action.
@@ -169,6 +174,7 @@ private:
     FragmentMesher mesher_;
     SessionMarks marks_;
     std::unique_ptr<ThresholdSpeed> speed_;  // for marks_.params; rebuilt lazily
+    mutable std::optional<std::optional<TissueModel>> model_;  // fitted lazily (inner nullopt: failed)
     std::optional<FrontConvergence> convergence_;
     SegmentStatus segment_;
     RepairOptions repair_options_;

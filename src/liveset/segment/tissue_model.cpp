@@ -1,0 +1,322 @@
+// Tissue intensity model: histogram, multi-level Otsu start, EM with partial-volume classes, window.
+#include "liveset/segment/tissue_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <sstream>
+#include <stdexcept>
+
+namespace liveset {
+
+namespace {
+
+constexpr int kMixSteps = 16;  // fractions f = (t + ½)/16 sample the partial-volume classes
+
+// One histogram bin: count, and the mean and variance of the values that fell into it.
+struct Bin {
+    double count = 0.0, mean = 0.0, var = 0.0;
+};
+
+double gauss(double x, double mean, double sigma) {
+    const double z = (x - mean) / sigma;
+    return std::exp(-0.5 * z * z) / (sigma * std::sqrt(2.0 * std::numbers::pi));
+}
+
+double quantile_sorted(const std::vector<float>& v, double q) {
+    const double pos = q * static_cast<double>(v.size() - 1);
+    const auto lo = static_cast<std::size_t>(std::floor(pos));
+    const std::size_t hi = std::min(lo + 1, v.size() - 1);
+    return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
+}
+
+// Non-empty bins of the values between the options' quantiles.
+std::vector<Bin> histogram(std::vector<float> v, const TissueModelOptions& o, std::size_t& used) {
+    std::sort(v.begin(), v.end());
+    const double lo = quantile_sorted(v, o.low_quantile), hi = quantile_sorted(v, o.high_quantile);
+    if (!(hi > lo)) throw std::invalid_argument("the region's intensities are flat: no tissue classes to model");
+    std::vector<double> n(static_cast<std::size_t>(o.bins), 0.0), s(n), s2(n);
+    const double scale = o.bins / (hi - lo);
+    used = 0;
+    for (const float x : v) {
+        if (x < lo || x > hi) continue;
+        const auto b = std::min(static_cast<std::size_t>((x - lo) * scale), n.size() - 1);
+        n[b] += 1.0;
+        s[b] += x;
+        s2[b] += static_cast<double>(x) * x;
+        ++used;
+    }
+    std::vector<Bin> bins;
+    for (std::size_t b = 0; b < n.size(); ++b) {
+        if (n[b] == 0.0) continue;
+        const double m = s[b] / n[b];
+        bins.push_back({n[b], m, std::max(0.0, s2[b] / n[b] - m * m)});
+    }
+    return bins;
+}
+
+// Multi-level Otsu by dynamic programming: splits the bins into `k` runs maximising the
+// between-class variance (Σ S1²/S0 over the runs). Returns the first bin of runs 1..k-1.
+std::vector<std::size_t> otsu_splits(const std::vector<Bin>& bins, int k) {
+    const std::size_t n = bins.size();
+    std::vector<double> c0(n + 1, 0.0), c1(n + 1, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        c0[i + 1] = c0[i] + bins[i].count;
+        c1[i + 1] = c1[i] + bins[i].count * bins[i].mean;
+    }
+    const auto run = [&](std::size_t a, std::size_t b) {  // bins [a, b)
+        const double w = c0[b] - c0[a], s = c1[b] - c1[a];
+        return w > 0 ? s * s / w : 0.0;
+    };
+    const double none = -1.0;
+    // best[j][i]: best value splitting bins [0, i) into j + 1 runs; from[j][i]: start of the last.
+    std::vector<std::vector<double>> best(static_cast<std::size_t>(k), std::vector<double>(n + 1, none));
+    std::vector<std::vector<std::size_t>> from(best.size(), std::vector<std::size_t>(n + 1, 0));
+    for (std::size_t i = 1; i <= n; ++i) best[0][i] = run(0, i);
+    for (std::size_t j = 1; j < best.size(); ++j)
+        for (std::size_t i = j + 1; i <= n; ++i)
+            for (std::size_t a = j; a < i; ++a) {
+                if (best[j - 1][a] == none) continue;
+                const double v = best[j - 1][a] + run(a, i);
+                if (v > best[j][i]) {
+                    best[j][i] = v;
+                    from[j][i] = a;
+                }
+            }
+    std::vector<std::size_t> splits(static_cast<std::size_t>(k - 1));
+    std::size_t end = n;
+    for (std::size_t j = best.size() - 1; j >= 1; --j) {
+        end = from[j][end];
+        splits[j - 1] = end;
+    }
+    return splits;
+}
+
+// Moments of the bins [a, b) as a class.
+TissueClass moments(const std::vector<Bin>& bins, std::size_t a, std::size_t b, double total) {
+    double w = 0, s = 0, s2 = 0;
+    for (std::size_t i = a; i < b; ++i) {
+        w += bins[i].count;
+        s += bins[i].count * bins[i].mean;
+        s2 += bins[i].count * (bins[i].var + bins[i].mean * bins[i].mean);
+    }
+    const double m = s / w;
+    return {m, std::sqrt(std::max(s2 / w - m * m, 1e-12)), w / total};
+}
+
+// Density of the partial-volume class between classes a and b (weight excluded).
+double mixed_density(double x, const TissueClass& a, const TissueClass& b) {
+    double sum = 0.0;
+    for (int t = 0; t < kMixSteps; ++t) {
+        const double f = (t + 0.5) / kMixSteps;
+        sum += gauss(x, (1 - f) * a.mean + f * b.mean, std::sqrt((1 - f) * a.sigma * a.sigma + f * b.sigma * b.sigma));
+    }
+    return sum / kMixSteps;
+}
+
+// One EM iteration over the bins; returns the mean log-likelihood per voxel before the update.
+double em_step(const std::vector<Bin>& bins, double total, double var_floor, bool pv, TissueModel& m) {
+    const std::size_t k = m.classes.size();
+    std::vector<double> r(k, 0.0), s(k, 0.0), s2(k, 0.0), mix(k - 1, 0.0), p(k), q(k - 1);
+    double ll = 0.0;
+    for (const Bin& bin : bins) {
+        double sum = 0.0;
+        for (std::size_t c = 0; c < k; ++c) sum += p[c] = m.classes[c].weight * gauss(bin.mean, m.classes[c].mean, m.classes[c].sigma);
+        for (std::size_t c = 0; pv && c + 1 < k; ++c)
+            sum += q[c] = m.mixed[c] * mixed_density(bin.mean, m.classes[c], m.classes[c + 1]);
+        sum = std::max(sum, 1e-300);
+        ll += bin.count * std::log(sum);
+        for (std::size_t c = 0; c < k; ++c) {
+            const double g = bin.count * p[c] / sum;
+            r[c] += g;
+            s[c] += g * bin.mean;
+            s2[c] += g * (bin.var + bin.mean * bin.mean);
+        }
+        for (std::size_t c = 0; pv && c + 1 < k; ++c) mix[c] += bin.count * q[c] / sum;
+    }
+    for (std::size_t c = 0; c < k; ++c) {
+        TissueClass& t = m.classes[c];
+        t.weight = r[c] / total;
+        if (r[c] <= 0) continue;
+        t.mean = s[c] / r[c];
+        t.sigma = std::sqrt(std::max(s2[c] / r[c] - t.mean * t.mean, var_floor));
+    }
+    for (std::size_t c = 0; pv && c + 1 < k; ++c) m.mixed[c] = mix[c] / total;
+    return ll / total;
+}
+
+// EM iterations from the model's current state until the log-likelihood settles.
+void run_em(const std::vector<Bin>& bins, double total, double var_floor, bool pv, const TissueModelOptions& o,
+            TissueModel& m) {
+    double previous = -1e300;
+    m.converged = false;
+    for (m.iterations = 1; m.iterations <= o.max_iterations; ++m.iterations) {
+        m.log_likelihood = em_step(bins, total, var_floor, pv, m);
+        if (std::abs(m.log_likelihood - previous) <= o.tolerance) {
+            m.converged = true;
+            break;
+        }
+        previous = m.log_likelihood;
+    }
+    m.iterations = std::min(m.iterations, o.max_iterations);
+    std::sort(m.classes.begin(), m.classes.end(), [](const TissueClass& x, const TissueClass& y) { return x.mean < y.mean; });
+}
+
+// Why a fitted model cannot be used, or "".
+std::string degeneracy(const TissueModel& m) {
+    std::ostringstream os;
+    for (std::size_t c = 0; c < m.classes.size(); ++c)
+        if (!(m.classes[c].weight >= 0.01) || !std::isfinite(m.classes[c].mean)) {
+            os << "tissue class " << c + 1 << " of " << m.classes.size() << " holds under 1 % of the voxels";
+            return os.str();
+        }
+    for (std::size_t c = 0; c + 1 < m.classes.size(); ++c) {
+        const TissueClass &a = m.classes[c], &b = m.classes[c + 1];
+        // Two Gaussians of equal spread σ make two modes only when their means lie over 2σ apart;
+        // closer, the "classes" are pieces of one tissue (or tissues the image does not separate).
+        if (b.mean - a.mean < 2.0 * std::sqrt(0.5 * (a.sigma * a.sigma + b.sigma * b.sigma))) {
+            os << "tissue classes " << c + 1 << " and " << c + 2 << " overlap (means " << a.mean << " and " << b.mean
+               << " less than two spreads apart)";
+            return os.str();
+        }
+    }
+    return {};
+}
+
+}  // namespace
+
+void TissueModelOptions::validate() const {
+    if (classes < 2 || classes > 6) throw std::invalid_argument("the tissue model needs 2 to 6 classes");
+    if (bins < 32 || bins > 65536) throw std::invalid_argument("the tissue model's histogram needs 32 to 65536 bins");
+    if (!(low_quantile >= 0.0 && high_quantile <= 1.0 && low_quantile < high_quantile))
+        throw std::invalid_argument("the tissue model's quantiles must satisfy 0 <= low < high <= 1");
+    if (max_iterations < 1) throw std::invalid_argument("the tissue model needs at least one EM iteration");
+    if (!(tolerance >= 0.0) || !std::isfinite(tolerance)) throw std::invalid_argument("the EM tolerance must be finite and >= 0");
+}
+
+int TissueModel::classify(double value) const {
+    int best = 0;
+    double top = -1.0;
+    for (std::size_t c = 0; c < classes.size(); ++c) {
+        const double p = classes[c].weight * gauss(value, classes[c].mean, classes[c].sigma);
+        if (p > top) {
+            top = p;
+            best = static_cast<int>(c);
+        }
+    }
+    return best;
+}
+
+double TissueModel::density(double value) const {
+    double sum = 0.0;
+    for (const TissueClass& c : classes) sum += c.weight * gauss(value, c.mean, c.sigma);
+    for (std::size_t c = 0; c < mixed.size(); ++c) sum += mixed[c] * mixed_density(value, classes[c], classes[c + 1]);
+    return sum;
+}
+
+TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOptions& o) {
+    o.validate();
+    if (values.empty()) throw std::invalid_argument("the tissue model has no voxels to fit");
+    for (const float x : values)
+        if (!std::isfinite(x)) throw std::invalid_argument("image has non-finite voxels");
+    std::size_t used = 0;
+    const std::vector<Bin> bins = histogram(std::vector<float>(values.begin(), values.end()), o, used);
+    if (bins.size() < static_cast<std::size_t>(2 * o.classes)) {
+        std::ostringstream os;
+        os << "the region has " << bins.size() << " distinct intensity levels: too few for " << o.classes << " tissue classes";
+        throw std::invalid_argument(os.str());
+    }
+    const double total = static_cast<double>(used);
+    TissueModel m;
+    m.voxels = used;
+    const std::vector<std::size_t> splits = otsu_splits(bins, o.classes);
+    std::size_t a = 0;
+    for (int c = 0; c < o.classes; ++c) {
+        const std::size_t b = c + 1 < o.classes ? splits[static_cast<std::size_t>(c)] : bins.size();
+        m.classes.push_back(moments(bins, a, b, total));
+        a = b;
+    }
+    m.mixed.assign(static_cast<std::size_t>(o.classes - 1), 0.0);
+    const double width = (bins.back().mean - bins.front().mean) / o.bins;
+    const double var_floor = std::max(width * width, 1e-12);
+    run_em(bins, total, var_floor, false, o, m);  // a plain Gaussian mixture first
+    if (o.partial_volume && degeneracy(m).empty()) {
+        TissueModel pv = m;  // then the partial-volume classes, started from it
+        pv.mixed.assign(m.mixed.size(), 0.1);
+        for (TissueClass& c : pv.classes) c.weight *= 1.0 - 0.1 * (o.classes - 1);
+        run_em(bins, total, var_floor, true, o, pv);
+        pv.iterations += m.iterations;
+        if (const std::string why = degeneracy(pv); why.empty())
+            m = pv;
+        else
+            m.note = "the partial-volume fit failed (" + why + "): plain mixture used";
+    }
+    m.degenerate = degeneracy(m);
+    return m;
+}
+
+TissueModel fit_tissue_model(const Grid<float>& image, const Grid<std::uint8_t>* region, const TissueModelOptions& o) {
+    if (region && !(region->dims() == image.dims())) {
+        std::ostringstream os;
+        os << "tissue-model region " << region->dims() << " does not match the image " << image.dims();
+        throw std::invalid_argument(os.str());
+    }
+    std::vector<float> v;
+    v.reserve(image.size());
+    const std::span<const float> values = image.values();
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (!region || (*region)[static_cast<PointIndex>(i)] != 0) v.push_back(values[i]);
+    if (v.empty()) throw std::invalid_argument("the tissue model's region holds no voxel");
+    return fit_tissue_model(std::span<const float>(v), o);
+}
+
+std::vector<double> otsu_thresholds(std::span<const float> values, int classes, int bins) {
+    TissueModelOptions o;
+    o.classes = classes;
+    o.bins = bins;
+    o.validate();
+    for (const float x : values)
+        if (!std::isfinite(x)) throw std::invalid_argument("image has non-finite voxels");
+    std::size_t used = 0;
+    const std::vector<Bin> h = histogram(std::vector<float>(values.begin(), values.end()), o, used);
+    if (h.size() < static_cast<std::size_t>(classes)) throw std::invalid_argument("too few intensity levels to threshold");
+    std::vector<double> t;
+    for (const std::size_t s : otsu_splits(h, classes)) t.push_back(0.5 * (h[s - 1].mean + h[s].mean));
+    return t;
+}
+
+std::string tissue_class_name(const TissueModel& model, int k) {
+    if (model.classes.size() == 3 && k >= 0 && k < 3) {
+        static const char* const names[] = {"CSF", "GM", "WM"};
+        return names[k];
+    }
+    return "class " + std::to_string(k + 1);
+}
+
+ModelWindow model_window(const TissueModel& m, std::span<const float> seed_values) {
+    if (!m.usable()) throw std::invalid_argument("the tissue model is not usable: " + m.degenerate);
+    if (seed_values.empty()) throw std::invalid_argument("the seeds cover no voxel");
+    const std::size_t k = m.classes.size();
+    std::vector<std::size_t> votes(k, 0);
+    for (const float x : seed_values) ++votes[static_cast<std::size_t>(m.classify(x))];
+    ModelWindow w;
+    const auto top = std::max_element(votes.begin(), votes.end());
+    w.seed_class = static_cast<int>(top - votes.begin());
+    w.seed_class_share = static_cast<double>(*top) / static_cast<double>(seed_values.size());
+    const auto c = static_cast<std::size_t>(w.seed_class);
+    const TissueClass& t = m.classes[c];
+    const double lower = c > 0 ? 0.5 * (m.classes[c - 1].mean + t.mean) : 0.0;
+    const double upper = c + 1 < k ? 0.5 * (t.mean + m.classes[c + 1].mean) : 0.0;
+    w.lower = c > 0 ? lower : t.mean - std::max(upper - t.mean, 3.0 * t.sigma);
+    w.upper = c + 1 < k ? upper : t.mean + std::max(t.mean - lower, 3.0 * t.sigma);
+    if (w.seed_class_share < 0.7) {
+        std::ostringstream os;
+        os << "the seeds fall in two tissue classes (" << static_cast<int>(std::lround(100 * w.seed_class_share)) << " % "
+           << tissue_class_name(m, w.seed_class) << "): the window is " << tissue_class_name(m, w.seed_class)
+           << "'s; move the seeds deeper into one tissue";
+        w.warnings.push_back(os.str());
+    }
+    return w;
+}
+
+}  // namespace liveset

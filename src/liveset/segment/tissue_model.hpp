@@ -1,0 +1,101 @@
+// Tissue intensity model: a mixture of tissue classes (for a T1 brain CSF, grey and white matter)
+// fitted to the intensity histogram of a region, with partial-volume classes between neighbouring
+// tissues, and the threshold window it gives the seeds' class.
+//
+// Model (raw intensity units). K pure classes k = 0..K-1, sorted by mean, each a Gaussian
+// N(µ_k, σ_k²) with weight w_k; between neighbours k and k+1 a partial-volume class with weight v_k
+// whose voxels hold a fraction f ~ U(0, 1) of tissue k+1: N((1−f)µ_k + fµ_{k+1}, (1−f)σ_k² + fσ_{k+1}²)
+// (Santago & Gage 1993; FSL FAST's partial-volume model). Without the mixed classes, voxels on
+// tissue borders widen and shift the pure classes, and a plain Gaussian mixture's decision
+// boundaries drift toward the narrower class. Initialised by multi-level Otsu thresholds, fitted
+// by EM on a histogram (the mixed classes' shapes follow the pure classes' parameters).
+//
+// Window rule. The seeds pick their class (the pure class most of their voxels are most probably
+// in). The window reaches from the midpoint with the darker neighbour to the midpoint with the
+// brighter one: (µ_{k−1} + µ_k)/2 … (µ_k + µ_{k+1})/2. A voxel on the border between two tissues
+// holds a mix of both and its intensity is the fraction-weighted mean; the crisp truth assigns it
+// to the tissue with the larger fraction, so the border lies where the intensity equals the
+// midpoint of the two class means. The threshold term D is 0 exactly at µ ± ε, so the front settles
+// on that iso-intensity surface. The rule uses only the class means: it does not depend on the
+// classes' spreads or weights (noise, amount of partial volume, the brain's proportions), which
+// are what change between scanners and subjects. A class at either end of the intensity range
+// has one neighbour: its outer edge is placed symmetrically, at least 3σ_k beyond its mean.
+// µ is the window's centre and ε its half width.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+
+namespace liveset {
+
+struct TissueModelOptions {
+    int classes = 3;            // pure tissue classes, [2, 6] (T1 brain: CSF, GM, WM)
+    int bins = 512;             // histogram bins between the low and high quantiles, [32, 65536]
+    double low_quantile = 0.001;   // voxels outside these quantiles of the region are left out
+    double high_quantile = 0.999;
+    bool partial_volume = true;    // mixed classes between neighbouring tissues
+    int max_iterations = 1000;
+    double tolerance = 1e-9;       // stop when the mean log-likelihood per voxel changes less
+    void validate() const;         // std::invalid_argument with a one-line message
+};
+
+struct TissueClass {
+    double mean = 0.0;    // raw units
+    double sigma = 0.0;
+    double weight = 0.0;  // share of the region's voxels in this pure class
+};
+
+struct TissueModel {
+    std::vector<TissueClass> classes;  // sorted by mean
+    std::vector<double> mixed;         // weight of the partial-volume class between k and k+1
+    std::size_t voxels = 0;            // voxels fitted
+    int iterations = 0;
+    bool converged = false;
+    double log_likelihood = 0.0;       // mean per voxel at the end
+    // Why the model cannot be used (classes that merged, collapsed or lost all weight); empty
+    // when it is sound.
+    std::string degenerate;
+    std::string note;  // e.g. the partial-volume fit failed and the plain mixture is used
+
+    bool usable() const { return degenerate.empty(); }
+    // Index of the pure class with the largest posterior at `value` (mixed classes ignored).
+    int classify(double value) const;
+    // Mixture density at `value` (pure and mixed classes).
+    double density(double value) const;
+};
+
+// Fits the model to the values of `image` inside `region` (non-zero voxels; the whole image when
+// null). Throws std::invalid_argument for bad options, a region of other dimensions or without
+// voxels, non-finite voxels, or too few distinct intensities for the classes asked for. A model
+// that fits but is unusable comes back with `degenerate` set.
+TissueModel fit_tissue_model(const Grid<float>& image, const Grid<std::uint8_t>* region,
+                             const TissueModelOptions& options = {});
+// The same on a sample of values (the histogram is built from them).
+TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOptions& options = {});
+
+struct ModelWindow {
+    int seed_class = -1;
+    double seed_class_share = 0.0;  // share of the seed voxels classified into seed_class
+    double lower = 0.0, upper = 0.0;  // raw units; mu = (lower + upper)/2, epsilon = (upper − lower)/2
+    double mu() const { return 0.5 * (lower + upper); }
+    double epsilon() const { return 0.5 * (upper - lower); }
+    std::vector<std::string> warnings;  // one line each (seeds in two classes, ...)
+};
+
+// The window for the seeds' class (see the rule above) from the raw intensities of the seed
+// voxels. Throws std::invalid_argument when the model is not usable or there are no seed values.
+ModelWindow model_window(const TissueModel& model, std::span<const float> seed_values);
+
+// Multi-level Otsu thresholds (raw units, ascending) splitting `values` into `classes` classes on a
+// histogram of `bins` bins between their 0.1 and 99.9 % quantiles.
+std::vector<double> otsu_thresholds(std::span<const float> values, int classes, int bins = 256);
+
+// "CSF/GM/WM"-style names for a T1 model of 3 classes, else "class 1".."class K".
+std::string tissue_class_name(const TissueModel& model, int k);
+
+}  // namespace liveset

@@ -1,0 +1,99 @@
+// Threshold window from the tissue model or the seeds' statistics.
+#include "liveset/segment/window.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace liveset {
+
+const char* to_string(WindowSource source) {
+    switch (source) {
+        case WindowSource::kUser: return "user";
+        case WindowSource::kModel: return "model";
+        case WindowSource::kSeeds: return "seeds";
+    }
+    return "?";
+}
+
+void WindowOptions::validate() const {
+    if (estimate == WindowSource::kUser) throw std::invalid_argument("the window estimate must be 'model' or 'seeds'");
+    model.validate();
+    if (!std::isfinite(epsilon_sigmas) || epsilon_sigmas <= 0 || !std::isfinite(min_epsilon) || min_epsilon <= 0)
+        throw std::invalid_argument("the epsilon estimate needs positive sigmas and floor");
+}
+
+Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_t>* region, const Grid<std::uint8_t>* roi,
+                                int classes) {
+    for (const Grid<std::uint8_t>* m : {region, roi})
+        if (m && !(m->dims() == image.dims())) {
+            std::ostringstream os;
+            os << "mask " << m->dims() << " does not match the image " << image.dims();
+            throw std::invalid_argument(os.str());
+        }
+    if (region) return *region;
+    if (roi) return *roi;
+    // Background and the tissue classes: the lowest threshold separates the background.
+    const std::vector<double> t = otsu_thresholds(image.values(), std::min(classes + 1, 6));
+    Grid<std::uint8_t> fg(image.lattice(), 0);
+    for (std::size_t i = 0; i < image.size(); ++i) fg[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > t[0];
+    return fg;
+}
+
+std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid<std::uint8_t>& region,
+                                            const TissueModelOptions& options, std::vector<std::string>& warnings) {
+    try {
+        TissueModel m = fit_tissue_model(image, &region, options);
+        if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
+        if (!m.note.empty()) warnings.push_back("tissue model: " + m.note);
+        return m;
+    } catch (const std::invalid_argument& e) {
+        warnings.push_back(std::string("no tissue model (") + e.what() + ")");
+        return std::nullopt;
+    }
+}
+
+std::vector<std::string> window_warnings(const TissueModel& model, double lower, double upper) {
+    std::vector<int> inside;
+    for (std::size_t c = 0; c < model.classes.size(); ++c)
+        if (model.classes[c].mean >= lower && model.classes[c].mean <= upper) inside.push_back(static_cast<int>(c));
+    if (inside.size() < 2) return {};
+    std::ostringstream os;
+    os.precision(4);
+    os << "the window " << lower << " .. " << upper << " spans " << inside.size() << " tissue classes (";
+    for (std::size_t i = 0; i < inside.size(); ++i)
+        os << (i ? ", " : "") << tissue_class_name(model, inside[i]) << " " << model.classes[static_cast<std::size_t>(inside[i])].mean;
+    os << "): the front will grow through both";
+    return {os.str()};
+}
+
+WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& scale, std::span<const SeedBall> seeds,
+                               const Grid<std::uint8_t>* roi, const TissueModel* model, const WindowOptions& options) {
+    options.validate();
+    const std::vector<float> raw = seed_values(image, seeds, roi);
+    WindowEstimate w;
+    if (options.estimate == WindowSource::kModel && model && model->usable()) {
+        w.model_window = liveset::model_window(*model, raw);
+        w.source = WindowSource::kModel;
+        w.mu = (w.model_window->mu() - scale.low) / (scale.high - scale.low);
+        w.epsilon = scale.unit_length(w.model_window->epsilon());
+        w.warnings = w.model_window->warnings;
+        return w;
+    }
+    if (options.estimate == WindowSource::kModel)
+        w.warnings.push_back("the window comes from the seeds' statistics (µ = median, ε = 5 robust σ): check it");
+    std::vector<float> unit(raw.size());
+    std::transform(raw.begin(), raw.end(), unit.begin(), [&](float x) { return static_cast<float>(scale.to_unit(x)); });
+    w.seed_stats = seed_statistics_of(unit);
+    w.source = WindowSource::kSeeds;
+    w.mu = w.seed_stats->median;
+    w.epsilon = std::max(options.min_epsilon, options.epsilon_sigmas * w.seed_stats->mad_sigma);
+    if (model && model->usable()) {
+        const auto more = window_warnings(*model, scale.to_raw(w.mu - w.epsilon), scale.to_raw(w.mu + w.epsilon));
+        w.warnings.insert(w.warnings.end(), more.begin(), more.end());
+    }
+    return w;
+}
+
+}  // namespace liveset

@@ -1,0 +1,59 @@
+// The threshold window (µ, ε) a segmentation runs with, and where it came from: the tissue
+// model's window for the seeds' class (tissue_model.hpp), or the seeds' own statistics when the
+// model cannot be used or is not wanted. Shared by segment_image() (the CLI, the demo) and the
+// viewer's Session, so both estimate the same window from the same seeds.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "liveset/segment/intensity.hpp"
+#include "liveset/segment/tissue_model.hpp"
+
+namespace liveset {
+
+// Where a window came from: given by the user, the tissue model, or the seeds' statistics.
+enum class WindowSource { kUser, kModel, kSeeds };
+const char* to_string(WindowSource source);
+
+struct WindowOptions {
+    WindowSource estimate = WindowSource::kModel;  // kModel (falls back to kSeeds) or kSeeds
+    TissueModelOptions model;
+    double epsilon_sigmas = 5.0;  // seeds' window: ε = epsilon_sigmas × robust σ, at least min_epsilon
+    double min_epsilon = 0.05;    // normalised units
+    void validate() const;        // std::invalid_argument with a one-line message
+};
+
+struct WindowEstimate {
+    double mu = 0.5, epsilon = 0.1;  // normalised units
+    WindowSource source = WindowSource::kSeeds;
+    std::optional<SeedStatistics> seed_stats;  // normalised units
+    std::optional<ModelWindow> model_window;   // raw units
+    std::vector<std::string> warnings;
+};
+
+// The region the tissue model is fitted in: `region` when given, else `roi`, else the image's
+// foreground (voxels above the lowest of the Otsu thresholds that split the image into background
+// and `classes` tissue classes).
+Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_t>* region,
+                                const Grid<std::uint8_t>* roi, int classes);
+
+// Fits the model for estimate_window(). Never throws on data the model cannot describe: returns
+// nullopt (or a degenerate model) and says why in `warnings`.
+std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid<std::uint8_t>& region,
+                                            const TissueModelOptions& options, std::vector<std::string>& warnings);
+
+// The window for `seeds` on the raw `image` (normalised by `scale`): the model's when `model` is
+// usable and options.estimate is kModel, else the seeds' statistics (with a warning saying why).
+// Throws std::invalid_argument when the seeds cover no voxel (inside `roi`).
+WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& scale, std::span<const SeedBall> seeds,
+                               const Grid<std::uint8_t>* roi, const TissueModel* model, const WindowOptions& options);
+
+// One-line warnings about a window [lower, upper] (raw units) given any other way: it holds the
+// mean of more than one tissue class.
+std::vector<std::string> window_warnings(const TissueModel& model, double lower, double upper);
+
+}  // namespace liveset

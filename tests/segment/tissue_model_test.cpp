@@ -1,0 +1,197 @@
+// The tissue model against samples drawn from known mixtures (with partial-volume voxels), Otsu's
+// thresholds against brute force, the window rule's invariances and its warnings and fallbacks.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "liveset/segment/pipeline.hpp"
+#include "liveset/segment/tissue_model.hpp"
+#include "liveset/segment/window.hpp"
+
+using namespace liveset;
+
+namespace {
+
+struct TrueClass {
+    double mean, sigma, share;
+};
+
+// `n` values: pure classes with the given shares, the rest partial-volume voxels split evenly
+// between neighbours (fraction uniform in [0, 1], noise interpolated as the model assumes).
+std::vector<float> sample(const std::vector<TrueClass>& classes, double pv_share, std::size_t n, std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> z(0.0, 1.0);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::vector<float> v;
+    for (const TrueClass& c : classes)
+        for (std::size_t i = 0; i < static_cast<std::size_t>(c.share * n); ++i) v.push_back(static_cast<float>(c.mean + c.sigma * z(rng)));
+    const std::size_t per_pair = static_cast<std::size_t>(pv_share * n / (classes.size() - 1));
+    for (std::size_t k = 0; k + 1 < classes.size(); ++k)
+        for (std::size_t i = 0; i < per_pair; ++i) {
+            const double f = u(rng);
+            const TrueClass &a = classes[k], &b = classes[k + 1];
+            const double s = std::sqrt((1 - f) * a.sigma * a.sigma + f * b.sigma * b.sigma);
+            v.push_back(static_cast<float>((1 - f) * a.mean + f * b.mean + s * z(rng)));
+        }
+    return v;
+}
+
+const std::vector<TrueClass> kT1 = {{48, 10, 0.2}, {97, 8, 0.3}, {131, 6, 0.25}};  // CSF, GM, WM (raw)
+
+}  // namespace
+
+TEST(TissueModel, RecoversTheClassesOfAPartialVolumeMixture) {
+    const std::vector<float> v = sample(kT1, 0.25, 200000, 1);
+    const TissueModel m = fit_tissue_model(v);
+    ASSERT_TRUE(m.usable()) << m.degenerate;
+    ASSERT_EQ(m.classes.size(), 3u);
+    for (std::size_t c = 0; c < 3; ++c) {
+        EXPECT_NEAR(m.classes[c].mean, kT1[c].mean, 1.5) << c;
+        EXPECT_NEAR(m.classes[c].sigma, kT1[c].sigma, 1.5) << c;
+    }
+    double pv = 0;
+    for (double w : m.mixed) pv += w;
+    EXPECT_NEAR(pv, 0.25 / 1.0, 0.06);
+    EXPECT_EQ(m.classify(97.0), 1);
+    EXPECT_EQ(m.classify(40.0), 0);
+    EXPECT_EQ(m.classify(140.0), 2);
+}
+
+TEST(TissueModel, PartialVolumeClassesKeepThePureMeansWhereAPlainMixtureShiftsThem) {
+    const std::vector<float> v = sample(kT1, 0.35, 200000, 2);
+    TissueModelOptions plain;
+    plain.partial_volume = false;
+    const TissueModel a = fit_tissue_model(v), b = fit_tissue_model(v, plain);
+    ASSERT_TRUE(a.usable() && b.usable());
+    double err_pv = 0, err_plain = 0;
+    for (std::size_t c = 0; c < 3; ++c) {
+        err_pv += std::abs(a.classes[c].mean - kT1[c].mean);
+        err_plain += std::abs(b.classes[c].mean - kT1[c].mean);
+    }
+    EXPECT_LT(err_pv, 3.0);
+    EXPECT_GT(err_plain, 2.0 * err_pv);
+}
+
+TEST(TissueModel, WindowReachesTheMidpointsOfTheNeighbouringClasses) {
+    const TissueModel m = fit_tissue_model(sample(kT1, 0.25, 200000, 3));
+    const std::vector<float> gm_seeds(50, 95.0f);
+    const ModelWindow w = model_window(m, gm_seeds);
+    EXPECT_EQ(w.seed_class, 1);
+    EXPECT_DOUBLE_EQ(w.seed_class_share, 1.0);
+    EXPECT_TRUE(w.warnings.empty());
+    EXPECT_NEAR(w.lower, 0.5 * (m.classes[0].mean + m.classes[1].mean), 1e-9);
+    EXPECT_NEAR(w.upper, 0.5 * (m.classes[1].mean + m.classes[2].mean), 1e-9);
+    EXPECT_NEAR(w.lower, (48 + 97) / 2.0, 1.5);
+    EXPECT_NEAR(w.upper, (97 + 131) / 2.0, 1.5);
+    // The brightest class has one neighbour: the window is symmetric about its mean, at least 3σ.
+    const ModelWindow wm = model_window(m, std::vector<float>(20, 133.0f));
+    EXPECT_EQ(wm.seed_class, 2);
+    EXPECT_NEAR(wm.lower, 0.5 * (m.classes[1].mean + m.classes[2].mean), 1e-9);
+    EXPECT_NEAR(wm.upper - m.classes[2].mean, std::max(m.classes[2].mean - wm.lower, 3 * m.classes[2].sigma), 1e-9);
+    const ModelWindow csf = model_window(m, std::vector<float>(20, 45.0f));
+    EXPECT_EQ(csf.seed_class, 0);
+    EXPECT_NEAR(m.classes[0].mean - csf.lower, std::max(csf.upper - m.classes[0].mean, 3 * m.classes[0].sigma), 1e-9);
+}
+
+TEST(TissueModel, TheWindowFollowsALinearChangeOfIntensityUnits) {
+    const std::vector<float> v = sample(kT1, 0.25, 100000, 4);
+    std::vector<float> scaled(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) scaled[i] = 7.3f * v[i] + 300.0f;
+    const ModelWindow a = model_window(fit_tissue_model(v), std::vector<float>(10, 97.0f));
+    const ModelWindow b = model_window(fit_tissue_model(scaled), std::vector<float>(10, 7.3f * 97.0f + 300.0f));
+    EXPECT_NEAR(b.lower, 7.3 * a.lower + 300, 7.3 * 0.05);
+    EXPECT_NEAR(b.upper, 7.3 * a.upper + 300, 7.3 * 0.05);
+}
+
+TEST(TissueModel, SeedsInTwoClassesAreWarnedAbout) {
+    const TissueModel m = fit_tissue_model(sample(kT1, 0.25, 100000, 5));
+    std::vector<float> seeds(60, 97.0f);
+    seeds.insert(seeds.end(), 40, 132.0f);
+    const ModelWindow w = model_window(m, seeds);
+    EXPECT_EQ(w.seed_class, 1);
+    EXPECT_NEAR(w.seed_class_share, 0.6, 1e-12);
+    ASSERT_EQ(w.warnings.size(), 1u);
+    EXPECT_NE(w.warnings[0].find("two tissue classes"), std::string::npos) << w.warnings[0];
+    // A window given by hand that holds GM's and WM's means is warned about; one that holds only GM's is not.
+    EXPECT_EQ(window_warnings(m, 60, 140).size(), 1u);
+    EXPECT_TRUE(window_warnings(m, 75, 115).empty());
+}
+
+TEST(TissueModel, OtsuThresholdsMatchBruteForce) {
+    std::mt19937 rng(6);
+    std::vector<float> v;
+    std::uniform_int_distribution<int> level(0, 39);
+    for (int i = 0; i < 3000; ++i) v.push_back(static_cast<float>(level(rng) * level(rng) % 40));  // 40 levels, lumpy
+    const std::vector<double> t = otsu_thresholds(v, 3, 40);
+    ASSERT_EQ(t.size(), 2u);
+    // Brute force over all pairs of cuts between the 40 integer levels.
+    std::vector<double> n(40, 0);
+    for (float x : v) n[static_cast<std::size_t>(x)] += 1;
+    double best = -1;
+    int b1 = 0, b2 = 0;
+    for (int i = 1; i < 40; ++i)
+        for (int j = i + 1; j < 40; ++j) {
+            double score = 0;
+            for (auto [a, b] : {std::pair{0, i}, std::pair{i, j}, std::pair{j, 40}}) {
+                double w = 0, s = 0;
+                for (int k = a; k < b; ++k) {
+                    w += n[static_cast<std::size_t>(k)];
+                    s += n[static_cast<std::size_t>(k)] * k;
+                }
+                if (w > 0) score += s * s / w;
+            }
+            if (score > best + 1e-9) {
+                best = score;
+                b1 = i;
+                b2 = j;
+            }
+        }
+    // A threshold lies between the last level of one class and the first of the next.
+    EXPECT_GT(t[0], b1 - 1);
+    EXPECT_LT(t[0], b1);
+    EXPECT_GT(t[1], b2 - 1);
+    EXPECT_LT(t[1], b2);
+}
+
+TEST(TissueModel, DegenerateDataIsRefusedOrFlagged) {
+    EXPECT_THROW(fit_tissue_model(std::vector<float>(1000, 5.0f)), std::invalid_argument);  // constant
+    EXPECT_THROW(fit_tissue_model(std::vector<float>{}), std::invalid_argument);
+    std::vector<float> two_levels(1000, 1.0f);
+    for (std::size_t i = 0; i < 500; ++i) two_levels[i] = 2.0f;
+    EXPECT_THROW(fit_tissue_model(two_levels), std::invalid_argument);  // too few levels for 3 classes
+    // One tissue only: a single Gaussian asked for three classes ends in overlapping classes.
+    const TissueModel one = fit_tissue_model(sample({{100, 10, 1.0}}, 0.0, 50000, 7));
+    EXPECT_FALSE(one.usable()) << one.classes[0].mean << "±" << one.classes[0].sigma << " " << one.classes[1].mean << "±"
+                               << one.classes[1].sigma << " " << one.classes[2].mean << "±" << one.classes[2].sigma;
+    EXPECT_THROW(model_window(one, std::vector<float>(5, 100.0f)), std::invalid_argument);
+    TissueModelOptions bad;
+    bad.classes = 1;
+    EXPECT_THROW(bad.validate(), std::invalid_argument);
+    bad = {};
+    bad.bins = 4;
+    EXPECT_THROW(bad.validate(), std::invalid_argument);
+    std::vector<float> nan = sample(kT1, 0.2, 1000, 8);
+    nan[3] = std::nanf("");
+    EXPECT_THROW(fit_tissue_model(nan), std::invalid_argument);
+}
+
+TEST(TissueModel, AnUnusableModelFallsBackToTheSeedsWithAWarning) {
+    // A flat-topped single tissue: the model is degenerate, the window comes from the seeds.
+    Grid<float> image(Lattice({24, 24, 24}));
+    std::mt19937 rng(9);
+    std::normal_distribution<double> z(100.0, 5.0);
+    for (float& x : image.values()) x = static_cast<float>(z(rng));
+    const IntensityScale scale = robust_scale(image);
+    const SeedBall seed{{12, 12, 12}, 2.0};
+    std::vector<std::string> warnings;
+    const std::optional<TissueModel> m = fit_window_model(image, Grid<std::uint8_t>(image.lattice(), 1), {}, warnings);
+    ASSERT_TRUE(m.has_value());
+    EXPECT_FALSE(m->usable());
+    ASSERT_FALSE(warnings.empty());
+    const WindowEstimate w = estimate_window(image, scale, {&seed, 1}, nullptr, &*m, {});
+    EXPECT_EQ(w.source, WindowSource::kSeeds);
+    ASSERT_TRUE(w.seed_stats.has_value());
+    EXPECT_DOUBLE_EQ(w.mu, w.seed_stats->median);
+    ASSERT_FALSE(w.warnings.empty());
+}
