@@ -250,9 +250,7 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     const Grid<float> depth = depth_mm(head);
     white_matter_peak(image, head, depth, r);
     const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
-    const auto [low_bin, high_bin] = otsu3(h.counts, h);
-    (void)high_bin;
-    r.tissue_low = h.lo + low_bin * h.width;
+    r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;  // CSF/skin | GM/muscle cut
     r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
     Mask brain = extract_brain(image, head, o, r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
