@@ -30,7 +30,7 @@ struct SegmentArgs {
     std::string window_from = "model";
     int classes = 3;
     int iterations = 2000;
-    std::string out_mask, out_phi, out_mesh, log;
+    std::string out_mask, out_phi, out_mesh, out_roi, log;
     bool json = false, quiet = false;
 };
 
@@ -41,14 +41,16 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.out_phi.empty()) check_output_path(a.out_phi, OutputKind::kImage, "--out-phi");
     if (!a.out_mesh.empty()) check_output_path(a.out_mesh, OutputKind::kMesh, "--out-mesh");
     if (!a.log.empty()) check_output_path(a.log, OutputKind::kText, "--log");
+    if (!a.out_roi.empty()) check_output_path(a.out_roi, OutputKind::kImage, "--out-roi");
+    if (!a.out_roi.empty() && a.roi.empty()) throw UsageError("--out-roi needs --roi (a mask or auto)");
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");
     if (a.epsilon && a.epsilon_raw) throw UsageError("give --epsilon or --epsilon-raw, not both");
     if (a.seeds.empty() && a.seeds_mm.empty() && a.init_mask.empty())
         throw UsageError("give at least one --seed I,J,K[:R] (or --seed-mm, or --init-mask)");
 
     const Grid<float> image = read_image(a.image);
-    std::optional<Grid<std::uint8_t>> roi, init;
-    if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
+    std::optional<Grid<std::uint8_t>> init;
+    const std::optional<Roi> roi = load_roi(a.roi, image);
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
 
     SegmentRequest req;
@@ -60,7 +62,7 @@ int run_segment(const SegmentArgs& a, int threads) {
         req.seeds.push_back(parse_seed_mm(s, image.lattice(), a.seed_radius));
         check_seed_inside(req.seeds.back(), image.lattice(), s + " (mm)");
     }
-    if (roi) req.roi = &*roi;
+    if (roi) req.roi = &roi->mask;
     if (init) req.initial_mask = &*init;
     req.n = a.n;
     req.alpha = a.alpha;
@@ -81,6 +83,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     const SegmentOutcome& o = run.outcome;
     write_label_image(o.mask, a.out_mask);
     if (!a.out_phi.empty()) write_image(o.field->phi(), a.out_phi);
+    if (!a.out_roi.empty()) write_label_image(roi->mask, a.out_roi);
     std::size_t triangles = 0;
     if (!a.out_mesh.empty()) {
         const Mesh mesh = marching_cubes_band(o.field->phi(), o.field->zero_layer());
@@ -91,6 +94,8 @@ int run_segment(const SegmentArgs& a, int threads) {
     nlohmann::json j = segmentation_report(o, image.lattice());
     j["image"] = a.image;
     j["outputs"] = {{"mask", a.out_mask}};
+    if (roi) j["roi"] = roi_report(*roi);
+    if (!a.out_roi.empty()) j["outputs"]["roi"] = a.out_roi;
     if (!a.out_phi.empty()) j["outputs"]["phi"] = a.out_phi;
     if (!a.out_mesh.empty()) {
         j["outputs"]["mesh"] = a.out_mesh;
@@ -100,8 +105,9 @@ int run_segment(const SegmentArgs& a, int threads) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
         print_segmentation_summary(j);
-        fmt::print("  wrote        {}{}{}\n", a.out_mask, a.out_phi.empty() ? "" : ", " + a.out_phi,
-                   a.out_mesh.empty() ? "" : ", " + a.out_mesh);
+        if (roi) print_roi_summary(j["roi"]);
+        fmt::print("  wrote        {}{}{}{}\n", a.out_mask, a.out_phi.empty() ? "" : ", " + a.out_phi,
+                   a.out_mesh.empty() ? "" : ", " + a.out_mesh, a.out_roi.empty() ? "" : ", " + a.out_roi);
     }
     return 0;
 }
@@ -159,7 +165,7 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--seed-mm", sa.seeds_mm, "seed X,Y,Z[:R] in physical LPS mm (radius in mm); repeatable");
     seg->add_option("--seed-radius", sa.seed_radius, "default seed radius")->check(finite_number() & CLI::Range(0.5, 100.0))->capture_default_str();
     seg->add_option("--init-mask", sa.init_mask, "start from this mask instead of seeds (needs --mu/--epsilon)");
-    seg->add_option("--roi", sa.roi, "region-of-interest mask the front may not leave (e.g. a brain mask)");
+    seg->add_option("--roi", sa.roi, "region-of-interest mask the front may not leave (e.g. a brain mask), or 'auto': a brain mask computed from the T1");
     seg->add_option("--mu", sa.mu, "ideal intensity, normalised to [0,1] (default: the tissue model's window for the seeds' class)")->check(finite_number());
     seg->add_option("--epsilon", sa.epsilon, "half window, normalised units (default: from the tissue model)")->check(finite_number());
     seg->add_option("--mu-raw", sa.mu_raw, "ideal intensity in the image's own units")->check(finite_number());
@@ -172,6 +178,7 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--out-mask", sa.out_mask, "output mask (0/1, uint8), e.g. seg.nii.gz")->required();
     seg->add_option("--out-phi", sa.out_phi, "output level-set function phi (float, <0 inside)");
     seg->add_option("--out-mesh", sa.out_mesh, "output surface mesh (.ply/.obj/.stl, LPS mm)");
+    seg->add_option("--out-roi", sa.out_roi, "write the region of interest used (e.g. the --roi auto brain mask, uint8 0/1)");
     seg->add_option("--log", sa.log, "write one JSON line per iteration to this file");
     seg->add_flag("--json", sa.json, "print the report as one JSON object on stdout");
     seg->add_flag("--quiet,-q", sa.quiet, "no progress line and no report");

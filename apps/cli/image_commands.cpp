@@ -22,6 +22,39 @@ Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& refere
     return m;
 }
 
+std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option) {
+    if (arg.empty()) return std::nullopt;
+    if (arg != "auto") return Roi{load_mask_like(arg, image.lattice(), option), arg, std::nullopt};
+    BrainMaskReport report;
+    try {
+        Grid<std::uint8_t> mask = auto_brain_mask(image, {}, &report);
+        return Roi{std::move(mask), arg, report};
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(fmt::format("{} auto: {}", option, e.what()));
+    }
+}
+
+nlohmann::json roi_report(const Roi& roi) {
+    const Vec3d s = roi.mask.lattice().spacing();
+    std::size_t voxels = 0;
+    for (std::uint8_t v : roi.mask.values()) voxels += v != 0;
+    nlohmann::json j{{"source", roi.source}, {"voxels", voxels}, {"volume_mm3", static_cast<double>(voxels) * s.x * s.y * s.z}};
+    if (const auto& b = roi.brain_mask)
+        j["auto"] = {{"skull_stripped", b->skull_stripped}, {"background_threshold", b->background_threshold},
+                     {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
+                     {"surface_contact", b->surface_contact}};
+    return j;
+}
+
+void print_roi_summary(const nlohmann::json& j) {
+    std::string how = j["source"].get<std::string>();
+    if (j.contains("auto"))
+        how = fmt::format("auto brain mask ({}, tissue window {:.1f}..{:.1f})",
+                          j["auto"]["skull_stripped"].get<bool>() ? "skull-stripped input" : "full head",
+                          j["auto"]["tissue_low"].get<double>(), j["auto"]["tissue_high"].get<double>());
+    fmt::print("  roi          {}: {} voxels, {:.1f} ml\n", how, j["voxels"].get<std::size_t>(), j["volume_mm3"].get<double>() / 1000.0);
+}
+
 bool is_binary_mask(const Grid<float>& image) {
     for (float v : image.values())
         if (v != 0.0f && v != 1.0f) return false;

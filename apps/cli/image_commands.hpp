@@ -3,11 +3,13 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 
 #include "liveset/eval/overlap.hpp"
 #include "liveset/eval/surface_distance.hpp"
 #include "liveset/eval/topology.hpp"
+#include "liveset/segment/brain_mask.hpp"
 #include "liveset/segment/pipeline.hpp"
 
 namespace liveset::cli {
@@ -15,6 +17,21 @@ namespace liveset::cli {
 // Reads a mask/label image and checks that it overlays `reference` (same dims, spacing, origin
 // and direction within tolerance); UsageError naming `option` otherwise. Non-zero -> 1.
 Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& reference, const std::string& option);
+
+// A region of interest given as `--roi MASK` or `--roi auto` (the automatic brain mask of the image).
+struct Roi {
+    Grid<std::uint8_t> mask;
+    std::string source;                          // the file, or "auto"
+    std::optional<BrainMaskReport> brain_mask;   // what auto_brain_mask found (auto only)
+};
+// `arg` empty: no ROI. "auto": auto_brain_mask(image) (UsageError "<option> auto: ..." when it
+// fails: constant image, no head, empty mask). Otherwise a mask file overlaying the image
+// (load_mask_like); a file named "auto" can be given as ./auto.
+std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option = "--roi");
+// {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".
+nlohmann::json roi_report(const Roi& roi);
+// One line: "  roi          auto brain mask: N voxels, V ml (...)".
+void print_roi_summary(const nlohmann::json& roi);
 
 // True when every voxel is exactly 0 or 1 (a mask stored as a float image).
 bool is_binary_mask(const Grid<float>& image);

@@ -1,6 +1,8 @@
 // Threshold window from the tissue model or the seeds' statistics.
 #include "liveset/segment/window.hpp"
 
+#include "liveset/segment/brain_mask.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -34,6 +36,10 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
         }
     if (region) return *region;
     if (roi) return *roi;
+    try {  // a head (or a skull-stripped brain, or the phantom): the automatic brain mask
+        return auto_brain_mask(image);
+    } catch (const std::invalid_argument&) {  // not a head: the foreground
+    }
     // Background and the tissue classes: the lowest threshold separates the background.
     const std::vector<double> t = otsu_thresholds(image.values(), std::min(classes + 1, 6));
     Grid<std::uint8_t> fg(image.lattice(), 0);

@@ -35,9 +35,10 @@ struct WindowEstimate {
     std::vector<std::string> warnings;
 };
 
-// The region the tissue model is fitted in: `region` when given, else `roi`, else the image's
-// foreground (voxels above the lowest of the Otsu thresholds that split the image into background
-// and `classes` tissue classes).
+// The region the tissue model is fitted in: `region` when given, else `roi`, else the automatic
+// brain mask (brain_mask.hpp; full-head scans must not mix scalp and muscle into the classes),
+// else, when that finds no head, the image's foreground (voxels above the lowest of the Otsu
+// thresholds that split the image into background and `classes` tissue classes).
 Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_t>* region,
                                 const Grid<std::uint8_t>* roi, int classes);
 

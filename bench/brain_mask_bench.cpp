@@ -1,0 +1,40 @@
+// Automatic brain mask cost on BrainWeb (181x217x180, 1 mm) and its 2 mm version, 1 and 2 threads.
+// Results and the commands that produced them: docs/BENCHMARKS.md.
+#include <benchmark/benchmark.h>
+
+#include <tbb/global_control.h>
+
+#include "liveset/io/image_io.hpp"
+#include "liveset/segment/brain_mask.hpp"
+
+using namespace liveset;
+
+namespace {
+
+const Grid<float>& brainweb(bool two_mm) {
+    static const Grid<float> full = read_image(std::string(LIVESET_DATA_DIR) + "/brainweb/t1.mha");
+    static const Grid<float> half = [] {
+        const Lattice& l = full.lattice();
+        const Vec3i d{(l.dims().x + 1) / 2, (l.dims().y + 1) / 2, (l.dims().z + 1) / 2};
+        Grid<float> g(Lattice(d, l.spacing() * 2.0, l.origin(), l.direction()));
+        for (int z = 0; z < d.z; ++z)
+            for (int y = 0; y < d.y; ++y)
+                for (int x = 0; x < d.x; ++x) g({x, y, z}) = full({2 * x, 2 * y, 2 * z});
+        return g;
+    }();
+    return two_mm ? half : full;
+}
+
+// range(0): threads; range(1): 1 for the 2 mm version.
+void BM_AutoBrainMask(benchmark::State& state) {
+    const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+    const Grid<float>& image = brainweb(state.range(1) != 0);
+    BrainMaskReport r;
+    for (auto _ : state) benchmark::DoNotOptimize(auto_brain_mask(image, {}, &r));
+    state.counters["mask_ml"] = r.mask_volume_mm3 / 1000.0;
+}
+BENCHMARK(BM_AutoBrainMask)->Args({1, 0})->Args({2, 0})->Args({2, 1})->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3);
+
+}  // namespace
+
+BENCHMARK_MAIN();

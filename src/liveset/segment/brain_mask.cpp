@@ -1,0 +1,267 @@
+// Automatic brain mask (see brain_mask.hpp): histogram thresholds, morphology in mm, and the test
+// that tells a skull-stripped input from a full head.
+#include "liveset/segment/brain_mask.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "liveset/segment/morphology.hpp"
+
+namespace liveset {
+
+namespace {
+
+using Mask = Grid<std::uint8_t>;
+
+constexpr int kBins = 128;
+
+std::size_t count(const Mask& m) {
+    std::size_t n = 0;
+    for (std::uint8_t v : m.values()) n += v != 0;
+    return n;
+}
+
+// q in [0, 1]; reorders `v`, which must not be empty.
+double percentile(std::vector<float>& v, double q) {
+    const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + k, v.end());
+    return v[static_cast<std::size_t>(k)];
+}
+
+// Values of `image` inside `mask` (all voxels when null) that lie above `above`.
+std::vector<float> values_above(const Grid<float>& image, const Mask* mask, double above) {
+    std::vector<float> out;
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        const float v = image[static_cast<PointIndex>(i)];
+        if ((mask == nullptr || (*mask)[static_cast<PointIndex>(i)] != 0) && v > above) out.push_back(v);
+    }
+    return out;
+}
+
+// A kBins-bin histogram over [lo, hi] of the image's voxels inside `mask` (values outside the range
+// are not counted).
+struct Histogram {
+    double lo = 0, width = 1;
+    std::vector<double> counts = std::vector<double>(kBins, 0.0);
+    double centre(int bin) const { return lo + (bin + 0.5) * width; }
+};
+
+Histogram histogram(const Grid<float>& image, const Mask& mask, double lo, double hi) {
+    Histogram h;
+    h.lo = lo;
+    h.width = (hi - lo) / kBins;
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        const double v = image[static_cast<PointIndex>(i)];
+        if (mask[static_cast<PointIndex>(i)] == 0 || v < lo || v > hi) continue;
+        h.counts[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((v - lo) / h.width)))] += 1.0;
+    }
+    return h;
+}
+
+std::vector<double> smoothed(const std::vector<double>& c, double sigma_bins) {
+    const int r = static_cast<int>(std::ceil(3 * sigma_bins));
+    std::vector<double> out(c.size(), 0.0);
+    for (int i = 0; i < static_cast<int>(c.size()); ++i)
+        for (int k = -r; k <= r; ++k) {
+            const int j = std::clamp(i + k, 0, static_cast<int>(c.size()) - 1);
+            out[static_cast<std::size_t>(i)] += c[static_cast<std::size_t>(j)] * std::exp(-0.5 * k * k / (sigma_bins * sigma_bins));
+        }
+    return out;
+}
+
+// Three-class Otsu (maximal between-class variance) on a histogram: returns the first bins of the
+// middle and upper classes.
+std::pair<int, int> otsu3(const std::vector<double>& h, const Histogram& geom) {
+    const int n = static_cast<int>(h.size());
+    std::vector<double> w(static_cast<std::size_t>(n) + 1, 0.0), m(static_cast<std::size_t>(n) + 1, 0.0);
+    for (int i = 0; i < n; ++i) {
+        w[static_cast<std::size_t>(i) + 1] = w[static_cast<std::size_t>(i)] + h[static_cast<std::size_t>(i)];
+        m[static_cast<std::size_t>(i) + 1] = m[static_cast<std::size_t>(i)] + h[static_cast<std::size_t>(i)] * geom.centre(i);
+    }
+    auto term = [&](int a, int b) {  // bins [a, b)
+        const double ww = w[static_cast<std::size_t>(b)] - w[static_cast<std::size_t>(a)];
+        const double mm = m[static_cast<std::size_t>(b)] - m[static_cast<std::size_t>(a)];
+        return ww > 0 ? mm * mm / ww : -std::numeric_limits<double>::infinity();
+    };
+    double best = -std::numeric_limits<double>::infinity();
+    std::pair<int, int> arg{1, 2};
+    for (int i = 1; i < n - 1; ++i)
+        for (int j = i + 1; j < n; ++j) {
+            const double v = term(0, i) + term(i, j) + term(j, n);
+            if (v > best) {
+                best = v;
+                arg = {i, j};
+            }
+        }
+    return arg;
+}
+
+void check_image(const Grid<float>& image) {
+    if (image.size() == 0) throw std::invalid_argument("brain mask: the image is empty");
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (float v : image.values()) {
+        if (!std::isfinite(v)) throw std::invalid_argument("brain mask: the image has NaN or infinite voxels");
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+    }
+    if (!(hi > lo)) throw std::invalid_argument("brain mask: the image is constant (every voxel is " + std::to_string(lo) + ")");
+}
+
+// The head threshold: p2 + fraction·(p98 − p2), with p98 taken over the voxels above p2 so that a
+// small head in a large empty field still has a range.
+double head_threshold(const Grid<float>& image, double fraction) {
+    std::vector<float> all(image.values().begin(), image.values().end());
+    const double p2 = percentile(all, 0.02);
+    std::vector<float> above = values_above(image, nullptr, p2);
+    if (above.empty()) throw std::invalid_argument("brain mask: no head found (98% of the voxels share the lowest value)");
+    const double p98 = percentile(above, 0.98);
+    return p2 + fraction * (p98 - p2);
+}
+
+double max_spacing(const Lattice& l) { return std::max({l.spacing().x, l.spacing().y, l.spacing().z}); }
+
+// The foreground above `threshold`: its components of at least a tenth of the largest (the skull can
+// part scalp from brain); throws when it has no solid part (noise passes a threshold as scattered
+// voxels that a few mm of erosion removes).
+Mask head_foreground(const Grid<float>& image, double threshold) {
+    Mask f(image.lattice());
+    for (std::size_t i = 0; i < f.size(); ++i) f[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > threshold;
+    f = large_components(f, 0.1);
+    const std::size_t n = count(f);
+    const double r = std::max(3.0, 2.0 * max_spacing(image.lattice()));
+    if (n == 0 || static_cast<double>(count(erode_mm(f, r))) < 0.05 * static_cast<double>(n))
+        throw std::invalid_argument("brain mask: no head found (the foreground has no solid part: noise or an empty scan?)");
+    return f;
+}
+
+// White-matter peak and width from the deepest half of the head (T1: mostly white matter).
+void white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r) {
+    float deepest = 0;
+    for (std::size_t i = 0; i < head.size(); ++i)
+        if (head[static_cast<PointIndex>(i)] != 0) deepest = std::max(deepest, depth[static_cast<PointIndex>(i)]);
+    Mask deep(head.lattice());
+    for (std::size_t i = 0; i < head.size(); ++i)
+        deep[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && depth[static_cast<PointIndex>(i)] >= 0.5f * deepest;
+    std::vector<float> in_head = values_above(image, &head, r.background_threshold);
+    if (in_head.empty()) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
+    const double top = percentile(in_head, 0.995);
+    if (!(top > r.background_threshold)) throw std::invalid_argument("brain mask: no brain tissue found (the head has no contrast)");
+    const Histogram h = histogram(image, deep, r.background_threshold, top);
+    const std::vector<double> s = smoothed(h.counts, 2.0);
+    const int peak = static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin());
+    int j = peak;
+    while (j < kBins - 1 && s[static_cast<std::size_t>(j)] > 0.5 * s[static_cast<std::size_t>(peak)]) ++j;
+    r.wm_peak = h.centre(peak);
+    r.wm_sigma = std::max(h.width, (h.centre(j) - r.wm_peak) / 1.1774);
+}
+
+// The brain boundary's share that lies within `near_mm` of the head surface (boundary: mask voxels
+// with a 6-neighbour outside the mask inside the lattice).
+double surface_contact(const Mask& mask, const Grid<float>& head_depth, double near_mm) {
+    const Lattice& lat = mask.lattice();
+    const Vec3i d = lat.dims();
+    std::size_t boundary = 0, near = 0;
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                if (mask({x, y, z}) == 0) continue;
+                bool edge = false;
+                for (int k = 0; k < 6 && !edge; ++k) {
+                    Vec3i q{x, y, z};
+                    q[k / 2] += k % 2 ? 1 : -1;
+                    edge = lat.contains(q) && mask(q) == 0;
+                }
+                if (!edge) continue;
+                ++boundary;
+                near += head_depth({x, y, z}) <= near_mm;
+            }
+    return boundary > 0 ? static_cast<double>(near) / static_cast<double>(boundary) : 0.0;
+}
+
+// A skull-stripped input: the filled largest component of everything above the background (the
+// lowest value when it fills at least 2 % of the image, as masking leaves it; else the head threshold).
+Mask stripped_foreground(const Grid<float>& image, double threshold) {
+    const float lowest = *std::min_element(image.values().begin(), image.values().end());
+    std::size_t at_lowest = 0;
+    for (float v : image.values()) at_lowest += v == lowest;
+    const double floor = static_cast<double>(at_lowest) >= 0.02 * static_cast<double>(image.size()) ? lowest : threshold;
+    Mask f(image.lattice());
+    for (std::size_t i = 0; i < f.size(); ++i) f[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > floor;
+    return fill_holes(largest_component(f));
+}
+
+Mask intersect(Mask a, const Mask& b) {
+    for (std::size_t i = 0; i < a.size(); ++i) a[static_cast<PointIndex>(i)] &= b[static_cast<PointIndex>(i)] != 0;
+    return a;
+}
+
+// Tissue window → erosion → largest component → regrowth inside the window → fill → close → rim.
+Mask extract_brain(const Grid<float>& image, const Mask& head, const BrainMaskOptions& o, BrainMaskReport& r) {
+    Mask tissue(image.lattice());
+    for (std::size_t i = 0; i < tissue.size(); ++i) {
+        const double v = image[static_cast<PointIndex>(i)];
+        tissue[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && v >= r.tissue_low && v <= r.tissue_high;
+    }
+    r.tissue_voxels = count(tissue);
+    const Mask core = largest_component(erode_mm(tissue, o.erosion_mm));
+    r.core_voxels = count(core);
+    if (r.core_voxels == 0)
+        throw std::invalid_argument("brain mask: the mask is empty (no brain tissue survives a " + std::to_string(o.erosion_mm) + " mm erosion)");
+    Mask brain = fill_holes(largest_component(intersect(dilate_mm(core, o.erosion_mm + o.regrow_margin_mm), tissue)));
+    brain = fill_holes(close_mm(brain, o.closing_mm));
+    if (o.rim_mm > 0) {
+        Mask rim = dilate_mm(brain, o.rim_mm);
+        for (std::size_t i = 0; i < rim.size(); ++i)
+            rim[static_cast<PointIndex>(i)] &= head[static_cast<PointIndex>(i)] != 0 && image[static_cast<PointIndex>(i)] > r.background_threshold;
+        for (std::size_t i = 0; i < rim.size(); ++i) rim[static_cast<PointIndex>(i)] |= brain[static_cast<PointIndex>(i)];
+        brain = fill_holes(rim);
+    }
+    return brain;
+}
+
+}  // namespace
+
+void validate(const BrainMaskOptions& o) {
+    auto require = [](bool ok, const char* what) {
+        if (!ok) throw std::invalid_argument(std::string("brain mask options: ") + what);
+    };
+    require(std::isfinite(o.background_fraction) && o.background_fraction > 0 && o.background_fraction < 1,
+            "background_fraction must lie in (0, 1)");
+    require(std::isfinite(o.erosion_mm) && o.erosion_mm > 0 && o.erosion_mm <= 50, "erosion_mm must lie in (0, 50]");
+    require(std::isfinite(o.regrow_margin_mm) && o.regrow_margin_mm >= 0 && o.regrow_margin_mm <= 50, "regrow_margin_mm must lie in [0, 50]");
+    require(std::isfinite(o.closing_mm) && o.closing_mm >= 0 && o.closing_mm <= 50, "closing_mm must lie in [0, 50]");
+    require(std::isfinite(o.rim_mm) && o.rim_mm >= 0 && o.rim_mm <= 50, "rim_mm must lie in [0, 50]");
+    require(std::isfinite(o.head_closing_mm) && o.head_closing_mm >= 0 && o.head_closing_mm <= 50, "head_closing_mm must lie in [0, 50]");
+    require(std::isfinite(o.stripped_near_mm) && o.stripped_near_mm > 0 && o.stripped_near_mm <= 50, "stripped_near_mm must lie in (0, 50]");
+    require(std::isfinite(o.stripped_fraction) && o.stripped_fraction > 0 && o.stripped_fraction <= 1, "stripped_fraction must lie in (0, 1]");
+}
+
+Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport* report) {
+    validate(o);
+    check_image(image);
+    BrainMaskReport r;
+    r.background_threshold = head_threshold(image, o.background_fraction);
+    const Mask head = fill_holes(close_mm(head_foreground(image, r.background_threshold), o.head_closing_mm));
+    r.head_voxels = count(head);
+    const Grid<float> depth = depth_mm(head);
+    white_matter_peak(image, head, depth, r);
+    const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
+    r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;  // CSF/skin | GM/muscle cut
+    r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
+    Mask brain = extract_brain(image, head, o, r);
+    r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
+    r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
+    if (r.skull_stripped) brain = stripped_foreground(image, r.background_threshold);
+    r.mask_voxels = count(brain);
+    if (r.mask_voxels == 0) throw std::invalid_argument("brain mask: the mask is empty");
+    const Vec3d s = image.lattice().spacing();
+    r.mask_volume_mm3 = static_cast<double>(r.mask_voxels) * s.x * s.y * s.z;
+    if (report != nullptr) *report = r;
+    return brain;
+}
+
+}  // namespace liveset

@@ -1,0 +1,65 @@
+// Automatic brain mask from a T1-weighted image (full head or already skull-stripped), so a
+// segmentation of a full-head scan cannot leak into scalp, muscle, eyes or neck. In the spirit of
+// morphological brain-extraction tools: head threshold, brain-tissue window from the histogram,
+// erosion to cut the thin bridges, largest component, regrowth, hole filling, closing.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "liveset/grid/grid.hpp"
+
+namespace liveset {
+
+// Radii are in millimetres (the lattice spacing), so 2 mm scans and anisotropic voxels behave.
+// The defaults are meant to work untuned on adult human T1 scans.
+struct BrainMaskOptions {
+    // Head threshold: p2 + fraction·(p98 − p2) of the intensities (FSL BET's robust 10 %).
+    double background_fraction = 0.1;
+    // Erosion of the brain-tissue mask that cuts the bridges (optic nerves, vessels, partial volume)
+    // to scalp, muscle and eyes before the largest component is taken.
+    double erosion_mm = 4.0;
+    // The core grows back by erosion_mm + regrow_margin_mm, but only into brain-tissue voxels.
+    double regrow_margin_mm = 1.0;
+    // Closing that takes in the sulcal CSF and the cortex's outer partial-volume layer.
+    double closing_mm = 6.0;
+    // Final growth into voxels brighter than the head threshold (extracerebral CSF, dark cortex).
+    double rim_mm = 2.0;
+    // Closing of the head foreground that bridges the dark skull, giving a solid head whose surface
+    // the skull-stripping test measures from.
+    double head_closing_mm = 5.0;
+    // Skull-stripped input: at least `stripped_fraction` of the mask's boundary lies within
+    // `stripped_near_mm` of the head's surface (a full head has scalp and skull in between). The
+    // mask is then the filled non-background foreground. Set detect_skull_stripped false to skip.
+    bool detect_skull_stripped = true;
+    double stripped_near_mm = 4.0;
+    double stripped_fraction = 0.1;
+};
+
+// Throws std::invalid_argument naming the first bad field.
+void validate(const BrainMaskOptions& options);
+
+// What the method found.
+struct BrainMaskReport {
+    double background_threshold = 0;  // head threshold (image units)
+    double wm_peak = 0;               // white-matter peak of the deep head's histogram
+    double wm_sigma = 0;              // its width (upper half-width at half maximum / 1.1774)
+    double tissue_low = 0;            // brain-tissue window (image units)
+    double tissue_high = 0;
+    std::size_t head_voxels = 0;      // solid head (filled, closed foreground)
+    std::size_t tissue_voxels = 0;    // head voxels in the tissue window
+    std::size_t core_voxels = 0;      // largest component after the erosion
+    double surface_contact = 0;       // fraction of the mask boundary near the head surface
+    bool skull_stripped = false;      // the input looked skull-stripped (mask = filled foreground)
+    std::size_t mask_voxels = 0;
+    double mask_volume_mm3 = 0;
+};
+
+// The brain mask (0/1) on the image's lattice. Deterministic for any thread count.
+// Throws std::invalid_argument with a one-line message on bad options, an empty image, non-finite
+// voxels, a constant image, an image with no head (no solid foreground: e.g. pure noise), or when no
+// brain tissue survives the erosion (mask empty).
+Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& options = {},
+                                   BrainMaskReport* report = nullptr);
+
+}  // namespace liveset

@@ -1,0 +1,104 @@
+// `liveset segment --roi auto --out-roi`: the written ROI is the library's automatic brain mask of
+// the image, the segmentation stays inside it, the report counts it; bad input is one line.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <random>
+
+#include "cli_run.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/segment/brain_mask.hpp"
+
+namespace fs = std::filesystem;
+using liveset::testing::lines;
+using liveset::testing::run_cli;
+using namespace liveset;
+
+namespace {
+
+fs::path work_dir() {
+    static const fs::path dir = [] {
+        const fs::path d = fs::temp_directory_path() / ("liveset_roi_cli_" + std::to_string(::getpid()));
+        fs::create_directories(d);
+        return d;
+    }();
+    return dir;
+}
+
+// An analytic head at 1.5 mm (64³): white matter, grey matter, CSF, dark skull, bright scalp, air.
+fs::path head_image() {
+    static const fs::path path = [] {
+        Grid<float> g(Lattice({64, 64, 64}, {1.5, 1.5, 1.5}));
+        std::mt19937 rng(5);
+        std::normal_distribution<float> noise(0.0f, 3.0f);
+        for (int z = 0; z < 64; ++z)
+            for (int y = 0; y < 64; ++y)
+                for (int x = 0; x < 64; ++x) {
+                    const double r = 1.5 * norm(Vec3d{x - 31.5, y - 31.5, z - 31.5});
+                    const float v = r < 18 ? 130.0f : r < 27 ? 95.0f : r < 29 ? 45.0f : r < 35 ? 8.0f : r < 42 ? 160.0f : 0.0f;
+                    g({x, y, z}) = std::abs(v + noise(rng));
+                }
+        const fs::path p = work_dir() / "head.nii.gz";
+        write_image(g, p.string());
+        return p;
+    }();
+    return path;
+}
+
+}  // namespace
+
+TEST(RoiAutoCli, WritesTheAutomaticBrainMaskAndSegmentsInsideIt) {
+    const fs::path roi = work_dir() / "roi.nii.gz", seg = work_dir() / "seg.nii.gz";
+    const auto r = run_cli("segment " + head_image().string() + " --roi auto --out-roi " + roi.string() +
+                           " --seed 32,32,32:3 --mu-raw 112 --epsilon-raw 40 --iterations 300 --json --out-mask " + seg.string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const Grid<float> image = read_image(head_image().string());
+    BrainMaskReport expected;
+    const Grid<std::uint8_t> library = auto_brain_mask(image, {}, &expected);
+    const Grid<std::uint8_t> written = read_label_image(roi.string()), mask = read_label_image(seg.string());
+    ASSERT_TRUE(written.lattice().same_geometry(image.lattice()));
+    EXPECT_TRUE(std::equal(written.values().begin(), written.values().end(), library.values().begin()));
+    std::size_t outside = 0, inside = 0;
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+        outside += mask[static_cast<PointIndex>(i)] != 0 && written[static_cast<PointIndex>(i)] == 0;
+        inside += mask[static_cast<PointIndex>(i)] != 0;
+    }
+    EXPECT_EQ(outside, 0u);
+    EXPECT_GT(inside, 1000u);  // the front grew (grey and white matter: the window spans both)
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["roi"]["source"], "auto");
+    EXPECT_EQ(j["roi"]["voxels"].get<std::size_t>(), expected.mask_voxels);
+    EXPECT_NEAR(j["roi"]["volume_mm3"].get<double>(), expected.mask_volume_mm3, 1e-6);
+    EXPECT_FALSE(j["roi"]["auto"]["skull_stripped"].get<bool>());
+    EXPECT_EQ(j["outputs"]["roi"], roi.string());
+}
+
+TEST(RoiAutoCli, BadInputIsOneLineAndWritesNothing) {
+    const fs::path flat = work_dir() / "flat.nii.gz", noise = work_dir() / "noise.nii.gz";
+    write_image(Grid<float>(Lattice({32, 32, 32}), 7.0f), flat.string());
+    Grid<float> n(Lattice({32, 32, 32}));
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> u(0.0f, 100.0f);
+    for (float& v : n.values()) v = u(rng);
+    write_image(n, noise.string());
+    const fs::path out = work_dir() / "never.nii.gz", roi = work_dir() / "never_roi.nii.gz";
+    const std::string o = " --seed 5,5,5 --mu-raw 50 --epsilon-raw 5 --out-mask " + out.string();
+    struct Case {
+        std::string args, phrase;
+    };
+    for (const Case& c : std::vector<Case>{{"segment " + flat.string() + " --roi auto --out-roi " + roi.string() + o, "constant"},
+                                           {"segment " + noise.string() + " --roi auto --out-roi " + roi.string() + o, "no head"},
+                                           {"segment " + head_image().string() + " --out-roi " + roi.string() + o, "--out-roi needs --roi"}}) {
+        const auto r = run_cli(c.args);
+        EXPECT_NE(r.rc, 0) << c.args;
+        EXPECT_EQ(lines(r.err), 1) << r.err;
+        EXPECT_NE(r.err.find(c.phrase), std::string::npos) << r.err;
+        EXPECT_FALSE(fs::exists(out));
+        EXPECT_FALSE(fs::exists(roi));
+    }
+}

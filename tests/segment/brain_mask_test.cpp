@@ -1,0 +1,303 @@
+// Automatic brain mask: BrainWeb against its tissue labels (and variants built from it: intensity
+// scaling, bias field, noise, 2 mm voxels, skull-stripped), an analytic head of spheres, bad input.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+
+#include "liveset/io/image_io.hpp"
+#include "liveset/segment/brain_mask.hpp"
+
+using namespace liveset;
+
+namespace {
+
+using Mask = Grid<std::uint8_t>;
+
+struct BrainWeb {
+    Grid<float> t1;
+    Mask labels, brain_mask;  // brain_mask.nii.gz: the mask the skull-stripped variant is cut with
+};
+
+const BrainWeb& brainweb() {
+    static const BrainWeb data = [] {
+        const std::filesystem::path dir = std::filesystem::path(LIVESET_DATA_DIR) / "brainweb";
+        if (!std::filesystem::exists(dir / "t1.mha")) throw std::runtime_error("BrainWeb data not found in " + dir.string());
+        return BrainWeb{read_image((dir / "t1.mha").string()), read_label_image((dir / "labels_crisp.nii.gz").string()),
+                        read_label_image((dir / "brain_mask.nii.gz").string())};
+    }();
+    return data;
+}
+
+bool brain_label(int l) { return l == 1 || l == 2 || l == 3 || l == 8; }
+bool extracranial_label(int l) { return l == 4 || l == 5 || l == 6 || l == 9; }  // fat, muscle, skin, connective
+
+// Every other voxel along each axis: a 2 mm version of a 1 mm grid (same origin and direction).
+template <class T>
+Grid<T> every_other(const Grid<T>& g) {
+    const Lattice& l = g.lattice();
+    const Vec3i d{(l.dims().x + 1) / 2, (l.dims().y + 1) / 2, (l.dims().z + 1) / 2};
+    Grid<T> out(Lattice(d, l.spacing() * 2.0, l.origin(), l.direction()));
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) out({x, y, z}) = g({2 * x, 2 * y, 2 * z});
+    return out;
+}
+
+enum class Variant { kPlain, kScaled, kBias, kNoise, kStripped };
+
+// A variant of an image (the same truth holds for each); kStripped multiplies by `brain`.
+Grid<float> make_variant(const Grid<float>& t1, const Mask& brain, Variant v) {
+    Grid<float> out = t1;
+    const Vec3i d = t1.dims();
+    std::mt19937 rng(12345);
+    std::normal_distribution<float> noise(0.0f, 8.0f);  // ~6 % of white matter
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                float& o = out({x, y, z});
+                const double u = 2.0 * x / (d.x - 1) - 1, w = 2.0 * y / (d.y - 1) - 1, s = 2.0 * z / (d.z - 1) - 1;
+                switch (v) {
+                    case Variant::kPlain: break;
+                    case Variant::kScaled: o = 7.3f * o + 250.0f; break;
+                    case Variant::kBias:  // smooth multiplicative field within ±20 %
+                        o *= static_cast<float>(1.0 + 0.2 * std::sin(1.3 * u + 0.4) * std::cos(1.1 * w - 0.3) * std::cos(0.9 * s + 0.2));
+                        break;
+                    case Variant::kNoise: o += noise(rng); break;
+                    case Variant::kStripped: o = brain({x, y, z}) != 0 ? o : 0.0f; break;
+                }
+            }
+    return out;
+}
+
+struct TruthCheck {
+    double dice = 0, gm = 0, wm = 0, extracranial = 0, leak = 0;
+};
+
+// The mask against BrainWeb's brain tissue (labels 1, 2, 3, 8). `leak`: non-brain voxels inside the
+// mask whose intensity lies in grey matter's 1st–99th percentile (where a grey-matter front could
+// grow), as a fraction of the grey-matter volume.
+TruthCheck check_against_truth(const Mask& mask, const Mask& labels, const Grid<float>& image) {
+    std::vector<float> gm_values;
+    for (std::size_t i = 0; i < labels.size(); ++i)
+        if (labels[static_cast<PointIndex>(i)] == 2) gm_values.push_back(image[static_cast<PointIndex>(i)]);
+    std::sort(gm_values.begin(), gm_values.end());
+    const float lo = gm_values[gm_values.size() / 100], hi = gm_values[gm_values.size() * 99 / 100];
+    std::size_t m = 0, t = 0, both = 0, gm = 0, gm_in = 0, wm = 0, wm_in = 0, ex = 0, ex_in = 0, leak = 0;
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        const int l = labels[p];
+        const bool in = mask[p] != 0;
+        m += in;
+        t += brain_label(l);
+        both += in && brain_label(l);
+        gm += l == 2;
+        gm_in += l == 2 && in;
+        wm += l == 3;
+        wm_in += l == 3 && in;
+        ex += extracranial_label(l);
+        ex_in += extracranial_label(l) && in;
+        leak += in && !brain_label(l) && image[p] >= lo && image[p] <= hi;
+    }
+    return {2.0 * double(both) / double(m + t), double(gm_in) / double(gm), double(wm_in) / double(wm),
+            double(ex_in) / double(ex), double(leak) / double(gm)};
+}
+
+double dice(const Mask& a, const Mask& b) {
+    std::size_t na = 0, nb = 0, both = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const bool x = a[static_cast<PointIndex>(i)] != 0, y = b[static_cast<PointIndex>(i)] != 0;
+        na += x;
+        nb += y;
+        both += x && y;
+    }
+    return 2.0 * double(both) / double(na + nb);
+}
+
+// A full head (stripped_with == nullptr) or the image cut with `stripped_with`, whose non-zero brain
+// the mask must then cover whole.
+TruthCheck run_variant(const char* name, const Grid<float>& image, const Mask& labels, const Mask* stripped_with = nullptr) {
+    const bool expect_stripped = stripped_with != nullptr;
+    BrainMaskReport r;
+    const auto t0 = std::chrono::steady_clock::now();
+    const Mask mask = auto_brain_mask(image, {}, &r);
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const TruthCheck c = check_against_truth(mask, labels, image);
+    std::printf("%-9s dice %.4f  GM in %.4f  WM in %.4f  scalp/muscle/skin/fat in %.4f  GM-window leak %.4f  "
+                "(window %.1f..%.1f, contact %.2f, stripped %d, %.1f s)\n",
+                name, c.dice, c.gm, c.wm, c.extracranial, c.leak, r.tissue_low, r.tissue_high, r.surface_contact,
+                int(r.skull_stripped), s);
+    EXPECT_EQ(r.skull_stripped, expect_stripped) << name << ": surface contact " << r.surface_contact;
+    if (expect_stripped) {  // the truth is the non-zero brain (brain_mask.nii.gz also keeps some non-brain)
+        Mask nonzero(image.lattice());
+        for (std::size_t i = 0; i < image.size(); ++i) nonzero[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != 0;
+        const double d = dice(mask, nonzero);
+        std::printf("%-9s dice against the non-zero brain %.4f\n", name, d);
+        EXPECT_GE(d, 0.995) << name;
+    }
+    EXPECT_GE(c.gm, 0.99) << name;
+    EXPECT_GE(c.wm, 0.998) << name;
+    if (!expect_stripped) {
+        EXPECT_GE(c.dice, 0.95) << name;
+        EXPECT_LE(c.extracranial, 0.03) << name;
+        EXPECT_LE(c.leak, 0.015) << name;
+    }
+    EXPECT_EQ(r.mask_voxels, static_cast<std::size_t>(std::count(mask.values().begin(), mask.values().end(), 1)));
+    return c;
+}
+
+}  // namespace
+
+TEST(BrainMask, BrainWebFullHeadMatchesBrainTissue) {
+    const BrainWeb& bw = brainweb();
+    run_variant("1mm", bw.t1, bw.labels);
+}
+
+TEST(BrainMask, BrainWebSkullStrippedPassesThrough) {
+    const BrainWeb& bw = brainweb();
+    run_variant("stripped", make_variant(bw.t1, bw.brain_mask, Variant::kStripped), bw.labels, &bw.brain_mask);
+}
+
+TEST(BrainMask, BrainWebVariantsAt2mm) {
+    const BrainWeb& bw = brainweb();
+    const Grid<float> t1 = every_other(bw.t1);
+    const Mask labels = every_other(bw.labels), brain = every_other(bw.brain_mask);
+    run_variant("2mm", t1, labels);
+    run_variant("scaled", make_variant(t1, brain, Variant::kScaled), labels);
+    run_variant("bias", make_variant(t1, brain, Variant::kBias), labels);
+    run_variant("noise", make_variant(t1, brain, Variant::kNoise), labels);
+    run_variant("strip2mm", make_variant(t1, brain, Variant::kStripped), labels, &brain);
+}
+
+TEST(BrainMask, SameMaskWhateverTheThreadCount) {
+    const Grid<float> t1 = every_other(brainweb().t1);
+    const Mask many = auto_brain_mask(t1);
+    Mask one;
+    {
+        const tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+        one = auto_brain_mask(t1);
+    }
+    EXPECT_TRUE(std::equal(many.values().begin(), many.values().end(), one.values().begin()));
+}
+
+namespace {
+
+// An analytic head on a lattice of `spacing` (mm), centred: white matter (r < 18 mm, 130), grey matter
+// (< 27, 95), CSF (< 29, 45), dark skull (< 35, 8), bright scalp (< 42, 160), air (0); Gaussian
+// noise σ 3 (absolute value, like magnitude MR). The brain is r < 29 mm.
+Grid<float> sphere_head(Vec3d spacing, Mask* brain) {
+    const Vec3i d{static_cast<int>(100 / spacing.x), static_cast<int>(100 / spacing.y), static_cast<int>(100 / spacing.z)};
+    Grid<float> g(Lattice(d, spacing));
+    *brain = Mask(g.lattice());
+    std::mt19937 rng(7);
+    std::normal_distribution<float> noise(0.0f, 3.0f);
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                const double r = norm(Vec3d{(x - (d.x - 1) / 2.0) * spacing.x, (y - (d.y - 1) / 2.0) * spacing.y,
+                                            (z - (d.z - 1) / 2.0) * spacing.z});
+                const float v = r < 18 ? 130.0f : r < 27 ? 95.0f : r < 29 ? 45.0f : r < 35 ? 8.0f : r < 42 ? 160.0f : 0.0f;
+                g({x, y, z}) = std::abs(v + noise(rng));
+                (*brain)({x, y, z}) = r < 29;
+            }
+    return g;
+}
+
+// Voxels where the two masks differ that lie more than one voxel (the largest spacing) from the
+// other mask's boundary: counted by brute force over the 26-neighbourhood scaled to one voxel.
+std::size_t differences_beyond_a_voxel(const Mask& a, const Mask& b) {
+    std::size_t far = 0;
+    const Vec3i d = a.dims();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                if (a({x, y, z}) == b({x, y, z})) continue;
+                bool near = false;  // does b take a's value within one voxel?
+                for (int k = 0; k < 27 && !near; ++k) {
+                    const Vec3i q{x + k % 3 - 1, y + k / 3 % 3 - 1, z + k / 9 - 1};
+                    near = a.lattice().contains(q) && b(q) == a({x, y, z});
+                }
+                far += !near;
+            }
+    return far;
+}
+
+}  // namespace
+
+TEST(BrainMask, AnalyticHeadGivesTheBrainSphereWithinAVoxel) {
+    for (const Vec3d spacing : {Vec3d{1, 1, 1}, Vec3d{1, 1.5, 2}}) {
+        Mask brain;
+        const Grid<float> head = sphere_head(spacing, &brain);
+        BrainMaskReport r;
+        const Mask mask = auto_brain_mask(head, {}, &r);
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < mask.size(); ++i) differ += mask[static_cast<PointIndex>(i)] != brain[static_cast<PointIndex>(i)];
+        std::printf("spacing %s: window %.1f..%.1f, brain %zu voxels, mask %zu, %zu differ, contact %.2f\n",
+                    head.lattice().describe().c_str(), r.tissue_low, r.tissue_high,
+                    static_cast<std::size_t>(std::count(brain.values().begin(), brain.values().end(), 1)), r.mask_voxels, differ,
+                    r.surface_contact);
+        EXPECT_FALSE(r.skull_stripped);
+        EXPECT_GT(r.tissue_low, 45.0);  // CSF below the window, grey matter inside it
+        EXPECT_LT(r.tissue_low, 95.0);
+        EXPECT_EQ(differences_beyond_a_voxel(mask, brain), 0u) << spacing;
+        EXPECT_EQ(differences_beyond_a_voxel(brain, mask), 0u) << spacing;
+    }
+}
+
+TEST(BrainMask, AnalyticSkullStrippedHeadIsTheWholeForeground) {
+    Mask brain;
+    Grid<float> head = sphere_head({1, 1, 1}, &brain);
+    for (std::size_t i = 0; i < head.size(); ++i)
+        if (brain[static_cast<PointIndex>(i)] == 0) head[static_cast<PointIndex>(i)] = 0.0f;
+    BrainMaskReport r;
+    const Mask mask = auto_brain_mask(head, {}, &r);
+    EXPECT_TRUE(r.skull_stripped);
+    for (std::size_t i = 0; i < mask.size(); ++i) ASSERT_EQ(mask[static_cast<PointIndex>(i)], brain[static_cast<PointIndex>(i)]) << i;
+}
+
+TEST(BrainMask, BadInputThrowsOneLine) {
+    const Lattice lat({48, 48, 48});
+    auto message = [](const Grid<float>& g) {
+        try {
+            auto_brain_mask(g);
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string("no exception");
+    };
+    EXPECT_NE(message(Grid<float>(lat, 42.0f)).find("constant"), std::string::npos);
+    Grid<float> noise(lat);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(0.0f, 100.0f);
+    for (float& v : noise.values()) v = u(rng);
+    EXPECT_NE(message(noise).find("no head"), std::string::npos) << message(noise);
+    std::normal_distribution<float> gauss(100.0f, 20.0f);
+    for (float& v : noise.values()) v = gauss(rng);
+    EXPECT_NE(message(noise).find("no head"), std::string::npos) << message(noise);
+    Grid<float> speck(lat, 0.0f);
+    speck({20, 20, 20}) = 5.0f;
+    EXPECT_NE(message(speck).find("no head"), std::string::npos) << message(speck);
+    // A head with no brain: a bright 5 mm shell around a dark interior (nothing survives the erosion).
+    Grid<float> shell(lat, 0.0f);
+    for (int z = 0; z < 48; ++z)
+        for (int y = 0; y < 48; ++y)
+            for (int x = 0; x < 48; ++x) {
+                const double r = norm(Vec3d{x - 23.5, y - 23.5, z - 23.5});
+                shell({x, y, z}) = r < 15 ? 10.0f : r < 20 ? 100.0f + static_cast<float>((x * 7 + y * 3 + z) % 11) : 0.0f;
+            }
+    EXPECT_NE(message(shell).find("empty"), std::string::npos) << message(shell);
+    Grid<float> nan = shell;
+    nan({1, 2, 3}) = std::nanf("");
+    EXPECT_NE(message(nan).find("NaN"), std::string::npos);
+    BrainMaskOptions bad;
+    bad.erosion_mm = -1;
+    EXPECT_THROW(validate(bad), std::invalid_argument);
+    bad = {};
+    bad.background_fraction = 1.5;
+    EXPECT_THROW(auto_brain_mask(shell, bad), std::invalid_argument);
+}

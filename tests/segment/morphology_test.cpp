@@ -1,0 +1,115 @@
+// Morphology in mm against brute force: erosion/dilation by a ball with anisotropic spacing,
+// closing, largest component and hole filling on small grids.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "liveset/segment/morphology.hpp"
+
+using namespace liveset;
+
+namespace {
+
+using Mask = Grid<std::uint8_t>;
+
+Mask random_blobs(const Lattice& lat, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Mask m(lat);
+    const Vec3i d = lat.dims();
+    for (int b = 0; b < 6; ++b) {  // a few balls (in index space) of random size
+        const Vec3d c{u(rng) * d.x, u(rng) * d.y, u(rng) * d.z};
+        const double r = 1.5 + 3.5 * u(rng);
+        for (int z = 0; z < d.z; ++z)
+            for (int y = 0; y < d.y; ++y)
+                for (int x = 0; x < d.x; ++x)
+                    if (norm(Vec3d{x - c.x, y - c.y, z - c.z}) <= r) m({x, y, z}) = 1;
+    }
+    for (std::uint8_t& v : m.values()) v ^= u(rng) < 0.03;  // speckle
+    return m;
+}
+
+// Squared mm distance between two lattice points.
+double dist2(const Lattice& lat, Vec3i a, Vec3i b) {
+    const Vec3d s = lat.spacing();
+    const Vec3d d{(a.x - b.x) * s.x, (a.y - b.y) * s.y, (a.z - b.z) * s.z};
+    return dot(d, d);
+}
+
+// Brute force: is any voxel with `value` within r mm of p? (Ties within rounding count as within,
+// as in morphology.cpp.)
+bool any_within(const Mask& m, Vec3i p, double r, std::uint8_t value) {
+    const Vec3i d = m.dims();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x)
+                if ((m({x, y, z}) != 0) == (value != 0) && dist2(m.lattice(), p, {x, y, z}) <= r * r * (1 + 1e-9)) return true;
+    return false;
+}
+
+}  // namespace
+
+TEST(Morphology, ErodeAndDilateMatchBruteForceBallsWithAnisotropicSpacing) {
+    const Lattice lat({14, 12, 10}, {1.0, 1.3, 0.7});
+    for (unsigned seed : {1u, 2u, 3u}) {
+        const Mask m = random_blobs(lat, seed);
+        for (double r : {0.9, 1.5, 2.6}) {
+            const Mask e = erode_mm(m, r), g = dilate_mm(m, r);
+            for (int z = 0; z < 10; ++z)
+                for (int y = 0; y < 12; ++y)
+                    for (int x = 0; x < 14; ++x) {
+                        const Vec3i p{x, y, z};
+                        // eroded: inside and no outside voxel within r (outside the lattice does not count)
+                        EXPECT_EQ(e(p) != 0, m(p) != 0 && !any_within(m, p, r, 0)) << seed << " r " << r << " at " << p;
+                        EXPECT_EQ(g(p) != 0, any_within(m, p, r, 1)) << seed << " r " << r << " at " << p;
+                    }
+            // closing = m ∪ erode(dilate(m)) ⊇ m
+            const Mask c = close_mm(m, r), ce = erode_mm(g, r);
+            for (std::size_t i = 0; i < m.size(); ++i)
+                EXPECT_EQ(c[static_cast<PointIndex>(i)] != 0, m[static_cast<PointIndex>(i)] != 0 || ce[static_cast<PointIndex>(i)] != 0);
+        }
+    }
+}
+
+TEST(Morphology, DepthIsTheDistanceToTheNearestOutsideVoxel) {
+    const Lattice lat({9, 8, 7}, {1.0, 2.0, 0.5});
+    const Mask m = random_blobs(lat, 9);
+    const Grid<float> depth = depth_mm(m);
+    for (PointIndex i = 0; i < m.size(); ++i) {
+        double best = std::numeric_limits<double>::infinity();
+        for (PointIndex j = 0; j < m.size(); ++j)
+            if (m[j] == 0) best = std::min(best, dist2(lat, lat.coord(i), lat.coord(j)));
+        EXPECT_NEAR(depth[i], std::sqrt(best), 1e-5) << lat.coord(i);
+    }
+}
+
+TEST(Morphology, LargestComponentAndFillHoles) {
+    Mask m(Lattice({12, 10, 10}));
+    // a hollow 5x5x5 box (a 3x3x3 cavity) and a separate 2x2x2 cube; a 1-voxel diagonal neighbour
+    // of the box is a different 6-connected component.
+    for (int z = 1; z <= 5; ++z)
+        for (int y = 1; y <= 5; ++y)
+            for (int x = 1; x <= 5; ++x) m({x, y, z}) = !(x > 1 && x < 5 && y > 1 && y < 5 && z > 1 && z < 5);
+    for (int z = 7; z <= 8; ++z)
+        for (int y = 7; y <= 8; ++y)
+            for (int x = 8; x <= 9; ++x) m({x, y, z}) = 1;
+    m({6, 6, 6}) = 1;
+    const Mask lc = largest_component(m);
+    EXPECT_EQ(std::count(lc.values().begin(), lc.values().end(), 1), 125 - 27);
+    EXPECT_EQ(lc({8, 7, 7}), 0);
+    EXPECT_EQ(lc({6, 6, 6}), 0);
+    const Mask big = large_components(m, 0.05);  // 8 >= 0.05·98, 1 < 0.05·98
+    EXPECT_EQ(std::count(big.values().begin(), big.values().end(), 1), 98 + 8);
+    EXPECT_EQ(big({6, 6, 6}), 0);
+    const Mask f = fill_holes(m);
+    EXPECT_EQ(std::count(f.values().begin(), f.values().end(), 1), 125 + 8 + 1);
+    EXPECT_EQ(f({3, 3, 3}), 1);
+    // an opening to the border: the cavity is not a hole any more
+    Mask open = m;
+    for (int x = 0; x <= 2; ++x) open({x, 3, 3}) = 0;
+    EXPECT_EQ(fill_holes(open)({3, 3, 3}), 0);
+    const Mask none = largest_component(Mask(Lattice({3, 3, 3})));
+    EXPECT_EQ(std::count(none.values().begin(), none.values().end(), 1), 0);
+    EXPECT_THROW(erode_mm(m, -1.0), std::invalid_argument);
+    EXPECT_THROW(dilate_mm(m, std::nan("")), std::invalid_argument);
+}
