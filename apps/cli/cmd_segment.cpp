@@ -73,7 +73,6 @@ int run_segment(const SegmentArgs& a, int threads) {
     req.epsilon_raw = a.epsilon_raw;
     req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
     req.window.model.classes = a.classes;
-    if (std::getenv("LIVESET_EXP_NOPV")) req.window.model.partial_volume = false;  // EXPERIMENT-ONLY
 
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {

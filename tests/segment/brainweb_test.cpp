@@ -5,6 +5,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "liveset/eval/overlap.hpp"
 #include "liveset/io/image_io.hpp"
@@ -25,27 +26,59 @@ Grid<T> crop(const Grid<T>& g, Vec3i lo, Vec3i size) {
     return out;
 }
 
+// A slab through the middle of the brain: T1, brain mask, grey-matter truth, and seeds: GM voxels
+// whose whole 3x3x3 neighbourhood is GM, on a 10-voxel grid (as a user would click a few dozen
+// points in clearly grey voxels).
+struct Slab {
+    Grid<float> t1;
+    Grid<std::uint8_t> brain, gm;
+    std::vector<SeedBall> seeds;
+};
+
+const Slab& slab() {
+    static const Slab s = [] {
+        const std::filesystem::path dir = std::filesystem::path(LIVESET_DATA_DIR) / "brainweb";
+        const Vec3i lo{40, 50, 70}, size{100, 120, 48};
+        Slab out{crop(read_image((dir / "t1.mha").string()), lo, size),
+                 crop(read_label_image((dir / "brain_mask.nii.gz").string()), lo, size),
+                 crop(read_label_image((dir / "labels_crisp.nii.gz").string()), lo, size), {}};
+        for (std::uint8_t& v : out.gm.values()) v = v == 2;
+        for (int z = 2; z < size.z - 2; z += 10)
+            for (int y = 2; y < size.y - 2; y += 10)
+                for (int x = 2; x < size.x - 2; x += 10) {
+                    bool deep = true;
+                    for (int k = 0; k < 27 && deep; ++k) deep = out.gm({x + k % 3 - 1, y + k / 3 % 3 - 1, z + k / 9 - 1}) != 0;
+                    if (deep) out.seeds.push_back({{double(x), double(y), double(z)}, 1.0});
+                }
+        return out;
+    }();
+    return s;
+}
+
+double slab_dice(const Grid<float>& t1, std::optional<double> mu_raw, std::optional<double> epsilon_raw,
+                 SegmentOutcome* keep = nullptr) {
+    SegmentRequest req;
+    req.seeds = slab().seeds;
+    req.roi = &slab().brain;
+    req.mu_raw = mu_raw;
+    req.epsilon_raw = epsilon_raw;
+    SegmentOutcome out = segment_image(t1, req);
+    EXPECT_EQ(out.result.reason, StopReason::kConverged) << out.result.iterations;
+    const double dice = compare_overlap(out.mask, slab().gm).dice;
+    if (keep) *keep = std::move(out);
+    return dice;
+}
+
 }  // namespace
 
 TEST(BrainWeb, GreyMatterDiceInsideTheBrainMask) {
     const std::filesystem::path dir = std::filesystem::path(LIVESET_DATA_DIR) / "brainweb";
     ASSERT_TRUE(std::filesystem::exists(dir / "t1.mha")) << "BrainWeb data (bundled in data/brainweb) not found in " << dir;
-    const Vec3i lo{40, 50, 70}, size{100, 120, 48};  // a slab through the middle of the brain
-    const Grid<float> t1 = crop(read_image((dir / "t1.mha").string()), lo, size);
-    const Grid<std::uint8_t> brain = crop(read_label_image((dir / "brain_mask.nii.gz").string()), lo, size);
-    Grid<std::uint8_t> gm = crop(read_label_image((dir / "labels_crisp.nii.gz").string()), lo, size);
-    for (std::uint8_t& v : gm.values()) v = v == 2;
-
-    // Seeds: GM voxels whose whole 3x3x3 neighbourhood is GM, on a 10-voxel grid (as a user would
-    // click a few dozen points in clearly grey voxels).
+    const Grid<float>& t1 = slab().t1;
+    const Grid<std::uint8_t>& brain = slab().brain;
+    const Grid<std::uint8_t>& gm = slab().gm;
     SegmentRequest req;
-    for (int z = 2; z < size.z - 2; z += 10)
-        for (int y = 2; y < size.y - 2; y += 10)
-            for (int x = 2; x < size.x - 2; x += 10) {
-                bool deep = true;
-                for (int k = 0; k < 27 && deep; ++k) deep = gm({x + k % 3 - 1, y + k / 3 % 3 - 1, z + k / 9 - 1}) != 0;
-                if (deep) req.seeds.push_back({{double(x), double(y), double(z)}, 1.0});
-            }
+    req.seeds = slab().seeds;
     ASSERT_GE(req.seeds.size(), 10u);
     req.roi = &brain;
     // The documented BrainWeb window: 94 ± 22 in the T1's units (inside-mask percentiles map it).
@@ -60,4 +93,74 @@ TEST(BrainWeb, GreyMatterDiceInsideTheBrainMask) {
     std::printf("BrainWeb slab: dice %.4f, volume difference %+.3f, %d iterations\n", m.dice, m.volume_difference, out.result.iterations);
     EXPECT_GE(m.dice, 0.90) << "iterations " << out.result.iterations;
     EXPECT_LT(std::abs(m.volume_difference), 0.10);
+}
+
+// Seeds alone: the tissue model's window (no µ, ε given) reaches the documented hand-picked
+// window's Dice, and its edges lie at the midpoints of the truth's class means in the slab.
+TEST(BrainWeb, SeedsAloneReachTheHandPickedWindowOnTheSlab) {
+    const Slab& s = slab();
+    const double hand = slab_dice(s.t1, 94.0, 22.0);
+    SegmentOutcome out;
+    const double model = slab_dice(s.t1, std::nullopt, std::nullopt, &out);
+    std::printf("BrainWeb slab: hand-picked window dice %.4f, seeds alone %.4f\n", hand, model);
+    EXPECT_EQ(out.window_source, WindowSource::kModel);
+    EXPECT_GE(model, hand - 0.01);
+    EXPECT_TRUE(out.warnings.empty()) << out.warnings.front();
+    // Class means of the crisp labels inside the brain mask (the truth the window should follow).
+    const Grid<std::uint8_t> labels = crop(read_label_image(std::string(LIVESET_DATA_DIR) + "/brainweb/labels_crisp.nii.gz"),
+                                           {40, 50, 70}, {100, 120, 48});
+    double sum[4] = {0, 0, 0, 0}, n[4] = {0, 0, 0, 0};
+    for (std::size_t i = 0; i < labels.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if (s.brain[p] && labels[p] >= 1 && labels[p] <= 3) {
+            sum[labels[p]] += s.t1[p];
+            n[labels[p]] += 1;
+        }
+    }
+    const double csf = sum[1] / n[1], gm = sum[2] / n[2], wm = sum[3] / n[3];
+    ASSERT_TRUE(out.model_window.has_value());
+    EXPECT_NEAR(out.model_window->lower, 0.5 * (csf + gm), 6.0);
+    EXPECT_NEAR(out.model_window->upper, 0.5 * (gm + wm), 4.0);
+}
+
+// A scan from another scanner: other units (×7.3 + 300) and another contrast (γ 0.7 and 1.4
+// compress or stretch the dark end). The hand-picked window must be re-read off each histogram;
+// seeds alone need nothing and keep the Dice.
+TEST(BrainWeb, SeedsAloneFollowScaleAndContrastChanges) {
+    const Slab& s = slab();
+    const double reference = slab_dice(s.t1, std::nullopt, std::nullopt);
+    const auto variant = [&](auto f) {
+        Grid<float> g = s.t1;
+        for (float& v : g.values()) v = static_cast<float>(f(double(v)));
+        return g;
+    };
+    const double scaled = slab_dice(variant([](double v) { return 7.3 * v + 300.0; }), std::nullopt, std::nullopt);
+    const double soft = slab_dice(variant([](double v) { return 255.0 * std::pow(v / 255.0, 0.7); }), std::nullopt, std::nullopt);
+    const double hard = slab_dice(variant([](double v) { return 255.0 * std::pow(v / 255.0, 1.4); }), std::nullopt, std::nullopt);
+    std::printf("BrainWeb slab, seeds alone: dice %.4f; x7.3+300 %.4f; gamma 0.7 %.4f; gamma 1.4 %.4f\n", reference, scaled,
+                soft, hard);
+    EXPECT_NEAR(scaled, reference, 0.002);
+    EXPECT_GE(soft, reference - 0.01);
+    EXPECT_GE(hard, reference - 0.01);
+}
+
+// The acceptance run: the whole brain from eight seeds alone, inside the brain mask.
+TEST(BrainWeb, WholeBrainFromEightSeedsAlone) {
+    const std::string dir = std::string(LIVESET_DATA_DIR) + "/brainweb/";
+    const Grid<float> t1 = read_image(dir + "t1.mha");
+    const Grid<std::uint8_t> brain = read_label_image(dir + "brain_mask.nii.gz");
+    Grid<std::uint8_t> gm = read_label_image(dir + "labels_crisp.nii.gz");
+    for (std::uint8_t& v : gm.values()) v = v == 2;
+    SegmentRequest req;
+    for (const Vec3i p : {Vec3i{35, 83, 113}, Vec3i{35, 125, 38}, Vec3i{44, 164, 92}, Vec3i{71, 74, 53}, Vec3i{122, 149, 47},
+                          Vec3i{140, 86, 74}, Vec3i{38, 71, 26}, Vec3i{83, 23, 71}})
+        req.seeds.push_back({{double(p.x), double(p.y), double(p.z)}, 2.0});
+    req.roi = &brain;
+    const SegmentOutcome out = segment_image(t1, req);
+    const double dice = compare_overlap(out.mask, gm).dice;
+    std::printf("BrainWeb whole brain, 8 seeds alone: window %.1f .. %.1f, dice %.4f, %d iterations\n",
+                out.scale.to_raw(out.params.mu - out.params.epsilon), out.scale.to_raw(out.params.mu + out.params.epsilon), dice,
+                out.result.iterations);
+    EXPECT_EQ(out.window_source, WindowSource::kModel);
+    EXPECT_GE(dice, 0.92);
 }
