@@ -15,6 +15,7 @@
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
+#include "liveset/preprocess/bias_correction.hpp"
 
 namespace liveset::cli {
 
@@ -30,6 +31,8 @@ struct SegmentArgs {
     int iterations = 2000;
     std::string out_mask, out_phi, out_mesh, log;
     bool json = false, quiet = false;
+    bool bias_correct = false;  // N4 before everything else (the corrected image replaces the input)
+    std::string out_corrected;
 };
 
 int run_segment(const SegmentArgs& a, int threads) {
@@ -39,15 +42,25 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.out_phi.empty()) check_output_path(a.out_phi, OutputKind::kImage, "--out-phi");
     if (!a.out_mesh.empty()) check_output_path(a.out_mesh, OutputKind::kMesh, "--out-mesh");
     if (!a.log.empty()) check_output_path(a.log, OutputKind::kText, "--log");
+    if (!a.out_corrected.empty() && !a.bias_correct) throw UsageError("--out-corrected needs --bias-correct");
+    if (!a.out_corrected.empty()) check_output_path(a.out_corrected, OutputKind::kImage, "--out-corrected");
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");
     if (a.epsilon && a.epsilon_raw) throw UsageError("give --epsilon or --epsilon-raw, not both");
     if (a.seeds.empty() && a.seeds_mm.empty() && a.init_mask.empty())
         throw UsageError("give at least one --seed I,J,K[:R] (or --seed-mm, or --init-mask)");
 
-    const Grid<float> image = read_image(a.image);
+    Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> roi, init;
     if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
+    std::optional<BiasCorrectionReport> bias;
+    if (a.bias_correct) {  // fitted inside the ROI (Otsu's foreground without one)
+        image = correct_bias(image, roi ? &*roi : nullptr, {}, &bias.emplace(), &interrupt.flag());
+        if (bias->interrupted) {
+            if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
+            return 130;
+        }
+    }
 
     SegmentRequest req;
     for (const std::string& s : a.seeds) {
@@ -76,6 +89,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     const SegmentOutcome& o = run.outcome;
     write_label_image(o.mask, a.out_mask);
     if (!a.out_phi.empty()) write_image(o.field->phi(), a.out_phi);
+    if (!a.out_corrected.empty()) write_image(image, a.out_corrected);
     std::size_t triangles = 0;
     if (!a.out_mesh.empty()) {
         const Mesh mesh = marching_cubes_band(o.field->phi(), o.field->zero_layer());
@@ -84,9 +98,11 @@ int run_segment(const SegmentArgs& a, int threads) {
     }
 
     nlohmann::json j = segmentation_report(o, image.lattice());
+    if (bias) j["bias_correction"] = bias_correction_report(*bias);
     j["image"] = a.image;
     j["outputs"] = {{"mask", a.out_mask}};
     if (!a.out_phi.empty()) j["outputs"]["phi"] = a.out_phi;
+    if (!a.out_corrected.empty()) j["outputs"]["corrected"] = a.out_corrected;
     if (!a.out_mesh.empty()) {
         j["outputs"]["mesh"] = a.out_mesh;
         j["mesh_triangles"] = triangles;
@@ -95,8 +111,8 @@ int run_segment(const SegmentArgs& a, int threads) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
         print_segmentation_summary(j);
-        fmt::print("  wrote        {}{}{}\n", a.out_mask, a.out_phi.empty() ? "" : ", " + a.out_phi,
-                   a.out_mesh.empty() ? "" : ", " + a.out_mesh);
+        fmt::print("  wrote        {}{}{}{}\n", a.out_mask, a.out_phi.empty() ? "" : ", " + a.out_phi,
+                   a.out_mesh.empty() ? "" : ", " + a.out_mesh, a.out_corrected.empty() ? "" : ", " + a.out_corrected);
     }
     return 0;
 }
@@ -166,6 +182,8 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--out-phi", sa.out_phi, "output level-set function phi (float, <0 inside)");
     seg->add_option("--out-mesh", sa.out_mesh, "output surface mesh (.ply/.obj/.stl, LPS mm)");
     seg->add_option("--log", sa.log, "write one JSON line per iteration to this file");
+    seg->add_flag("--bias-correct", sa.bias_correct, "correct the intensity non-uniformity first (N4, fitted inside --roi or Otsu's foreground)");
+    seg->add_option("--out-corrected", sa.out_corrected, "write the bias-corrected image (float) here (needs --bias-correct)");
     seg->add_flag("--json", sa.json, "print the report as one JSON object on stdout");
     seg->add_flag("--quiet,-q", sa.quiet, "no progress line and no report");
     seg->callback([&threads] {

@@ -79,7 +79,23 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
     return j;
 }
 
+nlohmann::json bias_correction_report(const BiasCorrectionReport& r) {
+    const auto vec = [](Vec3i v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+    return {{"ms", r.ms}, {"n4_ms", r.n4_ms}, {"field_min", r.field_min}, {"field_max", r.field_max},
+            {"mask", r.otsu_mask ? "otsu" : "roi"}, {"mask_voxels", r.mask_voxels},
+            {"shrink_factors", vec(r.shrink_factors)}, {"shrunk_dims", vec(r.shrunk_dims)},
+            {"control_points", vec(r.control_points)}, {"level_iterations", r.level_iterations},
+            {"final_convergence", r.final_convergence}};
+}
+
 void print_segmentation_summary(const nlohmann::json& j) {
+    if (j.contains("bias_correction")) {
+        const nlohmann::json& b = j["bias_correction"];
+        fmt::print("  bias field   {:.3f} .. {:.3f} inside the {} ({:.2f} s, N4 on a {}x{}x{} grid)\n",
+                   b["field_min"].get<double>(), b["field_max"].get<double>(),
+                   b["mask"].get<std::string>() == "otsu" ? "Otsu foreground" : "ROI", b["ms"].get<double>() / 1000.0,
+                   b["shrunk_dims"][0].get<int>(), b["shrunk_dims"][1].get<int>(), b["shrunk_dims"][2].get<int>());
+    }
     fmt::print("  segmentation {} iterations ({}), {:.2f} s, {:.2f} ms/iteration\n", j["iterations"].get<int>(),
                j["stop"].get<std::string>(), j["seconds"].get<double>(), j["ms_per_iteration"].get<double>());
     fmt::print("  window       mu {:.4f} epsilon {:.4f} (raw {:.1f} +- {:.1f}{}), n {}, alpha {}\n", j["mu"].get<double>(),

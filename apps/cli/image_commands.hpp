@@ -8,6 +8,7 @@
 #include "liveset/eval/overlap.hpp"
 #include "liveset/eval/surface_distance.hpp"
 #include "liveset/eval/topology.hpp"
+#include "liveset/preprocess/bias_correction.hpp"
 #include "liveset/segment/pipeline.hpp"
 
 namespace liveset::cli {
@@ -37,6 +38,11 @@ SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest&
 
 // Parameters, iterations, timing and volume of a segmentation.
 nlohmann::json segmentation_report(const SegmentOutcome& outcome, const Lattice& lattice);
+// The report's "bias_correction" object: ms (whole correction) and n4_ms, field_min/field_max (the
+// multiplicative field's range inside the fit mask), mask ("roi" or "otsu") and mask_voxels,
+// shrink_factors, shrunk_dims, control_points, level_iterations, final_convergence.
+nlohmann::json bias_correction_report(const BiasCorrectionReport& report);
+// Prints the report's lines (with a bias-correction line when it holds "bias_correction").
 void print_segmentation_summary(const nlohmann::json& report);
 
 // `liveset eval` metrics of a mask against a truth mask: dice, jaccard, volume_difference,
