@@ -80,7 +80,7 @@ Grid<std::uint8_t> fit_mask(const Grid<float>& image, const Grid<std::uint8_t>* 
 
 // The shrunk grid: along each axis samples 0, f, 2f, ... up to the first one at or past the last
 // voxel (n_s = ceil((n-1)/f) + 1), so its span (n_s-1)·f covers the image's n-1 exactly or with a
-// few padding samples (value 0, outside the fit mask). Its voxel i·f is full-resolution voxel i·f,
+// few padding samples (value 0, outside the fit mask). Its voxel i is full-resolution voxel i·f,
 // so the B-spline domain of the fit maps onto the full grid without any resampling.
 struct ShrinkPlan {
     Vec3i factors{1, 1, 1};
