@@ -10,8 +10,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev  # tests and benchmarks
   libcli11-dev libfmt-dev nlohmann-json3-dev  # command line, formatting, JSON reports
   gnuplot-nox                                 # plots of the Figure 3 experiment
-  libinsighttoolkit5-dev zlib1g-dev           # image IO (NIfTI, MetaImage, NRRD, MINC, DICOM)
   minc-tools                                  # tests: MINC geometry checked with nii2mnc, mincinfo, worldtovoxel
+  libinsighttoolkit5-dev zlib1g-dev           # image IO (NIfTI, MetaImage, NRRD, MINC, DICOM); N4 bias correction
+  python3-nibabel python3-numpy               # scripts/brainweb_bias_variant.py (bias-correction benchmark)
   libglfw3-dev libepoxy-dev libimgui-dev      # viewer: window, OpenGL 3.3 loader, Dear ImGui
   libglm-dev libstb-dev                       # viewer: matrices, PNG screenshots
   libegl-dev libgl-dev libgl1-mesa-dri        # OpenGL / EGL (Mesa llvmpipe without a GPU; headless runs)

@@ -15,6 +15,7 @@
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
+#include "liveset/preprocess/bias_correction.hpp"
 
 namespace liveset::cli {
 
@@ -32,6 +33,8 @@ struct SegmentArgs {
     int iterations = 2000;
     std::string out_mask, out_phi, out_mesh, out_roi, log;
     bool json = false, quiet = false;
+    bool bias_correct = false;  // N4 before everything else (the corrected image replaces the input)
+    std::string out_corrected;
 };
 
 int run_segment(const SegmentArgs& a, int threads) {
@@ -43,15 +46,30 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.log.empty()) check_output_path(a.log, OutputKind::kText, "--log");
     if (!a.out_roi.empty()) check_output_path(a.out_roi, OutputKind::kImage, "--out-roi");
     if (!a.out_roi.empty() && a.roi.empty()) throw UsageError("--out-roi needs --roi (a mask or auto)");
+    if (!a.out_corrected.empty() && !a.bias_correct) throw UsageError("--out-corrected needs --bias-correct");
+    if (!a.out_corrected.empty()) check_output_path(a.out_corrected, OutputKind::kImage, "--out-corrected");
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");
     if (a.epsilon && a.epsilon_raw) throw UsageError("give --epsilon or --epsilon-raw, not both");
     if (a.seeds.empty() && a.seeds_mm.empty() && a.init_mask.empty())
         throw UsageError("give at least one --seed I,J,K[:R] (or --seed-mm, or --init-mask)");
 
-    const Grid<float> image = read_image(a.image);
+    Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> init;
     const std::optional<Roi> roi = load_roi(a.roi, image);
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
+    // Without an ROI, the automatic brain mask (when the image is a head) is where N4 and the
+    // tissue model are fitted: scalp fat and muscle would pull both off the brain.
+    std::optional<Grid<std::uint8_t>> fit_region;
+    if (!roi) fit_region = try_auto_brain_mask(image);
+    const Grid<std::uint8_t>* fit = roi ? &roi->mask : fit_region ? &*fit_region : nullptr;
+    std::optional<BiasCorrectionReport> bias;
+    if (a.bias_correct) {  // fitted inside `fit` (Otsu's foreground when there is none)
+        image = correct_bias(image, fit, {}, &bias.emplace(), &interrupt.flag());
+        if (bias->interrupted) {
+            if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
+            return 130;
+        }
+    }
 
     SegmentRequest req;
     for (const std::string& s : a.seeds) {
@@ -64,6 +82,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     }
     if (roi) req.roi = &roi->mask;
     if (init) req.initial_mask = &*init;
+    req.model_region = fit;
     req.n = a.n;
     req.alpha = a.alpha;
     req.loop.max_iterations = a.iterations;
@@ -83,6 +102,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     write_label_image(o.mask, a.out_mask);
     if (!a.out_phi.empty()) write_image(o.field->phi(), a.out_phi);
     if (!a.out_roi.empty()) write_label_image(roi->mask, a.out_roi);
+    if (!a.out_corrected.empty()) write_image(image, a.out_corrected);
     std::size_t triangles = 0;
     if (!a.out_mesh.empty()) {
         const Mesh mesh = marching_cubes_band(o.field->phi(), o.field->zero_layer());
@@ -91,11 +111,16 @@ int run_segment(const SegmentArgs& a, int threads) {
     }
 
     nlohmann::json j = segmentation_report(o, image.lattice());
+    if (bias) {
+        j["bias_correction"] = bias_correction_report(*bias);
+        j["bias_correction"]["mask"] = roi ? "roi" : fit_region ? "auto brain mask" : "otsu";
+    }
     j["image"] = a.image;
     j["outputs"] = {{"mask", a.out_mask}};
     if (roi) j["roi"] = roi_report(*roi);
     if (!a.out_roi.empty()) j["outputs"]["roi"] = a.out_roi;
     if (!a.out_phi.empty()) j["outputs"]["phi"] = a.out_phi;
+    if (!a.out_corrected.empty()) j["outputs"]["corrected"] = a.out_corrected;
     if (!a.out_mesh.empty()) {
         j["outputs"]["mesh"] = a.out_mesh;
         j["mesh_triangles"] = triangles;
@@ -105,8 +130,9 @@ int run_segment(const SegmentArgs& a, int threads) {
     } else if (!a.quiet) {
         print_segmentation_summary(j);
         if (roi) print_roi_summary(j["roi"]);
-        fmt::print("  wrote        {}{}{}{}\n", a.out_mask, a.out_phi.empty() ? "" : ", " + a.out_phi,
-                   a.out_mesh.empty() ? "" : ", " + a.out_mesh, a.out_roi.empty() ? "" : ", " + a.out_roi);
+        fmt::print("  wrote        {}{}{}{}{}\n", a.out_mask, a.out_phi.empty() ? "" : ", " + a.out_phi,
+                   a.out_mesh.empty() ? "" : ", " + a.out_mesh, a.out_roi.empty() ? "" : ", " + a.out_roi,
+                   a.out_corrected.empty() ? "" : ", " + a.out_corrected);
     }
     return 0;
 }
@@ -179,6 +205,8 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--out-mesh", sa.out_mesh, "output surface mesh (.ply/.obj/.stl, LPS mm)");
     seg->add_option("--out-roi", sa.out_roi, "write the region of interest used (e.g. the --roi auto brain mask, uint8 0/1)");
     seg->add_option("--log", sa.log, "write one JSON line per iteration to this file");
+    seg->add_flag("--bias-correct,!--no-bias-correct", sa.bias_correct, "correct the intensity non-uniformity first (N4, fitted inside --roi, else the automatic brain mask, else Otsu's foreground); recommended, see the README")->capture_default_str();
+    seg->add_option("--out-corrected", sa.out_corrected, "write the bias-corrected image (float) here (needs --bias-correct)");
     seg->add_flag("--json", sa.json, "print the report as one JSON object on stdout");
     seg->add_flag("--quiet,-q", sa.quiet, "no progress line and no report");
     seg->callback([&threads] {

@@ -34,6 +34,14 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
     }
 }
 
+std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image) {
+    try {
+        return auto_brain_mask(image);
+    } catch (const std::invalid_argument&) {
+        return std::nullopt;
+    }
+}
+
 nlohmann::json roi_report(const Roi& roi) {
     const Vec3d s = roi.mask.lattice().spacing();
     std::size_t voxels = 0;
@@ -133,7 +141,23 @@ nlohmann::json tissue_model_report(const TissueModel& m, const ModelWindow* w) {
     return j;
 }
 
+nlohmann::json bias_correction_report(const BiasCorrectionReport& r) {
+    const auto vec = [](Vec3i v) { return nlohmann::json::array({v.x, v.y, v.z}); };
+    return {{"ms", r.ms}, {"n4_ms", r.n4_ms}, {"field_min", r.field_min}, {"field_max", r.field_max},
+            {"mask", r.otsu_mask ? "otsu" : "roi"}, {"mask_voxels", r.mask_voxels},
+            {"shrink_factors", vec(r.shrink_factors)}, {"shrunk_dims", vec(r.shrunk_dims)},
+            {"control_points", vec(r.control_points)}, {"level_iterations", r.level_iterations},
+            {"final_convergence", r.final_convergence}};
+}
+
 void print_segmentation_summary(const nlohmann::json& j) {
+    if (j.contains("bias_correction")) {
+        const nlohmann::json& b = j["bias_correction"];
+        fmt::print("  bias field   {:.3f} .. {:.3f} inside the {} ({:.2f} s, N4 on a {}x{}x{} grid)\n",
+                   b["field_min"].get<double>(), b["field_max"].get<double>(),
+                   b["mask"].get<std::string>() == "otsu" ? "Otsu foreground" : b["mask"].get<std::string>(), b["ms"].get<double>() / 1000.0,
+                   b["shrunk_dims"][0].get<int>(), b["shrunk_dims"][1].get<int>(), b["shrunk_dims"][2].get<int>());
+    }
     fmt::print("  segmentation {} iterations ({}), {:.2f} s, {:.2f} ms/iteration\n", j["iterations"].get<int>(),
                j["stop"].get<std::string>(), j["seconds"].get<double>(), j["ms_per_iteration"].get<double>());
     if (j.contains("tissue_model")) {

@@ -10,6 +10,7 @@
 #include "liveset/eval/surface_distance.hpp"
 #include "liveset/eval/topology.hpp"
 #include "liveset/segment/brain_mask.hpp"
+#include "liveset/preprocess/bias_correction.hpp"
 #include "liveset/segment/pipeline.hpp"
 
 namespace liveset::cli {
@@ -28,6 +29,8 @@ struct Roi {
 // fails: constant image, no head, empty mask). Otherwise a mask file overlaying the image
 // (load_mask_like); a file named "auto" can be given as ./auto.
 std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option = "--roi");
+// auto_brain_mask(image), or nullopt when the image does not look like a head (no error).
+std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image);
 // {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".
 nlohmann::json roi_report(const Roi& roi);
 // One line: "  roi          auto brain mask: N voxels, V ml (...)".
@@ -59,6 +62,11 @@ nlohmann::json tissue_model_report(const TissueModel& model, const ModelWindow* 
 // Parameters, window (raw, with its source), tissue model, warnings, iterations, timing and
 // volume of a segmentation.
 nlohmann::json segmentation_report(const SegmentOutcome& outcome, const Lattice& lattice);
+// The report's "bias_correction" object: ms (whole correction) and n4_ms, field_min/field_max (the
+// multiplicative field's range inside the fit mask), mask ("roi" or "otsu") and mask_voxels,
+// shrink_factors, shrunk_dims, control_points, level_iterations, final_convergence.
+nlohmann::json bias_correction_report(const BiasCorrectionReport& report);
+// Prints the report's lines (with a bias-correction line when it holds "bias_correction").
 void print_segmentation_summary(const nlohmann::json& report);
 
 // `liveset eval` metrics of a mask against a truth mask: dice, jaccard, volume_difference,

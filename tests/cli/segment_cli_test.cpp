@@ -1,8 +1,9 @@
 // The image commands end to end through the real binary: phantom -> segment -> mesh -> eval, the
-// eval numbers against hand-made masks, Ctrl-C, and bad input (one line on stderr, non-zero exit,
-// no output file left behind).
+// eval numbers against hand-made masks, --bias-correct, Ctrl-C, and bad input (one line on stderr,
+// non-zero exit, no output file left behind).
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
@@ -20,6 +21,9 @@
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
+#include "liveset/preprocess/bias_correction.hpp"
+#include "liveset/segment/brain_mask.hpp"
+#include "liveset/segment/intensity.hpp"
 
 extern char** environ;
 
@@ -67,6 +71,22 @@ Grid<std::uint8_t> box_mask(Vec3i lo, Vec3i hi) {
         for (int y = lo.y; y < hi.y; ++y)
             for (int x = lo.x; x < hi.x; ++x) g({x, y, z}) = 1;
     return g;
+}
+
+// A 160^3 image of uniform noise in [100, 356), written once.
+fs::path big_noise_image() {
+    static const fs::path img = [] {
+        const fs::path path = work_dir() / "big.nii";
+        Grid<float> g(Lattice({160, 160, 160}));
+        std::uint32_t state = 12345;
+        for (float& v : g.values()) {
+            state = state * 1664525u + 1013904223u;
+            v = 100.0f + static_cast<float>(state >> 24);
+        }
+        write_image(g, path.string());
+        return path;
+    }();
+    return img;
 }
 
 }  // namespace
@@ -139,16 +159,7 @@ TEST(SegmentCli, EvalMatchesHandComputedOverlap) {
 TEST(SegmentCli, CtrlCStopsTheRunAndWritesNothing) {
     // A 160^3 noisy image whose every voxel is in the window: the front needs hundreds of
     // iterations to fill it, so the run is still going when Ctrl-C arrives.
-    const fs::path img = work_dir() / "big.nii";
-    {
-        Grid<float> g(Lattice({160, 160, 160}));
-        std::uint32_t state = 12345;
-        for (float& v : g.values()) {
-            state = state * 1664525u + 1013904223u;
-            v = 100.0f + static_cast<float>(state >> 24);
-        }
-        write_image(g, img.string());
-    }
+    const fs::path img = big_noise_image();
     const fs::path out = work_dir() / "interrupted.nii.gz";
     std::vector<std::string> args{LIVESET_CLI_PATH, "segment", img.string(), "--seed", "5,5,5",
                                   "--mu", "0.5", "--epsilon", "0.9", "--iterations", "100000", "--quiet",
@@ -168,6 +179,32 @@ TEST(SegmentCli, CtrlCStopsTheRunAndWritesNothing) {
     for (const auto& e : fs::directory_iterator(work_dir())) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);
 }
 
+TEST(SegmentCli, CtrlCDuringBiasCorrectionWritesNothing) {
+    // N4 on the 160^3 noise image's 41^3 samples runs for many seconds: Ctrl-C lands inside it.
+    const fs::path img = big_noise_image(), out = work_dir() / "interrupted_bc.nii.gz",
+                   corrected = work_dir() / "interrupted_corrected.nii.gz", err = work_dir() / "bc_stderr.txt";
+    std::vector<std::string> args{LIVESET_CLI_PATH, "segment", img.string(), "--seed", "5,5,5", "--bias-correct",
+                                  "--out-corrected", corrected.string(), "--out-mask", out.string()};
+    std::vector<char*> argv;
+    for (auto& s : args) argv.push_back(s.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    ASSERT_EQ(posix_spawn(&pid, LIVESET_CLI_PATH, &actions, nullptr, argv.data(), environ), 0);
+    posix_spawn_file_actions_destroy(&actions);
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    ::kill(pid, SIGINT);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_NE(slurp(err).find("interrupted during bias correction"), std::string::npos) << slurp(err);
+    EXPECT_FALSE(fs::exists(out));
+    EXPECT_FALSE(fs::exists(corrected));
+}
+
 TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
     const PhantomFiles& ph = phantom64();
     const std::string img = (ph.dir / "t1.nii.gz").string();
@@ -180,6 +217,10 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
     write_image(g, flat.string());
     Grid<std::uint8_t> small(Lattice({16, 16, 16}), 1);
     write_label_image(small, (work_dir() / "small_mask.nii.gz").string());
+    Grid<std::uint8_t> corner(read_image(img).lattice(), 0);  // one voxel, between N4's samples (every 4th)
+    corner({1, 1, 1}) = 1;
+    write_label_image(corner, (work_dir() / "corner_mask.nii.gz").string());
+    const fs::path corrected = work_dir() / "never_corrected.nii.gz";
     {  // a NIfTI file with a NaN voxel, written through ITK then patched (ITK refuses nothing on write)
         Grid<float> n(Lattice({8, 8, 8}), 1.0f);
         n[100] = 12345.0f;
@@ -209,6 +250,10 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
         {"segment " + img + " --seed 32,32,32 --alpha 1.5" + o, "alpha"},
         {"segment " + img + " --seed 32,32,32 --mu nan" + o, ""},
         {"segment " + img + " --seed 32,32,32 --roi " + (work_dir() / "small_mask.nii.gz").string() + o, "overlay"},
+        {"segment " + img + " --seed 32,32,32 --out-corrected " + corrected.string() + o, "needs --bias-correct"},
+        {"segment " + img + " --seed 32,32,32 --bias-correct --out-corrected " + corrected.string() + " --roi " +
+             (work_dir() / "corner_mask.nii.gz").string() + o, "no voxel on the shrunk grid"},
+        {"segment " + img + " --seed 32,32,32 --bias-correct --out-corrected /no/such/dir/c.nii.gz" + o, "does not exist"},
         {"segment " + img + " --seed 32,32,32 --out-mask /no/such/dir/m.nii.gz", "does not exist"},
         {"segment " + img + " --seed 32,32,32 --out-mask " + (work_dir() / "m.png").string(), "unknown image format"},
         {"segment " + img + " --seed 32,32,32 --out-mesh " + (work_dir() / "m.vtk").string() + o, "mesh format"},
@@ -231,8 +276,43 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
             EXPECT_NE(r.err.find(c.phrase), std::string::npos) << c.args << ": " << r.err;
         }
         EXPECT_FALSE(fs::exists(out)) << c.args;
+        EXPECT_FALSE(fs::exists(corrected)) << c.args;
         EXPECT_FALSE(fs::exists(work_dir() / "x.ply")) << c.args;
     }
+}
+
+// --bias-correct: the corrected image written by the CLI is the library's
+// correct_bias() of the input (fitted inside the automatic brain mask without --roi; the phantom
+// looks like a skull-stripped head), the segmentation ran on it (its intensity scale is the
+// corrected image's), and the report carries the field.
+TEST(SegmentCli, BiasCorrectSegmentsTheCorrectedImageAndWritesIt) {
+    const PhantomFiles& ph = phantom64();
+    const fs::path mask = work_dir() / "bc_seg.nii.gz", corrected = work_dir() / "bc_corrected.nii.gz";
+    const Result r = run_cli("segment " + (ph.dir / "t1.nii.gz").string() + ph.seeds + " --iterations 20 --bias-correct --json" +
+                             " --out-mask " + mask.string() + " --out-corrected " + corrected.string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    ASSERT_TRUE(j.contains("bias_correction")) << r.out;
+    const nlohmann::json& b = j["bias_correction"];
+    EXPECT_EQ(b["mask"], "auto brain mask");
+    EXPECT_LT(b["field_min"].get<double>(), 1.0);
+    EXPECT_GT(b["field_max"].get<double>(), 1.0);
+    EXPECT_GT(b["ms"].get<double>(), 0.0);
+    EXPECT_EQ(j["outputs"]["corrected"], corrected.string());
+
+    const Grid<float> input = read_image((ph.dir / "t1.nii.gz").string());
+    BiasCorrectionReport rep;
+    const Grid<std::uint8_t> brain = auto_brain_mask(input);
+    const Grid<float> expected = correct_bias(input, &brain, {}, &rep);
+    const Grid<float> written = read_image(corrected.string());
+    ASSERT_TRUE(written.lattice().same_geometry(input.lattice()));
+    for (std::size_t i = 0; i < expected.size(); ++i)
+        ASSERT_EQ(written[static_cast<PointIndex>(i)], expected[static_cast<PointIndex>(i)]) << i;
+    EXPECT_DOUBLE_EQ(b["field_min"].get<double>(), rep.field_min);
+    EXPECT_DOUBLE_EQ(b["field_max"].get<double>(), rep.field_max);
+    const IntensityScale scale = robust_scale(expected);
+    EXPECT_DOUBLE_EQ(j["intensity_scale"]["low"].get<double>(), scale.low);
+    EXPECT_DOUBLE_EQ(j["intensity_scale"]["high"].get<double>(), scale.high);
 }
 
 TEST(SegmentCli, DemoWritesItsOutputsAndAJsonReport) {

@@ -1,5 +1,5 @@
 // Image IO: reads 3D medical images (NIfTI, MetaImage, NRRD, MINC, DICOM series) into Grids and
-// writes Grids back, through ITK. This is liveset's only ITK user; this header includes no ITK.
+// writes Grids back, through ITK (with preprocess/, liveset's only ITK user); this header includes no ITK.
 //
 // Geometry follows ITK: world = origin + D * (spacing ⊙ ijk) in LPS, exactly as Lattice does, so
 // outputs overlay their inputs in ITK-SNAP, 3D Slicer and FSLeyes.

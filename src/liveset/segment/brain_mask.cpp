@@ -1,6 +1,7 @@
 // Automatic brain mask (see brain_mask.hpp): histogram thresholds, morphology in mm, and the test
 // that tells a skull-stripped input from a full head.
 #include "liveset/segment/brain_mask.hpp"
+#include "liveset/segment/tissue_model.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -73,31 +74,13 @@ std::vector<double> smoothed(const std::vector<double>& c, double sigma_bins) {
     return out;
 }
 
-// Three-class Otsu (maximal between-class variance) on a histogram: returns the first bins of the
-// middle and upper classes.
+// Three-class Otsu (tissue_model.hpp) on a histogram: returns the first bins of the middle and
+// upper classes.
 std::pair<int, int> otsu3(const std::vector<double>& h, const Histogram& geom) {
-    const int n = static_cast<int>(h.size());
-    std::vector<double> w(static_cast<std::size_t>(n) + 1, 0.0), m(static_cast<std::size_t>(n) + 1, 0.0);
-    for (int i = 0; i < n; ++i) {
-        w[static_cast<std::size_t>(i) + 1] = w[static_cast<std::size_t>(i)] + h[static_cast<std::size_t>(i)];
-        m[static_cast<std::size_t>(i) + 1] = m[static_cast<std::size_t>(i)] + h[static_cast<std::size_t>(i)] * geom.centre(i);
-    }
-    auto term = [&](int a, int b) {  // bins [a, b)
-        const double ww = w[static_cast<std::size_t>(b)] - w[static_cast<std::size_t>(a)];
-        const double mm = m[static_cast<std::size_t>(b)] - m[static_cast<std::size_t>(a)];
-        return ww > 0 ? mm * mm / ww : -std::numeric_limits<double>::infinity();
-    };
-    double best = -std::numeric_limits<double>::infinity();
-    std::pair<int, int> arg{1, 2};
-    for (int i = 1; i < n - 1; ++i)
-        for (int j = i + 1; j < n; ++j) {
-            const double v = term(0, i) + term(i, j) + term(j, n);
-            if (v > best) {
-                best = v;
-                arg = {i, j};
-            }
-        }
-    return arg;
+    std::vector<double> centres(h.size());
+    for (std::size_t i = 0; i < h.size(); ++i) centres[i] = geom.centre(static_cast<int>(i));
+    const std::vector<std::size_t> s = otsu_split_bins(h, centres, 3);
+    return {static_cast<int>(s[0]), static_cast<int>(s[1])};
 }
 
 void check_image(const Grid<float>& image) {

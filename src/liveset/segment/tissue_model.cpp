@@ -55,41 +55,13 @@ std::vector<Bin> histogram(std::vector<float> v, const TissueModelOptions& o, st
     return bins;
 }
 
-// Multi-level Otsu by dynamic programming: splits the bins into `k` runs maximising the
-// between-class variance (Σ S1²/S0 over the runs). Returns the first bin of runs 1..k-1.
 std::vector<std::size_t> otsu_splits(const std::vector<Bin>& bins, int k) {
-    const std::size_t n = bins.size();
-    std::vector<double> c0(n + 1, 0.0), c1(n + 1, 0.0);
-    for (std::size_t i = 0; i < n; ++i) {
-        c0[i + 1] = c0[i] + bins[i].count;
-        c1[i + 1] = c1[i] + bins[i].count * bins[i].mean;
+    std::vector<double> counts, centres;
+    for (const Bin& b : bins) {
+        counts.push_back(b.count);
+        centres.push_back(b.mean);
     }
-    const auto run = [&](std::size_t a, std::size_t b) {  // bins [a, b)
-        const double w = c0[b] - c0[a], s = c1[b] - c1[a];
-        return w > 0 ? s * s / w : 0.0;
-    };
-    const double none = -1.0;
-    // best[j][i]: best value splitting bins [0, i) into j + 1 runs; from[j][i]: start of the last.
-    std::vector<std::vector<double>> best(static_cast<std::size_t>(k), std::vector<double>(n + 1, none));
-    std::vector<std::vector<std::size_t>> from(best.size(), std::vector<std::size_t>(n + 1, 0));
-    for (std::size_t i = 1; i <= n; ++i) best[0][i] = run(0, i);
-    for (std::size_t j = 1; j < best.size(); ++j)
-        for (std::size_t i = j + 1; i <= n; ++i)
-            for (std::size_t a = j; a < i; ++a) {
-                if (best[j - 1][a] == none) continue;
-                const double v = best[j - 1][a] + run(a, i);
-                if (v > best[j][i]) {
-                    best[j][i] = v;
-                    from[j][i] = a;
-                }
-            }
-    std::vector<std::size_t> splits(static_cast<std::size_t>(k - 1));
-    std::size_t end = n;
-    for (std::size_t j = best.size() - 1; j >= 1; --j) {
-        end = from[j][end];
-        splits[j - 1] = end;
-    }
-    return splits;
+    return otsu_split_bins(counts, centres, k);
 }
 
 // Moments of the bins [a, b) as a class.
@@ -184,6 +156,45 @@ std::string degeneracy(const TissueModel& m) {
 }
 
 }  // namespace
+
+// Multi-level Otsu by dynamic programming: splits the bins into `k` runs maximising the
+// between-class variance (Σ S1²/S0 over the runs; the first maximum in bin order wins).
+std::vector<std::size_t> otsu_split_bins(std::span<const double> counts, std::span<const double> centres, int k) {
+    const std::size_t n = counts.size();
+    if (k < 2 || centres.size() != n || n < static_cast<std::size_t>(k))
+        throw std::invalid_argument("Otsu thresholds need at least as many bins as classes (and 2 classes or more)");
+    std::vector<double> c0(n + 1, 0.0), c1(n + 1, 0.0);
+    for (std::size_t i = 0; i < n; ++i) {
+        c0[i + 1] = c0[i] + counts[i];
+        c1[i + 1] = c1[i] + counts[i] * centres[i];
+    }
+    const auto run = [&](std::size_t a, std::size_t b) {  // bins [a, b)
+        const double w = c0[b] - c0[a], s = c1[b] - c1[a];
+        return w > 0 ? s * s / w : 0.0;
+    };
+    const double none = -1.0;
+    // best[j][i]: best value splitting bins [0, i) into j + 1 runs; from[j][i]: start of the last.
+    std::vector<std::vector<double>> best(static_cast<std::size_t>(k), std::vector<double>(n + 1, none));
+    std::vector<std::vector<std::size_t>> from(best.size(), std::vector<std::size_t>(n + 1, 0));
+    for (std::size_t i = 1; i <= n; ++i) best[0][i] = run(0, i);
+    for (std::size_t j = 1; j < best.size(); ++j)
+        for (std::size_t i = j + 1; i <= n; ++i)
+            for (std::size_t a = j; a < i; ++a) {
+                if (best[j - 1][a] == none) continue;
+                const double v = best[j - 1][a] + run(a, i);
+                if (v > best[j][i]) {
+                    best[j][i] = v;
+                    from[j][i] = a;
+                }
+            }
+    std::vector<std::size_t> splits(static_cast<std::size_t>(k - 1));
+    std::size_t end = n;
+    for (std::size_t j = best.size() - 1; j >= 1; --j) {
+        end = from[j][end];
+        splits[j - 1] = end;
+    }
+    return splits;
+}
 
 void TissueModelOptions::validate() const {
     if (classes < 2 || classes > 6) throw std::invalid_argument("the tissue model needs 2 to 6 classes");

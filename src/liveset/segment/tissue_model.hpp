@@ -91,6 +91,11 @@ struct ModelWindow {
 // voxels. Throws std::invalid_argument when the model is not usable or there are no seed values.
 ModelWindow model_window(const TissueModel& model, std::span<const float> seed_values);
 
+// Multi-level Otsu on a histogram (bin counts and the bins' intensities): the first bin of each
+// class after the first (k − 1 indices, ascending), maximising the between-class variance.
+// Throws std::invalid_argument with fewer bins than classes.
+std::vector<std::size_t> otsu_split_bins(std::span<const double> counts, std::span<const double> centres, int classes);
+
 // Multi-level Otsu thresholds (raw units, ascending) splitting `values` into `classes` classes on a
 // histogram of `bins` bins between their 0.1 and 99.9 % quantiles.
 std::vector<double> otsu_thresholds(std::span<const float> values, int classes, int bins = 256);
