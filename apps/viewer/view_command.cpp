@@ -29,6 +29,7 @@ struct ViewArgs {
     bool recover = false, no_autosave = false;
     double autosave_every = 120.0;
     std::string recovery_dir;
+    std::string window_from = "model";  // µ, ε from the seeds: the tissue model or the seeds' statistics
 };
 
 void parse_size(const std::string& text, int& w, int& h) {
@@ -52,6 +53,7 @@ std::unique_ptr<Session> load_session(const ViewArgs& a) {
     if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
     SessionOptions so;
     so.fragment_size = a.fragment_size;
+    so.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
     so.repair = demo_repair_options();
     const Lattice lattice = image.lattice();
     std::unique_ptr<Session> s;
@@ -186,6 +188,7 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--phi", va.phi, "start from this level set (< 0 inside)");
     v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave");
     v->add_option("--seed", va.seeds, "seed I,J,K[:R] (voxels); repeatable");
+    v->add_option("--window-from", va.window_from, "estimate the window from the tissue model (the seeds pick the class) or from the seeds' statistics, as `segment`")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     v->add_option("--seed-radius", va.seed_radius, "default seed radius, voxels")->check(CLI::PositiveNumber)->capture_default_str();
     v->add_flag("--headless", va.headless, "no window: render with EGL into an offscreen framebuffer (needs --script or --bench)");
     v->add_option("--script", va.script, "replay a session: JSON list of actions (see README)");

@@ -35,21 +35,9 @@ using Result = liveset::testing::CliResult;
 
 namespace {
 
-class MincCli : public ::testing::Test {
+class MincCli : public liveset::testing::MincFolderTest {
 protected:
-    void SetUp() override {
-        const std::string missing = liveset::testing::missing_minc_tools();
-        ASSERT_TRUE(missing.empty()) << missing;
-        dir_ = fs::temp_directory_path() / ("liveset_minc_cli_" + std::to_string(::getpid()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override {
-        std::error_code ec;
-        if (!std::getenv("LIVESET_KEEP")) fs::remove_all(dir_, ec);
-    }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    fs::path dir_;
+    MincCli() : MincFolderTest("liveset_minc_cli_") {}
 };
 
 // The phantom's voxels on an oblique lattice whose axes run roughly left-to-right,

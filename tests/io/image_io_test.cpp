@@ -19,11 +19,13 @@
 
 #include "dicom_writer.hpp"
 #include "liveset/io/image_io.hpp"
+#include "io/minc_tools.hpp"
 
 namespace liveset {
 namespace {
 
 namespace fs = std::filesystem;
+using testing::rotation;
 
 // A fresh folder per test, removed afterwards.
 class ImageIo : public ::testing::Test {
@@ -51,14 +53,6 @@ protected:
     fs::path dir_;
 };
 
-// Rotation by `deg` degrees about the (normalised) axis a: an oblique, proper direction matrix.
-Mat3d rotation(Vec3d a, double deg) {
-    a = a / norm(a);
-    const double t = deg * std::acos(-1.0) / 180.0, c = std::cos(t), s = std::sin(t), C = 1 - c;
-    return {c + a.x * a.x * C,       a.x * a.y * C - a.z * s, a.x * a.z * C + a.y * s,
-            a.y * a.x * C + a.z * s, c + a.y * a.y * C,       a.y * a.z * C - a.x * s,
-            a.z * a.x * C - a.y * s, a.z * a.y * C + a.x * s, c + a.z * a.z * C};
-}
 
 Lattice test_lattice() {
     return Lattice({7, 9, 11}, {0.7, 1.3, 2.1}, {-12.5, 30.25, 4.0}, rotation({1, 2, 3}, 25));

@@ -29,35 +29,14 @@ using testing::missing_minc_tools;
 using testing::numbers;
 using testing::ras_lps;
 using testing::shell_quote;
+using testing::rotation;
 
 // A fresh folder per test; fails the test up front when minc-tools are missing.
-class Minc : public ::testing::Test {
+class Minc : public testing::MincFolderTest {
 protected:
-    void SetUp() override {
-        const std::string missing = missing_minc_tools();
-        ASSERT_TRUE(missing.empty()) << missing;
-        dir_ = fs::temp_directory_path() /
-               ("liveset_minc_" + std::to_string(::getpid()) + "_" +
-                ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
-    void TearDown() override {
-        std::error_code ec;
-        if (!std::getenv("LIVESET_KEEP")) fs::remove_all(dir_, ec);
-    }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    fs::path dir_;
+    Minc() : MincFolderTest("liveset_minc_") {}
 };
 
-// Rotation by `deg` degrees about the axis a.
-Mat3d rotation(Vec3d a, double deg) {
-    a = a / norm(a);
-    const double t = deg * std::acos(-1.0) / 180.0, c = std::cos(t), s = std::sin(t), C = 1 - c;
-    return {c + a.x * a.x * C,       a.x * a.y * C - a.z * s, a.x * a.z * C + a.y * s,
-            a.y * a.x * C + a.z * s, c + a.y * a.y * C,       a.y * a.z * C - a.x * s,
-            a.z * a.x * C - a.y * s, a.z * a.y * C + a.x * s, c + a.z * a.z * C};
-}
 
 Mat3d product(const Mat3d& a, const Mat3d& b) {
     Mat3d p{};

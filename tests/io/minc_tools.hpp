@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -146,5 +147,36 @@ void expect_same_place(const Grid<T>& ref, const Grid<T>& got, double tol_mm = 0
     for (char h : hit) covered += h != 0;
     EXPECT_EQ(covered, ref.size()) << "not one to one";
 }
+
+// Rotation by `deg` degrees about the (normalised) axis a: an oblique, proper direction matrix.
+inline Mat3d rotation(Vec3d a, double deg) {
+    a = a / norm(a);
+    const double t = deg * std::acos(-1.0) / 180.0, c = std::cos(t), s = std::sin(t), C = 1 - c;
+    return {c + a.x * a.x * C,       a.x * a.y * C - a.z * s, a.x * a.z * C + a.y * s,
+            a.y * a.x * C + a.z * s, c + a.y * a.y * C,       a.y * a.z * C - a.x * s,
+            a.z * a.x * C - a.y * s, a.z * a.y * C + a.x * s, c + a.z * a.z * C};
+}
+
+// A fresh folder per test (named after `prefix`, the process and the test), removed afterwards
+// unless LIVESET_KEEP is set; fails the test up front when minc-tools are missing.
+class MincFolderTest : public ::testing::Test {
+protected:
+    explicit MincFolderTest(std::string prefix) : prefix_(std::move(prefix)) {}
+    void SetUp() override {
+        const std::string missing = missing_minc_tools();
+        ASSERT_TRUE(missing.empty()) << missing;
+        dir_ = std::filesystem::temp_directory_path() /
+               (prefix_ + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        std::filesystem::remove_all(dir_);
+        std::filesystem::create_directories(dir_);
+    }
+    void TearDown() override {
+        std::error_code ec;
+        if (!std::getenv("LIVESET_KEEP")) std::filesystem::remove_all(dir_, ec);
+    }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    std::string prefix_;
+    std::filesystem::path dir_;
+};
 
 }  // namespace liveset::testing

@@ -65,7 +65,8 @@ RepairRun scripted_repair() {
     write_text(dir / "segment.json", "[" + seeds + R"({"segment": "converge"},
         {"save_phi": ")" + (dir / "phi.nii.gz").string() + R"("}, {"save_mask": ")" + (dir / "seg.nii.gz").string() + R"("},
         {"eval": {"truth": ")" + truth + R"("}}])");
-    const CliResult seg = run_cli("view " + image + " --headless --script " + (dir / "segment.json").string());
+    // The seeds' statistics window, which the demo's repair presets were made for (as the demo).
+    const CliResult seg = run_cli("view " + image + " --window-from seeds --headless --script " + (dir / "segment.json").string());
     EXPECT_EQ(seg.rc, 0) << seg.err;
     const auto before = evals(seg.out);
     if (before.size() != 1u) {
