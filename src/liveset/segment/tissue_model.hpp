@@ -39,8 +39,8 @@ struct TissueModelOptions {
     double low_quantile = 0.001;   // voxels outside these quantiles of the region are left out
     double high_quantile = 0.999;
     bool partial_volume = true;    // mixed classes between neighbouring tissues
-    int max_iterations = 1000;
-    double tolerance = 1e-9;       // stop when the mean log-likelihood per voxel changes less
+    int max_iterations = 2000;
+    double tolerance = 1e-8;       // stop when the mean log-likelihood per voxel changes less
     void validate() const;         // std::invalid_argument with a one-line message
 };
 

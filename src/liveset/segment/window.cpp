@@ -53,6 +53,9 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
         TissueModel m = fit_tissue_model(image, &region, options);
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
         if (!m.note.empty()) warnings.push_back("tissue model: " + m.note);
+        if (m.usable() && !m.converged)
+            warnings.push_back("tissue model: EM stopped at its limit of " + std::to_string(options.max_iterations) +
+                               " iterations before converging (the class means still drift slowly)");
         return m;
     } catch (const std::invalid_argument& e) {
         warnings.push_back(std::string("no tissue model (") + e.what() + ")");
