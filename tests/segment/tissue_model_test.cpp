@@ -195,3 +195,32 @@ TEST(TissueModel, AnUnusableModelFallsBackToTheSeedsWithAWarning) {
     EXPECT_DOUBLE_EQ(w.mu, w.seed_stats->median);
     ASSERT_FALSE(w.warnings.empty());
 }
+
+// A skull-stripped image's constant background inside the region (between gyri, in the ventricles)
+// is a spike at the minimum no tissue makes: the model leaves it out and finds the same classes.
+TEST(TissueModel, TheBackgroundSpikeOfAStrippedImageIsLeftOut) {
+    std::vector<float> v = sample(kT1, 0.25, 60000, 10);
+    Grid<float> image(Lattice({static_cast<int>(v.size()) + 30000, 1, 1}), 0.0f);  // 30 000 background zeros
+    for (std::size_t i = 0; i < v.size(); ++i) image[static_cast<PointIndex>(i)] = v[i];
+    const TissueModel with = fit_tissue_model(image, nullptr), without = fit_tissue_model(v);
+    ASSERT_TRUE(with.usable()) << with.degenerate;
+    for (std::size_t c = 0; c < 3; ++c) EXPECT_NEAR(with.classes[c].mean, without.classes[c].mean, 1e-6) << c;
+}
+
+// A region with two tissues where three classes are asked for (a tight mask with next to no CSF):
+// the model drops to two classes, says so, and the window still reaches the GM/WM midpoint.
+TEST(TissueModel, TooManyClassesFallBackToFewerWithAWarning) {
+    const std::vector<float> v = sample({{97, 8, 0.6}, {131, 6, 0.3}}, 0.1, 60000, 11);
+    Grid<float> image(Lattice({static_cast<int>(v.size()), 1, 1}));
+    for (std::size_t i = 0; i < v.size(); ++i) image[static_cast<PointIndex>(i)] = v[i];
+    std::vector<std::string> warnings;
+    const std::optional<TissueModel> m = fit_window_model(image, Grid<std::uint8_t>(image.lattice(), 1), {}, warnings);
+    ASSERT_TRUE(m.has_value());
+    ASSERT_TRUE(m->usable()) << m->degenerate;
+    EXPECT_EQ(m->classes.size(), 2u);
+    ASSERT_FALSE(warnings.empty());
+    EXPECT_NE(warnings[0].find("2 used"), std::string::npos) << warnings[0];
+    const ModelWindow w = model_window(*m, std::vector<float>(20, 96.0f));
+    EXPECT_EQ(w.seed_class, 0);
+    EXPECT_NEAR(w.upper, (97 + 131) / 2.0, 1.5);
+}

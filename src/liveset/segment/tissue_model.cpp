@@ -278,6 +278,12 @@ TissueModel fit_tissue_model(const Grid<float>& image, const Grid<std::uint8_t>*
     for (std::size_t i = 0; i < values.size(); ++i)
         if (!region || (*region)[static_cast<PointIndex>(i)] != 0) v.push_back(values[i]);
     if (v.empty()) throw std::invalid_argument("the tissue model's region holds no voxel");
+    // A skull-stripped or masked image holds its background at one value, its minimum, often inside
+    // the region too (between gyri, in the ventricles): a spike no tissue makes. Left out when it
+    // is at least 1 % of the region.
+    const float low = *std::min_element(values.begin(), values.end());
+    const auto at_low = static_cast<std::size_t>(std::count(v.begin(), v.end(), low));
+    if (at_low * 100 >= v.size() && at_low < v.size()) std::erase(v, low);
     return fit_tissue_model(std::span<const float>(v), o);
 }
 

@@ -51,6 +51,17 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
                                             const TissueModelOptions& options, std::vector<std::string>& warnings) {
     try {
         TissueModel m = fit_tissue_model(image, &region, options);
+        // Fewer classes than asked for in the region (a tight mask with next to no CSF, a scan with
+        // two contrasts): one class fewer, down to two, before giving up on the model.
+        for (TissueModelOptions fewer = options; !m.usable() && fewer.classes > 2;) {
+            const std::string why = m.degenerate;
+            --fewer.classes;
+            TissueModel next = fit_tissue_model(image, &region, fewer);
+            if (next.usable())
+                warnings.push_back("tissue model: " + std::to_string(options.classes) + " classes do not fit (" + why + "); " +
+                                   std::to_string(fewer.classes) + " used");
+            m = std::move(next);
+        }
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
         if (!m.note.empty()) warnings.push_back("tissue model: " + m.note);
         if (m.usable() && !m.converged)
