@@ -12,8 +12,10 @@
 #include "demo_brain.hpp"
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"
+#include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_io.hpp"
+#include "headless_app.hpp"
 
 namespace liveset::cli {
 
@@ -88,6 +90,14 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     j["dice"] = ev["dice"];
     j["timings_ms"] = {{"bias_correction", bias.ms}, {"segment", 1000.0 * o.result.seconds}, {"mesh", mesh_ms}, {"eval", eval_ms}};
     j["outputs"] = a.out;
+    try {  // the surface seen from above (headless EGL; a warning where there is no OpenGL)
+        FragmentMesher mesher(t1.lattice(), 16);
+        mesher.full_rebuild(o.field->phi(), o.field->zero_layer());
+        viewer::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
+        j["screenshots"] = {{"surface", "surface.png"}};
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "liveset: warning: no picture: {}\n", e.what());
+    }
     write_atomically((dir / "report.json").string(), j.dump(2) + "\n");
     if (a.json) {
         fmt::print("{}\n", j.dump());
@@ -99,7 +109,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
         fmt::print("  mesh         {} triangles, {:.1f} ms\n", surface.triangle_count(), mesh_ms);
         fmt::print("  evaluation   against BrainWeb's grey-matter labels ({:.0f} ms):\n", eval_ms);
         print_evaluation(ev, "               ");
-        fmt::print("  outputs      {}/ (seg.nii.gz, phi.nii.gz, surface.ply, report.json)\n", a.out);
+        fmt::print("  outputs      {}/ (seg.nii.gz, phi.nii.gz, surface.ply, surface.png, report.json)\n", a.out);
     }
     return 0;
 }
