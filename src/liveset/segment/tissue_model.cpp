@@ -145,8 +145,10 @@ std::string degeneracy(const TissueModel& m) {
     for (std::size_t c = 0; c + 1 < m.classes.size(); ++c) {
         const TissueClass &a = m.classes[c], &b = m.classes[c + 1];
         // Two Gaussians of equal spread σ make two modes only when their means lie over 2σ apart;
-        // closer, the "classes" are pieces of one tissue (or tissues the image does not separate).
-        if (b.mean - a.mean < 2.0 * std::sqrt(0.5 * (a.sigma * a.sigma + b.sigma * b.sigma))) {
+        // closer, the "classes" are pieces of one tissue. With unequal spreads the narrower class
+        // stands out of the wider one when its mean lies over two of its own spreads from the other's
+        // (GM against a WM widened by a strong bias field).
+        if (b.mean - a.mean < 2.0 * std::min(a.sigma, b.sigma)) {
             os << "tissue classes " << c + 1 << " and " << c + 2 << " overlap (means " << a.mean << " and " << b.mean
                << " less than two spreads apart)";
             return os.str();

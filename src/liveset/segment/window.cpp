@@ -51,8 +51,8 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
                                             const TissueModelOptions& options, std::vector<std::string>& warnings) {
     try {
         TissueModel m = fit_tissue_model(image, &region, options);
-        // Fewer classes than asked for in the region (a tight mask with next to no CSF, a scan with
-        // two contrasts): one class fewer, down to two, before giving up on the model.
+        // Fewer tissues in the region than classes asked for (a tight mask with next to no CSF: a
+        // class under 1 %, or one tissue split in two): one class fewer, down to two.
         for (TissueModelOptions fewer = options; !m.usable() && fewer.classes > 2;) {
             const std::string why = m.degenerate;
             --fewer.classes;
