@@ -193,11 +193,13 @@ void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
 // ---------------------------------------------------------------------------------------------
 // Global step
 
-std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const StepOptions& options,
-                                                     double* dt_out) const {
-    if (!(options.cfl > 0.0f) || options.cfl > 0.5f || !std::isfinite(options.cfl))
-        throw std::invalid_argument("CFL number must be in (0, 0.5]");
-    if (!(options.max_dt > 0.0f)) throw std::invalid_argument("maximum time step must be positive");
+void validate(const StepOptions& o) {
+    if (!(o.cfl > 0.0f) || o.cfl > 0.5f || !std::isfinite(o.cfl)) throw std::invalid_argument("CFL number must be in (0, 0.5]");
+    if (!(o.max_dt > 0.0f)) throw std::invalid_argument("maximum time step must be positive");
+    if (o.mode != StepMode::kFullBand && o.mode != StepMode::kIncremental) throw std::invalid_argument("unknown step mode");
+}
+
+std::vector<double> SparseField::zero_rates(const Speed& speed) const {
     const auto zero = zero_layer();
     std::vector<double> rate(zero.size());
     parallel_range(zero.size(), [&](std::size_t n) {
@@ -208,6 +210,10 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
         if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi_, p));
         rate[n] = r;
     });
+    return rate;
+}
+
+double SparseField::time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const {
     double max_rate = 0.0;
     for (double r : rate) {
         if (!std::isfinite(r)) throw std::runtime_error("speed term returned a non-finite value");
@@ -216,6 +222,15 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
     double dt = options.max_dt;
     if (max_rate > 0.0) dt = std::min(dt, static_cast<double>(options.cfl) / max_rate);
     if (speed.curvature_weight() > 0.0f) dt = std::min(dt, 1.0 / (6.0 * speed.curvature_weight()));
+    return dt;
+}
+
+std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const StepOptions& options,
+                                                     double* dt_out) const {
+    validate(options);
+    const auto zero = zero_layer();
+    const std::vector<double> rate = zero_rates(speed);
+    const double dt = time_step(rate, speed, options);
     std::vector<ZeroLayerEdit> edits(zero.size());
     parallel_range(zero.size(), [&](std::size_t n) {
         edits[n] = {zero[n], static_cast<float>(std::clamp(dt * rate[n], -0.5, 0.5))};
@@ -232,6 +247,11 @@ void SparseField::sort_lists() {
 }
 
 StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
+    validate(options);
+    return options.mode == StepMode::kFullBand ? step_full_band(speed, options) : step_incremental(speed, options);
+}
+
+StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& options) {
     // Layer lists drift into a scattered order as points enter and leave; every few steps put
     // them back in lattice order so the sweeps below walk memory mostly forwards.
     if (++steps_since_sort_ >= 8) {
@@ -348,14 +368,17 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     }
     for (std::size_t k = 0; k < n; ++k) {
         const PointIndex i = edits[k].point;
+        // A point that keeps its layer and its bits changes nothing: not a seed of the region.
+        if (move[k] == 0 && std::bit_cast<std::uint32_t>(phi_[i]) == std::bit_cast<std::uint32_t>(old_phi[k])) continue;
         region.push_back({i, 0, old_phi[k]});
         status_[i] = move[k] > 0 ? kPendPos : (move[k] < 0 ? kPendNeg : kPendZero);
     }
 
     // 4. The region to re-layer: every point within Manhattan distance N of a changed point
     //    (a layer-k point depends on points up to k away, layer_value.hpp), or, for a global
-    //    update, the whole band plus its outer ring.
-    if (scope == RepairScope::kLocal) {
+    //    update, the whole band plus its outer ring. Where the balls would hold more points than
+    //    the band, the band is cheaper to collect (and gives the same bits).
+    if (scope == RepairScope::kLocal && region.size() * ball_.size() < 2 * band_size()) {
         const std::size_t seeds = region.size();
         for (std::size_t k = 0; k < seeds; ++k) collect_ball(region[k].point, region);
     } else {

@@ -45,10 +45,20 @@ enum class RepairScope {
     kGlobal,  // recompute the whole band (what a global update does)
 };
 
+// How a global step repairs the band (docs/ARCHITECTURE.md, "Incremental step").
+enum class StepMode {
+    kFullBand,     // the reference: re-layers the whole band and its outer ring every step
+    kIncremental,  // re-layers only around the zero-layer points whose value moved (same bits)
+};
+
 struct StepOptions {
     float cfl = 0.5f;        // largest |Δφ| of one step (at most 0.5, the sparse-field step bound)
     float max_dt = 1.0e9f;   // optional cap on the time step
+    StepMode mode = StepMode::kIncremental;
 };
+
+// Throws std::invalid_argument with a one-line message on an option out of range.
+void validate(const StepOptions& options);
 
 // One point's complete level-set state (φ and status), as recorded for undo and redo.
 struct PointState {
@@ -91,7 +101,8 @@ public:
 
     // --- updates ----------------------------------------------------------------------------
     // One global step of ∂φ/∂t = |∇φ| F with a CFL time step (|Δφ| ≤ cfl and the parabolic bound
-    // dt ≤ 1/(6·curvature weight)), multithreaded over the zero layer.
+    // dt ≤ 1/(6·curvature weight)), multithreaded over the zero layer. Both modes give the same φ,
+    // statuses and change report (as a set); kIncremental costs what moved, kFullBand the band.
     StepResult step(const Speed& speed, const StepOptions& options = {});
     // The Δφ a global step would apply (one edit per zero-layer point) and its time step.
     std::vector<ZeroLayerEdit> compute_step(const Speed& speed, const StepOptions& options, double* dt) const;
@@ -126,7 +137,13 @@ private:
     };
 
     void evaluate_sdf(const std::function<double(Vec3d)>& sdf);
+    std::vector<double> zero_rates(const Speed& speed) const;  // |∇φ|F at each zero-layer point
+    double time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const;
+    StepResult step_full_band(const Speed& speed, const StepOptions& options);
+    StepResult step_incremental(const Speed& speed, const StepOptions& options);  // incremental_step.cpp
     ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);  // timed repair_band
+    // scope kLocal switches to the whole band when the balls would cover more points than it holds
+    // (the same bits either way, see above).
     ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope);
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     void collect_band(std::vector<RegionPoint>& region);
