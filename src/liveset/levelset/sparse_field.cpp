@@ -111,6 +111,7 @@ void SparseField::list_remove(PointIndex i, int layer) {
 // Initialisation
 
 void SparseField::evaluate_sdf(const std::function<double(Vec3d)>& sdf) {
+    activity_.reset();  // a new front: everything awake again
     for (auto& l : lists_) l.clear();
     slot_.fill(kNoSlot);
     const Vec3i d = lattice().dims();
@@ -170,6 +171,7 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {
     for (PointIndex i : zero) collect_ball(i, region);
     sweep_layers(region);
     finish(region);
+    sign_changes_.clear();
 }
 
 void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
@@ -197,6 +199,8 @@ void validate(const StepOptions& o) {
     if (!(o.cfl > 0.0f) || o.cfl > 0.5f || !std::isfinite(o.cfl)) throw std::invalid_argument("CFL number must be in (0, 0.5]");
     if (!(o.max_dt > 0.0f)) throw std::invalid_argument("maximum time step must be positive");
     if (o.mode != StepMode::kFullBand && o.mode != StepMode::kIncremental) throw std::invalid_argument("unknown step mode");
+    if (o.sleep_after < 0 || o.sleep_after > 1'000'000)
+        throw std::invalid_argument("steps before a still stretch of front sleeps must be in [0, 1000000] (0: never)");
 }
 
 std::vector<double> SparseField::zero_rates(const Speed& speed) const {
@@ -248,7 +252,10 @@ void SparseField::sort_lists() {
 
 StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
     validate(options);
-    return options.mode == StepMode::kFullBand ? step_full_band(speed, options) : step_incremental(speed, options);
+    ++steps_;
+    StepResult result = options.mode == StepMode::kFullBand ? step_full_band(speed, options) : step_incremental(speed, options);
+    activity_.wake_near(sign_changes_, lattice(), steps_);  // a no-op until a sleeping step ran
+    return result;
 }
 
 StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& options) {
@@ -260,6 +267,7 @@ StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& op
     }
     StepResult result;
     result.zero_layer = zero_layer().size();
+    result.awake = result.zero_layer;
     const auto edits = compute_step(speed, options, &result.dt);
     result.changed = commit(edits, RepairScope::kGlobal);
     return result;
@@ -286,7 +294,9 @@ ChangedPoints SparseField::apply_edits(std::span<const ZeroLayerEdit> edits, Rep
     }
     merged.resize(out);
     for (auto& e : merged) e.delta = std::clamp(e.delta, -0.5f, 0.5f);
-    return commit(merged, scope);
+    ChangedPoints changed = commit(merged, scope);
+    activity_.wake_near(changed.points, lattice(), steps_);  // an edit wakes the front around it
+    return changed;
 }
 
 ChangedPoints SparseField::apply_in_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta) {
@@ -318,6 +328,7 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
 }
 
 ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
+    sign_changes_.clear();
     const std::size_t n = edits.size();
     if (n == 0) return {};
 
@@ -412,6 +423,7 @@ ChangedPoints SparseField::restore(std::span<const PointState> states) {
         phi_[i] = s.phi;
         changed.points.push_back(i);
     }
+    activity_.wake_near(changed.points, lattice(), steps_);  // so does an undo
     last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return changed;
 }
@@ -507,6 +519,7 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
         }
         if (s != r.old_status || std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(r.old_phi))
             changed.points.push_back(i);
+        if ((phi_[i] < 0.0f) != (r.old_phi < 0.0f)) sign_changes_.push_back(i);
     }
     return changed;
 }

@@ -23,6 +23,7 @@
 
 #include "liveset/grid/grid.hpp"
 #include "liveset/grid/index_decoder.hpp"
+#include "liveset/levelset/activity.hpp"
 #include "liveset/levelset/speed.hpp"
 
 namespace liveset {
@@ -55,6 +56,12 @@ struct StepOptions {
     float cfl = 0.5f;        // largest |Δφ| of one step (at most 0.5, the sparse-field step bound)
     float max_dt = 1.0e9f;   // optional cap on the time step
     StepMode mode = StepMode::kIncremental;
+    // Sleeping (kIncremental only; docs/ARCHITECTURE.md, "Activity"): a stretch of front where no
+    // point changed sign within 2-3 points for `sleep_after` steps sleeps - its zero-layer points
+    // are neither evaluated nor moved - until a sign change or an edit near it, or a new speed,
+    // wakes it. 0 (the default) never sleeps: the step is then the full-band step bit for bit.
+    // Segmentations use 20 (SegmentationOptions). At most 1 000 000.
+    int sleep_after = 0;
 };
 
 // Throws std::invalid_argument with a one-line message on an option out of range.
@@ -70,6 +77,7 @@ struct PointState {
 struct StepResult {
     double dt = 0.0;               // time step taken
     std::size_t zero_layer = 0;    // zero-layer size before the step
+    std::size_t awake = 0;         // zero-layer points evaluated (all of them unless sleeping)
     ChangedPoints changed;         // points whose φ or status changed
 };
 
@@ -163,6 +171,9 @@ private:
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
     int steps_since_sort_ = 0;
     double last_update_ms_ = 0.0;
+    std::int64_t steps_ = 0;                    // global steps taken (the activity's clock)
+    FrontActivity activity_;                    // sleeping stretches of front (kIncremental)
+    std::vector<PointIndex> sign_changes_;      // points whose sign of φ the last update changed
     IndexDecoder decoder_;  // division-free index -> coordinate for the hot loops
 };
 

@@ -24,10 +24,17 @@ struct SegmentationOptions {
     // across the front at the edge of the threshold window cancel out).
     int window = 20;
     double tolerance = 1e-3;
+    // The step: exact by default; `liveset segment` lets converged stretches of front sleep
+    // (step.sleep_after = kSegmentationSleepAfter, docs/ARCHITECTURE.md "Activity").
     StepOptions step;
 };
 
-// Throws std::invalid_argument for non-positive limits or a negative/non-finite tolerance.
+// The sleeping window a segmentation uses when it lets converged stretches of front sleep: as many
+// steps without a sign change nearby as the convergence window looks back over.
+inline constexpr int kSegmentationSleepAfter = 20;
+
+// Throws std::invalid_argument for non-positive limits, a negative/non-finite tolerance or bad step
+// options.
 void validate(const SegmentationOptions& options);
 
 struct SegmentationProgress {
