@@ -16,45 +16,21 @@
 #include <string>
 
 #include "liveset/grid/sampling.hpp"
+#include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/layer_value.hpp"
 
 namespace liveset {
 
 namespace {
 
-// Temporary status codes used only inside one update (never visible outside it).
-constexpr std::int8_t kPendPos = 100;   // to be re-layered, outside sign
-constexpr std::int8_t kPendNeg = -100;  // to be re-layered, inside sign
-constexpr std::int8_t kPendZero = 101;  // on the new zero layer
+using detail::for_each_neighbor6;
+using detail::is_temp;
+using detail::kPendNeg;
+using detail::kPendPos;
+using detail::kPendZero;
+using detail::parallel_range;
+
 constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;
-constexpr std::size_t kParallelMin = 4096;  // below this, loops run serially
-
-bool is_temp(std::int8_t s) { return s >= kPendPos || s <= kPendNeg; }
-
-template <class F>
-void for_each_neighbor6(const Lattice& lat, const IndexDecoder& decode, PointIndex i, F&& f) {
-    const Vec3i c = decode.coord(i);
-    const Vec3i d = lat.dims();
-    const auto sy = static_cast<PointIndex>(lat.stride_y());
-    const auto sz = static_cast<PointIndex>(lat.stride_z());
-    if (c.x > 0) f(i - 1);
-    if (c.x < d.x - 1) f(i + 1);
-    if (c.y > 0) f(i - sy);
-    if (c.y < d.y - 1) f(i + sy);
-    if (c.z > 0) f(i - sz);
-    if (c.z < d.z - 1) f(i + sz);
-}
-
-template <class F>
-void parallel_range(std::size_t n, F&& f) {
-    if (n < kParallelMin) {
-        for (std::size_t i = 0; i < n; ++i) f(i);
-        return;
-    }
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
-    });
-}
 
 std::string point_text(const Lattice& lat, PointIndex i) {
     const Vec3i c = lat.coord(i);
@@ -243,8 +219,9 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
     return edits;
 }
 
-void SparseField::sort_lists() {
+void SparseField::sort_lists(bool zero_only) {
     for (auto& list : lists_) {
+        if (zero_only && &list != &lists_[static_cast<std::size_t>(layers_)]) continue;
         std::sort(list.begin(), list.end());
         for (std::size_t k = 0; k < list.size(); ++k) slot_[list[k]] = static_cast<std::uint32_t>(k);
     }
@@ -385,19 +362,15 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         status_[i] = move[k] > 0 ? kPendPos : (move[k] < 0 ? kPendNeg : kPendZero);
     }
 
-    // 4. The region to re-layer: every point within Manhattan distance N of a changed point
-    //    (a layer-k point depends on points up to k away, layer_value.hpp), or, for a global
-    //    update, the whole band plus its outer ring. Where the balls would hold more points than
-    //    the band, the band is cheaper to collect (and gives the same bits).
-    if (scope == RepairScope::kLocal && region.size() * ball_.size() < 2 * band_size()) {
-        const std::size_t seeds = region.size();
-        for (std::size_t k = 0; k < seeds; ++k) collect_ball(region[k].point, region);
+    // 4-5. Outer layers from the new zero layer: a local update re-layers outwards from the
+    //    changed points only (relayer_changes, incremental_step.cpp); a global one the whole band
+    //    plus its outer ring. 6. Bookkeeping and the change report.
+    if (scope == RepairScope::kLocal) {
+        relayer_changes(region);
     } else {
         collect_band(region);
+        sweep_layers(region);
     }
-
-    // 5. Outer layers from the new zero layer; 6. bookkeeping and the change report.
-    sweep_layers(region);
     return finish(region);
 }
 

@@ -150,16 +150,17 @@ private:
     StepResult step_full_band(const Speed& speed, const StepOptions& options);
     StepResult step_incremental(const Speed& speed, const StepOptions& options);  // incremental_step.cpp
     ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);  // timed repair_band
-    // scope kLocal switches to the whole band when the balls would cover more points than it holds
-    // (the same bits either way, see above).
     ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope);
+    // Re-layers level by level from the pending points in `region` (the zero layer's changes),
+    // re-evaluating only what a change at the level below can reach; appends what it marks.
+    void relayer_changes(std::vector<RegionPoint>& region);  // incremental_step.cpp
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     void collect_band(std::vector<RegionPoint>& region);
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
     void sweep_layers(std::span<const RegionPoint> region);
     float inner_layer_value(PointIndex i, int k, bool outside) const;
     ChangedPoints finish(std::span<const RegionPoint> region);
-    void sort_lists();  // each layer list in ascending point order (values unchanged)
+    void sort_lists(bool zero_only = false);  // each (or the zero) layer list in ascending point order
     void list_add(PointIndex i, int layer);
     void list_remove(PointIndex i, int layer);
 
