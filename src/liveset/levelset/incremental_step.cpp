@@ -84,13 +84,10 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
 
 StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& options) {
     const auto start = std::chrono::steady_clock::now();
-    // Every 32 steps the zero layer's list goes back into lattice order, so that the scan below
-    // walks φ and the activity blocks mostly forwards (-8 % CPU on BrainWeb; the other lists are
-    // not walked by this step).
-    if (++steps_since_sort_ >= 32) {
-        sort_lists(true);
-        steps_since_sort_ = 0;
-    }
+    // Once an eighth of the zero-layer list has been reordered by insertions and removals, it goes
+    // back into lattice order, so that the scan below walks φ and the activity blocks mostly
+    // forwards (BrainWeb: -8 % CPU; never sorting makes the box flow 1.5x slower per step).
+    if (zero_reordered_ * 8 >= zero_layer().size()) sort_lists(true);
     StepResult result;
     const auto zero = zero_layer();
     result.zero_layer = zero.size();

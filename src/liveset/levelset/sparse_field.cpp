@@ -71,6 +71,7 @@ void SparseField::list_add(PointIndex i, int layer) {
     auto& list = lists_[static_cast<std::size_t>(layer + layers_)];
     slot_[i] = static_cast<std::uint32_t>(list.size());
     list.push_back(i);
+    if (layer == 0) ++zero_reordered_;
 }
 
 void SparseField::list_remove(PointIndex i, int layer) {
@@ -81,6 +82,7 @@ void SparseField::list_remove(PointIndex i, int layer) {
     slot_[last] = pos;
     list.pop_back();
     slot_[i] = kNoSlot;
+    if (layer == 0) ++zero_reordered_;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -220,6 +222,7 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
 }
 
 void SparseField::sort_lists(bool zero_only) {
+    zero_reordered_ = 0;
     for (auto& list : lists_) {
         if (zero_only && &list != &lists_[static_cast<std::size_t>(layers_)]) continue;
         std::sort(list.begin(), list.end());

@@ -171,6 +171,7 @@ private:
     std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
     int steps_since_sort_ = 0;
+    std::size_t zero_reordered_ = 0;  // zero-layer list insertions and removals since its last sort
     double last_update_ms_ = 0.0;
     std::int64_t steps_ = 0;                    // global steps taken (the activity's clock)
     FrontActivity activity_;                    // sleeping stretches of front (kIncremental)
