@@ -17,6 +17,7 @@ namespace {
 
 StepOptions sleeping(int after) {
     StepOptions o;
+    o.mode = StepMode::kIncremental;
     o.sleep_after = after;
     return o;
 }
@@ -146,6 +147,10 @@ TEST(Activity, SleepingKeepsTheSegmentationOfTheExactStep) {
 
 TEST(Activity, SleepAfterIsValidated) {
     StepOptions o;
+    o.sleep_after = 5;
+    EXPECT_THROW(validate(o), std::invalid_argument);  // sleeping needs the incremental step
+    o.mode = StepMode::kIncremental;
+    EXPECT_NO_THROW(validate(o));
     o.sleep_after = -1;
     EXPECT_THROW(validate(o), std::invalid_argument);
     o.sleep_after = 1'000'001;

@@ -176,6 +176,7 @@ TEST(FragmentMesher, IncrementalStepsWithSleepingFrontMatchFullRebuild) {
     f.init_from_sdf(shapes::Sphere({17.5, 16.5, 15.5}, 4.0));
     const testing::BlobSpeed speed({17.5, 16.5, 15.5}, 11.0);
     StepOptions options;
+    options.mode = StepMode::kIncremental;
     options.sleep_after = 8;
     FragmentMesher m(f.lattice(), 5);
     m.full_rebuild(f.phi());

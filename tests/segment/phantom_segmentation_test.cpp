@@ -47,14 +47,14 @@ TEST(PhantomSegmentation, DefaultsFromSeedsReachDiceAndLeaveHolesAtTheBias) {
 }
 
 TEST(PhantomSegmentation, SleepingFrontKeepsTheDiceOfTheExactStep) {
-    // Converged stretches of front sleeping (sleep_after = kSegmentationSleepAfter, as `liveset
-    // segment` runs) against the exact step (sleep_after = 0): the same Dice within 0.002.
+    // Converged stretches of front sleeping (sleeping_step(), as `liveset segment` runs) against
+    // the exact step (the default, full band): the same Dice within 0.002.
     const Phantom ph = make_phantom();
     SegmentRequest req;
     for (const Vec3i& s : ph.seeds) req.seeds.push_back({{double(s.x), double(s.y), double(s.z)}, 2.0});
-    req.loop.step.sleep_after = kSegmentationSleepAfter;
+    req.loop.step = sleeping_step();
     const SegmentOutcome fast = segment_image(ph.image, req);
-    req.loop.step.sleep_after = 0;
+    req.loop.step = StepOptions{};
     const SegmentOutcome exact = segment_image(ph.image, req);
     EXPECT_EQ(fast.result.reason, StopReason::kConverged);
     EXPECT_EQ(exact.result.reason, StopReason::kConverged);

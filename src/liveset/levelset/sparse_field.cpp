@@ -179,6 +179,8 @@ void validate(const StepOptions& o) {
     if (o.mode != StepMode::kFullBand && o.mode != StepMode::kIncremental) throw std::invalid_argument("unknown step mode");
     if (o.sleep_after < 0 || o.sleep_after > 1'000'000)
         throw std::invalid_argument("steps before a still stretch of front sleeps must be in [0, 1000000] (0: never)");
+    if (o.sleep_after > 0 && o.mode != StepMode::kIncremental)
+        throw std::invalid_argument("sleeping stretches of front need the incremental step (StepMode::kIncremental)");
 }
 
 std::vector<double> SparseField::zero_rates(const Speed& speed) const {

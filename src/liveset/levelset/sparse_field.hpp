@@ -49,18 +49,20 @@ enum class RepairScope {
 // How a global step repairs the band (docs/ARCHITECTURE.md, "Incremental step").
 enum class StepMode {
     kFullBand,     // the reference: re-layers the whole band and its outer ring every step
-    kIncremental,  // re-layers only around the zero-layer points whose value moved (same bits)
+    kIncremental,  // re-layers only outwards from what moved (same bits); can let stretches sleep
 };
 
 struct StepOptions {
     float cfl = 0.5f;        // largest |Δφ| of one step (at most 0.5, the sparse-field step bound)
     float max_dt = 1.0e9f;   // optional cap on the time step
-    StepMode mode = StepMode::kIncremental;
-    // Sleeping (kIncremental only; docs/ARCHITECTURE.md, "Activity"): a stretch of front where no
+    // The full-band reference by default: the fastest exact step when most of the front moves
+    // every step (a curvature flow, a growing segmentation); kIncremental costs what moves.
+    StepMode mode = StepMode::kFullBand;
+    // Sleeping (needs kIncremental; docs/ARCHITECTURE.md, "Activity"): a stretch of front where no
     // point changed sign within 2-3 points for `sleep_after` steps sleeps - its zero-layer points
     // are neither evaluated nor moved - until a sign change or an edit near it, or a new speed,
-    // wakes it. 0 (the default) never sleeps: the step is then the full-band step bit for bit.
-    // Segmentations use 20 (SegmentationOptions). At most 1 000 000.
+    // wakes it. 0 (the default) never sleeps: kIncremental is then the full-band step bit for bit.
+    // `liveset segment` uses 20 (sleeping_step(), segmentation.hpp). At most 1 000 000.
     int sleep_after = 0;
 };
 
