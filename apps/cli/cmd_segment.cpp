@@ -86,6 +86,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     req.n = a.n;
     req.alpha = a.alpha;
     req.loop.max_iterations = a.iterations;
+    req.loop.step = sleeping_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
     req.mu = a.mu;
     req.epsilon = a.epsilon;
     req.mu_raw = a.mu_raw;

@@ -8,6 +8,7 @@
 #include <bit>
 #include <cmath>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "liveset/levelset/invariants.hpp"
@@ -67,6 +68,37 @@ inline std::vector<ZeroLayerEdit> random_edit(const SparseField& f, std::mt19937
                 edits.push_back({i, a * static_cast<float>(std::exp(-d2 / (radius * radius)))});
             }
     return edits;
+}
+
+// A threshold-like speed on a synthetic "image": the front expands (F = -0.45) inside a blob with a
+// wavy surface and contracts (F = +0.45) outside it, plus a small curvature term - the regime of a
+// segmentation (growth, then a front that stalls, flickers and oscillates at the window's edge).
+// Points with x < still_below_x have F = 0: there the front stops dead, so only part of it moves.
+class BlobSpeed final : public Speed {
+public:
+    BlobSpeed(Vec3d centre, double radius, float curvature = 0.05f, int still_below_x = -1)
+        : c_(centre), r_(radius), w_(curvature), still_(still_below_x) {}
+    SpeedSample at(const Grid<float>& phi, Vec3i p) const override {
+        if (p.x < still_) return {};
+        const Vec3d d = p.cast<double>() - c_;
+        const double wave = 1.5 * std::sin(0.9 * d.x) * std::cos(0.7 * d.y) + std::sin(1.3 * d.z + 0.4 * d.x);
+        const float prop = norm(d) < r_ + wave ? -0.45f : 0.45f;
+        return {prop, w_ * mean_curvature(phi, p)};
+    }
+    float curvature_weight() const override { return w_; }
+
+private:
+    Vec3d c_;
+    double r_;
+    float w_;
+    int still_;
+};
+
+// Every point's state in `before` at the points of X (what an undo records).
+inline std::vector<PointState> states_at(const SparseField& before, std::span<const PointIndex> x) {
+    std::vector<PointState> out;
+    for (PointIndex i : x) out.push_back({i, before.phi()[i], before.status()[i]});
+    return out;
 }
 
 inline void expect_valid(const SparseField& f, const char* where) {

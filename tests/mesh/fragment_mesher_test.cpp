@@ -13,6 +13,8 @@
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
+#include "levelset/levelset_test_util.hpp"
+#include "liveset/levelset/shapes.hpp"
 #include "mesh/mesh_test_fields.hpp"
 
 namespace liveset {
@@ -165,6 +167,32 @@ TEST(FragmentMesher, IncrementalEditsMatchFullRebuild) {
     run_incremental(5, 12, 200);
     run_incremental(7, 13, 200);
     run_incremental(1000, 14, 150);
+}
+
+// The level set's own X: the incremental step with sleeping stretches of front (growth, stall,
+// flicker, plus local edits) fed to update() gives, after every step, the fragments of a rebuild.
+TEST(FragmentMesher, IncrementalStepsWithSleepingFrontMatchFullRebuild) {
+    SparseField f(Lattice({36, 34, 32}), 2);
+    f.init_from_sdf(shapes::Sphere({17.5, 16.5, 15.5}, 4.0));
+    const testing::BlobSpeed speed({17.5, 16.5, 15.5}, 11.0);
+    StepOptions options;
+    options.mode = StepMode::kIncremental;
+    options.sleep_after = 8;
+    FragmentMesher m(f.lattice(), 5);
+    m.full_rebuild(f.phi());
+    std::mt19937 rng(77);
+    std::size_t slept = 0;
+    for (int s = 1; s <= 160; ++s) {
+        const StepResult r = f.step(speed, options);
+        slept += r.zero_layer - r.awake;
+        m.update(f.phi(), r.changed.points);
+        if (s % 23 == 0) m.update(f.phi(), f.apply_edits(testing::random_edit(f, rng)).points);
+        FragmentMesher fresh(f.lattice(), 5);
+        fresh.full_rebuild(f.phi());
+        expect_same_meshers(m, fresh);
+        if (::testing::Test::HasFatalFailure()) FAIL() << "step " << s;
+    }
+    EXPECT_GT(slept, 10000u);  // the steps did let stretches of front sleep
 }
 
 TEST(FragmentMesher, FarFragmentsAreNotRebuilt) {

@@ -46,3 +46,21 @@ TEST(PhantomSegmentation, DefaultsFromSeedsReachDiceAndLeaveHolesAtTheBias) {
     const double near_rate = double(near_missed) / double(near_gm), far_rate = double(far_missed) / double(far_gm);
     EXPECT_GT(near_rate, 3.0 * far_rate) << near_rate << " vs " << far_rate;
 }
+
+TEST(PhantomSegmentation, SleepingFrontKeepsTheDiceOfTheExactStep) {
+    // Converged stretches of front sleeping (sleeping_step(), as `liveset segment` runs) against
+    // the exact step (the default, full band): the same Dice within 0.002.
+    const Phantom ph = make_phantom();
+    SegmentRequest req;
+    for (const Vec3i& s : ph.seeds) req.seeds.push_back({{double(s.x), double(s.y), double(s.z)}, 2.0});
+    req.loop.step = sleeping_step();
+    const SegmentOutcome fast = segment_image(ph.image, req);
+    req.loop.step = StepOptions{};
+    const SegmentOutcome exact = segment_image(ph.image, req);
+    EXPECT_EQ(fast.result.reason, StopReason::kConverged);
+    EXPECT_EQ(exact.result.reason, StopReason::kConverged);
+    const double dice_fast = compare_overlap(fast.mask, ph.truth).dice;
+    const double dice_exact = compare_overlap(exact.mask, ph.truth).dice;
+    EXPECT_NEAR(dice_fast, dice_exact, 0.002);
+    EXPECT_GE(compare_overlap(fast.mask, exact.mask).dice, 0.99);
+}

@@ -16,45 +16,21 @@
 #include <string>
 
 #include "liveset/grid/sampling.hpp"
+#include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/layer_value.hpp"
 
 namespace liveset {
 
 namespace {
 
-// Temporary status codes used only inside one update (never visible outside it).
-constexpr std::int8_t kPendPos = 100;   // to be re-layered, outside sign
-constexpr std::int8_t kPendNeg = -100;  // to be re-layered, inside sign
-constexpr std::int8_t kPendZero = 101;  // on the new zero layer
+using detail::for_each_neighbor6;
+using detail::is_temp;
+using detail::kPendNeg;
+using detail::kPendPos;
+using detail::kPendZero;
+using detail::parallel_range;
+
 constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;
-constexpr std::size_t kParallelMin = 4096;  // below this, loops run serially
-
-bool is_temp(std::int8_t s) { return s >= kPendPos || s <= kPendNeg; }
-
-template <class F>
-void for_each_neighbor6(const Lattice& lat, const IndexDecoder& decode, PointIndex i, F&& f) {
-    const Vec3i c = decode.coord(i);
-    const Vec3i d = lat.dims();
-    const auto sy = static_cast<PointIndex>(lat.stride_y());
-    const auto sz = static_cast<PointIndex>(lat.stride_z());
-    if (c.x > 0) f(i - 1);
-    if (c.x < d.x - 1) f(i + 1);
-    if (c.y > 0) f(i - sy);
-    if (c.y < d.y - 1) f(i + sy);
-    if (c.z > 0) f(i - sz);
-    if (c.z < d.z - 1) f(i + sz);
-}
-
-template <class F>
-void parallel_range(std::size_t n, F&& f) {
-    if (n < kParallelMin) {
-        for (std::size_t i = 0; i < n; ++i) f(i);
-        return;
-    }
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
-    });
-}
 
 std::string point_text(const Lattice& lat, PointIndex i) {
     const Vec3i c = lat.coord(i);
@@ -95,6 +71,7 @@ void SparseField::list_add(PointIndex i, int layer) {
     auto& list = lists_[static_cast<std::size_t>(layer + layers_)];
     slot_[i] = static_cast<std::uint32_t>(list.size());
     list.push_back(i);
+    if (layer == 0) ++zero_reordered_;
 }
 
 void SparseField::list_remove(PointIndex i, int layer) {
@@ -105,12 +82,14 @@ void SparseField::list_remove(PointIndex i, int layer) {
     slot_[last] = pos;
     list.pop_back();
     slot_[i] = kNoSlot;
+    if (layer == 0) ++zero_reordered_;
 }
 
 // ---------------------------------------------------------------------------------------------
 // Initialisation
 
 void SparseField::evaluate_sdf(const std::function<double(Vec3d)>& sdf) {
+    activity_.reset();  // a new front: everything awake again
     for (auto& l : lists_) l.clear();
     slot_.fill(kNoSlot);
     const Vec3i d = lattice().dims();
@@ -170,6 +149,7 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {
     for (PointIndex i : zero) collect_ball(i, region);
     sweep_layers(region);
     finish(region);
+    sign_changes_.clear();
 }
 
 void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
@@ -193,11 +173,17 @@ void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
 // ---------------------------------------------------------------------------------------------
 // Global step
 
-std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const StepOptions& options,
-                                                     double* dt_out) const {
-    if (!(options.cfl > 0.0f) || options.cfl > 0.5f || !std::isfinite(options.cfl))
-        throw std::invalid_argument("CFL number must be in (0, 0.5]");
-    if (!(options.max_dt > 0.0f)) throw std::invalid_argument("maximum time step must be positive");
+void validate(const StepOptions& o) {
+    if (!(o.cfl > 0.0f) || o.cfl > 0.5f || !std::isfinite(o.cfl)) throw std::invalid_argument("CFL number must be in (0, 0.5]");
+    if (!(o.max_dt > 0.0f)) throw std::invalid_argument("maximum time step must be positive");
+    if (o.mode != StepMode::kFullBand && o.mode != StepMode::kIncremental) throw std::invalid_argument("unknown step mode");
+    if (o.sleep_after < 0 || o.sleep_after > 1'000'000)
+        throw std::invalid_argument("steps before a still stretch of front sleeps must be in [0, 1000000] (0: never)");
+    if (o.sleep_after > 0 && o.mode != StepMode::kIncremental)
+        throw std::invalid_argument("sleeping stretches of front need the incremental step (StepMode::kIncremental)");
+}
+
+std::vector<double> SparseField::zero_rates(const Speed& speed) const {
     const auto zero = zero_layer();
     std::vector<double> rate(zero.size());
     parallel_range(zero.size(), [&](std::size_t n) {
@@ -208,6 +194,10 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
         if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi_, p));
         rate[n] = r;
     });
+    return rate;
+}
+
+double SparseField::time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const {
     double max_rate = 0.0;
     for (double r : rate) {
         if (!std::isfinite(r)) throw std::runtime_error("speed term returned a non-finite value");
@@ -216,6 +206,15 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
     double dt = options.max_dt;
     if (max_rate > 0.0) dt = std::min(dt, static_cast<double>(options.cfl) / max_rate);
     if (speed.curvature_weight() > 0.0f) dt = std::min(dt, 1.0 / (6.0 * speed.curvature_weight()));
+    return dt;
+}
+
+std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const StepOptions& options,
+                                                     double* dt_out) const {
+    validate(options);
+    const auto zero = zero_layer();
+    const std::vector<double> rate = zero_rates(speed);
+    const double dt = time_step(rate, speed, options);
     std::vector<ZeroLayerEdit> edits(zero.size());
     parallel_range(zero.size(), [&](std::size_t n) {
         edits[n] = {zero[n], static_cast<float>(std::clamp(dt * rate[n], -0.5, 0.5))};
@@ -224,14 +223,24 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
     return edits;
 }
 
-void SparseField::sort_lists() {
+void SparseField::sort_lists(bool zero_only) {
+    zero_reordered_ = 0;
     for (auto& list : lists_) {
+        if (zero_only && &list != &lists_[static_cast<std::size_t>(layers_)]) continue;
         std::sort(list.begin(), list.end());
         for (std::size_t k = 0; k < list.size(); ++k) slot_[list[k]] = static_cast<std::uint32_t>(k);
     }
 }
 
 StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
+    validate(options);
+    ++steps_;
+    StepResult result = options.mode == StepMode::kFullBand ? step_full_band(speed, options) : step_incremental(speed, options);
+    activity_.wake_near(sign_changes_, lattice(), steps_);  // a no-op until a sleeping step ran
+    return result;
+}
+
+StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& options) {
     // Layer lists drift into a scattered order as points enter and leave; every few steps put
     // them back in lattice order so the sweeps below walk memory mostly forwards.
     if (++steps_since_sort_ >= 8) {
@@ -240,6 +249,7 @@ StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
     }
     StepResult result;
     result.zero_layer = zero_layer().size();
+    result.awake = result.zero_layer;
     const auto edits = compute_step(speed, options, &result.dt);
     result.changed = commit(edits, RepairScope::kGlobal);
     return result;
@@ -266,7 +276,9 @@ ChangedPoints SparseField::apply_edits(std::span<const ZeroLayerEdit> edits, Rep
     }
     merged.resize(out);
     for (auto& e : merged) e.delta = std::clamp(e.delta, -0.5f, 0.5f);
-    return commit(merged, scope);
+    ChangedPoints changed = commit(merged, scope);
+    activity_.wake_near(changed.points, lattice(), steps_);  // an edit wakes the front around it
+    return changed;
 }
 
 ChangedPoints SparseField::apply_in_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta) {
@@ -298,6 +310,7 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
 }
 
 ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
+    sign_changes_.clear();
     const std::size_t n = edits.size();
     if (n == 0) return {};
 
@@ -348,22 +361,21 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     }
     for (std::size_t k = 0; k < n; ++k) {
         const PointIndex i = edits[k].point;
+        // A point that keeps its layer and its bits changes nothing: not a seed of the region.
+        if (move[k] == 0 && std::bit_cast<std::uint32_t>(phi_[i]) == std::bit_cast<std::uint32_t>(old_phi[k])) continue;
         region.push_back({i, 0, old_phi[k]});
         status_[i] = move[k] > 0 ? kPendPos : (move[k] < 0 ? kPendNeg : kPendZero);
     }
 
-    // 4. The region to re-layer: every point within Manhattan distance N of a changed point
-    //    (a layer-k point depends on points up to k away, layer_value.hpp), or, for a global
-    //    update, the whole band plus its outer ring.
+    // 4-5. Outer layers from the new zero layer: a local update re-layers outwards from the
+    //    changed points only (relayer_changes, incremental_step.cpp); a global one the whole band
+    //    plus its outer ring. 6. Bookkeeping and the change report.
     if (scope == RepairScope::kLocal) {
-        const std::size_t seeds = region.size();
-        for (std::size_t k = 0; k < seeds; ++k) collect_ball(region[k].point, region);
+        relayer_changes(region);
     } else {
         collect_band(region);
+        sweep_layers(region);
     }
-
-    // 5. Outer layers from the new zero layer; 6. bookkeeping and the change report.
-    sweep_layers(region);
     return finish(region);
 }
 
@@ -389,6 +401,7 @@ ChangedPoints SparseField::restore(std::span<const PointState> states) {
         phi_[i] = s.phi;
         changed.points.push_back(i);
     }
+    activity_.wake_near(changed.points, lattice(), steps_);  // so does an undo
     last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return changed;
 }
@@ -484,6 +497,7 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
         }
         if (s != r.old_status || std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(r.old_phi))
             changed.points.push_back(i);
+        if ((phi_[i] < 0.0f) != (r.old_phi < 0.0f)) sign_changes_.push_back(i);
     }
     return changed;
 }

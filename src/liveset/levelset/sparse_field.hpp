@@ -23,6 +23,7 @@
 
 #include "liveset/grid/grid.hpp"
 #include "liveset/grid/index_decoder.hpp"
+#include "liveset/levelset/activity.hpp"
 #include "liveset/levelset/speed.hpp"
 
 namespace liveset {
@@ -45,10 +46,28 @@ enum class RepairScope {
     kGlobal,  // recompute the whole band (what a global update does)
 };
 
+// How a global step repairs the band (docs/ARCHITECTURE.md, "Incremental step").
+enum class StepMode {
+    kFullBand,     // the reference: re-layers the whole band and its outer ring every step
+    kIncremental,  // re-layers only outwards from what moved (same bits); can let stretches sleep
+};
+
 struct StepOptions {
     float cfl = 0.5f;        // largest |Δφ| of one step (at most 0.5, the sparse-field step bound)
     float max_dt = 1.0e9f;   // optional cap on the time step
+    // The full-band reference by default: the fastest exact step when most of the front moves
+    // every step (a curvature flow, a growing segmentation); kIncremental costs what moves.
+    StepMode mode = StepMode::kFullBand;
+    // Sleeping (needs kIncremental; docs/ARCHITECTURE.md, "Activity"): a stretch of front where no
+    // point changed sign within 2-3 points for `sleep_after` steps sleeps - its zero-layer points
+    // are neither evaluated nor moved - until a sign change or an edit near it, or a new speed,
+    // wakes it. 0 (the default) never sleeps: kIncremental is then the full-band step bit for bit.
+    // `liveset segment` uses 20 (sleeping_step(), segmentation.hpp). At most 1 000 000.
+    int sleep_after = 0;
 };
+
+// Throws std::invalid_argument with a one-line message on an option out of range.
+void validate(const StepOptions& options);
 
 // One point's complete level-set state (φ and status), as recorded for undo and redo.
 struct PointState {
@@ -60,6 +79,7 @@ struct PointState {
 struct StepResult {
     double dt = 0.0;               // time step taken
     std::size_t zero_layer = 0;    // zero-layer size before the step
+    std::size_t awake = 0;         // zero-layer points evaluated (all of them unless sleeping)
     ChangedPoints changed;         // points whose φ or status changed
 };
 
@@ -91,7 +111,8 @@ public:
 
     // --- updates ----------------------------------------------------------------------------
     // One global step of ∂φ/∂t = |∇φ| F with a CFL time step (|Δφ| ≤ cfl and the parabolic bound
-    // dt ≤ 1/(6·curvature weight)), multithreaded over the zero layer.
+    // dt ≤ 1/(6·curvature weight)), multithreaded over the zero layer. Both modes give the same φ,
+    // statuses and change report (as a set); kIncremental costs what moved, kFullBand the band.
     StepResult step(const Speed& speed, const StepOptions& options = {});
     // The Δφ a global step would apply (one edit per zero-layer point) and its time step.
     std::vector<ZeroLayerEdit> compute_step(const Speed& speed, const StepOptions& options, double* dt) const;
@@ -126,15 +147,22 @@ private:
     };
 
     void evaluate_sdf(const std::function<double(Vec3d)>& sdf);
+    std::vector<double> zero_rates(const Speed& speed) const;  // |∇φ|F at each zero-layer point
+    double time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const;
+    StepResult step_full_band(const Speed& speed, const StepOptions& options);
+    StepResult step_incremental(const Speed& speed, const StepOptions& options);  // incremental_step.cpp
     ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);  // timed repair_band
     ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope);
+    // Re-layers level by level from the pending points in `region` (the zero layer's changes),
+    // re-evaluating only what a change at the level below can reach; appends what it marks.
+    void relayer_changes(std::vector<RegionPoint>& region);  // incremental_step.cpp
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     void collect_band(std::vector<RegionPoint>& region);
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
     void sweep_layers(std::span<const RegionPoint> region);
     float inner_layer_value(PointIndex i, int k, bool outside) const;
     ChangedPoints finish(std::span<const RegionPoint> region);
-    void sort_lists();  // each layer list in ascending point order (values unchanged)
+    void sort_lists(bool zero_only = false);  // each (or the zero) layer list in ascending point order
     void list_add(PointIndex i, int layer);
     void list_remove(PointIndex i, int layer);
 
@@ -145,7 +173,11 @@ private:
     std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
     int steps_since_sort_ = 0;
+    std::size_t zero_reordered_ = 0;  // zero-layer list insertions and removals since its last sort
     double last_update_ms_ = 0.0;
+    std::int64_t steps_ = 0;                    // global steps taken (the activity's clock)
+    FrontActivity activity_;                    // sleeping stretches of front (kIncremental)
+    std::vector<PointIndex> sign_changes_;      // points whose sign of φ the last update changed
     IndexDecoder decoder_;  // division-free index -> coordinate for the hot loops
 };
 

@@ -1,6 +1,7 @@
 // Mean curvature by the difference of normals, and the curvature speed term.
 #include "liveset/levelset/speed.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <stdexcept>
 
@@ -37,6 +38,11 @@ float half_point_normal_interior(const float* v, std::size_t i, const std::size_
 }
 
 }  // namespace
+
+std::uint64_t Speed::next_serial() {
+    static std::atomic<std::uint64_t> counter{0};
+    return ++counter;
+}
 
 float mean_curvature(const Grid<float>& phi, Vec3i p) {
     const Vec3i d = phi.dims();

@@ -3,6 +3,8 @@
 // (multiplied by the upwind |∇φ|) and a curvature part (multiplied by the central |∇φ|).
 #pragma once
 
+#include <cstdint>
+
 #include "liveset/grid/grid.hpp"
 
 namespace liveset {
@@ -14,12 +16,26 @@ struct SpeedSample {
 
 class Speed {
 public:
+    Speed() : serial_(next_serial()) {}
+    Speed(const Speed&) : serial_(next_serial()) {}
+    Speed& operator=(const Speed&) {
+        serial_ = next_serial();
+        return *this;
+    }
     virtual ~Speed() = default;
+    // Distinct for every speed object (a copy or an assignment gets a new one): a sparse field
+    // that lets converged stretches sleep wakes everything when the speed is not the last one's.
+    // A speed must therefore not change its behaviour after construction.
+    std::uint64_t serial() const { return serial_; }
     // F at zero-layer point p. Must be thread-safe (called concurrently) and deterministic.
     virtual SpeedSample at(const Grid<float>& phi, Vec3i p) const = 0;
     // Upper bound of the coefficient w in the curvature part w·κ, for the parabolic time-step
     // bound dt ≤ 1/(6w). Zero when the speed has no curvature part.
     virtual float curvature_weight() const = 0;
+
+private:
+    static std::uint64_t next_serial();
+    std::uint64_t serial_;
 };
 
 // Mean curvature κ = ∇·(∇φ/|∇φ|) (sum of principal curvatures, 2/r on a sphere) at lattice point p,

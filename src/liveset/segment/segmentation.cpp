@@ -13,6 +13,7 @@ void validate(const SegmentationOptions& o) {
     if (o.max_iterations < 1) throw std::invalid_argument("the iteration limit must be at least 1");
     if (o.window < 1) throw std::invalid_argument("the convergence window must be at least 1 iteration");
     if (!std::isfinite(o.tolerance) || o.tolerance < 0) throw std::invalid_argument("the convergence tolerance must be >= 0");
+    validate(o.step);
 }
 
 std::string to_string(StopReason reason) {

@@ -1,0 +1,43 @@
+// FrontActivity: which stretches of a sparse field's front are awake, for the incremental step's
+// sleeping rule (docs/ARCHITECTURE.md, "Activity"). The lattice is cut into blocks of 2×2×2
+// points; each block remembers the last step at which something woke it: a sign change of φ, or
+// any change made outside a step (a local edit, an undo), within one block of it - that is, within
+// 2 to 3 points. A zero-layer point is awake while its block was woken in the last `sleep_after`
+// steps. Everything is awake for `sleep_after` steps after the first step, a re-initialisation or
+// a new speed.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "liveset/grid/lattice.hpp"
+
+namespace liveset {
+
+class FrontActivity {
+public:
+    // Forgets everything (nothing allocated; the next begin_step wakes everything).
+    void reset();
+    bool enabled() const { return !stamp_.empty(); }
+    // Called by a sleeping step with the step number `now` (steps count from 1): allocates the
+    // blocks on first use, and wakes everything when the speed (by serial) is not the last one's.
+    void begin_step(const Lattice& lattice, std::uint64_t speed_serial, std::int64_t now);
+    // Wakes the blocks within one block of each point (no-op when not enabled).
+    void wake_near(std::span<const PointIndex> points, const Lattice& lattice, std::int64_t now);
+    // Whether lattice point p is awake at step `now` under the rule with window `sleep_after`.
+    bool awake(Vec3i p, std::int64_t now, int sleep_after) const {
+        const std::size_t b = static_cast<std::size_t>(p.x >> 1) +
+                              blocks_x_ * (static_cast<std::size_t>(p.y >> 1) + blocks_y_ * static_cast<std::size_t>(p.z >> 1));
+        const std::int64_t last = stamp_[b] > all_woken_at_ ? stamp_[b] : all_woken_at_;
+        return now - last <= sleep_after;
+    }
+
+private:
+    std::size_t blocks_x_ = 0, blocks_y_ = 0, blocks_z_ = 0;
+    std::vector<std::int64_t> stamp_;  // per block: the last step that woke it
+    std::int64_t all_woken_at_ = 0;
+    std::uint64_t speed_serial_ = 0;
+};
+
+}  // namespace liveset

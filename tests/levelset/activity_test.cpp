@@ -1,0 +1,160 @@
+// Sleeping stretches of front (StepOptions::sleep_after): a sleeping zero-layer point never moves
+// and the awake set is exactly the rule's (replayed by brute force from the history of sign changes,
+// edits and undos), X stays exactly the changed points, a new speed wakes everything, and sleeping
+// keeps the segmentation of the exact step.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <random>
+
+#include "levelset_test_util.hpp"
+#include "liveset/levelset/shapes.hpp"
+
+using namespace liveset;
+using namespace liveset::testing;
+
+namespace {
+
+StepOptions sleeping(int after) {
+    StepOptions o;
+    o.mode = StepMode::kIncremental;
+    o.sleep_after = after;
+    return o;
+}
+
+SparseField seed_field(double radius = 4.0) {
+    SparseField f(Lattice({40, 40, 40}), 2);
+    f.init_from_sdf(shapes::Sphere({20.5, 20.5, 17.5}, radius));
+    return f;
+}
+
+std::vector<PointIndex> sign_changes(const SparseField& before, const SparseField& after) {
+    std::vector<PointIndex> out;
+    for (std::size_t i = 0; i < before.phi().size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if ((before.phi()[p] < 0.0f) != (after.phi()[p] < 0.0f)) out.push_back(p);
+    }
+    return out;
+}
+
+// The rule replayed point by point: last[p] is the latest step at which a wake event happened at a
+// point w whose 2×2×2 block is within one block of p's (|⌊w/2⌋ − ⌊p/2⌋| ≤ 1 on every axis).
+class BruteForceActivity {
+public:
+    explicit BruteForceActivity(const Lattice& l) : lat_(l), last_(l.size(), -1000000) {}
+    void wake(std::span<const PointIndex> points, std::int64_t step) {
+        const Vec3i d = lat_.dims();
+        for (PointIndex w : points) {
+            const Vec3i c = lat_.coord(w);
+            for (int z = std::max(0, 2 * (c.z / 2 - 1)); z <= std::min(d.z - 1, 2 * (c.z / 2 + 1) + 1); ++z)
+                for (int y = std::max(0, 2 * (c.y / 2 - 1)); y <= std::min(d.y - 1, 2 * (c.y / 2 + 1) + 1); ++y)
+                    for (int x = std::max(0, 2 * (c.x / 2 - 1)); x <= std::min(d.x - 1, 2 * (c.x / 2 + 1) + 1); ++x) {
+                        auto& v = last_[lat_.index({x, y, z})];
+                        v = std::max<std::int64_t>(v, step);
+                    }
+        }
+    }
+    bool awake(PointIndex p, std::int64_t step, int after, std::int64_t all_woken_at) const {
+        return step - std::max(last_[p], all_woken_at) <= after;
+    }
+
+private:
+    Lattice lat_;
+    std::vector<std::int64_t> last_;
+};
+
+}  // namespace
+
+TEST(Activity, SleepingPointsNeverMoveAndTheAwakeSetIsTheRules) {
+    constexpr int kAfter = 6;
+    SparseField f = seed_field();
+    const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0);
+    BruteForceActivity brute(f.lattice());
+    std::mt19937 rng(21);
+    std::size_t slept = 0, edits_applied = 0;
+    for (std::int64_t s = 1; s <= 300; ++s) {
+        const SparseField before = f;
+        const StepResult r = f.step(speed, sleeping(kAfter));
+        // Brute force: which zero-layer points were awake, and a sleeping one keeps φ and status.
+        std::size_t awake = 0;
+        for (PointIndex p : before.zero_layer()) {
+            if (brute.awake(p, s, kAfter, 0)) {
+                ++awake;
+                continue;
+            }
+            ASSERT_EQ(std::bit_cast<std::uint32_t>(f.phi()[p]), std::bit_cast<std::uint32_t>(before.phi()[p])) << "step " << s;
+            ASSERT_EQ(f.status()[p], 0) << "step " << s;
+        }
+        ASSERT_EQ(r.awake, awake) << "step " << s;
+        slept += before.zero_layer().size() - awake;
+        ASSERT_EQ(sorted(r.changed.points), brute_force_changes(before, f)) << "step " << s;
+        const InvariantReport inv = check_invariants(f);
+        ASSERT_TRUE(inv.ok()) << "step " << s << ": " << inv.summary();
+        brute.wake(sign_changes(before, f), s);
+        if (s % 29 == 0) {  // undo the step: the restored points wake the front around them
+            const ChangedPoints x = f.restore(states_at(before, r.changed.points));
+            ASSERT_TRUE(same_state(f, before));
+            brute.wake(x.points, s);
+        }
+        if (s % 17 == 0) {  // a local edit wakes the front around it
+            const ChangedPoints x = f.apply_edits(random_edit(f, rng));
+            brute.wake(x.points, s);
+            edits_applied += x.size();
+        }
+    }
+    EXPECT_GT(slept, 100000u);  // the rule did put most of the stalled front to sleep
+    EXPECT_GT(edits_applied, 0u);
+}
+
+TEST(Activity, ANewSpeedOrANewFrontWakesEverything) {
+    SparseField f = seed_field();
+    const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0);
+    StepResult r;
+    for (int s = 0; s < 120; ++s) r = f.step(speed, sleeping(5));
+    ASSERT_GT(r.zero_layer, 1000u);
+    ASSERT_LT(r.awake, r.zero_layer / 2);  // most of the front sleeps by now
+    const BlobSpeed same_again = speed;    // a new speed object, even an equal one
+    r = f.step(same_again, sleeping(5));
+    EXPECT_EQ(r.awake, r.zero_layer);
+    for (int s = 0; s < 60; ++s) r = f.step(same_again, sleeping(5));
+    ASSERT_LT(r.awake, r.zero_layer / 2);
+    f.init_from_sdf(shapes::Sphere({20.5, 20.5, 17.5}, 6.0));
+    r = f.step(same_again, sleeping(5));
+    EXPECT_EQ(r.awake, r.zero_layer);
+}
+
+TEST(Activity, SleepingKeepsTheSegmentationOfTheExactStep) {
+    // Growth, stall and hundreds of steps of flicker: the inside sets agree to Dice ≥ 0.995 and the
+    // sleeping run evaluates far fewer points.
+    SparseField exact = seed_field(), fast = exact;
+    const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0);
+    std::size_t evaluated_exact = 0, evaluated_fast = 0;
+    for (int s = 0; s < 400; ++s) {
+        evaluated_exact += exact.step(speed, sleeping(0)).awake;
+        evaluated_fast += fast.step(speed, sleeping(20)).awake;
+    }
+    std::size_t both = 0, a = 0, b = 0;
+    for (std::size_t i = 0; i < exact.phi().size(); ++i) {
+        const bool in_a = exact.phi()[static_cast<PointIndex>(i)] < 0, in_b = fast.phi()[static_cast<PointIndex>(i)] < 0;
+        both += in_a && in_b;
+        a += in_a;
+        b += in_b;
+    }
+    EXPECT_GE(2.0 * double(both) / double(a + b), 0.995);
+    EXPECT_LT(evaluated_fast * 2, evaluated_exact);
+    expect_valid(fast, "after sleeping steps");
+}
+
+TEST(Activity, SleepAfterIsValidated) {
+    StepOptions o;
+    o.sleep_after = 5;
+    EXPECT_THROW(validate(o), std::invalid_argument);  // sleeping needs the incremental step
+    o.mode = StepMode::kIncremental;
+    EXPECT_NO_THROW(validate(o));
+    o.sleep_after = -1;
+    EXPECT_THROW(validate(o), std::invalid_argument);
+    o.sleep_after = 1'000'001;
+    EXPECT_THROW(validate(o), std::invalid_argument);
+    o.sleep_after = 1'000'000;
+    EXPECT_NO_THROW(validate(o));
+}
