@@ -11,9 +11,11 @@
 //   3. the outer layers are recomputed from the new zero layer, layer by layer (L±k from L±(k-1):
 //      φ = min/max over neighbours of φ ± 1, layer_value.hpp), as Jacobi sweeps over a region.
 // The layers are a pure function of the zero layer, its values and the points' signs, and each
-// point depends only on points within Manhattan distance N. So a *global* update (region = whole
-// band) and a *local* one (region = the N-ball around the changed points, cost proportional to the
-// points touched) give bitwise-identical φ and status, whatever the thread count.
+// point depends only on its neighbours one level further in. So a *global* update (region = whole
+// band) and a *local* one (re-layering outwards from what changed, level by level, cost
+// proportional to the points touched) give bitwise-identical φ and status, whatever the thread
+// count. A global step can be either (StepMode); the incremental one can also let converged
+// stretches of front sleep (StepOptions::sleep_after, activity.hpp).
 #pragma once
 
 #include <cstdint>
