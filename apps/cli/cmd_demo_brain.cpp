@@ -60,6 +60,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     SegmentRequest req;
     for (const Vec3i& s : kBrainSeeds) req.seeds.push_back({{double(s.x), double(s.y), double(s.z)}, 2.0});
     req.roi = &roi;
+    req.loop.step = sleeping_step();  // as `liveset segment`
     const SegmentRun run = segment_with_progress(t1, req, a.quiet || a.json);
     if (run.interrupted) {
         fmt::print(stderr, "liveset: interrupted; nothing written\n");
