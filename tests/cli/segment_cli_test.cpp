@@ -156,6 +156,30 @@ TEST(SegmentCli, EvalMatchesHandComputedOverlap) {
     EXPECT_NE(text.out.find("dice 0.6667"), std::string::npos) << text.out;
 }
 
+namespace {
+
+// Runs the CLI with `args`, sends SIGINT after 1.5 s and returns its exit status (-1 when it did
+// not exit normally); stderr goes to `err` when given.
+int run_and_interrupt(std::vector<std::string> args, const fs::path& err) {
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    if (!err.empty()) posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = 0;
+    const int spawned = posix_spawn(&pid, LIVESET_CLI_PATH, &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    if (spawned != 0) return -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    ::kill(pid, SIGINT);
+    int status = 0;
+    if (::waitpid(pid, &status, 0) != pid || !WIFEXITED(status)) return -1;
+    return WEXITSTATUS(status);
+}
+
+}  // namespace
+
 TEST(SegmentCli, CtrlCStopsTheRunAndWritesNothing) {
     // A 160^3 noisy image whose every voxel is in the window: the front needs hundreds of
     // iterations to fill it, so the run is still going when Ctrl-C arrives.
@@ -164,17 +188,7 @@ TEST(SegmentCli, CtrlCStopsTheRunAndWritesNothing) {
     std::vector<std::string> args{LIVESET_CLI_PATH, "segment", img.string(), "--seed", "5,5,5",
                                   "--mu", "0.5", "--epsilon", "0.9", "--iterations", "100000", "--quiet",
                                   "--out-mask", out.string()};
-    std::vector<char*> argv;
-    for (auto& s : args) argv.push_back(s.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, LIVESET_CLI_PATH, nullptr, nullptr, argv.data(), environ), 0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-    ::kill(pid, SIGINT);
-    int status = 0;
-    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_EQ(run_and_interrupt(args, {}), 130);
     EXPECT_FALSE(fs::exists(out));
     for (const auto& e : fs::directory_iterator(work_dir())) EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos);
 }
@@ -185,21 +199,7 @@ TEST(SegmentCli, CtrlCDuringBiasCorrectionWritesNothing) {
                    corrected = work_dir() / "interrupted_corrected.nii.gz", err = work_dir() / "bc_stderr.txt";
     std::vector<std::string> args{LIVESET_CLI_PATH, "segment", img.string(), "--seed", "5,5,5", "--bias-correct",
                                   "--out-corrected", corrected.string(), "--out-mask", out.string()};
-    std::vector<char*> argv;
-    for (auto& s : args) argv.push_back(s.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = 0;
-    ASSERT_EQ(posix_spawn(&pid, LIVESET_CLI_PATH, &actions, nullptr, argv.data(), environ), 0);
-    posix_spawn_file_actions_destroy(&actions);
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-    ::kill(pid, SIGINT);
-    int status = 0;
-    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-    ASSERT_TRUE(WIFEXITED(status));
-    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_EQ(run_and_interrupt(args, err), 130);
     EXPECT_NE(slurp(err).find("interrupted during bias correction"), std::string::npos) << slurp(err);
     EXPECT_FALSE(fs::exists(out));
     EXPECT_FALSE(fs::exists(corrected));
