@@ -44,9 +44,9 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     check_output_path((dir / "seg.nii.gz").string(), OutputKind::kImage, "--out");
 
     Grid<float> t1 = read_image((data / "t1.mha").string());
-    Grid<std::uint8_t> truth = load_mask_like((data / "labels_crisp.nii.gz").string(), t1.lattice(), "labels");
-    const Grid<std::uint8_t> labels = read_label_image((data / "labels_crisp.nii.gz").string());
-    for (std::size_t i = 0; i < truth.size(); ++i) truth[static_cast<PointIndex>(i)] = labels[static_cast<PointIndex>(i)] == 2;
+    Grid<std::uint8_t> truth = read_label_image((data / "labels_crisp.nii.gz").string());  // read once
+    if (!truth.lattice().same_geometry(t1.lattice())) throw UsageError("labels_crisp.nii.gz does not overlay t1.mha");
+    for (std::uint8_t& v : truth.values()) v = v == 2;  // grey matter
     const Grid<std::uint8_t> roi = load_mask_like((data / "brain_mask.nii.gz").string(), t1.lattice(), "brain mask");
 
     // As `liveset segment` does by default: N4 inside the brain mask first.
