@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"

@@ -1,5 +1,7 @@
-// Mesh writers (PLY/OBJ/STL, world coordinates, atomic temp-file + rename) and bounded readers.
+// Mesh writers (PLY/OBJ/STL, world coordinates, through the atomic file writer) and bounded readers.
 #include "liveset/mesh/mesh_io.hpp"
+
+#include "liveset/base/atomic_file.hpp"
 
 #include <algorithm>
 #include <array>
@@ -10,7 +12,6 @@
 #include <cstring>
 #include <fstream>
 #include <map>
-#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -172,30 +173,16 @@ void write_mesh(const fs::path& path, MeshView mesh, const Lattice& lattice) {
 void write_mesh(const fs::path& path, MeshView mesh, const Lattice& lattice, MeshFormat format) {
     check_indices(path, mesh);
     const std::vector<WorldVertex> world = to_world(mesh, lattice);
-    std::random_device rd;
-    fs::path tmp = path;
-    tmp += ".tmp-" + std::to_string(rd());
     try {
-        {
-            std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-            if (!os) fail(path, "cannot create temporary file " + tmp.string());
+        write_file_atomically(path, [&](std::ostream& os) {
             switch (format) {
                 case MeshFormat::ply: write_ply_body(os, world, mesh); break;
                 case MeshFormat::obj: write_obj_body(os, world, mesh); break;
                 case MeshFormat::stl: write_stl_body(os, world, mesh); break;
             }
-            os.flush();
-            if (!os) fail(path, "write error (disk full?)");
-            os.close();
-            if (os.fail()) fail(path, "error closing the file");
-        }
-        std::error_code ec;
-        fs::rename(tmp, path, ec);
-        if (ec) fail(path, "cannot rename temporary file (" + ec.message() + ")");
-    } catch (...) {
-        std::error_code ignore;
-        fs::remove(tmp, ignore);
-        throw;
+        });
+    } catch (const std::runtime_error& e) {
+        fail(path, e.what());
     }
 }
 

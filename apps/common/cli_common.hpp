@@ -1,5 +1,5 @@
-// Shared pieces of the CLI: validators for CLI11 options, the user-facing error type, and the
-// thread-count control every subcommand honours.
+// Shared pieces of the apps: validators for CLI11 options, the user-facing error type, the
+// thread-count control every subcommand honours, and atomic text output.
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -21,17 +21,8 @@ CLI::Validator finite_number();
 // Limits TBB to `threads` workers for the lifetime of the returned object (0 = all cores).
 std::shared_ptr<void> limit_threads(int threads);
 
-// Writes `text` to `path` through a temporary file in the same directory and a rename, so readers
+// Writes `text` to `path` through the atomic file writer (liveset/base/atomic_file.hpp), so readers
 // never see a half-written file. Throws UsageError when the file cannot be written.
 void write_atomically(const std::string& path, const std::string& text);
-
-// Each subcommand registers itself on the app.
-void add_flow_commands(CLI::App& app, const int& threads);
-void add_bench_commands(CLI::App& app, const int& threads);
-void add_segment_commands(CLI::App& app, const int& threads);
-void add_eval_commands(CLI::App& app, const int& threads);
-void add_demo_command(CLI::App& app, const int& threads);
-void add_repair_command(CLI::App& app, const int& threads);
-void add_soak_command(CLI::App* bench, const int& threads);  // `bench soak`
 
 }  // namespace liveset::cli
