@@ -140,6 +140,8 @@ std::vector<std::uint8_t> encode_recovery(const RecoveryView& state) {
     return out;
 }
 
+// Reads the format field by field in file order (the layout in recovery.hpp), so that it can be read
+// side by side with that layout: a little over 80 lines on purpose.
 RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
     Reader r(data, size);
     if (std::memcmp(r.take(8, "magic"), kMagic, 8) != 0) throw std::runtime_error("not a liveset recovery file (wrong magic)");
