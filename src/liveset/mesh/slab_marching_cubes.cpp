@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <memory>
 #include <stdexcept>
 
@@ -57,76 +58,163 @@ constexpr std::array<EdgeStart, mc::kEdges> kEdgeStarts = [] {
     return t;
 }();
 
+// make_edge_vertex() for an edge whose two endpoints have all 6 neighbours inside the lattice: the
+// same arithmetic in the same order (so bit-identical), from the linear index i of the start point.
+inline Vertex interior_edge_vertex(const float* v, std::size_t i, Vec3i p, int axis, std::size_t sy, std::size_t sz) {
+    const std::size_t step = axis == 0 ? 1 : axis == 1 ? sy : sz;
+    const std::size_t j = i + step;
+    const float a = v[i], b = v[j];
+    float t = a / (a - b);
+    if (!std::isfinite(t)) t = 0.5f;
+    t = std::clamp(t, kEdgeVertexMargin, 1.0f - kEdgeVertexMargin);
+    const float ga[3] = {(v[i + 1] - v[i - 1]) / 2.0f, (v[i + sy] - v[i - sy]) / 2.0f, (v[i + sz] - v[i - sz]) / 2.0f};
+    const float gb[3] = {(v[j + 1] - v[j - 1]) / 2.0f, (v[j + sy] - v[j - sy]) / 2.0f, (v[j + sz] - v[j - sz]) / 2.0f};
+    const float s = 1.0f - t;
+    const float n[3] = {s * ga[0] + t * gb[0], s * ga[1] + t * gb[1], s * ga[2] + t * gb[2]};
+    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    Vertex out{};
+    if (std::isfinite(len) && len > 1e-20f) {
+        const float inv = 1.0f / len;
+        for (int k = 0; k < 3; ++k) out.normal[k] = n[k] * inv;
+    } else {
+        out.normal[axis] = is_inside(a) ? 1.0f : -1.0f;
+    }
+    for (int k = 0; k < 3; ++k) out.position[k] = static_cast<float>(p[k]);
+    out.position[axis] = static_cast<float>(p[axis]) + t;
+    return out;
+}
+
+// The four point rows around cell row (y, z): corner bit k of a cell = row k>>1 at x + (k & 1).
+struct CellRows {
+    const std::uint64_t* r[4];  // (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1)
+    CellRows(const SignBits& s, int y, int z) : r{s.row(y, z), s.row(y + 1, z), s.row(y, z + 1), s.row(y + 1, z + 1)} {}
+
+    // Bit x - 64k set when cell x of the row has corners of both signs (cells x < ncx only).
+    std::uint64_t crossing(std::size_t k, std::size_t wpr, int ncx) const {
+        const std::uint64_t o = r[0][k] | r[1][k] | r[2][k] | r[3][k];
+        const std::uint64_t a = r[0][k] & r[1][k] & r[2][k] & r[3][k];
+        const bool more = k + 1 < wpr;
+        const std::uint64_t o1 = more ? (r[0][k + 1] | r[1][k + 1] | r[2][k + 1] | r[3][k + 1]) : 0;
+        const std::uint64_t a1 = more ? (r[0][k + 1] & r[1][k + 1] & r[2][k + 1] & r[3][k + 1]) : 0;
+        std::uint64_t cross = (o | (o >> 1) | (o1 << 63)) & ~(a & ((a >> 1) | (a1 << 63)));
+        const int valid = ncx - static_cast<int>(64 * k);
+        if (valid < 64) cross &= valid <= 0 ? 0 : (std::uint64_t{1} << valid) - 1;
+        return cross;
+    }
+    int cell_case(int x) const {
+        return bit(r[0], x) | bit(r[0], x + 1) << 1 | bit(r[1], x) << 2 | bit(r[1], x + 1) << 3 | bit(r[2], x) << 4 |
+               bit(r[2], x + 1) << 5 | bit(r[3], x) << 6 | bit(r[3], x + 1) << 7;
+    }
+};
+
+// Crossing edges (bits differing between neighbours) along x in one point row of nx points.
+inline std::size_t x_edge_count(const std::uint64_t* r, std::size_t wpr, int nx) {
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < wpr; ++k) {
+        std::uint64_t e = r[k] ^ ((r[k] >> 1) | (k + 1 < wpr ? r[k + 1] << 63 : 0));
+        const int valid = nx - 1 - static_cast<int>(64 * k);
+        if (valid < 64) e &= valid <= 0 ? 0 : (std::uint64_t{1} << valid) - 1;
+        n += static_cast<std::size_t>(std::popcount(e));
+    }
+    return n;
+}
+
+inline std::size_t diff_count(const std::uint64_t* a, const std::uint64_t* b, std::size_t wpr) {
+    std::size_t n = 0;
+    for (std::size_t k = 0; k < wpr; ++k) n += static_cast<std::size_t>(std::popcount(a[k] ^ b[k]));
+    return n;
+}
+
+// Sizes of a slab's output: the vertices it creates (every crossing edge of its cell layers
+// except the x/y edges of its bottom plane when a slab lies below) and its T entries.
+struct SlabCount {
+    std::size_t vertices = 0, indices = 0;
+};
+
+SlabCount count_slab(const SignBits& s, int z0, int z1) {
+    const Vec3i d = s.dims;
+    const std::size_t wpr = s.words_per_row;
+    SlabCount c;
+    for (int z = z0; z < z1; ++z) {
+        for (int y = 0; y + 1 < d.y; ++y) {
+            const CellRows rows(s, y, z);
+            for (std::size_t k = 0; k < wpr; ++k)
+                for (std::uint64_t cross = rows.crossing(k, wpr, d.x - 1); cross != 0; cross &= cross - 1)
+                    c.indices += 3u * mc::kTables.triangle_count[static_cast<std::size_t>(
+                                          rows.cell_case(static_cast<int>(64 * k) + std::countr_zero(cross)))];
+        }
+        for (int plane = (z == 0 ? 0 : z + 1); plane <= z + 1; ++plane)  // x/y edges of owned planes
+            for (int y = 0; y < d.y; ++y) {
+                c.vertices += x_edge_count(s.row(y, plane), wpr, d.x);
+                if (y + 1 < d.y) c.vertices += diff_count(s.row(y, plane), s.row(y + 1, plane), wpr);
+            }
+        for (int y = 0; y < d.y; ++y) c.vertices += diff_count(s.row(y, z), s.row(y, z + 1), wpr);  // z edges
+    }
+    return c;
+}
+
 // Index of an x- or y-edge within a z-plane of points: (y * dims.x + x) * 2 + axis.
 constexpr std::uint32_t kExternal = 0x8000'0000u;  // T entry naming a vertex of the slab below
 
-// One slab's output. Vertex ids in mesh.indices are local (creation order), except entries with
-// kExternal set: x/y-edge vertices of the slab's bottom plane, created by the slab below and named
-// by their plane edge index. `top` maps the plane edge index of the top plane to a local id.
-struct SlabOut {
-    Mesh mesh;
-    std::unique_ptr<std::uint32_t[]> top;
+// Where one slab writes: its vertices from `vertices` on with global ids from `first_id`, its T
+// entries from `indices` on. T entries of the bottom plane's x/y edges (created by the slab
+// below) are written as kExternal | plane edge index; `top` receives the global ids of the top
+// plane's x/y edges (plane edge index -> id).
+struct SlabTarget {
+    Vertex* vertices;
+    std::uint32_t* indices;
+    std::uint32_t first_id;
+    std::uint32_t* top;           // null for the last slab
+    std::size_t first_layer_end;  // out: T entries written by the first cell layer
 };
 
-// Polygonises cell layers [z0, z1) into a SlabOut; reusable (one per thread).
+// Polygonises cell layers [z0, z1); reusable (one per thread).
 class SlabWorker {
 public:
-    void run(const Grid<float>& phi, const SignBits& s, int z0, int z1, SlabOut& out);
+    SlabCount run(const Grid<float>& phi, const SignBits& s, int z0, int z1, SlabTarget& out);
 
 private:
     void renew(int slot) { generation_[slot] = std::uint64_t{next_generation_++} << 32; }
 
-    std::vector<std::uint64_t> g_;  // 2 slots * plane * 3: (generation << 32) | local id
+    std::vector<std::uint64_t> g_;  // 2 slots * plane * 3: (generation << 32) | global id
     std::array<std::uint64_t, 2> generation_{};
     std::uint64_t next_generation_ = 1;
 };
 
-void SlabWorker::run(const Grid<float>& phi, const SignBits& s, int z0, int z1, SlabOut& out) {
+SlabCount SlabWorker::run(const Grid<float>& phi, const SignBits& s, int z0, int z1, SlabTarget& out) {
     const Vec3i d = s.dims;
     const std::size_t plane = static_cast<std::size_t>(d.x) * static_cast<std::size_t>(d.y);
     if (g_.size() < 2 * plane * 3 || next_generation_ > 0xFFFF'FF00u) {
         g_.assign(2 * plane * 3, 0);  // generation 0 is never current
         next_generation_ = 1;
     }
-    const bool has_below = z0 > 0, has_above = z1 < d.z - 1;
-    if (has_above) out.top.reset(new std::uint32_t[plane * 2]);
     const auto& tables = mc::kTables;
-    const int ncx = d.x - 1;
     const std::size_t wpr = s.words_per_row;
-    Mesh& m = out.mesh;
-    std::uint32_t own = 0;
+    const float* values = phi.values().data();
+    const std::size_t sy = static_cast<std::size_t>(d.x), sz = plane;
+    SlabCount c;
     for (int z = z0; z < z1; ++z) {
         if (z == z0) {
             renew(0);
             renew(1);
         } else {
             renew((z + 1) & 1);  // plane z - 1 is done; its slot now holds plane z + 1
+            if (z == z0 + 1) out.first_layer_end = c.indices;
         }
         const int slot0 = z & 1;
-        const bool bottom_external = has_below && z == z0, top_record = has_above && z == z1 - 1;
+        const bool bottom_external = z0 > 0 && z == z0, top_record = out.top != nullptr && z == z1 - 1;
         for (int y = 0; y + 1 < d.y; ++y) {
-            const std::uint64_t* r00 = s.row(y, z);
-            const std::uint64_t* r10 = s.row(y + 1, z);
-            const std::uint64_t* r01 = s.row(y, z + 1);
-            const std::uint64_t* r11 = s.row(y + 1, z + 1);
+            const CellRows rows(s, y, z);
             for (std::size_t k = 0; k < wpr; ++k) {
-                const std::uint64_t o = r00[k] | r10[k] | r01[k] | r11[k];
-                const std::uint64_t a = r00[k] & r10[k] & r01[k] & r11[k];
-                const std::uint64_t o1 = k + 1 < wpr ? (r00[k + 1] | r10[k + 1] | r01[k + 1] | r11[k + 1]) : 0;
-                const std::uint64_t a1 = k + 1 < wpr ? (r00[k + 1] & r10[k + 1] & r01[k + 1] & r11[k + 1]) : 0;
-                std::uint64_t cross = (o | (o >> 1) | (o1 << 63)) & ~(a & ((a >> 1) | (a1 << 63)));
-                const int valid = ncx - static_cast<int>(64 * k);  // cells x < ncx only
-                if (valid < 64) cross &= valid <= 0 ? 0 : (std::uint64_t{1} << valid) - 1;
-                for (; cross != 0; cross &= cross - 1) {
+                for (std::uint64_t cross = rows.crossing(k, wpr, d.x - 1); cross != 0; cross &= cross - 1) {
                     const int x = static_cast<int>(64 * k) + std::countr_zero(cross);
-                    const int cs = bit(r00, x) | bit(r00, x + 1) << 1 | bit(r10, x) << 2 | bit(r10, x + 1) << 3 |
-                                   bit(r01, x) << 4 | bit(r01, x + 1) << 5 | bit(r11, x) << 6 | bit(r11, x + 1) << 7;
+                    const int cs = rows.cell_case(x);
                     std::uint32_t v[mc::kEdges];
                     for (unsigned mask = tables.edges[static_cast<std::size_t>(cs)]; mask != 0; mask &= mask - 1) {
                         const int e = std::countr_zero(mask);
                         const EdgeStart& es = kEdgeStarts[static_cast<std::size_t>(e)];
-                        const std::size_t pidx = static_cast<std::size_t>(y + es.dy) * static_cast<std::size_t>(d.x) +
-                                                 static_cast<std::size_t>(x + es.dx);
+                        const Vec3i p{x + es.dx, y + es.dy, z + es.dz};
+                        const std::size_t pidx = static_cast<std::size_t>(p.y) * sy + static_cast<std::size_t>(p.x);
                         if (bottom_external && es.dz == 0 && es.axis < 2) {
                             v[e] = kExternal | static_cast<std::uint32_t>(pidx * 2 + static_cast<std::size_t>(es.axis));
                             continue;
@@ -137,19 +225,25 @@ void SlabWorker::run(const Grid<float>& phi, const SignBits& s, int z0, int z1, 
                             v[e] = static_cast<std::uint32_t>(entry);
                             continue;
                         }
-                        if (own >= kExternal) throw std::length_error("mesh has too many vertices for 32-bit indices");
-                        m.vertices.push_back(make_edge_vertex(phi, {x + es.dx, y + es.dy, z + es.dz}, es.axis));
-                        entry = generation_[slot] | own;
-                        if (top_record && es.dz == 1 && es.axis < 2) out.top[pidx * 2 + static_cast<std::size_t>(es.axis)] = own;
-                        v[e] = own++;
+                        Vec3i q = p;
+                        q[es.axis] += 1;
+                        const bool interior = p.x >= 1 && p.y >= 1 && p.z >= 1 && q.x <= d.x - 2 && q.y <= d.y - 2 && q.z <= d.z - 2;
+                        out.vertices[c.vertices] = interior ? interior_edge_vertex(values, pidx + static_cast<std::size_t>(p.z) * sz, p, es.axis, sy, sz)
+                                                            : make_edge_vertex(phi, p, es.axis);
+                        const auto id = out.first_id + static_cast<std::uint32_t>(c.vertices++);
+                        entry = generation_[slot] | id;
+                        if (top_record && es.dz == 1 && es.axis < 2) out.top[pidx * 2 + static_cast<std::size_t>(es.axis)] = id;
+                        v[e] = id;
                     }
                     const auto& tri = tables.triangles[static_cast<std::size_t>(cs)];
                     const int n = 3 * tables.triangle_count[static_cast<std::size_t>(cs)];
-                    for (int j = 0; j < n; ++j) m.indices.push_back(v[tri[static_cast<std::size_t>(j)]]);
+                    for (int j = 0; j < n; ++j) out.indices[c.indices++] = v[tri[static_cast<std::size_t>(j)]];
                 }
             }
         }
     }
+    if (z1 == z0 + 1) out.first_layer_end = c.indices;
+    return c;
 }
 
 }  // namespace
@@ -181,36 +275,46 @@ Mesh marching_cubes_slabs(const Grid<float>& phi, const SlabMarchingCubesOptions
     const SignBits s = sign_bits(phi);
     const int layers = d.z - 1;
     const int nslabs = (layers + options.slab_layers - 1) / options.slab_layers;
-    std::vector<SlabOut> slabs(static_cast<std::size_t>(nslabs));
+    const auto slab_z = [&](int i) { return std::pair{i * options.slab_layers, std::min((i + 1) * options.slab_layers, layers)}; };
+    // Pass 1 (parallel): output sizes per slab, so that pass 2 writes in place in the naive order.
+    std::vector<SlabCount> counts(static_cast<std::size_t>(nslabs));
+    tbb::parallel_for(tbb::blocked_range<int>(0, nslabs, 1), [&](const tbb::blocked_range<int>& r) {
+        for (int i = r.begin(); i != r.end(); ++i) counts[static_cast<std::size_t>(i)] = count_slab(s, slab_z(i).first, slab_z(i).second);
+    });
+    std::vector<std::size_t> voff(counts.size() + 1, 0), ioff(counts.size() + 1, 0);
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+        voff[i + 1] = voff[i] + counts[i].vertices;
+        ioff[i + 1] = ioff[i] + counts[i].indices;
+    }
+    if (voff.back() >= kExternal) throw std::length_error("mesh has too many vertices for 32-bit indices");
+    result.vertices.resize(voff.back());
+    result.indices.resize(ioff.back());
+    const std::size_t plane_edges = static_cast<std::size_t>(d.x) * static_cast<std::size_t>(d.y) * 2;
+    std::vector<std::unique_ptr<std::uint32_t[]>> tops(counts.size());
+    std::vector<SlabTarget> targets(counts.size());
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+        if (i + 1 < counts.size()) tops[i].reset(new std::uint32_t[plane_edges]);
+        targets[i] = {result.vertices.data() + voff[i], result.indices.data() + ioff[i], static_cast<std::uint32_t>(voff[i]),
+                      tops[i].get(), 0};
+    }
+    // Pass 2 (parallel): polygonise every slab in place.
     tbb::enumerable_thread_specific<SlabWorker> workers;
     tbb::parallel_for(tbb::blocked_range<int>(0, nslabs, 1), [&](const tbb::blocked_range<int>& r) {
         SlabWorker& w = workers.local();
         for (int i = r.begin(); i != r.end(); ++i) {
-            const int z0 = i * options.slab_layers;
-            w.run(phi, s, z0, std::min(z0 + options.slab_layers, layers), slabs[static_cast<std::size_t>(i)]);
+            const auto k = static_cast<std::size_t>(i);
+            const SlabCount c = w.run(phi, s, slab_z(i).first, slab_z(i).second, targets[k]);
+            if (c.vertices != counts[k].vertices || c.indices != counts[k].indices)
+                throw std::logic_error("marching_cubes_slabs: slab output differs from its count");
         }
     });
-    // Stitch: slab i's own vertices follow those of slabs < i (the naive creation order).
-    std::vector<std::size_t> voff(slabs.size() + 1, 0), ioff(slabs.size() + 1, 0);
-    for (std::size_t i = 0; i < slabs.size(); ++i) {
-        voff[i + 1] = voff[i] + slabs[i].mesh.vertices.size();
-        ioff[i + 1] = ioff[i] + slabs[i].mesh.indices.size();
-    }
-    if (voff.back() >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
-    result.vertices.resize(voff.back());
-    result.indices.resize(ioff.back());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, slabs.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
+    // Pass 3 (parallel): the first layer of each slab names bottom-plane vertices of the slab below.
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(1, counts.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const Mesh& m = slabs[i].mesh;
-            std::copy(m.vertices.begin(), m.vertices.end(), result.vertices.begin() + static_cast<std::ptrdiff_t>(voff[i]));
-            const auto base = static_cast<std::uint32_t>(voff[i]);
-            const auto below = i > 0 ? static_cast<std::uint32_t>(voff[i - 1]) : 0u;
-            const std::uint32_t* top = i > 0 ? slabs[i - 1].top.get() : nullptr;
-            std::uint32_t* dst = result.indices.data() + ioff[i];
-            for (std::size_t j = 0; j < m.indices.size(); ++j) {
-                const std::uint32_t id = m.indices[j];
-                dst[j] = (id & kExternal) != 0 ? below + top[id & ~kExternal] : base + id;
-            }
+            std::uint32_t* t = targets[i].indices;
+            const std::uint32_t* top = tops[i - 1].get();
+            for (std::size_t j = 0; j < targets[i].first_layer_end; ++j)
+                if ((t[j] & kExternal) != 0) t[j] = top[t[j] & ~kExternal];
         }
     });
     return result;
