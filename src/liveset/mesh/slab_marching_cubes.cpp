@@ -58,32 +58,6 @@ constexpr std::array<EdgeStart, mc::kEdges> kEdgeStarts = [] {
     return t;
 }();
 
-// make_edge_vertex() for an edge whose two endpoints have all 6 neighbours inside the lattice: the
-// same arithmetic in the same order (so bit-identical), from the linear index i of the start point.
-inline Vertex interior_edge_vertex(const float* v, std::size_t i, Vec3i p, int axis, std::size_t sy, std::size_t sz) {
-    const std::size_t step = axis == 0 ? 1 : axis == 1 ? sy : sz;
-    const std::size_t j = i + step;
-    const float a = v[i], b = v[j];
-    float t = a / (a - b);
-    if (!std::isfinite(t)) t = 0.5f;
-    t = std::clamp(t, kEdgeVertexMargin, 1.0f - kEdgeVertexMargin);
-    const float ga[3] = {(v[i + 1] - v[i - 1]) / 2.0f, (v[i + sy] - v[i - sy]) / 2.0f, (v[i + sz] - v[i - sz]) / 2.0f};
-    const float gb[3] = {(v[j + 1] - v[j - 1]) / 2.0f, (v[j + sy] - v[j - sy]) / 2.0f, (v[j + sz] - v[j - sz]) / 2.0f};
-    const float s = 1.0f - t;
-    const float n[3] = {s * ga[0] + t * gb[0], s * ga[1] + t * gb[1], s * ga[2] + t * gb[2]};
-    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    Vertex out{};
-    if (std::isfinite(len) && len > 1e-20f) {
-        const float inv = 1.0f / len;
-        for (int k = 0; k < 3; ++k) out.normal[k] = n[k] * inv;
-    } else {
-        out.normal[axis] = is_inside(a) ? 1.0f : -1.0f;
-    }
-    for (int k = 0; k < 3; ++k) out.position[k] = static_cast<float>(p[k]);
-    out.position[axis] = static_cast<float>(p[axis]) + t;
-    return out;
-}
-
 // The four point rows around cell row (y, z): corner bit k of a cell = row k>>1 at x + (k & 1).
 struct CellRows {
     const std::uint64_t* r[4];  // (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1)
@@ -228,7 +202,7 @@ SlabCount SlabWorker::run(const Grid<float>& phi, const SignBits& s, int z0, int
                         Vec3i q = p;
                         q[es.axis] += 1;
                         const bool interior = p.x >= 1 && p.y >= 1 && p.z >= 1 && q.x <= d.x - 2 && q.y <= d.y - 2 && q.z <= d.z - 2;
-                        out.vertices[c.vertices] = interior ? interior_edge_vertex(values, pidx + static_cast<std::size_t>(p.z) * sz, p, es.axis, sy, sz)
+                        out.vertices[c.vertices] = interior ? edge_vertex_interior(values, pidx + static_cast<std::size_t>(p.z) * sz, p, es.axis, sy, sz)
                                                             : make_edge_vertex(phi, p, es.axis);
                         const auto id = out.first_id + static_cast<std::uint32_t>(c.vertices++);
                         entry = generation_[slot] | id;
