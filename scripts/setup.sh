@@ -49,5 +49,5 @@ cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_WERROR=ON >/de
 cmake --build build -j "$jobs"
 if ((peers)); then
   cmake -S . -B build-peer -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_BUILD_PEER_BENCHMARKS=ON -DLIVESET_BUILD_TESTS=OFF >/dev/null
-  cmake --build build-peer -j "$jobs" --target itk_threshold_levelset vtk_flying_edges
+  cmake --build build-peer -j "$jobs" --target itk_threshold_levelset itk_box_flow vtk_flying_edges
 fi
