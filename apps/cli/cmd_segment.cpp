@@ -14,6 +14,7 @@
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
+#include "liveset/mesh/slab_marching_cubes.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
 #include "liveset/preprocess/bias_correction.hpp"
@@ -182,7 +183,7 @@ int run_mesh(const MeshArgs& a, int threads) {
         fragments = static_cast<int>(m.fragment_count());
         mesh = weld_vertices(m.merged().view());
     } else {
-        mesh = marching_cubes_naive(phi);
+        mesh = marching_cubes_slabs(phi);  // == marching_cubes_naive(phi), sign bits + parallel z-slabs
     }
     if (mesh.triangle_count() == 0) throw UsageError(fmt::format("{} holds no surface (no voxel changes sign)", a.input));
     write_mesh(a.out, mesh.view(), input.lattice());
