@@ -77,6 +77,37 @@ void BM_LocalBump(benchmark::State& state) {
 }
 BENCHMARK(BM_LocalBump)->Arg(64)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
 
+// A seed ball (radius 2) added on the BrainWeb-sized lattice (181×217×180) holding a sphere, the way
+// the session adds one: Arg 0 the local union (unite_in_box, what Session::add_seed does), Arg 1 the
+// whole-lattice re-initialisation init_from_sdf(min(φ, ball)) it replaced. Each iteration adds the
+// ball to the field reset to the sphere (the reset is not timed).
+void BM_AddSeed(benchmark::State& state) {
+    static std::unique_ptr<SparseField> base;
+    if (!base) {
+        base = std::make_unique<SparseField>(Lattice({181, 217, 180}), 2);
+        base->init_from_sdf(shapes::Sphere({90.2, 108.4, 89.7}, 60.3));
+    }
+    const shapes::Sphere ball({40.3, 60.2, 50.6}, 2.0);  // outside the sphere: a new piece
+    const bool whole = state.range(0) == 1;
+    std::size_t changed = 0;
+    SparseField f = *base;  // reset by copy-assignment (no allocation, no page faults) each iteration
+    for (auto _ : state) {
+        state.PauseTiming();
+        f = *base;
+        state.ResumeTiming();
+        if (whole) {
+            const Grid<float>& phi = f.phi();
+            const Lattice& lat = f.lattice();
+            f.init_from_sdf([&](Vec3d p) { return std::min(static_cast<double>(phi[lat.index(p.cast<int>())]), ball(p)); });
+        } else {
+            changed = f.unite_in_box({35, 55, 45}, {46, 66, 56}, ball).size();
+        }
+        benchmark::DoNotOptimize(f.zero_layer().size());
+    }
+    state.counters["changed_points"] = static_cast<double>(changed);
+}
+BENCHMARK(BM_AddSeed)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
+
 // Peak resident memory after building a sphere level set in N³ (run one size per process).
 void BM_Memory(benchmark::State& state) {
     const int n = static_cast<int>(state.range(0));

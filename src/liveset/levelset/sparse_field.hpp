@@ -126,6 +126,13 @@ public:
     // Local edit of the zero-layer points inside the box [lo, hi] (inclusive, clipped to the
     // lattice): delta(p, φ(p)) gives each point's Δ. Cost grows with the box, not the band.
     ChangedPoints apply_in_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta);
+    // The union with a shape — init_from_sdf(min(φ, sdf)) — computed only where it can differ:
+    // `sdf` (index space, negative inside) must be ≥ N + 1 outside the box [lo, hi] (clipped to
+    // the lattice). Re-layers the Manhattan N-ball of every changed value; cost grows with the box.
+    // Same bits as the whole-lattice re-initialisation wherever that one keeps the band's values
+    // (it also re-snaps a non-zero-layer point whose φ is exactly ±0.5 anywhere; this does not).
+    // Throws std::invalid_argument, before changing anything, where `sdf` is not finite.
+    ChangedPoints unite_in_box(Vec3i lo, Vec3i hi, const std::function<double(Vec3d)>& sdf);
 
     // Writes back φ and status at the given points and moves them to the lists of their restored
     // layers (undo / redo). The states must be ones recorded earlier for *every* point that changed

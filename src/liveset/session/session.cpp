@@ -121,14 +121,17 @@ SessionUpdate Session::add_seed(SeedBall seed) {
         throw std::invalid_argument("a seed lies outside the image");
     if (!std::isfinite(seed.radius) || seed.radius <= 0) throw std::invalid_argument("a seed's radius must be positive");
     return edit("seed", Action::kOwn, [&] {
+        // Union with the ball, min(φ, distance to the ball), re-initialised only around it: beyond
+        // N + 1 voxels from the ball the distance cannot undercut φ.
         const shapes::Sphere ball(seed.center, std::max(seed.radius, 0.5));
-        const Grid<float>& phi = field_.phi();
-        const Lattice& lat = lattice();
-        // Union with the ball: min(φ, distance to the ball). Each evaluation reads only its own point.
-        field_.init_from_sdf([&](Vec3d p) { return std::min(static_cast<double>(phi[lat.index(p.cast<int>())]), ball(p)); });
+        const double reach = ball.radius + field_.layers() + 1.0;
+        const Vec3d lo = seed.center - Vec3d{reach, reach, reach}, hi = seed.center + Vec3d{reach, reach, reach};
+        ChangedPoints changed = field_.unite_in_box(
+            {static_cast<int>(std::floor(lo.x)), static_cast<int>(std::floor(lo.y)), static_cast<int>(std::floor(lo.z))},
+            {static_cast<int>(std::ceil(hi.x)), static_cast<int>(std::ceil(hi.y)), static_cast<int>(std::ceil(hi.z))}, ball);
         marks_.seeds.push_back(seed);
         refresh_window();
-        return Change{{}, true};
+        return Change{std::move(changed)};
     });
 }
 
