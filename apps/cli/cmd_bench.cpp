@@ -1,19 +1,6 @@
-// `liveset bench fig3`: the paper's Figure 3. A box contracts under mean curvature flow; after
-// every level-set step each fragment size re-meshes from the SAME changed points X, and only
-// "find and re-polygonise the affected fragments" (FragmentMesher::update) is timed, so the
-// level-set cost is excluded and the sizes are compared on identical input. Writes the cumulative
-// seconds per step as CSV and a gnuplot PNG, and prints a summary table.
-//
-// Columns: x<S> for each fragment size S (cells per fragment edge). A size whose single fragment
-// covers the whole lattice (S >= lattice - 1 cells) is the paper's naive method: every cell of the
-// lattice is scanned every step (CellPolygoniser::polygonise_box into one reused mesh, with none
-// of the incremental mesher's bookkeeping; O(volume)), whether or not
-// anything changed. x<L>_band (L = lattice points per edge) is the same whole-lattice fragment
-// updated band-driven (FragmentMesher::update, O(surface)).
-//
-// After the box vanishes (zero layer empty) the level set stops; the remaining steps have no
-// changed points (incremental columns pay only the empty update) while the naive column keeps
-// scanning the lattice, as a renderer re-meshing every frame would.
+// `liveset bench fig3`: the paper's Figure 3 (the experiment is liveset/experiments/figure3.hpp):
+// runs it, writes the cumulative seconds per step as CSV and a gnuplot PNG, and prints a summary
+// table.
 #include <fmt/core.h>
 #include <fcntl.h>
 #include <spawn.h>
@@ -37,10 +24,7 @@
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "liveset/base/atomic_file.hpp"
-#include "liveset/levelset/curvature_flow.hpp"
-#include "liveset/mesh/fragment_mesher.hpp"
-#include "liveset/mesh/marching_cubes.hpp"
-#include "liveset/mesh/mesh_analysis.hpp"
+#include "liveset/experiments/figure3.hpp"
 
 extern char** environ;
 
@@ -52,47 +36,19 @@ namespace fs = std::filesystem;
 
 struct Fig3Args {
     std::string out = "fig3-out";
-    int steps = 1500;
-    int lattice = 100;
-    int box = 50;
-    int verify_every = 250;
+    Figure3Options experiment;
     bool no_plot = false;
-    std::vector<int> sizes{3, 5, 10, 20, 25, 50, 100};
 };
-
-struct Column {
-    std::string name;
-    bool naive = false;  // whole-lattice scan every step
-    FragmentMesher mesher;
-    std::vector<double> cumulative;  // seconds after each step
-    double total_s = 0.0;
-    std::size_t rebuilt_sum = 0, rebuilt_max = 0;
-    std::size_t cells_sum = 0;
-    // The naive column: one polygoniser scanning every cell into one reused mesh (the paper's
-    // whole-lattice marching cubes; no incremental bookkeeping such as the mesher's sign bits).
-    CellPolygoniser scan;
-    Mesh scan_mesh;
-};
-
-void naive_scan(Column& c, const Grid<float>& phi) {
-    const Vec3i d = phi.dims();
-    c.scan_mesh.clear();
-    c.scan.polygonise_box(phi, {0, 0, 0}, {d.x - 1, d.y - 1, d.z - 1}, c.scan_mesh);
-}
 
 void validate(const Fig3Args& a) {
-    if (a.steps < 1 || a.steps > 1'000'000) throw UsageError(fmt::format("--steps must be in [1, 1000000], got {}", a.steps));
-    if (a.lattice < 4 || a.lattice > 1024)
-        throw UsageError(fmt::format("--lattice must be in [4, 1024], got {}", a.lattice));
-    if (a.box < 1 || a.box > a.lattice - 2)
-        throw UsageError(fmt::format("--box must be in [1, lattice - 2 = {}], got {}", a.lattice - 2, a.box));
-    if (a.verify_every < 0) throw UsageError(fmt::format("--verify-every must not be negative, got {}", a.verify_every));
-    if (a.sizes.empty()) throw UsageError("--sizes needs at least one fragment size");
-    std::set<int> seen;
-    for (int s : a.sizes) {
-        if (s < 3 || s > 1'000'000)
-            throw UsageError(fmt::format("fragment sizes must be in [3, 1000000] (3 is the smallest workable size), got {}", s));
-        if (!seen.insert(s).second) throw UsageError(fmt::format("fragment size {} given twice in --sizes", s));
+    try {
+        a.experiment.validate();
+    } catch (const std::invalid_argument& e) {
+        // The option names are the fields' with dashes: "--steps must be in [1, 1000000], got 0".
+        std::string why = e.what();
+        if (why.rfind("verify_every", 0) == 0) why.replace(0, 12, "verify-every");
+        if (const auto at = why.find(" in sizes"); at != std::string::npos) why.replace(at, 9, " in --sizes");
+        throw UsageError(why.rfind("fragment", 0) == 0 ? why : "--" + why);
     }
     if (a.out.empty()) throw UsageError("--out must not be empty");
 }
@@ -129,7 +85,7 @@ std::string gp_quote(const std::string& s) {
     return r + "'";
 }
 
-std::string plot_script(const Fig3Args& a, const std::vector<Column>& cols, int threads) {
+std::string plot_script(const Figure3Options& a, std::size_t columns, int threads) {
     std::string s;
     s += "# Figure 3 (Feltell & Bai): regenerate with `gnuplot fig3.gp` in this directory.\n";
     s += "if (!exists(\"outfile\")) outfile = 'fig3.png'\n";
@@ -150,7 +106,7 @@ std::string plot_script(const Fig3Args& a, const std::vector<Column>& cols, int 
     s += "set grid\n";
     s += "set key outside right top\n";
     s += fmt::format("set xrange [0:{}]\n", a.steps);
-    s += fmt::format("plot for [i=2:{}] 'fig3.csv' using 1:i with lines lw 2 title columnheader(i)\n", cols.size() + 1);
+    s += fmt::format("plot for [i=2:{}] 'fig3.csv' using 1:i with lines lw 2 title columnheader(i)\n", columns + 1);
     return s;
 }
 
@@ -197,20 +153,35 @@ void run_gnuplot(const fs::path& dir) {
     }
 }
 
-void verify(int step, const Grid<float>& phi, std::span<const PointIndex> zero_layer, const std::vector<Column>& cols) {
-    const Mesh ref = marching_cubes_band(phi, zero_layer);
-    const auto ref_tris = canonical_triangles(ref);
-    for (const Column& c : cols) {
-        const Mesh m = c.naive ? c.scan_mesh : c.mesher.merged();
-        if (m.triangle_count() != ref.triangle_count())
-            throw std::runtime_error(fmt::format(
-                "figure 3 check failed at step {}: {} mesh has {} triangles, marching_cubes_band has {}", step, c.name,
-                m.triangle_count(), ref.triangle_count()));
-        if (canonical_triangles(m) != ref_tris)
-            throw std::runtime_error(fmt::format(
-                "figure 3 check failed at step {}: {} mesh differs from marching_cubes_band ({} triangles each)", step,
-                c.name, m.triangle_count()));
+// The summary table: each column's time, and how many times cheaper than the naive scan and the
+// band-only single fragment.
+void print_figure3(const Figure3Options& a, const Figure3Result& r, int threads) {
+    const Figure3Column* naive = nullptr;
+    for (const Figure3Column& c : r.columns)
+        if (c.naive) naive = &c;  // the largest whole-lattice size
+    const Figure3Column& band = r.columns.back();
+    fmt::print("liveset bench fig3: {0}^3 lattice, {1}^3 box, {2} steps of mean curvature flow, {3} thread(s)\n", a.lattice,
+               a.box, a.steps, threads);
+    if (r.flow_steps < a.steps)
+        fmt::print("  level set    the box vanished after step {}; steps {}..{} have no changed points\n", r.flow_steps,
+                   r.flow_steps + 1, a.steps);
+    else
+        fmt::print("  level set    {} steps, the box did not vanish\n", r.flow_steps);
+    fmt::print("  level set    {:.2f} s in total (not timed below); mean |X| = {:.0f} changed points per step\n", r.level_set_s,
+               static_cast<double>(r.changed_sum) / a.steps);
+    fmt::print("  mesh checks  {} passed: every merged mesh equals marching_cubes_band of the current phi\n", r.checks);
+    fmt::print("  {:<10} {:>9} {:>10} {:>10} {:>11} {:>11} {:>14} {:>8} {:>12}\n", "column", "fragments", "total s",
+               "ms/step", "naive/this", "band/this", "rebuilt/step", "max", "cells/step");
+    for (const Figure3Column& c : r.columns) {
+        const std::string frags = c.naive ? "1 (scan)" : std::to_string(c.fragments);
+        const std::string vs_naive = naive ? fmt::format("{:.1f}x", naive->total_s / c.total_s) : "-";
+        fmt::print("  {:<10} {:>9} {:>10.4f} {:>10.4f} {:>11} {:>10.2f}x {:>14.1f} {:>8} {:>12.0f}\n", c.name, frags,
+                   c.total_s, 1000.0 * c.total_s / a.steps, vs_naive, band.total_s / c.total_s,
+                   static_cast<double>(c.rebuilt_sum) / a.steps, c.rebuilt_max,
+                   static_cast<double>(c.cells_sum) / a.steps);
     }
+    fmt::print("  (naive/this, band/this: how many times cheaper than the naive whole-lattice scan and the band-only "
+               "single fragment)\n");
 }
 
 void run_fig3(const Fig3Args& a, int threads) {
@@ -222,113 +193,23 @@ void run_fig3(const Fig3Args& a, int threads) {
     const fs::path dir(a.out);
     if (!a.no_plot && !gnuplot_on_path()) throw UsageError("gnuplot not found on PATH (install gnuplot or pass --no-plot)");
     prepare_output_dir(dir);
+    const Figure3Options& e = a.experiment;
+    const Figure3Result r = run_figure3(e);
 
-    BoxFlowOptions box;
-    box.lattice = a.lattice;
-    box.box = a.box;
-    box.max_steps = a.steps;
-    SparseField field = make_box_field(box);
-    const Lattice& lattice = field.lattice();
-    const int cells = a.lattice - 1;
-
-    std::vector<Column> cols;
-    for (int s : a.sizes) {
-        Column c{fmt::format("x{}", s), s >= cells, FragmentMesher(lattice, std::min(s, cells)), {}, 0.0, 0, 0, 0, {}, {}};
-        cols.push_back(std::move(c));
-    }
-    cols.push_back(Column{fmt::format("x{}_band", a.lattice), false, FragmentMesher(lattice, cells), {}, 0.0, 0, 0, 0, {}, {}});
-    for (Column& c : cols) {
-        if (c.naive)
-            naive_scan(c, field.phi());
-        else
-            c.mesher.full_rebuild(field.phi(), field.zero_layer());
-        c.cumulative.reserve(static_cast<std::size_t>(a.steps));
-    }
-    verify(0, field.phi(), field.zero_layer(), cols);
-
-    using clock = std::chrono::steady_clock;
-    int checks = 1;
-    std::size_t changed_sum = 0;
-    const auto mesh_step = [&](int step, std::span<const PointIndex> changed) {
-        const Grid<float>& phi = field.phi();
-        changed_sum += changed.size();
-        const std::size_t n = cols.size();
-        for (std::size_t k = 0; k < n; ++k) {  // rotate the order so no size always runs first
-            Column& c = cols[(k + static_cast<std::size_t>(step)) % n];
-            std::size_t rebuilt = 1;
-            const auto t0 = clock::now();
-            if (c.naive)
-                naive_scan(c, phi);
-            else
-                rebuilt = c.mesher.update(phi, changed).size();
-            const auto t1 = clock::now();
-            c.total_s += std::chrono::duration<double>(t1 - t0).count();
-            c.cumulative.push_back(c.total_s);
-            c.rebuilt_sum += rebuilt;
-            c.rebuilt_max = std::max(c.rebuilt_max, rebuilt);
-            c.cells_sum += c.naive ? static_cast<std::size_t>(cells) * cells * cells : c.mesher.last_stats().cells_visited;
-        }
-        if ((a.verify_every > 0 && step % a.verify_every == 0) || step == a.steps) {
-            verify(step, phi, field.zero_layer(), cols);
-            ++checks;
-        }
-    };
-
-    const FlowHook hook = [&](const SparseField&, const StepResult& r, const FlowStepRecord& rec) {
-        mesh_step(rec.step, r.changed.points);
-        return true;
-    };
-    const BoxFlowReport rep = run_curvature_flow(field, a.steps, box.cfl, hook);
-    const int flow_steps = static_cast<int>(rep.steps.size());
-    for (int s = flow_steps + 1; s <= a.steps; ++s) mesh_step(s, {});
-
-    // CSV and plot.
     std::string csv = "step";
-    for (const Column& c : cols) csv += "," + c.name;
+    for (const Figure3Column& c : r.columns) csv += "," + c.name;
     csv += "\n";
-    for (int s = 0; s < a.steps; ++s) {
+    for (int s = 0; s < e.steps; ++s) {
         csv += std::to_string(s + 1);
-        for (const Column& c : cols) csv += fmt::format(",{:.9f}", c.cumulative[static_cast<std::size_t>(s)]);
+        for (const Figure3Column& c : r.columns) csv += fmt::format(",{:.9f}", c.cumulative[static_cast<std::size_t>(s)]);
         csv += "\n";
     }
     write_atomically((dir / "fig3.csv").string(), csv);
     if (!a.no_plot) {
-        write_atomically((dir / "fig3.gp").string(), plot_script(a, cols, used_threads));
+        write_atomically((dir / "fig3.gp").string(), plot_script(e, r.columns.size(), used_threads));
         run_gnuplot(dir);
     }
-
-    // Summary table.
-    const Column* naive = nullptr;
-    for (const Column& c : cols)
-        if (c.naive) naive = &c;  // the largest whole-lattice size
-    const Column& band = cols.back();
-    fmt::print("liveset bench fig3: {0}^3 lattice, {1}^3 box, {2} steps of mean curvature flow, {3} thread(s)\n", a.lattice,
-               a.box, a.steps, used_threads);
-    if (flow_steps < a.steps)
-        fmt::print("  level set    the box vanished after step {}; steps {}..{} have no changed points\n", flow_steps,
-                   flow_steps + 1, a.steps);
-    else
-        fmt::print("  level set    {} steps, the box did not vanish\n", flow_steps);
-    fmt::print("  level set    {:.2f} s in total (not timed below); mean |X| = {:.0f} changed points per step\n",
-               [&] {
-                   double ms = 0;
-                   for (const FlowStepRecord& r : rep.steps) ms += r.ms;
-                   return ms / 1000.0;
-               }(),
-               static_cast<double>(changed_sum) / a.steps);
-    fmt::print("  mesh checks  {} passed: every merged mesh equals marching_cubes_band of the current phi\n", checks);
-    fmt::print("  {:<10} {:>9} {:>10} {:>10} {:>11} {:>11} {:>14} {:>8} {:>12}\n", "column", "fragments", "total s",
-               "ms/step", "naive/this", "band/this", "rebuilt/step", "max", "cells/step");
-    for (const Column& c : cols) {
-        const std::string frags = c.naive ? "1 (scan)" : std::to_string(c.mesher.fragment_count());
-        const std::string vs_naive = naive ? fmt::format("{:.1f}x", naive->total_s / c.total_s) : "-";
-        fmt::print("  {:<10} {:>9} {:>10.4f} {:>10.4f} {:>11} {:>10.2f}x {:>14.1f} {:>8} {:>12.0f}\n", c.name, frags,
-                   c.total_s, 1000.0 * c.total_s / a.steps, vs_naive, band.total_s / c.total_s,
-                   static_cast<double>(c.rebuilt_sum) / a.steps, c.rebuilt_max,
-                   static_cast<double>(c.cells_sum) / a.steps);
-    }
-    fmt::print("  (naive/this, band/this: how many times cheaper than the naive whole-lattice scan and the band-only "
-               "single fragment)\n");
+    print_figure3(e, r, used_threads);
     fmt::print("  wrote {}{}\n", (dir / "fig3.csv").string(), a.no_plot ? "" : ", " + (dir / "fig3.png").string());
 }
 
@@ -342,15 +223,15 @@ void add_bench_commands(CLI::App& app, const int& threads) {
     auto* fig3 = bench->add_subcommand(
         "fig3", "the paper's Figure 3: cumulative re-meshing time per fragment size during mean curvature flow of a box");
     fig3->add_option("--out", fig3_args.out, "output directory (fig3.csv, fig3.png, fig3.gp)")->capture_default_str();
-    fig3->add_option("--steps", fig3_args.steps, "level-set time steps")->capture_default_str();
-    fig3->add_option("--lattice", fig3_args.lattice, "lattice edge length in points")->capture_default_str();
-    fig3->add_option("--box", fig3_args.box, "box edge length in points")->capture_default_str();
-    fig3->add_option("--sizes", fig3_args.sizes,
+    fig3->add_option("--steps", fig3_args.experiment.steps, "level-set time steps")->capture_default_str();
+    fig3->add_option("--lattice", fig3_args.experiment.lattice, "lattice edge length in points")->capture_default_str();
+    fig3->add_option("--box", fig3_args.experiment.box, "box edge length in points")->capture_default_str();
+    fig3->add_option("--sizes", fig3_args.experiment.sizes,
                      "fragment sizes in cells, comma separated (>= 3; a size covering the lattice is the naive "
                      "whole-lattice scan)")
         ->delimiter(',')
         ->capture_default_str();
-    fig3->add_option("--verify-every", fig3_args.verify_every,
+    fig3->add_option("--verify-every", fig3_args.experiment.verify_every,
                      "compare every mesher with marching_cubes_band every K steps (0: only at the start and the end)")
         ->capture_default_str();
     fig3->add_flag("--no-plot", fig3_args.no_plot, "write only the CSV (no gnuplot needed)");
