@@ -178,10 +178,9 @@ int run_mesh(const MeshArgs& a, int threads) {
     Mesh mesh;
     int fragments = 1;
     if (a.fragment > 0) {
-        FragmentMesher m(input.lattice(), a.fragment);
-        m.full_rebuild(phi);
-        fragments = static_cast<int>(m.fragment_count());
-        mesh = weld_vertices(m.merged().view());
+        std::size_t count = 0;
+        mesh = weld_vertices(mesh_in_fragments(phi, a.fragment, &count).view());
+        fragments = static_cast<int>(count);
     } else {
         mesh = marching_cubes_slabs(phi);  // == marching_cubes_naive(phi), sign bits + parallel z-slabs
     }

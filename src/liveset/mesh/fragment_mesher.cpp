@@ -302,4 +302,11 @@ Mesh FragmentMesher::merged() const {
     return concatenate(parts);
 }
 
+Mesh mesh_in_fragments(const Grid<float>& phi, int fragment_size, std::size_t* fragments) {
+    FragmentMesher m(phi.lattice(), fragment_size);
+    m.full_rebuild(phi);
+    if (fragments) *fragments = m.fragment_count();
+    return m.merged();
+}
+
 }  // namespace liveset

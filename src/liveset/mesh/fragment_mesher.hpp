@@ -127,4 +127,9 @@ private:
     std::unique_ptr<Scratch> scratch_;  // per-thread polygonisers
 };
 
+// The whole volume meshed fragment by fragment (`liveset mesh --fragment S`): a FragmentMesher of
+// `fragment_size` fully rebuilt on `phi`, its fragments merged (border vertices duplicated);
+// `fragments` receives their number.
+Mesh mesh_in_fragments(const Grid<float>& phi, int fragment_size, std::size_t* fragments = nullptr);
+
 }  // namespace liveset
