@@ -22,6 +22,7 @@
 #include "liveset/session/repair_presets.hpp"
 #include "view_command.hpp"
 #include "liveset/swarm/repair.hpp"
+#include "liveset/swarm/repair_schedule.hpp"
 
 namespace liveset::cli {
 
@@ -35,6 +36,7 @@ struct DemoArgs {
     int round_steps = 100;  // swarm steps per round
     bool json = false, quiet = false, no_view = false;
     bool brain = false;  // the real-brain demo instead (demo_brain.hpp)
+    bool repair = false;  // with --brain: the paper's Figure 5 (low threshold, finder, swarm repair)
     BrainDemoArgs brain_args;
 };
 
@@ -92,36 +94,35 @@ int run_demo(const DemoArgs& a, int threads) {
     for (PointIndex i = 0; i < white.size(); ++i) white[i] = ph.labels[i] == kWhiteMatter;
     const Grid<float> unit = normalise(ph.image, o.scale);
     RepairOptions ro = demo_repair_options();
-    ro.steps = a.round_steps;
+    ro.swarm.seed = a.seed;
+    // The holes a user would point at: perforations first, then spurious cavities (bubbles).
+    const HoleSiteFinder holes_left = [&](const SparseField& field) {
+        const Grid<std::uint8_t> m = inside_mask(field.phi());
+        std::vector<Perforation> h = find_perforations(m, ph.truth, white);
+        if (h.empty()) h = find_cavities(m, white);
+        std::vector<HoleSite> sites;
+        for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
+        return sites;
+    };
+    const std::vector<HoleSite> first = holes_left(*o.field);
+    const std::optional<Vec3d> first_hole = first.empty() ? std::nullopt : std::optional<Vec3d>(first.front().position);
+    RepairScheduleOptions so;
+    so.rounds = a.rounds;
+    so.round_steps = a.round_steps;
+    const RepairScheduleResult sched = run_repair_schedule(*o.field, unit, nullptr, ro, so, holes_left, {}, &mesher);
     nlohmann::json rounds = nlohmann::json::array();
     std::size_t steps = 0, fragments = 0, modified = 0;
     double repair_ms = 0.0;
-    Grid<std::uint8_t> repaired = o.mask;
-    // The holes a user would point at: perforations first, then spurious cavities (bubbles).
-    const auto holes_left = [&] {
-        std::vector<Perforation> h = find_perforations(repaired, ph.truth, white);
-        return h.empty() ? find_cavities(repaired, white) : h;
-    };
-    std::vector<Perforation> holes = holes_left();
-    const std::optional<Vec3d> first_hole = holes.empty() ? std::nullopt : std::optional<Vec3d>(holes.front().centroid);
-    for (int r = 0; r < a.rounds && !holes.empty(); ++r) {
-        const Vec3d t = holes.front().centroid;
-        ro.swarm.seed = a.seed + static_cast<std::uint64_t>(r);
-        ro.swarm.edit_range = hole_brush_range(holes.front().voxels);  // the brush sized to the hole
-        const RepairTarget target{t, 0};
-        const std::vector<RepairStepLog> log = run_repair(*o.field, unit, nullptr, {&target, 1}, ro, &mesher);
-        for (const RepairStepLog& l : log) {
-            fragments += l.fragments;
-            modified += l.modified;
-            repair_ms += l.ms;
-        }
-        steps += log.size();
-        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", holes.front().voxels}, {"holes", holes.size()},
-                          {"edit_range", ro.swarm.edit_range}});
-        repaired = inside_mask(o.field->phi());
-        holes = holes_left();
+    for (const RepairRoundLog& r : sched.rounds) {
+        const Vec3d t = r.target.position;
+        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", r.target.voxels}, {"holes", r.holes}, {"edit_range", r.edit_range}});
+        steps += static_cast<std::size_t>(r.steps);
+        fragments += r.fragments;
+        modified += r.modified;
+        repair_ms += r.ms;
     }
-    const std::size_t left = holes.size();
+    const Grid<std::uint8_t> repaired = inside_mask(o.field->phi());
+    const std::size_t left = sched.holes_left;
     nlohmann::json after = evaluation_report(repaired, ph.truth);
     const Mesh repaired_surface = weld_vertices(mesher.merged().view());
 
@@ -195,11 +196,13 @@ void add_demo_command(CLI::App& app, const int& threads) {
     demo->add_flag("--quiet,-q", da.quiet, "print nothing");
     demo->add_flag("--no-view", da.no_view, "do not open the viewer even when a display is available (--json implies it)");
     demo->add_flag("--brain", da.brain, "the real-brain path instead: BrainWeb T1 (bundled in data/brainweb), seeds only -> segment -> mesh -> eval");
+    demo->add_flag("--repair", da.repair, "with --brain: segment with a sub-optimally low threshold, find the holes without truth, repair them with 200 agents (the paper's Figure 5)");
     demo->add_option("--data", da.brain_args.data, "with --brain: the folder holding t1.mha, labels_crisp.nii.gz and brain_mask.nii.gz")->capture_default_str();
     demo->callback([&threads, out] {
         if (da.brain) {
             da.brain_args.json = da.json;
             da.brain_args.quiet = da.quiet;
+            da.brain_args.repair = da.repair;
             if (out->count() > 0) da.brain_args.out = da.out;
             const int rc = run_brain_demo(da.brain_args, threads);
             if (rc != 0) std::exit(rc);

@@ -16,6 +16,8 @@
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_io.hpp"
 #include "headless_app.hpp"
+#include "liveset/segment/window.hpp"
+#include "view_command.hpp"
 
 namespace liveset::cli {
 
@@ -28,6 +30,28 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 // The seeds a user would click in clearly grey voxels all over the cortex (voxel indices).
 const std::vector<Vec3i> kBrainSeeds = {{35, 83, 113}, {35, 125, 38}, {44, 164, 92},  {71, 74, 53},
                                         {122, 149, 47}, {140, 86, 74}, {38, 71, 26}, {83, 23, 71}};
+
+// The demo's sub-optimally low threshold (--repair): the tissue model's window for the seeds' class,
+// narrowed to brain_repair_epsilon_scale() of its half width around the same centre. Also fills
+// the grey matter's band and class mean for the finder and the sheet rule.
+void low_threshold(const Grid<float>& t1, const Grid<std::uint8_t>& roi, SegmentRequest& req, BrainRepairInput& band) {
+    std::vector<std::string> warnings;
+    const Grid<std::uint8_t> region = model_region(t1, nullptr, &roi, 3);
+    const std::optional<TissueModel> model = fit_window_model(t1, region, TissueModelOptions{}, warnings);
+    if (!model || !model->usable()) throw UsageError("demo --brain --repair: the tissue model cannot be fitted to the T1");
+    std::vector<float> seed_values;
+    for (const Vec3i& s : kBrainSeeds)
+        for (int dz = -2; dz <= 2; ++dz)
+            for (int dy = -2; dy <= 2; ++dy)
+                for (int dx = -2; dx <= 2; ++dx)
+                    if (dx * dx + dy * dy + dz * dz <= 4) seed_values.push_back(t1(s + Vec3i{dx, dy, dz}));
+    const ModelWindow w = model_window(*model, seed_values);
+    req.mu_raw = w.mu();
+    req.epsilon_raw = brain_repair_epsilon_scale() * w.epsilon();
+    band.band_lower = w.lower;
+    band.band_upper = w.upper;
+    band.sheet_mean = model->classes[static_cast<std::size_t>(w.seed_class)].mean;
+}
 
 }  // namespace
 
@@ -61,6 +85,8 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     for (const Vec3i& s : kBrainSeeds) req.seeds.push_back({{double(s.x), double(s.y), double(s.z)}, 2.0});
     req.roi = &roi;
     req.loop.step = sleeping_step();  // as `liveset segment`
+    BrainRepairInput rin{t1, roi, {}, 0, 0, 0};
+    if (a.repair) low_threshold(t1, roi, req, rin);
     const SegmentRun run = segment_with_progress(t1, req, a.quiet || a.json);
     if (run.interrupted) {
         fmt::print(stderr, "liveset: interrupted; nothing written\n");
@@ -73,9 +99,23 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     t0 = std::chrono::steady_clock::now();
     const nlohmann::json ev = evaluation_report(o.mask, truth);
     const double eval_ms = ms_since(t0);
+    nlohmann::json repair, after;
+    FragmentMesher mesher(t1.lattice(), 16);
+    mesher.full_rebuild(o.field->phi(), o.field->zero_layer());
+    const Grid<float> phi_before = o.field->phi();
+    if (a.repair) {
+        if (!a.quiet && !a.json) fmt::print("  segmented with a low threshold (epsilon x {}); repairing...\n", brain_repair_epsilon_scale());
+        rin.scale = o.scale;
+        repair = repair_brain_holes(rin, *o.field, mesher, true);
+        after = evaluation_report(inside_mask(o.field->phi(), &roi), truth);
+    }
 
     write_label_image(o.mask, (dir / "seg.nii.gz").string());
-    write_image(o.field->phi(), (dir / "phi.nii.gz").string());
+    write_image(phi_before, (dir / "phi.nii.gz").string());
+    if (a.repair) {
+        write_label_image(inside_mask(o.field->phi(), &roi), (dir / "seg_repaired.nii.gz").string());
+        write_image(o.field->phi(), (dir / "phi_repaired.nii.gz").string());
+    }
     write_mesh(dir / "surface.ply", surface.view(), t1.lattice());
     nlohmann::json j;
     j["demo"] = "BrainWeb T1 -> seeds only (tissue-model window) -> segment -> mesh -> eval against the grey-matter labels";
@@ -91,13 +131,20 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     j["dice"] = ev["dice"];
     j["timings_ms"] = {{"bias_correction", bias.ms}, {"segment", 1000.0 * o.result.seconds}, {"mesh", mesh_ms}, {"eval", eval_ms}};
     j["outputs"] = a.out;
-    try {  // the surface seen from above (headless EGL; a warning where there is no OpenGL)
-        FragmentMesher mesher(t1.lattice(), 16);
-        mesher.full_rebuild(o.field->phi(), o.field->zero_layer());
-        viewer::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
-        j["screenshots"] = {{"surface", "surface.png"}};
-    } catch (const std::exception& e) {
-        fmt::print(stderr, "liveset: warning: no picture: {}\n", e.what());
+    if (a.repair) {
+        j["before"] = ev;
+        j["after"] = after;
+        j["targets"] = repair["targets"];
+        j["repair"] = repair;
+        j["dice"] = after["dice"];
+        j["screenshots"] = write_before_after_pictures(dir, phi_before, mesher);  // superior view, headless
+    } else {
+        try {  // the surface seen from above (headless EGL; a warning where there is no OpenGL)
+            viewer::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
+            j["screenshots"] = {{"surface", "surface.png"}};
+        } catch (const std::exception& e) {
+            fmt::print(stderr, "liveset: warning: no picture: {}\n", e.what());
+        }
     }
     write_atomically((dir / "report.json").string(), j.dump(2) + "\n");
     if (a.json) {
@@ -110,7 +157,18 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
         fmt::print("  mesh         {} triangles, {:.1f} ms\n", surface.triangle_count(), mesh_ms);
         fmt::print("  evaluation   against BrainWeb's grey-matter labels ({:.0f} ms):\n", eval_ms);
         print_evaluation(ev, "               ");
-        fmt::print("  outputs      {}/ (seg.nii.gz, phi.nii.gz, surface.ply, surface.png, report.json)\n", a.out);
+        if (a.repair) {
+            const nlohmann::json& r = repair;
+            fmt::print("  repair       {} targets from the truth-free finder (>= {} voxels), {} agents x {} steps each, sheet rule:\n"
+                       "               {} of {} closed by the finder's verdict, {} voxels added, {:.3f} ms/step; finder holes {} -> {}\n",
+                       r["targets"].size(), r["finder"]["min_voxels"].get<std::size_t>(), r["agents"].get<std::size_t>(), r["round_steps"].get<int>(),
+                       r["closed"].get<std::size_t>(), r["targets"].size(), r["voxels_added"].get<std::size_t>(), r["ms_per_step"].get<double>(),
+                       r["finder"]["before"].get<std::size_t>(), r["finder"]["after"].get<std::size_t>());
+            fmt::print("  before       dice {:.4f}  holes {}\n", ev["dice"].get<double>(), ev["holes"].get<long>());
+            fmt::print("  after        dice {:.4f}  holes {}\n", after["dice"].get<double>(), after["holes"].get<long>());
+        }
+        fmt::print("  outputs      {}/ (seg{}.nii.gz, phi.nii.gz, surface.ply, {}, report.json)\n", a.out, a.repair ? ", seg_repaired" : "",
+                   a.repair ? "before.png, after.png" : "surface.png");
     }
     return 0;
 }

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
     liveset::cli::add_segment_commands(app, threads);
     liveset::cli::add_eval_commands(app, threads);
     liveset::cli::add_repair_command(app, threads);
+    liveset::cli::add_holes_command(app, threads);
     liveset::cli::add_bench_commands(app, threads);
     liveset::cli::add_demo_command(app, threads);
     liveset::cli::add_view_command(app, threads);
