@@ -26,10 +26,10 @@ namespace liveset::cli {
 
 namespace {
 
-constexpr double kLowThreshold = 0.6;   // ε of the demo's segmentation: 60 % of the model window's
+constexpr double kLowThreshold = 0.8;   // ε of the demo's segmentation: 80 % of the model window's
 constexpr std::size_t kMinHole = 50;    // the finder's smallest target, voxels
 constexpr std::size_t kMaxTargets = 10;  // the largest holes the user clicks, one round each
-constexpr int kRoundSteps = 300;         // swarm steps per target
+constexpr int kRoundSteps = 600;         // swarm steps per target
 constexpr double kVerdictRadius = 6.0;   // the finder's verdict counts hole voxels this close to the target
 
 // Genus of the mask in the box of half-width r around c (the local topology at a target).
@@ -70,7 +70,7 @@ Verdicts verdicts(const std::vector<HoleSite>& targets, const Grid<std::uint8_t>
         const std::size_t b = hole_voxels_near(holes_before, t.position, kVerdictRadius);
         const std::size_t a = hole_voxels_near(holes_after, t.position, kVerdictRadius);
         const Vec3i c = t.position.cast<int>();
-        const bool closed = a == 0;
+        const bool closed = 2 * a <= b;  // the finder's hole voxels near the target at least halved
         v.closed += closed;
         v.targets.push_back({{"target", {c.x, c.y, c.z}}, {"hole_voxels", t.voxels}, {"closed", closed},
                              {"finder_voxels_near", {{"before", b}, {"after", a}}},

@@ -20,6 +20,8 @@ namespace {
 struct HolesArgs {
     std::string input, image, roi;
     std::size_t min_voxels = 10;
+    double min_sheet_share = HoleFinderOptions{}.min_sheet_share;
+    std::string out_mask;
     std::size_t max_sites = 20;
     std::optional<double> lower, upper;  // the sheet's band (raw); from the tissue model when absent
     bool json = false;
@@ -39,6 +41,8 @@ int run_holes(const HolesArgs& a, int threads) {
 
     HoleFinderOptions fo;
     fo.min_voxels = a.min_voxels;
+    fo.min_sheet_share = a.min_sheet_share;
+    if (!a.out_mask.empty()) check_output_path(a.out_mask, OutputKind::kImage, "--out-mask");
     std::vector<std::string> warnings;
     std::string band_from = "user";
     if (a.lower) {
@@ -58,12 +62,13 @@ int run_holes(const HolesArgs& a, int threads) {
         throw UsageError(e.what());
     }
     const std::vector<HoleCandidate> holes = find_holes(mask, image, r, fo);
+    if (!a.out_mask.empty()) write_label_image(hole_voxels(mask, image, r, fo), a.out_mask);
     std::size_t total = 0;
     for (const HoleCandidate& h : holes) total += h.voxels;
     nlohmann::json sites = nlohmann::json::array();
     for (std::size_t k = 0; k < holes.size() && k < a.max_sites; ++k) {
         const HoleCandidate& h = holes[k];
-        sites.push_back({{"voxels", h.voxels}, {"rim", h.rim}, {"target", {h.site.x, h.site.y, h.site.z}},
+        sites.push_back({{"voxels", h.voxels}, {"rim", h.rim}, {"sheet", h.sheet}, {"target", {h.site.x, h.site.y, h.site.z}},
                          {"centroid", {h.centroid.x, h.centroid.y, h.centroid.z}}});
     }
     nlohmann::json j{{"holes", holes.size()}, {"voxels", total}, {"sheet_band", {fo.sheet_lower, fo.sheet_upper}},
@@ -90,6 +95,8 @@ void add_holes_command(CLI::App& app, const int& threads) {
     h->add_option("--image", ha.image, "the image the segmentation came from")->required();
     h->add_option("--roi", ha.roi, "region of interest (outside it counts as the outside tissue)");
     h->add_option("--min-voxels", ha.min_voxels, "smallest candidate listed")->check(CLI::Range(std::size_t{1}, std::size_t{1} << 40))->capture_default_str();
+    h->add_option("--min-sheet-share", ha.min_sheet_share, "leave out candidates with a smaller share of voxels touching the segmentation")->check(CLI::Range(0.0, 1.0))->capture_default_str();
+    h->add_option("--out-mask", ha.out_mask, "write every candidate's voxels as a 0/1 mask");
     h->add_option("--max-sites", ha.max_sites, "sites listed")->check(CLI::Range(std::size_t{0}, std::size_t{1} << 40))->capture_default_str();
     h->add_option("--sheet-lower", ha.lower, "the sheet tissue's lowest intensity (raw; default from the tissue model)")->check(finite_number());
     h->add_option("--sheet-upper", ha.upper, "the sheet tissue's highest intensity (raw; default from the tissue model)")->check(finite_number());

@@ -62,6 +62,7 @@ struct Labelled {
     std::vector<std::uint32_t> label;  // gap components
     std::vector<std::uint8_t> keep;    // per label: touches inner and outside
     std::vector<std::uint8_t> rim;     // per voxel: a gap voxel touching inner or outside
+    std::vector<std::size_t> size, sheet;  // per label: voxels, voxels touching the mask
 };
 
 Labelled label_gaps(const Grid<std::uint8_t>& mask, const Grid<float>& image, const Grid<std::uint8_t>* roi,
@@ -75,20 +76,28 @@ Labelled label_gaps(const Grid<std::uint8_t>& mask, const Grid<float>& image, co
     out.label = label_components(gap, 6, &count);
     std::vector<std::uint8_t> inner(count + 1, 0), outer(count + 1, 0);
     out.rim.assign(lat.size(), 0);
+    out.size.assign(count + 1, 0);
+    out.sheet.assign(count + 1, 0);
     for (PointIndex i = 0; i < lat.size(); ++i) {
         const std::uint32_t k = out.label[i];
         if (!k) continue;
         const Vec3i c = lat.coord(i);
+        ++out.size[k];
+        bool touches_sheet = false;
         for (int f = 0; f < 6; ++f) {
             Vec3i q = c;
             q[f / 2] += (f % 2) ? 1 : -1;
             const std::uint8_t kq = lat.contains(q) ? kind[lat.index(q)] : kOutside;
             if (kq == kInner) inner[k] = out.rim[i] = 1;
             if (kq == kOutside) outer[k] = out.rim[i] = 1;
+            touches_sheet = touches_sheet || kq == kSheet;
         }
+        out.sheet[k] += touches_sheet;
     }
     out.keep.assign(count + 1, 0);
-    for (std::size_t k = 1; k <= count; ++k) out.keep[k] = inner[k] && outer[k];
+    for (std::size_t k = 1; k <= count; ++k)
+        out.keep[k] = inner[k] && outer[k] && out.size[k] >= o.min_voxels &&
+                      static_cast<double>(out.sheet[k]) >= o.min_sheet_share * static_cast<double>(out.size[k]);
     return out;
 }
 
@@ -97,6 +106,8 @@ Labelled label_gaps(const Grid<std::uint8_t>& mask, const Grid<float>& image, co
 void HoleFinderOptions::validate() const {
     if (!(std::isfinite(sheet_lower) && std::isfinite(sheet_upper) && sheet_lower < sheet_upper))
         throw std::invalid_argument("hole finder: the sheet's band needs finite lower < upper intensities");
+    if (!(min_sheet_share >= 0 && min_sheet_share <= 1))
+        throw std::invalid_argument("hole finder: min_sheet_share must be in [0, 1]");
 }
 
 std::vector<HoleCandidate> find_holes(const Grid<std::uint8_t>& mask, const Grid<float>& image,
@@ -122,9 +133,9 @@ std::vector<HoleCandidate> find_holes(const Grid<std::uint8_t>& mask, const Grid
     std::vector<HoleCandidate> out;
     std::vector<Vec3d> aim;
     for (std::size_t k = 1; k <= count; ++k) {
-        if (!g.keep[k] || size[k] < options.min_voxels) continue;
+        if (!g.keep[k]) continue;
         slot[k] = out.size();
-        out.push_back({size[k], rim[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
+        out.push_back({size[k], rim[k], g.sheet[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
         aim.push_back(rim_sum[k] / static_cast<double>(rim[k]));
     }
     std::vector<double> best(out.size(), 1e300);
@@ -152,12 +163,10 @@ Grid<std::uint8_t> hole_voxels(const Grid<std::uint8_t>& mask, const Grid<float>
                                const HoleFinderOptions& options) {
     check(mask, image, roi, options);
     const Labelled g = label_gaps(mask, image, roi, options);
-    std::vector<std::size_t> size(g.keep.size(), 0);
-    for (const std::uint32_t k : g.label) ++size[k];
     Grid<std::uint8_t> out(mask.lattice(), 0);
     for (PointIndex i = 0; i < out.size(); ++i) {
         const std::uint32_t k = g.label[i];
-        out[i] = k && g.keep[k] && size[k] >= options.min_voxels;
+        out[i] = k && g.keep[k];
     }
     return out;
 }

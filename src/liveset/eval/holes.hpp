@@ -9,7 +9,7 @@
 // voxels 6-connected through outer voxels to the ROI's exterior or the image border: CSF enclosed
 // by the inner tissue (the ventricles under white matter) is no outside of the cortex. A candidate
 // hole is a 6-connected component of gap voxels that touches both an inner voxel and a counted
-// outer voxel through its faces. Ranked by size, largest first; its site (a voxel of the gap) is the
+// outer voxel through its faces, and of which at least min_sheet_share of the voxels touch the mask. Ranked by size, largest first; its site (a voxel of the gap) is the
 // one nearest the centroid of the component's voxels that touch the inner or the outer tissue.
 #pragma once
 
@@ -25,12 +25,17 @@ struct HoleFinderOptions {
     double sheet_lower = 0.0;  // raw intensity: below it the outer tissue (CSF)
     double sheet_upper = 0.0;  // raw intensity: at or above it the inner tissue (WM)
     std::size_t min_voxels = 1;  // smaller candidates are left out
+    // A gap in the sheet is bordered by the sheet: candidates with fewer than this share of their
+    // voxels touching the mask (face neighbours) are left out (a gap between white-matter-like
+    // and dark tissue where no sheet was segmented at all, e.g. muscle under the brain).
+    double min_sheet_share = 0.1;
     void validate() const;       // std::invalid_argument with a one-line message
 };
 
 struct HoleCandidate {
     std::size_t voxels = 0;     // gap voxels in the component
     std::size_t rim = 0;        // its voxels that touch the inner or the outer tissue
+    std::size_t sheet = 0;      // its voxels that touch the mask
     Vec3d centroid;             // index space, of the whole component
     Vec3i site;                 // a voxel of the component: aim --target here
 };
