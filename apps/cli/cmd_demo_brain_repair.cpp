@@ -29,7 +29,7 @@ namespace {
 constexpr double kLowThreshold = 0.8;   // ε of the demo's segmentation: 80 % of the model window's
 constexpr std::size_t kMinHole = 50;    // the finder's smallest target, voxels
 constexpr std::size_t kMaxTargets = 10;  // the largest holes the user clicks, one round each
-constexpr int kRoundSteps = 600;         // swarm steps per target
+constexpr int kRoundSteps = 1000;        // swarm steps per target
 constexpr double kVerdictRadius = 6.0;   // the finder's verdict counts hole voxels this close to the target
 
 // Genus of the mask in the box of half-width r around c (the local topology at a target).
