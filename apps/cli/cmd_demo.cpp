@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
@@ -19,6 +20,7 @@
 #include "liveset/eval/perforations.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/intensity.hpp"
+#include "liveset/segment/window.hpp"
 #include "liveset/session/repair_presets.hpp"
 #include "view_command.hpp"
 #include "liveset/swarm/repair.hpp"
@@ -34,6 +36,7 @@ struct DemoArgs {
     std::uint64_t seed = 1;
     int rounds = 20;        // repair rounds (one target each)
     int round_steps = 100;  // swarm steps per round
+    std::string rule = "intensity";  // repair rule: intensity (population statistics) or sheet
     bool json = false, quiet = false, no_view = false;
     bool brain = false;  // the real-brain demo instead (demo_brain.hpp)
     bool repair = false;  // with --brain: the paper's Figure 5 (low threshold, finder, swarm repair)
@@ -42,6 +45,28 @@ struct DemoArgs {
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// --repair-rule sheet: the sheet rule (EditDecision::kSheet) with the grey matter's band from the
+// tissue model of the phantom, shifted to the sheet's intensity around each target.
+RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, RepairOptions& ro) {
+    std::vector<std::string> warnings;
+    TissueModel model;
+    const std::optional<ModelWindow> w = sheet_window(image, o.mask, nullptr, TissueModelOptions{}, warnings, &model);
+    if (!w) throw UsageError("demo --repair-rule sheet: the tissue model cannot tell the sheet's tissue");
+    const double lo = o.scale.to_unit(w->lower), hi = o.scale.to_unit(w->upper);
+    const double mean = o.scale.to_unit(model.classes[static_cast<std::size_t>(w->seed_class)].mean);
+    ro.swarm.decision = EditDecision::kSheet;
+    ro.swarm.sheet_lower = lo;
+    ro.swarm.sheet_upper = hi;
+    ro.swarm.edit_radius = 2.0;
+    const SparseField* field = &*o.field;
+    auto unit = std::make_shared<Grid<float>>(normalise(image, o.scale));
+    return [=](RepairOptions& r, const HoleSite& t) {
+        const auto [l, u] = local_sheet_band(*unit, field->phi(), t.position, 10.0, lo, hi, mean);
+        r.swarm.sheet_lower = l;
+        r.swarm.sheet_upper = u;
+    };
 }
 
 int run_demo(const DemoArgs& a, int threads) {
@@ -67,7 +92,7 @@ int run_demo(const DemoArgs& a, int threads) {
     // statistics window, which its repair presets were made for. (The tissue model's window, the
     // default of `liveset segment`, gives Dice 0.9752 here, but the repair rounds then leave one
     // tunnel: holes 2 -> 1; docs/BENCHMARKS.md. `liveset demo --brain` shows the model window.)
-    req.window.estimate = WindowSource::kSeeds;
+    req.window.estimate = a.rule == "sheet" ? WindowSource::kModel : WindowSource::kSeeds;
     const bool quiet_progress = a.quiet || a.json;
     const SegmentRun run = segment_with_progress(ph.image, req, quiet_progress);
     if (run.interrupted) {
@@ -109,7 +134,9 @@ int run_demo(const DemoArgs& a, int threads) {
     RepairScheduleOptions so;
     so.rounds = a.rounds;
     so.round_steps = a.round_steps;
-    const RepairScheduleResult sched = run_repair_schedule(*o.field, unit, nullptr, ro, so, holes_left, {}, &mesher);
+    RoundSetup setup;
+    if (a.rule == "sheet") setup = sheet_rule_setup(ph.image, o, ro);
+    const RepairScheduleResult sched = run_repair_schedule(*o.field, unit, nullptr, ro, so, holes_left, setup, &mesher);
     nlohmann::json rounds = nlohmann::json::array();
     std::size_t steps = 0, fragments = 0, modified = 0;
     double repair_ms = 0.0;
@@ -146,7 +173,7 @@ int run_demo(const DemoArgs& a, int threads) {
     j["after"] = after;
     j["dice"] = after["dice"];
     j["holes"] = after["holes"];
-    j["repair"] = {{"agents", ro.swarm.agents}, {"p", ro.swarm.act_probability}, {"rounds", rounds}, {"steps", steps},
+    j["repair"] = {{"rule", a.rule}, {"agents", ro.swarm.agents}, {"p", ro.swarm.act_probability}, {"rounds", rounds}, {"steps", steps},
                    {"holes_left", left}, {"points_modified", modified}, {"fragments_rebuilt", fragments},
                    {"ms_per_step", steps ? repair_ms / static_cast<double>(steps) : 0.0},
                    {"triangles", repaired_surface.triangle_count()}};
@@ -192,6 +219,7 @@ void add_demo_command(CLI::App& app, const int& threads) {
     demo->add_option("--seed", da.seed, "phantom noise seed")->capture_default_str();
     demo->add_option("--rounds", da.rounds, "repair rounds (one target, the largest hole left, each)")->check(CLI::Range(0, 1000))->capture_default_str();
     demo->add_option("--round-steps", da.round_steps, "swarm steps per repair round")->check(CLI::Range(1, 100000))->capture_default_str();
+    demo->add_option("--repair-rule", da.rule, "intensity: the population-statistics rule with the seeds' window (the presets); sheet: the sheet rule with the tissue model's window")->check(CLI::IsMember({"intensity", "sheet"}))->capture_default_str();
     demo->add_flag("--json", da.json, "print the report as one JSON object on stdout");
     demo->add_flag("--quiet,-q", da.quiet, "print nothing");
     demo->add_flag("--no-view", da.no_view, "do not open the viewer even when a display is available (--json implies it)");

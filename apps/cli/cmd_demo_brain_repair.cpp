@@ -32,20 +32,10 @@ constexpr std::size_t kMaxTargets = 10;  // the largest holes the user clicks, o
 constexpr int kRoundSteps = 1000;        // swarm steps per target
 constexpr double kVerdictRadius = 6.0;   // the finder's verdict counts hole voxels this close to the target
 
-// Genus of the mask in the box of half-width r around c (the local topology at a target).
-long local_genus(const Grid<std::uint8_t>& mask, Vec3i c, int r) {
-    const Vec3i lo{std::max(c.x - r, 0), std::max(c.y - r, 0), std::max(c.z - r, 0)};
-    const Vec3i d = mask.dims();
-    const Vec3i hi{std::min(c.x + r, d.x - 1), std::min(c.y + r, d.y - 1), std::min(c.z + r, d.z - 1)};
-    Grid<std::uint8_t> box(Lattice(hi - lo + Vec3i{1, 1, 1}), 0);
-    for (int z = lo.z; z <= hi.z; ++z)
-        for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x) box(Vec3i{x, y, z} - lo) = mask(Vec3i{x, y, z});
-    return mask_topology(box).genus;
-}
-
 // The finder's targets: the largest candidates of >= kMinHole voxels, at most kMaxTargets, none
-// within 2·kVerdictRadius of one already chosen (one click per hole).
+// within 2·kVerdictRadius of one already chosen (one click per hole). (Preferring the superior half,
+// the holes the superior view shows, closed 6 of 10 by the truth's measure instead of 9 of 10:
+// docs/BENCHMARKS.md.)
 std::vector<HoleSite> pick_targets(const std::vector<HoleCandidate>& holes) {
     std::vector<HoleSite> out;
     for (const HoleCandidate& h : holes) {
@@ -67,14 +57,10 @@ Verdicts verdicts(const std::vector<HoleSite>& targets, const Grid<std::uint8_t>
                   const Grid<std::uint8_t>& mask_before, const Grid<std::uint8_t>& mask_after) {
     Verdicts v;
     for (const HoleSite& t : targets) {
-        const std::size_t b = hole_voxels_near(holes_before, t.position, kVerdictRadius);
-        const std::size_t a = hole_voxels_near(holes_after, t.position, kVerdictRadius);
+        const HoleVerdict h = hole_verdict(t.position, kVerdictRadius, holes_before, holes_after, mask_before, mask_after);
         const Vec3i c = t.position.cast<int>();
-        const bool closed = 2 * a <= b;  // the finder's hole voxels near the target at least halved
-        v.closed += closed;
-        v.targets.push_back({{"target", {c.x, c.y, c.z}}, {"hole_voxels", t.voxels}, {"closed", closed},
-                             {"finder_voxels_near", {{"before", b}, {"after", a}}},
-                             {"local_genus", {{"before", local_genus(mask_before, c, 8)}, {"after", local_genus(mask_after, c, 8)}}}});
+        v.closed += h.closed;
+        v.targets.push_back(verdict_json(c, t.voxels, h));
     }
     return v;
 }

@@ -187,4 +187,29 @@ std::size_t hole_voxels_near(const Grid<std::uint8_t>& holes, Vec3d site, double
     return n;
 }
 
+long local_genus(const Grid<std::uint8_t>& mask, Vec3i c, int r) {
+    if (r < 0) throw std::invalid_argument("local_genus: negative box half-width");
+    const Vec3i d = mask.dims();
+    const Vec3i lo{std::max(c.x - r, 0), std::max(c.y - r, 0), std::max(c.z - r, 0)};
+    const Vec3i hi{std::min(c.x + r, d.x - 1), std::min(c.y + r, d.y - 1), std::min(c.z + r, d.z - 1)};
+    if (lo.x > hi.x || lo.y > hi.y || lo.z > hi.z) return 0;
+    Grid<std::uint8_t> box(Lattice(hi - lo + Vec3i{1, 1, 1}), 0);
+    for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x) box(Vec3i{x, y, z} - lo) = mask(Vec3i{x, y, z});
+    return mask_topology(box).genus;
+}
+
+HoleVerdict hole_verdict(Vec3d site, double radius, const Grid<std::uint8_t>& holes_before, const Grid<std::uint8_t>& holes_after,
+                         const Grid<std::uint8_t>& mask_before, const Grid<std::uint8_t>& mask_after) {
+    HoleVerdict v;
+    v.before = hole_voxels_near(holes_before, site, radius);
+    v.after = hole_voxels_near(holes_after, site, radius);
+    v.closed = 2 * v.after <= v.before;
+    const Vec3i c{static_cast<int>(std::lround(site.x)), static_cast<int>(std::lround(site.y)), static_cast<int>(std::lround(site.z))};
+    v.genus_before = local_genus(mask_before, c, 8);
+    v.genus_after = local_genus(mask_after, c, 8);
+    return v;
+}
+
 }  // namespace liveset

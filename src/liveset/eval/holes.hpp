@@ -53,4 +53,18 @@ Grid<std::uint8_t> hole_voxels(const Grid<std::uint8_t>& mask, const Grid<float>
 // candidate-hole voxels (non-zero in `holes`, from hole_voxels) within `radius` voxels of `site`.
 std::size_t hole_voxels_near(const Grid<std::uint8_t>& holes, Vec3d site, double radius);
 
+// Genus (tunnels/handles, topology.hpp) of the mask inside the box of half-width r around c: the
+// local topology at a repair target.
+long local_genus(const Grid<std::uint8_t>& mask, Vec3i c, int r);
+
+// The finder's verdict on one repair target: hole voxels (from hole_voxels) within `radius` of it
+// before and after, closed when they at least halved; the local genus (box of half-width 8) too.
+struct HoleVerdict {
+    std::size_t before = 0, after = 0;
+    long genus_before = 0, genus_after = 0;
+    bool closed = false;
+};
+HoleVerdict hole_verdict(Vec3d site, double radius, const Grid<std::uint8_t>& holes_before, const Grid<std::uint8_t>& holes_after,
+                         const Grid<std::uint8_t>& mask_before, const Grid<std::uint8_t>& mask_after);
+
 }  // namespace liveset
