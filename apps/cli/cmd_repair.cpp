@@ -72,6 +72,29 @@ std::optional<HoleFinderOptions> sheet_band(const RepairArgs& a, const Grid<floa
     return o;
 }
 
+// Bad targets, before anything runs or is written: outside the ROI, or with no surface within the
+// brush (the edit range; the spawn radius without one) — one line each.
+void check_targets(const std::vector<RepairTarget>& targets, const SparseField& field, const Grid<std::uint8_t>* roi,
+                   const RepairOptions& o) {
+    const Lattice& lat = field.lattice();
+    const double reach = o.swarm.edit_range > 0 ? o.swarm.edit_range : o.spawn_radius;
+    for (const RepairTarget& t : targets) {
+        const Vec3i c{static_cast<int>(std::lround(t.position.x)), static_cast<int>(std::lround(t.position.y)),
+                      static_cast<int>(std::lround(t.position.z))};
+        const std::string at = fmt::format("{},{},{}", t.position.x, t.position.y, t.position.z);
+        if (roi && !(*roi)(c)) throw UsageError(fmt::format("target {} lies outside the region of interest", at));
+        bool near = false;
+        for (PointIndex i : field.zero_layer()) {
+            const Vec3d d = lat.coord(i).cast<double>() - t.position;
+            if (dot(d, d) <= reach * reach) {
+                near = true;
+                break;
+            }
+        }
+        if (!near) throw UsageError(fmt::format("target {} has no surface within {:g} voxels (the brush)", at, reach));
+    }
+}
+
 int run_repair_command(RepairArgs a, int threads) {
     const auto guard = limit_threads(threads);
     const InterruptGuard interrupt;
@@ -103,6 +126,7 @@ int run_repair_command(RepairArgs a, int threads) {
     for (const std::string& t : a.targets) targets.push_back(parse_target(t, image.lattice(), false));
     for (const std::string& t : a.targets_mm) targets.push_back(parse_target(t, image.lattice(), true));
     SparseField field = load_level_set(a.input, image.lattice());
+    check_targets(targets, field, roi ? &*roi : nullptr, a.options);
     const IntensityScale scale = robust_scale(image, roi ? &*roi : nullptr);
     const Grid<float> unit = normalise(image, scale);
     const Grid<std::uint8_t> mask_before = inside_mask(field.phi(), roi ? &*roi : nullptr);

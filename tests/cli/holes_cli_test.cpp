@@ -85,7 +85,13 @@ TEST(HolesCli, BadInputGetsOneLineAndNonZeroExit) {
                                     "holes " + f.mask.string() + " --image " + f.image.string() + " --sheet-lower 90 --sheet-upper 80",
                                     "repair " + f.mask.string() + " --image " + f.image.string() +
                                         " --decision sheet --sheet-lower 90 --sheet-upper 80 --target 57,32,32 --out-mask " +
-                                        (f.dir / "x.nii.gz").string()}) {
+                                        (f.dir / "x.nii.gz").string(),
+                                    // the centre of the white matter: no surface within an 8-voxel brush
+                                    "repair " + f.mask.string() + " --image " + f.image.string() +
+                                        " --edit-range 8 --target 32,32,32 --out-mask " + (f.dir / "x.nii.gz").string(),
+                                    // outside the ROI (the 8^3 corner box is not its size: use the mask itself as ROI)
+                                    "repair " + f.mask.string() + " --image " + f.image.string() + " --roi " + f.mask.string() +
+                                        " --target 57,32,32 --out-mask " + (f.dir / "x.nii.gz").string()}) {
         const auto r = run_cli(args);
         EXPECT_NE(r.rc, 0) << args;
         EXPECT_EQ(testing::lines(r.err), 1) << args << "\n" << r.err;
