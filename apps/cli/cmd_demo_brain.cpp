@@ -53,11 +53,9 @@ void low_threshold(const Grid<float>& t1, const Grid<std::uint8_t>& roi, Segment
     band.sheet_mean = model->classes[static_cast<std::size_t>(w.seed_class)].mean;
 }
 
-}  // namespace
-
-int run_brain_demo(const BrainDemoArgs& a, int threads) {
+// The sample's three files present and the output folder writable (one line each otherwise).
+void check_brain_inputs(const BrainDemoArgs& a) {
     namespace fs = std::filesystem;
-    const auto guard = limit_threads(threads);
     const fs::path data(a.data), dir(a.out);
     for (const char* f : {"t1.mha", "labels_crisp.nii.gz", "brain_mask.nii.gz"})
         if (!fs::exists(data / f))
@@ -66,6 +64,50 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     fs::create_directories(dir, ec);
     if (ec || !fs::is_directory(dir)) throw UsageError(fmt::format("cannot create output folder {}", a.out));
     check_output_path((dir / "seg.nii.gz").string(), OutputKind::kImage, "--out");
+}
+
+// The superior-view pictures (surface.png; with --repair before.png and after.png) and, with
+// --repair, the report's before/after/targets/repair objects.
+void add_pictures(nlohmann::json& j, const BrainDemoArgs& a, const std::filesystem::path& dir, const Grid<float>& phi_before,
+                  const FragmentMesher& mesher, const nlohmann::json& ev, const nlohmann::json& after, const nlohmann::json& repair) {
+    if (a.repair) {
+        j["demo"] = "BrainWeb T1 -> sub-optimally low threshold (the tissue model's window, epsilon x 0.8) -> segment -> truth-free hole "
+                    "finder -> 200-agent sheet-rule repair at its 10 largest holes -> eval before/after against the grey-matter labels";
+        j["before"] = ev;
+        j["after"] = after;
+        j["targets"] = repair["targets"];
+        j["repair"] = repair;
+        j["dice"] = after["dice"];
+        j["screenshots"] = write_before_after_pictures(dir, phi_before, mesher);  // superior view, headless
+    } else {
+        try {  // the surface seen from above (headless EGL; a warning where there is no OpenGL)
+            viewer::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
+            j["screenshots"] = {{"surface", "surface.png"}};
+        } catch (const std::exception& e) {
+            fmt::print(stderr, "liveset: warning: no picture: {}\n", e.what());
+        }
+    }
+}
+
+// The text summary of --repair: the finder's targets, their verdicts, Dice and holes before/after.
+void print_repair_summary(const nlohmann::json& j) {
+    const nlohmann::json& r = j["repair"];
+    fmt::print("  repair       {} targets from the truth-free finder (>= {} voxels), {} agents x {} steps each, sheet rule:\n"
+               "               {} of {} closed by the finder's verdict, {} voxels added, {:.3f} ms/step; finder holes {} -> {}\n",
+               r["targets"].size(), r["finder"]["min_voxels"].get<std::size_t>(), r["agents"].get<std::size_t>(), r["round_steps"].get<int>(),
+               r["closed"].get<std::size_t>(), r["targets"].size(), r["voxels_added"].get<std::size_t>(), r["ms_per_step"].get<double>(),
+               r["finder"]["before"].get<std::size_t>(), r["finder"]["after"].get<std::size_t>());
+    fmt::print("  before       dice {:.4f}  holes {}\n", j["before"]["dice"].get<double>(), j["before"]["holes"].get<long>());
+    fmt::print("  after        dice {:.4f}  holes {}\n", j["after"]["dice"].get<double>(), j["after"]["holes"].get<long>());
+}
+
+}  // namespace
+
+int run_brain_demo(const BrainDemoArgs& a, int threads) {
+    namespace fs = std::filesystem;
+    const auto guard = limit_threads(threads);
+    const fs::path data(a.data), dir(a.out);
+    check_brain_inputs(a);
 
     Grid<float> t1 = read_image((data / "t1.mha").string());
     Grid<std::uint8_t> truth = read_label_image((data / "labels_crisp.nii.gz").string());  // read once
@@ -131,23 +173,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     j["dice"] = ev["dice"];
     j["timings_ms"] = {{"bias_correction", bias.ms}, {"segment", 1000.0 * o.result.seconds}, {"mesh", mesh_ms}, {"eval", eval_ms}};
     j["outputs"] = a.out;
-    if (a.repair) {
-        j["demo"] = "BrainWeb T1 -> sub-optimally low threshold (the tissue model's window, epsilon x 0.8) -> segment -> truth-free hole "
-                    "finder -> 200-agent sheet-rule repair at its 10 largest holes -> eval before/after against the grey-matter labels";
-        j["before"] = ev;
-        j["after"] = after;
-        j["targets"] = repair["targets"];
-        j["repair"] = repair;
-        j["dice"] = after["dice"];
-        j["screenshots"] = write_before_after_pictures(dir, phi_before, mesher);  // superior view, headless
-    } else {
-        try {  // the surface seen from above (headless EGL; a warning where there is no OpenGL)
-            viewer::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
-            j["screenshots"] = {{"surface", "surface.png"}};
-        } catch (const std::exception& e) {
-            fmt::print(stderr, "liveset: warning: no picture: {}\n", e.what());
-        }
-    }
+    add_pictures(j, a, dir, phi_before, mesher, ev, after, repair);
     write_atomically((dir / "report.json").string(), j.dump(2) + "\n");
     if (a.json) {
         fmt::print("{}\n", j.dump());
@@ -159,16 +185,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
         fmt::print("  mesh         {} triangles, {:.1f} ms\n", surface.triangle_count(), mesh_ms);
         fmt::print("  evaluation   against BrainWeb's grey-matter labels ({:.0f} ms):\n", eval_ms);
         print_evaluation(ev, "               ");
-        if (a.repair) {
-            const nlohmann::json& r = repair;
-            fmt::print("  repair       {} targets from the truth-free finder (>= {} voxels), {} agents x {} steps each, sheet rule:\n"
-                       "               {} of {} closed by the finder's verdict, {} voxels added, {:.3f} ms/step; finder holes {} -> {}\n",
-                       r["targets"].size(), r["finder"]["min_voxels"].get<std::size_t>(), r["agents"].get<std::size_t>(), r["round_steps"].get<int>(),
-                       r["closed"].get<std::size_t>(), r["targets"].size(), r["voxels_added"].get<std::size_t>(), r["ms_per_step"].get<double>(),
-                       r["finder"]["before"].get<std::size_t>(), r["finder"]["after"].get<std::size_t>());
-            fmt::print("  before       dice {:.4f}  holes {}\n", ev["dice"].get<double>(), ev["holes"].get<long>());
-            fmt::print("  after        dice {:.4f}  holes {}\n", after["dice"].get<double>(), after["holes"].get<long>());
-        }
+        if (a.repair) print_repair_summary(j);
         fmt::print("  outputs      {}/ (seg{}.nii.gz, phi.nii.gz, surface.ply, {}, report.json)\n", a.out, a.repair ? ", seg_repaired" : "",
                    a.repair ? "before.png, after.png" : "surface.png");
     }

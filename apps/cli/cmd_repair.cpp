@@ -95,6 +95,18 @@ void check_targets(const std::vector<RepairTarget>& targets, const SparseField& 
     }
 }
 
+// One line per target: the finder's verdict and the local genus.
+void print_verdicts(const nlohmann::json& verdicts, bool have_band) {
+    if (!have_band) fmt::print("  (no hole verdicts: the tissue model cannot tell the sheet's tissue)\n");
+    for (const nlohmann::json& v : verdicts) {
+        const std::size_t b = v["finder_voxels_near"]["before"], a = v["finder_voxels_near"]["after"];
+        fmt::print("  target {},{},{}: finder hole voxels within {:g}: {} -> {} ({}), local genus {} -> {}\n", v["target"][0].get<int>(),
+                   v["target"][1].get<int>(), v["target"][2].get<int>(), kVerdictRadius, b, a,
+                   b == 0 ? "no hole there" : (v["closed"].get<bool>() ? "closed" : "open"), v["local_genus"]["before"].get<long>(),
+                   v["local_genus"]["after"].get<long>());
+    }
+}
+
 int run_repair_command(RepairArgs a, int threads) {
     const auto guard = limit_threads(threads);
     const InterruptGuard interrupt;
@@ -182,13 +194,7 @@ int run_repair_command(RepairArgs a, int threads) {
     } else if (!a.quiet) {
         fmt::print("liveset repair: {} steps of {} agents, {} point edits, {} fragment rebuilds, {:.3f} ms/step\n", log.size(),
                    a.options.swarm.agents, modified, fragments, j["ms_per_step"].get<double>());
-        if (!band) fmt::print("  (no hole verdicts: the tissue model cannot tell the sheet's tissue)\n");
-        for (const nlohmann::json& v : verdicts)
-            fmt::print("  target {},{},{}: finder hole voxels within {:g}: {} -> {} ({}), local genus {} -> {}\n", v["target"][0].get<int>(),
-                       v["target"][1].get<int>(), v["target"][2].get<int>(), kVerdictRadius, v["finder_voxels_near"]["before"].get<std::size_t>(),
-                       v["finder_voxels_near"]["after"].get<std::size_t>(),
-                       v["finder_voxels_near"]["before"].get<std::size_t>() == 0 ? "no hole there" : (v["closed"].get<bool>() ? "closed" : "open"),
-                       v["local_genus"]["before"].get<long>(), v["local_genus"]["after"].get<long>());
+        print_verdicts(verdicts, band.has_value());
     }
     return 0;
 }
