@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
@@ -17,12 +18,14 @@
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
-#include "liveset/render/surface_picture.hpp"
+#include "demo_pictures.hpp"
 #include "liveset/eval/perforations.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/intensity.hpp"
+#include "liveset/segment/window.hpp"
 #include "liveset/session/repair_presets.hpp"
 #include "liveset/swarm/repair.hpp"
+#include "liveset/swarm/repair_schedule.hpp"
 
 namespace liveset::cli {
 
@@ -34,31 +37,37 @@ struct DemoArgs {
     std::uint64_t seed = 1;
     int rounds = 20;        // repair rounds (one target each)
     int round_steps = 100;  // swarm steps per round
+    std::string rule = "intensity";  // repair rule: intensity (population statistics) or sheet
     bool json = false, quiet = false, no_view = false;
     bool brain = false;  // the real-brain demo instead (demo_brain.hpp)
+    bool repair = false;  // with --brain: the paper's Figure 5 (low threshold, finder, swarm repair)
     BrainDemoArgs brain_args;
 };
 
-// The demo's pictures without a display: before.png (the surface of `phi_before`) and after.png
-// (the surface in `after`), superior view, rendered headless (EGL) into `dir`. Returns
-// {"before": ..., "after": ...}, or null with a one-line warning on stderr when no OpenGL context
-// can be had (the demo's other outputs do not depend on it).
-nlohmann::json write_before_after_pictures(const std::filesystem::path& dir, const Grid<float>& phi_before,
-                                           const FragmentMesher& after) {
-    try {
-        FragmentMesher before(phi_before.lattice(), after.fragment_size());
-        before.full_rebuild(phi_before);
-        render::render_surface_png(before, (dir / "before.png").string(), "superior", 800, 800, 2);
-        render::render_surface_png(after, (dir / "after.png").string(), "superior", 800, 800, 2);
-        return {{"before", "before.png"}, {"after", "after.png"}};
-    } catch (const std::exception& e) {
-        fmt::print(stderr, "liveset: warning: no before/after pictures: {}\n", e.what());
-        return nullptr;
-    }
-}
-
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// --repair-rule sheet: the sheet rule (EditDecision::kSheet) with the grey matter's band from the
+// tissue model of the phantom, shifted to the sheet's intensity around each target.
+RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, RepairOptions& ro) {
+    std::vector<std::string> warnings;
+    TissueModel model;
+    const std::optional<ModelWindow> w = sheet_window(image, o.mask, nullptr, TissueModelOptions{}, warnings, &model);
+    if (!w) throw UsageError("demo --repair-rule sheet: the tissue model cannot tell the sheet's tissue");
+    const double lo = o.scale.to_unit(w->lower), hi = o.scale.to_unit(w->upper);
+    const double mean = o.scale.to_unit(model.classes[static_cast<std::size_t>(w->seed_class)].mean);
+    ro.swarm.decision = EditDecision::kSheet;
+    ro.swarm.sheet_lower = lo;
+    ro.swarm.sheet_upper = hi;
+    ro.swarm.edit_radius = 2.0;
+    const SparseField* field = &*o.field;
+    auto unit = std::make_shared<Grid<float>>(normalise(image, o.scale));
+    return [=](RepairOptions& r, const HoleSite& t) {
+        const auto [l, u] = local_sheet_band(*unit, field->phi(), t.position, 10.0, lo, hi, mean);
+        r.swarm.sheet_lower = l;
+        r.swarm.sheet_upper = u;
+    };
 }
 
 int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
@@ -84,7 +93,7 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     // statistics window, which its repair presets were made for. (The tissue model's window, the
     // default of `liveset segment`, gives Dice 0.9752 here, but the repair rounds then leave one
     // tunnel: holes 2 -> 1; docs/BENCHMARKS.md. `liveset demo --brain` shows the model window.)
-    req.window.estimate = WindowSource::kSeeds;
+    req.window.estimate = a.rule == "sheet" ? WindowSource::kModel : WindowSource::kSeeds;
     const bool quiet_progress = a.quiet || a.json;
     const SegmentRun run = segment_with_progress(ph.image, req, quiet_progress);
     if (run.interrupted) {
@@ -111,36 +120,37 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     for (PointIndex i = 0; i < white.size(); ++i) white[i] = ph.labels[i] == kWhiteMatter;
     const Grid<float> unit = normalise(ph.image, o.scale);
     RepairOptions ro = demo_repair_options();
-    ro.steps = a.round_steps;
+    ro.swarm.seed = a.seed;
+    // The holes a user would point at: perforations first, then spurious cavities (bubbles).
+    const HoleSiteFinder holes_left = [&](const SparseField& field) {
+        const Grid<std::uint8_t> m = inside_mask(field.phi());
+        std::vector<Perforation> h = find_perforations(m, ph.truth, white);
+        if (h.empty()) h = find_cavities(m, white);
+        std::vector<HoleSite> sites;
+        for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
+        return sites;
+    };
+    const std::vector<HoleSite> first = holes_left(*o.field);
+    const std::optional<Vec3d> first_hole = first.empty() ? std::nullopt : std::optional<Vec3d>(first.front().position);
+    RepairScheduleOptions so;
+    so.rounds = a.rounds;
+    so.round_steps = a.round_steps;
+    RoundSetup setup;
+    if (a.rule == "sheet") setup = sheet_rule_setup(ph.image, o, ro);
+    const RepairScheduleResult sched = run_repair_schedule(*o.field, unit, nullptr, ro, so, holes_left, setup, &mesher);
     nlohmann::json rounds = nlohmann::json::array();
     std::size_t steps = 0, fragments = 0, modified = 0;
     double repair_ms = 0.0;
-    Grid<std::uint8_t> repaired = o.mask;
-    // The holes a user would point at: perforations first, then spurious cavities (bubbles).
-    const auto holes_left = [&] {
-        std::vector<Perforation> h = find_perforations(repaired, ph.truth, white);
-        return h.empty() ? find_cavities(repaired, white) : h;
-    };
-    std::vector<Perforation> holes = holes_left();
-    const std::optional<Vec3d> first_hole = holes.empty() ? std::nullopt : std::optional<Vec3d>(holes.front().centroid);
-    for (int r = 0; r < a.rounds && !holes.empty(); ++r) {
-        const Vec3d t = holes.front().centroid;
-        ro.swarm.seed = a.seed + static_cast<std::uint64_t>(r);
-        ro.swarm.edit_range = hole_brush_range(holes.front().voxels);  // the brush sized to the hole
-        const RepairTarget target{t, 0};
-        const std::vector<RepairStepLog> log = run_repair(*o.field, unit, nullptr, {&target, 1}, ro, &mesher);
-        for (const RepairStepLog& l : log) {
-            fragments += l.fragments;
-            modified += l.modified;
-            repair_ms += l.ms;
-        }
-        steps += log.size();
-        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", holes.front().voxels}, {"holes", holes.size()},
-                          {"edit_range", ro.swarm.edit_range}});
-        repaired = inside_mask(o.field->phi());
-        holes = holes_left();
+    for (const RepairRoundLog& r : sched.rounds) {
+        const Vec3d t = r.target.position;
+        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", r.target.voxels}, {"holes", r.holes}, {"edit_range", r.edit_range}});
+        steps += static_cast<std::size_t>(r.steps);
+        fragments += r.fragments;
+        modified += r.modified;
+        repair_ms += r.ms;
     }
-    const std::size_t left = holes.size();
+    const Grid<std::uint8_t> repaired = inside_mask(o.field->phi());
+    const std::size_t left = sched.holes_left;
     nlohmann::json after = evaluation_report(repaired, ph.truth);
     const Mesh repaired_surface = weld_vertices(mesher.merged().view());
 
@@ -164,7 +174,7 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     j["after"] = after;
     j["dice"] = after["dice"];
     j["holes"] = after["holes"];
-    j["repair"] = {{"agents", ro.swarm.agents}, {"p", ro.swarm.act_probability}, {"rounds", rounds}, {"steps", steps},
+    j["repair"] = {{"rule", a.rule}, {"agents", ro.swarm.agents}, {"p", ro.swarm.act_probability}, {"rounds", rounds}, {"steps", steps},
                    {"holes_left", left}, {"points_modified", modified}, {"fragments_rebuilt", fragments},
                    {"ms_per_step", steps ? repair_ms / static_cast<double>(steps) : 0.0},
                    {"triangles", repaired_surface.triangle_count()}};
@@ -212,15 +222,18 @@ void add_demo_command(CLI::App& app, const int& threads, DemoWindow window) {
     demo->add_option("--seed", da.seed, "phantom noise seed")->capture_default_str();
     demo->add_option("--rounds", da.rounds, "repair rounds (one target, the largest hole left, each)")->check(CLI::Range(0, 1000))->capture_default_str();
     demo->add_option("--round-steps", da.round_steps, "swarm steps per repair round")->check(CLI::Range(1, 100000))->capture_default_str();
+    demo->add_option("--repair-rule", da.rule, "intensity: the population-statistics rule with the seeds' window (the presets); sheet: the sheet rule with the tissue model's window")->check(CLI::IsMember({"intensity", "sheet"}))->capture_default_str();
     demo->add_flag("--json", da.json, "print the report as one JSON object on stdout");
     demo->add_flag("--quiet,-q", da.quiet, "print nothing");
     demo->add_flag("--no-view", da.no_view, "do not open the viewer even when a display is available (--json implies it)");
     demo->add_flag("--brain", da.brain, "the real-brain path instead: BrainWeb T1 (bundled in data/brainweb), seeds only -> segment -> mesh -> eval");
+    demo->add_flag("--repair", da.repair, "with --brain: segment with a sub-optimally low threshold, find the holes without truth, repair them with 200 agents (the paper's Figure 5)");
     demo->add_option("--data", da.brain_args.data, "with --brain: the folder holding t1.mha, labels_crisp.nii.gz and brain_mask.nii.gz")->capture_default_str();
     demo->callback([&threads, out] {
         if (da.brain) {
             da.brain_args.json = da.json;
             da.brain_args.quiet = da.quiet;
+            da.brain_args.repair = da.repair;
             if (out->count() > 0) da.brain_args.out = da.out;
             const int rc = run_brain_demo(da.brain_args, threads);
             if (rc != 0) std::exit(rc);

@@ -16,7 +16,9 @@
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_io.hpp"
+#include "demo_pictures.hpp"
 #include "liveset/render/surface_picture.hpp"
+#include "liveset/segment/window.hpp"
 
 namespace liveset::cli {
 
@@ -30,11 +32,31 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 const std::vector<Vec3i> kBrainSeeds = {{35, 83, 113}, {35, 125, 38}, {44, 164, 92},  {71, 74, 53},
                                         {122, 149, 47}, {140, 86, 74}, {38, 71, 26}, {83, 23, 71}};
 
-}  // namespace
+// The demo's sub-optimally low threshold (--repair): the tissue model's window for the seeds' class,
+// narrowed to brain_repair_epsilon_scale() of its half width around the same centre. Also fills
+// the grey matter's band and class mean for the finder and the sheet rule.
+void low_threshold(const Grid<float>& t1, const Grid<std::uint8_t>& roi, SegmentRequest& req, BrainRepairInput& band) {
+    std::vector<std::string> warnings;
+    const Grid<std::uint8_t> region = model_region(t1, nullptr, &roi, 3);
+    const std::optional<TissueModel> model = fit_window_model(t1, region, TissueModelOptions{}, warnings);
+    if (!model || !model->usable()) throw UsageError("demo --brain --repair: the tissue model cannot be fitted to the T1");
+    std::vector<float> seed_values;
+    for (const Vec3i& s : kBrainSeeds)
+        for (int dz = -2; dz <= 2; ++dz)
+            for (int dy = -2; dy <= 2; ++dy)
+                for (int dx = -2; dx <= 2; ++dx)
+                    if (dx * dx + dy * dy + dz * dz <= 4) seed_values.push_back(t1(s + Vec3i{dx, dy, dz}));
+    const ModelWindow w = model_window(*model, seed_values);
+    req.mu_raw = w.mu();
+    req.epsilon_raw = brain_repair_epsilon_scale() * w.epsilon();
+    band.band_lower = w.lower;
+    band.band_upper = w.upper;
+    band.sheet_mean = model->classes[static_cast<std::size_t>(w.seed_class)].mean;
+}
 
-int run_brain_demo(const BrainDemoArgs& a, int threads) {
+// The sample's three files present and the output folder writable (one line each otherwise).
+void check_brain_inputs(const BrainDemoArgs& a) {
     namespace fs = std::filesystem;
-    const auto guard = limit_threads(threads);
     const fs::path data(a.data), dir(a.out);
     for (const char* f : {"t1.mha", "labels_crisp.nii.gz", "brain_mask.nii.gz"})
         if (!fs::exists(data / f))
@@ -43,6 +65,50 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     fs::create_directories(dir, ec);
     if (ec || !fs::is_directory(dir)) throw UsageError(fmt::format("cannot create output folder {}", a.out));
     check_output_path((dir / "seg.nii.gz").string(), OutputKind::kImage, "--out");
+}
+
+// The superior-view pictures (surface.png; with --repair before.png and after.png) and, with
+// --repair, the report's before/after/targets/repair objects.
+void add_pictures(nlohmann::json& j, const BrainDemoArgs& a, const std::filesystem::path& dir, const Grid<float>& phi_before,
+                  const FragmentMesher& mesher, const nlohmann::json& ev, const nlohmann::json& after, const nlohmann::json& repair) {
+    if (a.repair) {
+        j["demo"] = "BrainWeb T1 -> sub-optimally low threshold (the tissue model's window, epsilon x 0.8) -> segment -> truth-free hole "
+                    "finder -> 200-agent sheet-rule repair at its 10 largest holes -> eval before/after against the grey-matter labels";
+        j["before"] = ev;
+        j["after"] = after;
+        j["targets"] = repair["targets"];
+        j["repair"] = repair;
+        j["dice"] = after["dice"];
+        j["screenshots"] = write_before_after_pictures(dir, phi_before, mesher);  // superior view, headless
+    } else {
+        try {  // the surface seen from above (headless EGL; a warning where there is no OpenGL)
+            render::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
+            j["screenshots"] = {{"surface", "surface.png"}};
+        } catch (const std::exception& e) {
+            fmt::print(stderr, "liveset: warning: no picture: {}\n", e.what());
+        }
+    }
+}
+
+// The text summary of --repair: the finder's targets, their verdicts, Dice and holes before/after.
+void print_repair_summary(const nlohmann::json& j) {
+    const nlohmann::json& r = j["repair"];
+    fmt::print("  repair       {} targets from the truth-free finder (>= {} voxels), {} agents x {} steps each, sheet rule:\n"
+               "               {} of {} closed by the finder's verdict, {} voxels added, {:.3f} ms/step; finder holes {} -> {}\n",
+               r["targets"].size(), r["finder"]["min_voxels"].get<std::size_t>(), r["agents"].get<std::size_t>(), r["round_steps"].get<int>(),
+               r["closed"].get<std::size_t>(), r["targets"].size(), r["voxels_added"].get<std::size_t>(), r["ms_per_step"].get<double>(),
+               r["finder"]["before"].get<std::size_t>(), r["finder"]["after"].get<std::size_t>());
+    fmt::print("  before       dice {:.4f}  holes {}\n", j["before"]["dice"].get<double>(), j["before"]["holes"].get<long>());
+    fmt::print("  after        dice {:.4f}  holes {}\n", j["after"]["dice"].get<double>(), j["after"]["holes"].get<long>());
+}
+
+}  // namespace
+
+int run_brain_demo(const BrainDemoArgs& a, int threads) {
+    namespace fs = std::filesystem;
+    const auto guard = limit_threads(threads);
+    const fs::path data(a.data), dir(a.out);
+    check_brain_inputs(a);
 
     Grid<float> t1 = read_image((data / "t1.mha").string());
     Grid<std::uint8_t> truth = read_label_image((data / "labels_crisp.nii.gz").string());  // read once
@@ -62,6 +128,8 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     for (const Vec3i& s : kBrainSeeds) req.seeds.push_back({{double(s.x), double(s.y), double(s.z)}, 2.0});
     req.roi = &roi;
     req.loop.step = sleeping_step();  // as `liveset segment`
+    BrainRepairInput rin{t1, roi, {}, 0, 0, 0};
+    if (a.repair) low_threshold(t1, roi, req, rin);
     const SegmentRun run = segment_with_progress(t1, req, a.quiet || a.json);
     if (run.interrupted) {
         fmt::print(stderr, "liveset: interrupted; nothing written\n");
@@ -74,9 +142,23 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     t0 = std::chrono::steady_clock::now();
     const nlohmann::json ev = evaluation_report(o.mask, truth);
     const double eval_ms = ms_since(t0);
+    nlohmann::json repair, after;
+    FragmentMesher mesher(t1.lattice(), 16);
+    mesher.full_rebuild(o.field->phi(), o.field->zero_layer());
+    const Grid<float> phi_before = o.field->phi();
+    if (a.repair) {
+        if (!a.quiet && !a.json) fmt::print("  segmented with a low threshold (epsilon x {}); repairing...\n", brain_repair_epsilon_scale());
+        rin.scale = o.scale;
+        repair = repair_brain_holes(rin, *o.field, mesher, true);
+        after = evaluation_report(inside_mask(o.field->phi(), &roi), truth);
+    }
 
     write_label_image(o.mask, (dir / "seg.nii.gz").string());
-    write_image(o.field->phi(), (dir / "phi.nii.gz").string());
+    write_image(phi_before, (dir / "phi.nii.gz").string());
+    if (a.repair) {
+        write_label_image(inside_mask(o.field->phi(), &roi), (dir / "seg_repaired.nii.gz").string());
+        write_image(o.field->phi(), (dir / "phi_repaired.nii.gz").string());
+    }
     write_mesh(dir / "surface.ply", surface.view(), t1.lattice());
     nlohmann::json j;
     j["demo"] = "BrainWeb T1 -> seeds only (tissue-model window) -> segment -> mesh -> eval against the grey-matter labels";
@@ -92,14 +174,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     j["dice"] = ev["dice"];
     j["timings_ms"] = {{"bias_correction", bias.ms}, {"segment", 1000.0 * o.result.seconds}, {"mesh", mesh_ms}, {"eval", eval_ms}};
     j["outputs"] = a.out;
-    try {  // the surface seen from above (headless EGL; a warning where there is no OpenGL)
-        FragmentMesher mesher(t1.lattice(), 16);
-        mesher.full_rebuild(o.field->phi(), o.field->zero_layer());
-        render::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
-        j["screenshots"] = {{"surface", "surface.png"}};
-    } catch (const std::exception& e) {
-        fmt::print(stderr, "liveset: warning: no picture: {}\n", e.what());
-    }
+    add_pictures(j, a, dir, phi_before, mesher, ev, after, repair);
     write_atomically((dir / "report.json").string(), j.dump(2) + "\n");
     if (a.json) {
         fmt::print("{}\n", j.dump());
@@ -111,7 +186,9 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
         fmt::print("  mesh         {} triangles, {:.1f} ms\n", surface.triangle_count(), mesh_ms);
         fmt::print("  evaluation   against BrainWeb's grey-matter labels ({:.0f} ms):\n", eval_ms);
         print_evaluation(ev, "               ");
-        fmt::print("  outputs      {}/ (seg.nii.gz, phi.nii.gz, surface.ply, surface.png, report.json)\n", a.out);
+        if (a.repair) print_repair_summary(j);
+        fmt::print("  outputs      {}/ (seg{}.nii.gz, phi.nii.gz, surface.ply, {}, report.json)\n", a.out, a.repair ? ", seg_repaired" : "",
+                   a.repair ? "before.png, after.png" : "surface.png");
     }
     return 0;
 }

@@ -3,7 +3,9 @@
 // incremental mesh; one JSON line per step in --log.
 #include <fmt/core.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -12,6 +14,8 @@
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_io.hpp"
+#include "liveset/segment/segmentation.hpp"
+#include "liveset/segment/window.hpp"
 #include "liveset/swarm/repair.hpp"
 
 namespace liveset::cli {
@@ -24,6 +28,7 @@ struct RepairArgs {
     RepairOptions options;
     std::string out_phi, out_mask, out_mesh, log;
     std::string decision = "intensity";
+    std::optional<double> sheet_lower, sheet_upper;  // the sheet's band (raw); from the tissue model when absent
     bool json = false, quiet = false;
 };
 
@@ -48,6 +53,61 @@ RepairTarget parse_target(const std::string& text, const Lattice& lattice, bool 
     return {b.center, step};
 }
 
+constexpr double kVerdictRadius = 6.0;  // the finder's verdict counts hole voxels this close to a target
+
+// The sheet's band for the finder's verdicts and --decision sheet: given, or the tissue model's
+// window for the class most of the segmentation's voxels are in (nullopt when it cannot be told).
+std::optional<HoleFinderOptions> sheet_band(const RepairArgs& a, const Grid<float>& image, const Grid<std::uint8_t>& mask,
+                                            const Grid<std::uint8_t>* roi) {
+    HoleFinderOptions o;
+    if (a.sheet_lower) {
+        o.sheet_lower = *a.sheet_lower;
+        o.sheet_upper = *a.sheet_upper;
+        return o;
+    }
+    std::vector<std::string> warnings;
+    const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, warnings);
+    if (!w) return std::nullopt;
+    o.sheet_lower = w->lower;
+    o.sheet_upper = w->upper;
+    return o;
+}
+
+// Bad targets, before anything runs or is written: outside the ROI, or with no surface within the
+// brush (the edit range; the spawn radius without one) — one line each.
+void check_targets(const std::vector<RepairTarget>& targets, const SparseField& field, const Grid<std::uint8_t>* roi,
+                   const RepairOptions& o) {
+    const Lattice& lat = field.lattice();
+    const double reach = o.swarm.edit_range > 0 ? o.swarm.edit_range : o.spawn_radius;
+    for (const RepairTarget& t : targets) {
+        const Vec3i c{static_cast<int>(std::lround(t.position.x)), static_cast<int>(std::lround(t.position.y)),
+                      static_cast<int>(std::lround(t.position.z))};
+        const std::string at = fmt::format("{},{},{}", t.position.x, t.position.y, t.position.z);
+        if (roi && !(*roi)(c)) throw UsageError(fmt::format("target {} lies outside the region of interest", at));
+        bool near = false;
+        for (PointIndex i : field.zero_layer()) {
+            const Vec3d d = lat.coord(i).cast<double>() - t.position;
+            if (dot(d, d) <= reach * reach) {
+                near = true;
+                break;
+            }
+        }
+        if (!near) throw UsageError(fmt::format("target {} has no surface within {:g} voxels (the brush)", at, reach));
+    }
+}
+
+// One line per target: the finder's verdict and the local genus.
+void print_verdicts(const nlohmann::json& verdicts, bool have_band) {
+    if (!have_band) fmt::print("  (no hole verdicts: the tissue model cannot tell the sheet's tissue)\n");
+    for (const nlohmann::json& v : verdicts) {
+        const std::size_t b = v["finder_voxels_near"]["before"], a = v["finder_voxels_near"]["after"];
+        fmt::print("  target {},{},{}: finder hole voxels within {:g}: {} -> {} ({}), local genus {} -> {}\n", v["target"][0].get<int>(),
+                   v["target"][1].get<int>(), v["target"][2].get<int>(), kVerdictRadius, b, a,
+                   b == 0 ? "no hole there" : (v["closed"].get<bool>() ? "closed" : "open"), v["local_genus"]["before"].get<long>(),
+                   v["local_genus"]["after"].get<long>());
+    }
+}
+
 int run_repair_command(RepairArgs a, int threads) {
     const auto guard = limit_threads(threads);
     const InterruptGuard interrupt;
@@ -56,8 +116,16 @@ int run_repair_command(RepairArgs a, int threads) {
     if (!a.out_mask.empty()) check_output_path(a.out_mask, OutputKind::kImage, "--out-mask");
     if (!a.out_mesh.empty()) check_output_path(a.out_mesh, OutputKind::kMesh, "--out-mesh");
     if (!a.log.empty()) check_output_path(a.log, OutputKind::kText, "--log");
-    a.options.swarm.decision = a.decision == "random" ? EditDecision::kRandom : EditDecision::kIntensity;
+    a.options.swarm.decision = a.decision == "random" ? EditDecision::kRandom
+                               : a.decision == "sheet" ? EditDecision::kSheet
+                                                        : EditDecision::kIntensity;
+    if (a.sheet_lower.has_value() != a.sheet_upper.has_value()) throw UsageError("give both --sheet-lower and --sheet-upper, or neither");
+    if (a.sheet_lower && !(*a.sheet_lower < *a.sheet_upper)) throw UsageError("--sheet-lower must be below --sheet-upper");
     if (a.targets.empty() && a.targets_mm.empty()) throw UsageError("give at least one --target I,J,K[@STEP] (or --target-mm)");
+    if (a.options.swarm.decision == EditDecision::kSheet) {  // checked with the band below
+        a.options.swarm.sheet_lower = 0.0;
+        a.options.swarm.sheet_upper = 1.0;
+    }
     try {
         validate(a.options.swarm);
     } catch (const std::invalid_argument& e) {
@@ -71,7 +139,16 @@ int run_repair_command(RepairArgs a, int threads) {
     for (const std::string& t : a.targets) targets.push_back(parse_target(t, image.lattice(), false));
     for (const std::string& t : a.targets_mm) targets.push_back(parse_target(t, image.lattice(), true));
     SparseField field = load_level_set(a.input, image.lattice());
-    const Grid<float> unit = normalise(image, robust_scale(image, roi ? &*roi : nullptr));
+    check_targets(targets, field, roi ? &*roi : nullptr, a.options);
+    const IntensityScale scale = robust_scale(image, roi ? &*roi : nullptr);
+    const Grid<float> unit = normalise(image, scale);
+    const Grid<std::uint8_t> mask_before = inside_mask(field.phi(), roi ? &*roi : nullptr);
+    const std::optional<HoleFinderOptions> band = sheet_band(a, image, mask_before, roi ? &*roi : nullptr);
+    if (a.options.swarm.decision == EditDecision::kSheet) {
+        if (!band) throw UsageError("--decision sheet: the tissue model cannot tell the sheet's tissue; give --sheet-lower and --sheet-upper");
+        a.options.swarm.sheet_lower = scale.to_unit(band->sheet_lower);
+        a.options.swarm.sheet_upper = scale.to_unit(band->sheet_upper);
+    }
 
     FragmentMesher mesher(image.lattice(), 8);
     mesher.full_rebuild(field.phi(), field.zero_layer());
@@ -82,6 +159,18 @@ int run_repair_command(RepairArgs a, int threads) {
         return 130;
     }
     const Grid<std::uint8_t> mask = inside_mask(field.phi(), roi ? &*roi : nullptr);
+    nlohmann::json verdicts = nlohmann::json::array();
+    std::size_t closed = 0;
+    if (band) {  // the finder's verdict per target (no ground truth)
+        const Grid<std::uint8_t> hb = hole_voxels(mask_before, image, roi ? &*roi : nullptr, *band);
+        const Grid<std::uint8_t> ha = hole_voxels(mask, image, roi ? &*roi : nullptr, *band);
+        for (const RepairTarget& t : targets) {
+            const HoleVerdict v = hole_verdict(t.position, kVerdictRadius, hb, ha, mask_before, mask);
+            closed += v.closed && v.before > 0;
+            verdicts.push_back(verdict_json(Vec3i{static_cast<int>(std::lround(t.position.x)), static_cast<int>(std::lround(t.position.y)),
+                                                  static_cast<int>(std::lround(t.position.z))}, 0, v));
+        }
+    }
     if (!a.out_phi.empty()) write_image(field.phi(), a.out_phi);
     if (!a.out_mask.empty()) write_label_image(mask, a.out_mask);
     if (!a.out_mesh.empty()) write_mesh(a.out_mesh, marching_cubes_band(field.phi(), field.zero_layer()).view(), image.lattice());
@@ -98,12 +187,15 @@ int run_repair_command(RepairArgs a, int threads) {
     if (!a.log.empty()) write_atomically(a.log, lines);
     nlohmann::json j{{"steps", log.size()}, {"agents", a.options.swarm.agents}, {"points_modified", modified},
                      {"fragments_rebuilt", fragments}, {"ms_per_step", log.empty() ? 0.0 : ms / static_cast<double>(log.size())},
-                     {"agents_on_surface_end", log.empty() ? 0 : log.back().on_surface}};
+                     {"agents_on_surface_end", log.empty() ? 0 : log.back().on_surface}, {"targets", verdicts},
+                     {"verdict_radius", kVerdictRadius}};
+    if (band) j["sheet_band"] = {band->sheet_lower, band->sheet_upper};
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
         fmt::print("liveset repair: {} steps of {} agents, {} point edits, {} fragment rebuilds, {:.3f} ms/step\n", log.size(),
                    a.options.swarm.agents, modified, fragments, j["ms_per_step"].get<double>());
+        print_verdicts(verdicts, band.has_value());
     }
     return 0;
 }
@@ -129,9 +221,11 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--contract-sigmas", ra.options.swarm.contract_sigmas, "contract where the inside intensity is beyond this many sigmas")->check(finite_number())->capture_default_str();
     r->add_option("--sample-depth", ra.options.swarm.sample_depth, "population samples this many voxels inside the surface (0: at the agents)")->check(finite_number())->capture_default_str();
     r->add_option("--edit-range", ra.options.swarm.edit_range, "only agents within this many voxels of the target edit (0: all)")->check(finite_number())->capture_default_str();
-    r->add_option("--decision", ra.decision, "how acting agents edit: intensity (the repair rule) or random (raise/lower at random, the paper's speed test)")
-        ->check(CLI::IsMember({"intensity", "random"}))
+    r->add_option("--decision", ra.decision, "how acting agents edit: intensity (population statistics), sheet (grow only into voxels in the sheet tissue's band: hole repair without growing into the neighbours) or random (the paper's speed test)")
+        ->check(CLI::IsMember({"intensity", "random", "sheet"}))
         ->capture_default_str();
+    r->add_option("--sheet-lower", ra.sheet_lower, "the sheet tissue's lowest intensity (raw; default: the tissue model's)")->check(finite_number());
+    r->add_option("--sheet-upper", ra.sheet_upper, "the sheet tissue's highest intensity (raw; default: the tissue model's)")->check(finite_number());
     r->add_flag("--no-topology-guard{false}", ra.options.topology_guard, "let edits bridge pieces or open tunnels (by default they cannot)");
     r->add_option("--out-phi", ra.out_phi, "repaired phi");
     r->add_option("--out-mask", ra.out_mask, "repaired mask");

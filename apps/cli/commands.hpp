@@ -25,6 +25,7 @@ void add_segment_commands(CLI::App& app, const int& threads);
 void add_eval_commands(CLI::App& app, const int& threads);
 void add_demo_command(CLI::App& app, const int& threads, DemoWindow window = {});
 void add_repair_command(CLI::App& app, const int& threads);
+void add_holes_command(CLI::App& app, const int& threads);
 void add_soak_command(CLI::App* bench, const int& threads);  // `bench soak`
 
 }  // namespace liveset::cli

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
     liveset::cli::add_segment_commands(app, threads);
     liveset::cli::add_eval_commands(app, threads);
     liveset::cli::add_repair_command(app, threads);
+    liveset::cli::add_holes_command(app, threads);
     liveset::cli::add_bench_commands(app, threads);
     // The headless commands link no viewer code: the demo gets its live window from here.
     liveset::cli::add_demo_command(app, threads, {liveset::cli::viewer_display_available, liveset::cli::open_demo_viewer});

@@ -262,4 +262,11 @@ void load_level_set(Session& session, const std::string& path) {
     if (!session.has_surface()) throw UsageError(fmt::format("{} holds no surface (nothing inside, or no voxel changes sign)", path));
 }
 
+nlohmann::json verdict_json(Vec3i c, std::size_t hole_voxels, const HoleVerdict& h) {
+    nlohmann::json j{{"target", {c.x, c.y, c.z}}, {"closed", h.closed}, {"finder_voxels_near", {{"before", h.before}, {"after", h.after}}},
+                     {"local_genus", {{"before", h.genus_before}, {"after", h.genus_after}}}};
+    if (hole_voxels) j["hole_voxels"] = hole_voxels;
+    return j;
+}
+
 }  // namespace liveset::cli

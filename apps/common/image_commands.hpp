@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "liveset/eval/holes.hpp"
 #include "liveset/eval/overlap.hpp"
 #include "liveset/eval/surface_distance.hpp"
 #include "liveset/eval/topology.hpp"
@@ -77,5 +78,9 @@ void print_segmentation_summary(const nlohmann::json& report);
 // the truth's topology.
 nlohmann::json evaluation_report(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth);
 void print_evaluation(const nlohmann::json& report, const std::string& indent = "  ");
+
+// One repair target's verdict: {"target": [i,j,k], "hole_voxels", "closed", "finder_voxels_near":
+// {before, after}, "local_genus": {before, after}} (hole_voxels omitted when 0).
+nlohmann::json verdict_json(Vec3i target, std::size_t hole_voxels, const HoleVerdict& verdict);
 
 }  // namespace liveset::cli

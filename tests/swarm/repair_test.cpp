@@ -111,31 +111,28 @@ TEST(Repair, SwarmClosesThePhantomPerforations) {
     ASSERT_EQ(before.size(), 2u);
     const double dice_before = compare_overlap(o.mask, ph.truth).dice;
     const Grid<float> unit = normalise(ph.image, o.scale);
-    RepairOptions ro;
-    ro.steps = 100;
-    ro.swarm.act_probability = 0.3;
-    ro.swarm.expand_sigmas = 2.0;
-    ro.swarm.edit_radius = 3.0;
-    ro.swarm.edit_range = 8.0;
-    Grid<std::uint8_t> mask = o.mask;
-    const auto holes_left = [&] {  // perforations first, then bubbles, as the demo targets them
-        std::vector<Perforation> h = find_perforations(mask, ph.truth, white);
-        return h.empty() ? find_cavities(mask, white) : h;
+    RepairOptions ro = demo_repair_options();  // 200 agents, p = 0.3, 2 sigmas, radius 3, brush 8
+    ro.swarm.seed = 1;
+    const HoleSiteFinder holes_left = [&](const SparseField& field) {  // perforations, then bubbles, as the demo
+        const Grid<std::uint8_t> m = inside_mask(field.phi());
+        std::vector<Perforation> h = find_perforations(m, ph.truth, white);
+        if (h.empty()) h = find_cavities(m, white);
+        std::vector<HoleSite> sites;
+        for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
+        return sites;
     };
+    RepairScheduleOptions so;  // 20 rounds of 100 steps, the brush sized to each hole
+    const RepairScheduleResult sched = run_repair_schedule(*o.field, unit, nullptr, ro, so, holes_left);
     std::vector<Vec3d> targets;
     std::vector<double> ranges;
-    for (int round = 0; round < 20; ++round) {
-        const auto left = holes_left();
-        if (left.empty()) break;
-        ro.swarm.seed = 1 + static_cast<std::uint64_t>(round);
-        ro.swarm.edit_range = hole_brush_range(left.front().voxels);  // as the demo sizes its brush
-        const RepairTarget t{left.front().centroid, 0};
-        ranges.push_back(ro.swarm.edit_range);
-        targets.push_back(t.position);
-        run_repair(*o.field, unit, nullptr, {&t, 1}, ro);
-        mask = inside_mask(o.field->phi());
+    for (const RepairRoundLog& r : sched.rounds) {
+        targets.push_back(r.target.position);
+        ranges.push_back(r.edit_range);
+        EXPECT_DOUBLE_EQ(r.edit_range, hole_brush_range(r.target.voxels));
     }
-    EXPECT_TRUE(holes_left().empty());
+    const Grid<std::uint8_t> mask = inside_mask(o.field->phi());
+    EXPECT_EQ(sched.holes_left, 0u);
+    EXPECT_TRUE(holes_left(*o.field).empty());
     const Topology after = mask_topology(mask);
     EXPECT_EQ(after.genus, 0);  // both tunnels closed, none made
     EXPECT_EQ(holes_between(mask_topology(ph.truth), after), 0);  // the check: `holes` drops to 0

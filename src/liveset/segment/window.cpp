@@ -116,4 +116,23 @@ WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& s
     return w;
 }
 
+std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
+                                        const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
+                                        std::vector<std::string>& warnings, TissueModel* model) {
+    if (!(mask.dims() == image.dims()) || (roi && !(roi->dims() == image.dims())))
+        throw std::invalid_argument("sheet window: image, mask and ROI differ in size");
+    std::vector<float> values;
+    for (PointIndex i = 0; i < mask.size(); ++i)
+        if (mask[i] && (!roi || (*roi)[i])) values.push_back(image[i]);
+    if (values.empty()) {
+        warnings.push_back("the segmentation is empty: no sheet to find holes in");
+        return std::nullopt;
+    }
+    const Grid<std::uint8_t> region = model_region(image, nullptr, roi, options.classes);
+    const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings);
+    if (!m || !m->usable()) return std::nullopt;
+    if (model) *model = *m;
+    return model_window(*m, values);
+}
+
 }  // namespace liveset

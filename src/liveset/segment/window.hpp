@@ -57,4 +57,13 @@ WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& s
 // mean of more than one tissue class.
 std::vector<std::string> window_warnings(const TissueModel& model, double lower, double upper);
 
+// The intensity band of the tissue a segmented sheet is made of (for the hole finder and the sheet
+// repair rule): the model window (model_window) of the class most of the mask's voxels fall in,
+// from the tissue model fitted in model_region(image, nullptr, roi, classes). nullopt, with the
+// reason in `warnings`, when the model cannot be used or the mask is empty. `model` (optional)
+// receives the fitted model. Throws std::invalid_argument when the sizes differ.
+std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
+                                        const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
+                                        std::vector<std::string>& warnings, TissueModel* model = nullptr);
+
 }  // namespace liveset

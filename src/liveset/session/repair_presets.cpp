@@ -18,13 +18,4 @@ RepairOptions demo_repair_options() {
     return ro;
 }
 
-double hole_brush_range(std::size_t hole_voxels, double shell_thickness, double max_range) {
-    if (!(std::isfinite(shell_thickness) && shell_thickness > 0))
-        throw std::invalid_argument("hole brush: the shell thickness must be finite and > 0 voxels");
-    if (!(std::isfinite(max_range) && max_range >= 3.0))
-        throw std::invalid_argument("hole brush: the largest range must be finite and >= 3 voxels");
-    const double radius = std::sqrt(static_cast<double>(hole_voxels) / (std::numbers::pi * shell_thickness));
-    return std::clamp(radius + 1.0, 3.0, max_range);
-}
-
 }  // namespace liveset

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <climits>
+#include <cstdint>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -14,12 +16,37 @@ namespace {
 
 constexpr std::size_t kPocketLimit = 32768;
 
+// Visited marks for the pocket flood: one stamp per lattice point, reused across floods (a new
+// stamp per flood, so nothing is cleared). Per thread: guard_topology may run on several threads.
+struct FloodMarks {
+    std::vector<std::uint32_t> stamp;
+    std::uint32_t current = 0;
+    std::vector<Vec3i> queue;
+    void begin(std::size_t points) {
+        if (stamp.size() != points || current == UINT32_MAX) {
+            stamp.assign(points, 0);
+            current = 0;
+        }
+        ++current;
+        queue.clear();
+    }
+    bool visit(PointIndex i) {
+        if (stamp[i] == current) return false;
+        stamp[i] = current;
+        return true;
+    }
+};
+
 // Breadth-first flood of the outside (6-connected) from `start`: true when it ends within
-// kPocketLimit voxels without reaching the lattice border.
+// kPocketLimit voxels without reaching the lattice border. (A flat stamp array instead of a hash
+// set: the flood is the guard's worst case, ~30 k voxels when the outside is large.)
 template <class Inside>
 bool encloses_small_pocket(const Lattice& lat, Inside& inside, Vec3i start) {
-    std::vector<Vec3i> queue{start};
-    std::unordered_map<PointIndex, char> seen{{lat.index(start), 1}};
+    thread_local FloodMarks marks;
+    marks.begin(lat.size());
+    std::vector<Vec3i>& queue = marks.queue;
+    queue.push_back(start);
+    marks.visit(lat.index(start));
     const Vec3i dims = lat.dims();
     for (std::size_t head = 0; head < queue.size(); ++head) {
         if (queue.size() > kPocketLimit) return false;
@@ -28,7 +55,7 @@ bool encloses_small_pocket(const Lattice& lat, Inside& inside, Vec3i start) {
         for (int k = 0; k < 6; ++k) {
             Vec3i q = p;
             q[k / 2] += (k % 2) ? 1 : -1;
-            if (inside(q) || !seen.emplace(lat.index(q), 1).second) continue;
+            if (inside(q) || !marks.visit(lat.index(q))) continue;
             queue.push_back(q);
         }
     }

@@ -30,6 +30,12 @@
 //     contracts(Δ = +A) else if |I_in − μ| > k'·σ (the inside does not look like it: retreat)
 //   (decision kRandom, the paper's speed benchmark: an acting agent raises or lowers the surface
 //   with equal probability instead, from the same stream)
+//   (decision kSheet, hole repair in a sheet such as the cortex: no population statistics; an
+//   acting agent expands (Δ = −A) only when both I(x + 0.75n) and I_out lie in the sheet's band
+//   [sheet_lower, sheet_upper): the voxel it grows into looks like the sheet's tissue, neither the
+//   enclosed tissue above the band (white matter) nor the outside below it (CSF). It never
+//   contracts: a repair closes holes, the segmentation's own faces stay where they are; and its
+//   footprint skips the outside points whose own voxel lies outside the band)
 //   Δ is spread over the zero-layer points p with |p − x| ≤ edit_radius, weighted by the
 //   unit-peak Gaussian exp(−|p − x|²/(2σ_g²)), σ_g = edit_radius/2, so A is the change under the
 //   agent whatever the zero-layer sampling density. Contributions to a point are summed in agent
@@ -164,6 +170,9 @@ void validate(const SwarmOptions& o) {
     require(finite_positive(o.stats_smoothing) && o.stats_smoothing <= 1, "swarm: stats_smoothing must be in (0, 1]");
     require(std::isfinite(o.sample_depth) && o.sample_depth >= 0 && o.sample_depth <= 8, "swarm: sample_depth must be in [0, 8]");
     require(std::isfinite(o.edit_range) && o.edit_range >= 0, "swarm: edit_range must be finite and >= 0");
+    require(o.decision != EditDecision::kSheet ||
+                (std::isfinite(o.sheet_lower) && std::isfinite(o.sheet_upper) && o.sheet_lower < o.sheet_upper),
+            "swarm: the sheet decision needs a finite band sheet_lower < sheet_upper");
 }
 
 Swarm::Swarm(const SwarmOptions& options) : options_(options) { validate(options_); }
@@ -306,6 +315,7 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
     const double inv_two_var = 1.0 / (2.0 * sg * sg);
     const int reach = static_cast<int>(std::ceil(support));
 
+    const bool sheet = options_.decision == EditDecision::kSheet;
     std::vector<std::vector<ZeroLayerEdit>> per_agent(n_agents);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_agents), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -320,9 +330,13 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
             const double outside = trilinear(image_unit, x + n * 1.5);
             const double inside = trilinear(image_unit, x - n * 1.5);
             double amount = 0.0;
-            if (options_.decision == EditDecision::kRandom)
+            if (options_.decision == EditDecision::kRandom) {
                 amount = rng.uniform() < 0.5 ? -options_.edit_amount : options_.edit_amount;
-            else if (std::abs(outside - mu) <= options_.expand_sigmas * sigma)
+            } else if (options_.decision == EditDecision::kSheet) {
+                const double near = trilinear(image_unit, x + n * 0.75);
+                const auto in_band = [&](double v) { return v >= options_.sheet_lower && v < options_.sheet_upper; };
+                if (in_band(near) && in_band(outside)) amount = -options_.edit_amount;
+            } else if (std::abs(outside - mu) <= options_.expand_sigmas * sigma)
                 amount = -options_.edit_amount;
             else if (std::abs(inside - mu) > options_.contract_sigmas * sigma)
                 amount = options_.edit_amount;
@@ -338,6 +352,8 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
                         if (!lat.contains(q)) continue;
                         const PointIndex idx = lat.index(q);
                         if (field.status()[idx] != 0) continue;
+                        if (sheet && phi[idx] >= 0.0f && !(image_unit[idx] >= options_.sheet_lower && image_unit[idx] < options_.sheet_upper))
+                            continue;  // kSheet: never raise the surface over a voxel that is not the sheet's tissue
                         const Vec3d d = q.cast<double>() - x;
                         const double d2 = dot(d, d);
                         if (d2 > support * support) continue;

@@ -20,6 +20,7 @@ namespace liveset {
 enum class EditDecision {
     kIntensity,  // population intensity statistics (the repair rule, see swarm.cpp)
     kRandom,     // raise or lower at random (the paper's frame-rate experiment, §4)
+    kSheet,      // hole repair in a sheet: grow only into voxels of the sheet's own band (see swarm.cpp)
 };
 
 struct SwarmOptions {
@@ -46,6 +47,10 @@ struct SwarmOptions {
     // the user designates; 0: no limit (and always none without a target).
     double edit_range = 0.0;
     EditDecision decision = EditDecision::kIntensity;
+    // Decision kSheet: the sheet tissue's intensity band [sheet_lower, sheet_upper) (normalised
+    // units), between the tissue the sheet encloses (above) and the outside (below); sampled
+    // around the hole by local_sheet_band (repair_schedule.hpp). Must satisfy lower < upper.
+    double sheet_lower = 0.0, sheet_upper = 0.0;
 };
 
 // Throws std::invalid_argument (one-line message) on an invalid option.

@@ -1,0 +1,72 @@
+// The hole-repair schedule a user follows (and the demos, the viewer and the tests replay): rounds,
+// each aimed at the largest hole left with the brush sized to that hole, the swarm running a fixed
+// number of steps per round; plus the sheet repair's local intensity band sampled around a hole.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "liveset/swarm/repair.hpp"
+
+namespace liveset {
+
+// The brush a user sizes to a hole before clicking at its centre (ITK-SNAP users size the paint
+// brush the same way): the radius of a disc of `hole_voxels` voxels through a shell
+// `shell_thickness` voxels thick, plus one voxel so the brush reaches the hole's rim, clamped to
+// [3, max_range] voxels. A fixed 8-voxel brush keeps editing the shell around a hole that has
+// shrunk to a few voxels and grows it into white matter and CSF (docs/BENCHMARKS.md).
+// Throws std::invalid_argument for a non-positive thickness or max_range < 3.
+double hole_brush_range(std::size_t hole_voxels, double shell_thickness = 3.0, double max_range = 8.0);
+
+struct HoleSite {
+    Vec3d position;          // index space: where the round aims the swarm
+    std::size_t voxels = 0;  // the hole's size (sizes the brush)
+};
+
+struct RepairScheduleOptions {
+    int rounds = 20;        // at most this many rounds (one target each)
+    int round_steps = 100;  // swarm steps per round
+    double shell_thickness = 3.0;  // brush sizing (hole_brush_range)
+    double max_range = 8.0;
+    void validate() const;  // std::invalid_argument with a one-line message
+};
+
+struct RepairRoundLog {
+    HoleSite target;
+    std::size_t holes = 0;   // holes the finder listed before the round
+    double edit_range = 0;   // the brush
+    int steps = 0;
+    std::size_t modified = 0, fragments = 0;
+    double ms = 0.0;
+};
+
+struct RepairScheduleResult {
+    std::vector<RepairRoundLog> rounds;
+    std::size_t holes_left = 0;  // what the finder listed after the last round
+    bool interrupted = false;
+};
+
+// The holes left on the current surface, the one to aim at first.
+using HoleSiteFinder = std::function<std::vector<HoleSite>(const SparseField& field)>;
+// Adjusts a round's options for its target (e.g. the sheet band sampled there); may be empty.
+using RoundSetup = std::function<void(RepairOptions& round, const HoleSite& target)>;
+
+// Round r: holes = find(field); none left -> stop; else aim a fresh swarm (seed base.seed + r) at
+// holes.front() with edit_range = hole_brush_range(its voxels) and run round_steps steps
+// (run_repair). Throws std::invalid_argument on bad options.
+RepairScheduleResult run_repair_schedule(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
+                                         const RepairOptions& base, const RepairScheduleOptions& schedule,
+                                         const HoleSiteFinder& find, const RoundSetup& setup = {},
+                                         FragmentMesher* mesher = nullptr, const std::atomic<bool>* interrupt = nullptr);
+
+// The sheet's own band around a hole: the model's band [lower, upper) of the sheet tissue (class
+// mean `mean`; normalised units) shifted by (m − mean), m the median intensity of the voxels inside
+// the surface (φ < 0) within `radius` of `site` whose intensity lies in the band (a local bias moves
+// the sheet's intensities, and its neighbours' with it). The model's band unchanged when fewer than
+// 20 such voxels exist. Returns {lower, upper}.
+std::pair<double, double> local_sheet_band(const Grid<float>& image_unit, const Grid<float>& phi, Vec3d site, double radius,
+                                           double lower, double upper, double mean);
+
+}  // namespace liveset

@@ -1,0 +1,144 @@
+// The sheet repair rule (EditDecision::kSheet) and the repair schedule on a drilled shell whose
+// truth is known analytically: the hole closes, only sheet voxels are added, nothing contracts.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include "liveset/eval/holes.hpp"
+#include "liveset/eval/topology.hpp"
+#include "liveset/segment/segmentation.hpp"
+#include "liveset/swarm/repair_schedule.hpp"
+
+namespace liveset {
+namespace {
+
+// The white-matter core is larger than the topology guard's pocket limit (32 768 voxels): sealing
+// a smaller core off counts as making a spurious cavity, and the guard refuses the last voxel.
+constexpr int kN = 64;
+const Vec3d kCentre{32, 32, 32};
+constexpr double kCore = 21, kOuter = 25;
+constexpr float kCsf = 0.2f, kGm = 0.5f, kWm = 0.8f;  // normalised intensities
+constexpr double kLower = 0.35, kUpper = 0.65;        // midpoints: the sheet's band
+
+// WM ball r <= kCore, GM shell kCore < r <= kOuter, CSF outside; the mask is the shell minus a drill of
+// radius `drill` along +x.
+struct Shell {
+    Grid<float> image{Lattice({kN, kN, kN}), kCsf};
+    Grid<std::uint8_t> mask{Lattice({kN, kN, kN}), 0};
+};
+
+Shell drilled_shell(double drill) {
+    Shell s;
+    for (int z = 0; z < kN; ++z)
+        for (int y = 0; y < kN; ++y)
+            for (int x = 0; x < kN; ++x) {
+                const Vec3d p{double(x), double(y), double(z)};
+                const double r = norm(p - kCentre);
+                if (r <= kCore) s.image({x, y, z}) = kWm;
+                else if (r <= kOuter) {
+                    s.image({x, y, z}) = kGm;
+                    s.mask({x, y, z}) = !(p.x > kCentre.x && std::hypot(p.y - kCentre.y, p.z - kCentre.z) <= drill);
+                }
+            }
+    return s;
+}
+
+HoleFinderOptions finder() {
+    HoleFinderOptions o;
+    o.sheet_lower = kLower;
+    o.sheet_upper = kUpper;
+    return o;
+}
+
+RepairOptions sheet_options() {
+    RepairOptions ro;
+    ro.swarm.agents = 200;
+    ro.swarm.decision = EditDecision::kSheet;
+    ro.swarm.sheet_lower = kLower;
+    ro.swarm.sheet_upper = kUpper;
+    ro.swarm.edit_radius = 2.0;
+    ro.swarm.act_probability = 0.3;
+    return ro;
+}
+
+TEST(SheetRepair, ClosesADrilledHoleAddingOnlySheetVoxels) {
+    const Shell s = drilled_shell(3.0);
+    SparseField field(s.mask.lattice(), 2);
+    field.init_from_mask(s.mask);
+    ASSERT_EQ(find_holes(s.mask, s.image, nullptr, finder()).size(), 1u);
+    const HoleSiteFinder find = [&](const SparseField& f) {
+        std::vector<HoleSite> out;
+        for (const HoleCandidate& h : find_holes(inside_mask(f.phi()), s.image, nullptr, finder()))
+            out.push_back({h.site.cast<double>(), h.voxels});
+        return out;
+    };
+    RepairScheduleOptions so;
+    so.rounds = 5;
+    so.round_steps = 200;
+    const RepairScheduleResult r = run_repair_schedule(field, s.image, nullptr, sheet_options(), so, find);
+    EXPECT_EQ(r.holes_left, 0u);  // the finder's verdict
+    const Grid<std::uint8_t> after = inside_mask(field.phi());
+    EXPECT_EQ(mask_topology(after).genus, 0);  // the tunnel closed: a closed shell
+    for (PointIndex i = 0; i < after.size(); ++i) {
+        if (s.mask[i]) {
+            ASSERT_TRUE(after[i]) << "the sheet rule never contracts";
+        }
+        if (after[i] && !s.mask[i]) {
+            ASSERT_EQ(s.image[i], kGm) << "added a voxel that is not the sheet's tissue";
+        }
+    }
+}
+
+TEST(SheetRepair, NeverGrowsIntoTheNeighbouringTissues) {
+    // An intact shell: every outside voxel next to it is WM or CSF, so nothing may be added
+    // wherever the swarm is aimed.
+    const Shell s = drilled_shell(-1.0);
+    SparseField field(s.mask.lattice(), 2);
+    field.init_from_mask(s.mask);
+    RepairOptions ro = sheet_options();
+    ro.steps = 300;
+    const RepairTarget t{{kCentre.x + 23, kCentre.y, kCentre.z}, 0};
+    run_repair(field, s.image, nullptr, {&t, 1}, ro);
+    const Grid<std::uint8_t> after = inside_mask(field.phi());
+    for (PointIndex i = 0; i < after.size(); ++i) ASSERT_EQ(after[i], s.mask[i]);
+}
+
+TEST(SheetRepair, LocalBandFollowsTheSheetsOwnIntensity) {
+    Shell s = drilled_shell(-1.0);
+    for (float& v : s.image.values())
+        if (v == kGm) v = kGm + 0.04f;  // a local bias: the sheet reads 0.54
+    Grid<float> phi(s.mask.lattice(), 1.0f);
+    for (PointIndex i = 0; i < phi.size(); ++i)
+        if (s.mask[i]) phi[i] = -1.0f;
+    const auto [lo, hi] = local_sheet_band(s.image, phi, {kCentre.x + 23, kCentre.y, kCentre.z}, 6.0, kLower, kUpper, kGm);
+    EXPECT_NEAR(lo, kLower + 0.04, 1e-6);
+    EXPECT_NEAR(hi, kUpper + 0.04, 1e-6);
+    // Too few sheet voxels near the site: the model's band unchanged.
+    const auto [lo2, hi2] = local_sheet_band(s.image, phi, {2, 2, 2}, 3.0, kLower, kUpper, kGm);
+    EXPECT_DOUBLE_EQ(lo2, kLower);
+    EXPECT_DOUBLE_EQ(hi2, kUpper);
+}
+
+TEST(SheetRepair, BadOptionsThrow) {
+    SwarmOptions o;
+    o.decision = EditDecision::kSheet;
+    o.sheet_lower = 0.6;
+    o.sheet_upper = 0.4;
+    EXPECT_THROW(validate(o), std::invalid_argument);
+    RepairScheduleOptions so;
+    so.round_steps = 0;
+    EXPECT_THROW(so.validate(), std::invalid_argument);
+    EXPECT_THROW(hole_brush_range(10, 0.0), std::invalid_argument);
+}
+
+TEST(SheetRepair, BrushSizedToTheHole) {
+    EXPECT_DOUBLE_EQ(hole_brush_range(0), 3.0);
+    EXPECT_DOUBLE_EQ(hole_brush_range(1000000), 8.0);
+    const double v = 3.0 * std::numbers::pi * 16.0;  // a disc of radius 4 through a 3-voxel shell
+    EXPECT_NEAR(hole_brush_range(static_cast<std::size_t>(std::lround(v))), 5.0, 0.02);
+}
+
+}  // namespace
+}  // namespace liveset
