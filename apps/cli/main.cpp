@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
     liveset::cli::add_bench_commands(app, threads);
     liveset::cli::add_demo_command(app, threads);
     liveset::cli::add_view_command(app, threads);
+    liveset::cli::add_batch_command(app);
 
     try {
         app.parse(argc, argv);
