@@ -8,8 +8,8 @@ row per subject. Finished subjects (report.json with the same inputs) are skippe
 subject that fails is recorded and the others go on (exit status 1); a worker that dies is
 replaced and its subject re-run elsewhere (Dask's own rescheduling, plus ``--retries``).
 
-The default cluster is a LocalCluster of N worker processes listening on 127.0.0.1 only, without
-a dashboard. ``--scheduler tcp://host:8786`` or ``tls://host:8786`` uses a running cluster
+The default cluster is a LocalCluster of N worker processes whose scheduler, workers, nannies and
+HTTP endpoints listen on 127.0.0.1 only. ``--scheduler tcp://host:8786`` or ``tls://host:8786`` uses a running cluster
 (workers must be able to import liveset and read the manifest's paths); TLS takes the
 certificates from Dask's configuration (distributed.comm.tls.*) or --tls-ca-file/--tls-cert/--tls-key.
 """
@@ -152,10 +152,11 @@ class _Progress:
 
 def local_cluster(workers: int):
     """A LocalCluster of `workers` processes (one task thread each) whose scheduler, workers and
-    nannies listen on 127.0.0.1 only; no dashboard."""
+    nannies listen on 127.0.0.1 only, their HTTP endpoints (health, metrics; the dashboard when
+    bokeh is installed) too, on free ports."""
     from distributed import LocalCluster
     return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                        dashboard_address=None, worker_dashboard_address=None, protocol="tcp://",
+                        dashboard_address="127.0.0.1:0", worker_dashboard_address="127.0.0.1:0", protocol="tcp://",
                         silence_logs=logging.ERROR)
 
 

@@ -115,7 +115,7 @@ def test_worker_killed_mid_subject_loses_nothing(cohort, tmp_path):
 
 @pytest.mark.parametrize("header,row,message", [
     ("subject,image", "a,s1/t1.nii.gz", "missing column(s) seeds"),
-    ("subject,image,seeds", "a,s1/nope.nii.gz,1,2,3", "row 2: image 's1/nope.nii.gz' does not exist"),
+    ("subject,image,seeds", "a,s1/nope.nii.gz,\"1,2,3\"", "row 2: image 's1/nope.nii.gz' does not exist"),
     ("subject,image,seeds", "a,s1/t1.nii.gz,1;2;3", "row 2: bad seed '1'"),
     ("subject,image,seeds,mu_raw", "a,s1/t1.nii.gz,\"1,2,3\",high", "row 2: mu_raw 'high' is not a number"),
     ("subject,image,seeds,colour", "a,s1/t1.nii.gz,\"1,2,3\",red", "unknown column(s) colour"),
