@@ -14,7 +14,7 @@ packages=(
   libinsighttoolkit5-dev zlib1g-dev           # image IO (NIfTI, MetaImage, NRRD, MINC, DICOM); N4 bias correction
   python3-nibabel python3-numpy               # scripts/brainweb_bias_variant.py; the Python module (python/)
   python3-dev pybind11-dev python3-pytest     # the Python module `liveset` and its pytest suite (ctest runs it)
-  python3-distributed python3-dask            # liveset batch: cohorts on Dask distributed
+  python3-distributed python3-dask openssl    # liveset batch: cohorts on Dask distributed (openssl: its TLS test)
   libglfw3-dev libepoxy-dev libimgui-dev      # viewer: window, OpenGL 3.3 loader, Dear ImGui
   libglm-dev libstb-dev                       # viewer: matrices, PNG screenshots
   libegl-dev libgl-dev libgl1-mesa-dri        # OpenGL / EGL (Mesa llvmpipe without a GPU; headless runs)

@@ -190,3 +190,16 @@ def test_session_steps_undo_redo_and_swarm(phantom):
     assert phi.array.shape == img.shape and np.sum((phi.array < 0) != (grown != 0)) > 0
     with pytest.raises(ValueError, match="outside"):
         s.add_seed((1e4, 0, 0))
+
+
+def test_docs_example_runs(tmp_path):
+    """docs/python_example.py end to end on a small phantom."""
+    import subprocess
+    import sys
+    script = os.path.join(os.path.dirname(__file__), "..", "..", "docs", "python_example.py")
+    r = subprocess.run([sys.executable, script, "--size", "48", "--out", str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    result = json.loads(r.stdout.strip().splitlines()[-1])
+    assert result["dice"] > 0.8 and result["triangles"] > 0
+    seg = nib.load(str(tmp_path / "seg.nii.gz"))
+    np.testing.assert_allclose(seg.affine, nib.load(str(tmp_path / "t1.nii.gz")).affine, atol=1e-6)

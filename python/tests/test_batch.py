@@ -170,3 +170,47 @@ def test_local_cluster_listens_on_loopback_only():
         pids = [os.getpid(), *client.run(os.getpid).values(), *client.run(os.getppid).values()]  # + nannies
         addresses = [a for pid in pids for a in listening_addresses(pid)]
         assert addresses and all(a == "0100007F" for a in addresses), addresses  # 127.0.0.1
+
+
+def test_tls_scheduler_with_dask_certificates(cohort, tmp_path):
+    """A scheduler and a worker speaking TLS with mutual certificates (as docs/PYTHON.md shows):
+    batch with the client certificate gives the CLI's masks; without it, one line and no work."""
+    if not shutil.which("openssl") or not shutil.which("dask-scheduler"):
+        pytest.skip("openssl or dask-scheduler missing")
+    c = tmp_path / "certs"
+    c.mkdir()
+    run = lambda *a: subprocess.run(list(a), cwd=c, check=True, capture_output=True)  # noqa: E731
+    run("openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-days", "2", "-subj", "/CN=ca",
+        "-keyout", "ca-key.pem", "-out", "ca.pem")
+    for r in ("scheduler", "worker", "client"):
+        run("openssl", "req", "-newkey", "rsa:2048", "-nodes", "-subj", f"/CN={r}", "-keyout", f"{r}-key.pem",
+            "-out", f"{r}.csr")
+        run("openssl", "x509", "-req", "-in", f"{r}.csr", "-CA", "ca.pem", "-CAkey", "ca-key.pem",
+            "-CAcreateserial", "-days", "2", "-out", f"{r}.pem")
+    tls = lambda r: ["--tls-ca-file", str(c / "ca.pem"), "--tls-cert", str(c / f"{r}.pem"),  # noqa: E731
+                     "--tls-key", str(c / f"{r}-key.pem")]
+    sched_file = tmp_path / "scheduler.json"
+    procs = [subprocess.Popen(["dask-scheduler", "--protocol", "tls", "--host", "127.0.0.1", "--port", "0",
+                               "--no-dashboard", "--scheduler-file", str(sched_file), *tls("scheduler")],
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)]
+    try:
+        deadline = time.monotonic() + 60
+        while not sched_file.exists() and time.monotonic() < deadline:
+            time.sleep(0.1)
+        import json
+        address = json.loads(sched_file.read_text())["address"]
+        assert address.startswith("tls://127.0.0.1:")
+        procs.append(subprocess.Popen(["dask-worker", address, "--host", "127.0.0.1", "--nthreads", "1",
+                                       "--no-dashboard", *tls("worker")], stdout=subprocess.DEVNULL,
+                                      stderr=subprocess.DEVNULL))
+        r = batch(cohort["root"] / "manifest.csv", "--out", tmp_path / "none", "--scheduler", address,
+                  "--connect-timeout", "3")
+        assert r.returncode == 2 and f"cannot reach the Dask scheduler at {address}" in r.stderr
+        r = batch(cohort["root"] / "manifest.csv", "--out", tmp_path / "out", "--scheduler", address, *tls("client"),
+                  via_cli=True)
+        assert r.returncode == 0, r.stderr
+        assert_masks_match(tmp_path / "out", cohort["ref"])
+    finally:
+        for p in reversed(procs):
+            p.terminate()
+            p.wait(timeout=30)
