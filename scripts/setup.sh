@@ -34,5 +34,5 @@ if ((${#missing[@]})); then
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_WERROR=ON >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_WERROR=ON -DLIVESET_BUILD_PYTHON=ON >/dev/null
 cmake --build build -j "$jobs"
