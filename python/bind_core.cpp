@@ -242,6 +242,19 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
 }  // namespace
 
 void register_core(pyb::module_& m) {
+    m.def("_read_header", [](const std::string& path) {
+        const ImageHeader h = [&] { pyb::gil_scoped_release nogil; return read_image_header(path); }();
+        pyb::dict d;
+        d["dims"] = pyb::make_tuple(h.dims.x, h.dims.y, h.dims.z);
+        d["spacing"] = pyb::make_tuple(h.spacing.x, h.spacing.y, h.spacing.z);
+        d["origin"] = pyb::make_tuple(h.origin.x, h.origin.y, h.origin.z);
+        d["direction"] = std::vector<double>(h.direction.begin(), h.direction.end());
+        d["dimension"] = h.dimension;
+        d["components"] = h.components;
+        d["pixel_type"] = h.pixel_type;
+        d["format"] = h.format;
+        return d;
+    }, pyb::arg("path"));
     m.def("_read", &read, pyb::arg("path"), pyb::arg("labels") = false);
     m.def("_write", [](const pyb::array& v, const pyb::tuple& geo, const std::string& path, bool labels) {
         if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");

@@ -24,6 +24,12 @@ def read(path: str, labels: bool = False) -> Image:
     return Image(array, spacing, origin, direction)
 
 
+def read_header(path: str) -> dict:
+    """What an image file says about itself, without reading the voxels: dims, spacing, origin
+    (LPS), direction (9 numbers, row-major), dimension, components, pixel_type, format."""
+    return _liveset._read_header(str(path))
+
+
 def write(image, path: str, labels: bool = False) -> None:
     """Write an image atomically (temporary + rename) with its full geometry; the format follows
     the extension (.nii.gz, .nii, .mha, .nrrd, .mnc, ...). ``labels=True`` writes uint8 0..255 (a

@@ -132,8 +132,9 @@ def _subject(row: dict, line: int, base: str, where: str) -> Subject:
     return s
 
 
-def read_manifest(path: str) -> list[Subject]:
-    """Parse and check the whole manifest; ManifestError (one line) on the first problem."""
+def read_manifest(path: str, check_images: bool = True) -> list[Subject]:
+    """Parse and check the whole manifest; ManifestError (one line) on the first problem. With
+    check_images, also each image's header and that its voxel seeds lie inside it."""
     try:
         with open(path, newline="", encoding="utf-8-sig") as f:
             text = f.read()
@@ -172,4 +173,22 @@ def read_manifest(path: str) -> list[Subject]:
         subjects.append(s)
     if not subjects:
         raise ManifestError(f"manifest '{path}' lists no subjects")
+    if check_images:
+        for s in subjects:
+            _check_image(s, f"manifest '{path}' row {s.row}")
     return subjects
+
+
+def _check_image(s: Subject, where: str) -> None:
+    """The image's header is readable and every voxel seed lies inside it (as `liveset segment`
+    checks, but before any work)."""
+    import liveset
+    try:
+        h = liveset.read_header(s.image)
+    except OSError as e:
+        raise ManifestError(f"{where}: image: {e}") from None
+    dims = h["dims"]
+    for seed in s.seeds:
+        c = [float(v) for v in seed.partition(":")[0].split(",")]
+        if not all(0 <= c[a] <= dims[a] - 1 for a in range(3)):
+            raise ManifestError(f"{where}: seed {seed} lies outside the image ({dims[0]}x{dims[1]}x{dims[2]} voxels)")

@@ -118,6 +118,8 @@ def test_worker_killed_mid_subject_loses_nothing(cohort, tmp_path):
     ("subject,image,seeds", "a,s1/nope.nii.gz,\"1,2,3\"", "row 2: image 's1/nope.nii.gz' does not exist"),
     ("subject,image,seeds", "a,s1/t1.nii.gz,1;2;3", "row 2: bad seed '1'"),
     ("subject,image,seeds,mu_raw", "a,s1/t1.nii.gz,\"1,2,3\",high", "row 2: mu_raw 'high' is not a number"),
+    ("subject,image,seeds", "a,s1/t1.nii.gz,\"1,2,3;1,2,480\"", "row 2: seed 1,2,480 lies outside the image (48x48x48"),
+    ("subject,image,seeds", "a,s1/phantom.json,\"1,2,3\"", "row 2: image: cannot read"),
     ("subject,image,seeds,colour", "a,s1/t1.nii.gz,\"1,2,3\",red", "unknown column(s) colour"),
 ])
 def test_bad_manifest_one_line_before_any_work(cohort, tmp_path, header, row, message):
