@@ -152,6 +152,20 @@ def test_sigint_stops_a_segmentation_within_a_step(phantom):
     assert steps == [1, 2, 3]
 
 
+def test_sigint_while_the_gil_is_released_stops_a_long_segmentation():
+    """SIGINT from another thread while segment runs in C++ without a callback: the run stops
+    (KeyboardInterrupt) long before the front could have crossed the 160^3 image."""
+    rng = np.random.default_rng(1)
+    img = liveset.Image(rng.uniform(0, 1, size=(160, 160, 160)).astype(np.float32))
+    timer = threading.Timer(0.3, signal.pthread_kill, (threading.main_thread().ident, signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            liveset.segment(img, [(2, 2, 2)], mu=0.5, epsilon=0.7, alpha=0.0, iterations=100000)
+    finally:
+        timer.cancel()
+
+
 def test_gil_released_during_segment(phantom):
     img = liveset.read(phantom["image"])
     done, ticks = threading.Event(), []
