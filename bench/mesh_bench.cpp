@@ -1,8 +1,8 @@
 // Mesher benchmarks: (a) full meshing of a 256³ sphere signed distance (r = 100) - naive scan of
-// every cell, band-driven single mesh, fragment full rebuild (S = 16, scan and band), 1 and 2
+// every cell, slab-parallel sign-bit scan, band-driven single mesh (band given or computed), fragment full rebuild (S = 16, scan and band), 1 and 2
 // threads; (b) latency of one local edit of radius 3 (SparseField::apply_in_box) followed by
 // FragmentMesher::update of the affected fragments on spheres of radius 0.4·N in N³, N = 64..512,
-// for S = 16 and S = 8, 1 and 2 threads (must stay flat in N). Results and commands: docs/BENCHMARKS-mesh.md.
+// for S = 16 and S = 8, 1 and 2 threads (must stay flat in N). Results and commands: docs/BENCHMARKS.md.
 #include <benchmark/benchmark.h>
 
 #include <tbb/global_control.h>
@@ -16,6 +16,7 @@
 #include "liveset/levelset/sparse_field.hpp"
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
+#include "liveset/mesh/slab_marching_cubes.hpp"
 
 using namespace liveset;
 
@@ -83,6 +84,32 @@ void BM_FullBand(benchmark::State& state) {
     set_cell_rate(state, tris);
 }
 
+// Slab-parallel whole-volume marching cubes (sign bits + z-slabs): needs no band, output == naive.
+void BM_FullSlabs(benchmark::State& state) {
+    const auto t = threads(state);
+    const SphereSdf& s = sphere_sdf();
+    std::size_t tris = 0;
+    for (auto _ : state) {
+        const Mesh m = marching_cubes_slabs(s.phi);
+        tris = m.triangle_count();
+        benchmark::DoNotOptimize(m.indices.data());
+    }
+    set_cell_rate(state, tris);
+}
+
+// Band-driven single mesh with the band computed from phi (a phi read from a file has none).
+void BM_FullBandFromPhi(benchmark::State& state) {
+    const auto t = threads(state);
+    const SphereSdf& s = sphere_sdf();
+    std::size_t tris = 0;
+    for (auto _ : state) {
+        const Mesh m = marching_cubes_band(s.phi, zero_crossing_points(s.phi));
+        tris = m.triangle_count();
+        benchmark::DoNotOptimize(m.indices.data());
+    }
+    set_cell_rate(state, tris);
+}
+
 // FragmentMesher(S = 16).full_rebuild(phi): every fragment scanned, fragments in parallel.
 void BM_FragmentFullScan(benchmark::State& state) {
     const auto t = threads(state);
@@ -102,6 +129,8 @@ void BM_FragmentFullBand(benchmark::State& state) {
 }
 
 BENCHMARK(BM_FullNaive)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FullSlabs)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FullBandFromPhi)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FullBand)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FragmentFullScan)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FragmentFullBand)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -27,10 +27,10 @@ fi
 jobs=$(nproc 2>/dev/null || echo 2)
 case "$mode" in
   asan-core)
-    # The library's own test programs (grid, level set, mesher, segmentation, swarm, evaluation,
+    # The library's own test programs (atomic file writer, grid, level set, mesher, segmentation, swarm, evaluation,
     # phantom, session, image IO), each run whole in one process; the CLI, viewer and rendering
     # tests (which need the whole sanitized `liveset` binary) run with `asan`.
-    core=(grid levelset mesh segment swarm eval phantom session io)
+    core=(base grid levelset mesh segment swarm eval phantom session io)
     cmake --preset asan >/dev/null
     cmake --build --preset asan -j "$jobs" --target "${core[@]/%/_tests}"
     export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1

@@ -1,8 +1,18 @@
 #!/usr/bin/env bash
 # One-step set-up on a fresh Debian 12 machine: installs the Debian packages liveset needs (only
 # those missing, so it is idempotent and fast on re-runs) and builds everything into ./build.
+# `--peers` also installs the optional peer libraries (VTK) and builds the peer benchmarks
+# (bench/peers: ITK's threshold level set, VTK's Flying Edges) into ./build-peer; neither the tests
+# nor CI need them.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+peers=0
+for arg in "$@"; do
+  case "$arg" in
+    --peers) peers=1 ;;
+    *) echo "setup: unknown option $arg (use --peers)" >&2; exit 2 ;;
+  esac
+done
 
 packages=(
   cmake g++ ninja-build pkg-config            # toolchain
@@ -20,6 +30,9 @@ packages=(
   libegl-dev libgl-dev libgl1-mesa-dri        # OpenGL / EGL (Mesa llvmpipe without a GPU; headless runs)
   xvfb xauth xdotool                          # the real-window smoke test (Xvfb + real input events)
 )
+if ((peers)); then
+  packages+=(libvtk9-dev)                     # peer benchmark: vtkFlyingEdges3D / vtkMarchingCubes (optional)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -36,3 +49,7 @@ fi
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_WERROR=ON -DLIVESET_BUILD_PYTHON=ON >/dev/null
 cmake --build build -j "$jobs"
+if ((peers)); then
+  cmake -S . -B build-peer -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_BUILD_PEER_BENCHMARKS=ON -DLIVESET_BUILD_TESTS=OFF >/dev/null
+  cmake --build build-peer -j "$jobs" --target itk_threshold_levelset itk_box_flow vtk_flying_edges
+fi

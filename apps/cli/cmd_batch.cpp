@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "cli_common.hpp"
+#include "commands.hpp"
 
 namespace liveset::cli {
 

@@ -35,6 +35,8 @@
 #include <tbb/global_control.h>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
+#include "liveset/base/atomic_file.hpp"
 #include "liveset/levelset/curvature_flow.hpp"
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
@@ -155,7 +157,8 @@ std::string plot_script(const Fig3Args& a, const std::vector<Column>& cols, int 
 void run_gnuplot(const fs::path& dir) {
     const fs::path abs = fs::absolute(dir);
     const fs::path log = abs / "fig3.gp.log";
-    const std::string cd = "cd " + gp_quote(abs.string()) + "; outfile = 'fig3.png.tmp'";
+    AtomicFile png(abs / "fig3.png");  // gnuplot draws into its temporary
+    const std::string cd = "cd " + gp_quote(abs.string()) + "; outfile = " + gp_quote(png.temp_path().filename().string());
     const std::string script = (abs / "fig3.gp").string();
     std::vector<std::string> args{"gnuplot", "-e", cd, script};
     std::vector<char*> argv;
@@ -185,13 +188,13 @@ void run_gnuplot(const fs::path& dir) {
     }
     std::error_code ec;
     fs::remove(log, ec);
-    const fs::path tmp = abs / "fig3.png.tmp";
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !fs::exists(tmp)) {
-        fs::remove(tmp, ec);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || !fs::exists(png.temp_path()))
         throw UsageError("gnuplot failed to draw fig3.png" + (first_line.empty() ? std::string() : ": " + first_line));
+    try {
+        png.commit();
+    } catch (const std::runtime_error& e) {
+        throw UsageError("cannot write " + (abs / "fig3.png").string() + ": " + e.what());
     }
-    fs::rename(tmp, abs / "fig3.png", ec);
-    if (ec) throw UsageError("cannot write " + (abs / "fig3.png").string() + ": " + ec.message());
 }
 
 void verify(int step, const Grid<float>& phi, std::span<const PointIndex> zero_layer, const std::vector<Column>& cols) {

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "cli_support.hpp"
 #include "demo_brain.hpp"
 #include "image_commands.hpp"
@@ -16,11 +17,11 @@
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
+#include "liveset/render/surface_picture.hpp"
 #include "liveset/eval/perforations.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/session/repair_presets.hpp"
-#include "view_command.hpp"
 #include "liveset/swarm/repair.hpp"
 
 namespace liveset::cli {
@@ -38,11 +39,29 @@ struct DemoArgs {
     BrainDemoArgs brain_args;
 };
 
+// The demo's pictures without a display: before.png (the surface of `phi_before`) and after.png
+// (the surface in `after`), superior view, rendered headless (EGL) into `dir`. Returns
+// {"before": ..., "after": ...}, or null with a one-line warning on stderr when no OpenGL context
+// can be had (the demo's other outputs do not depend on it).
+nlohmann::json write_before_after_pictures(const std::filesystem::path& dir, const Grid<float>& phi_before,
+                                           const FragmentMesher& after) {
+    try {
+        FragmentMesher before(phi_before.lattice(), after.fragment_size());
+        before.full_rebuild(phi_before);
+        render::render_surface_png(before, (dir / "before.png").string(), "superior", 800, 800, 2);
+        render::render_surface_png(after, (dir / "after.png").string(), "superior", 800, 800, 2);
+        return {{"before", "before.png"}, {"after", "after.png"}};
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "liveset: warning: no before/after pictures: {}\n", e.what());
+        return nullptr;
+    }
+}
+
 double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-int run_demo(const DemoArgs& a, int threads) {
+int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     namespace fs = std::filesystem;
     using clock = std::chrono::steady_clock;
     const auto guard = limit_threads(threads);
@@ -173,18 +192,20 @@ int run_demo(const DemoArgs& a, int threads) {
         fmt::print("  outputs      {}/ (t1, truth_gm, seg, phi, seg_repaired, phi_repaired .nii.gz; surface(_repaired).ply; before/after.png; report.json)\n", a.out);
     }
     // With a display: the viewer on the segmented phantom, the swarm repairing the first hole live.
-    if (!a.no_view && !a.json && first_hole && viewer_display_available()) {
+    if (!a.no_view && !a.json && first_hole && window.available && window.open && window.available()) {
         auto session = std::make_unique<Session>(ph.image, SessionOptions{});
         session->load_phi(phi_before);
-        return open_demo_viewer(std::move(session), *first_hole);
+        return window.open(std::move(session), *first_hole);
     }
     return 0;
 }
 
 }  // namespace
 
-void add_demo_command(CLI::App& app, const int& threads) {
+void add_demo_command(CLI::App& app, const int& threads, DemoWindow window) {
     static DemoArgs da;
+    static DemoWindow live;
+    live = std::move(window);
     auto* demo = app.add_subcommand("demo", "the main job: phantom -> segment -> mesh -> eval, with a report");
     CLI::Option* out = demo->add_option("--out", da.out, "output folder (liveset-demo; liveset-demo-brain with --brain)")->capture_default_str();
     demo->add_option("--size", da.size, "phantom voxels per axis")->check(CLI::Range(48, 256))->capture_default_str();
@@ -205,7 +226,7 @@ void add_demo_command(CLI::App& app, const int& threads) {
             if (rc != 0) std::exit(rc);
             return;
         }
-        const int rc = run_demo(da, threads);
+        const int rc = run_demo(da, threads, live);
         if (rc != 0) std::exit(rc);
     });
 }

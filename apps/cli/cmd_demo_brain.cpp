@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "cli_support.hpp"
 #include "demo_brain.hpp"
 #include "image_commands.hpp"
@@ -15,7 +16,7 @@
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_io.hpp"
-#include "headless_app.hpp"
+#include "liveset/render/surface_picture.hpp"
 
 namespace liveset::cli {
 
@@ -94,7 +95,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     try {  // the surface seen from above (headless EGL; a warning where there is no OpenGL)
         FragmentMesher mesher(t1.lattice(), 16);
         mesher.full_rebuild(o.field->phi(), o.field->zero_layer());
-        viewer::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
+        render::render_surface_png(mesher, (dir / "surface.png").string(), "superior", 800, 800, 2);
         j["screenshots"] = {{"surface", "surface.png"}};
     } catch (const std::exception& e) {
         fmt::print(stderr, "liveset: warning: no picture: {}\n", e.what());

@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
 #include "liveset/eval/perforations.hpp"

@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "liveset/levelset/curvature_flow.hpp"
 #include "liveset/levelset/invariants.hpp"
 

@@ -8,11 +8,13 @@
 #include <optional>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
+#include "liveset/mesh/slab_marching_cubes.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
 #include "liveset/preprocess/bias_correction.hpp"
@@ -37,9 +39,8 @@ struct SegmentArgs {
     std::string out_corrected;
 };
 
-int run_segment(const SegmentArgs& a, int threads) {
-    const auto guard = limit_threads(threads);
-    const InterruptGuard interrupt;
+// Every option combination and output path checked before any work starts.
+void check_segment_args(const SegmentArgs& a) {
     check_output_path(a.out_mask, OutputKind::kImage, "--out-mask");
     if (!a.out_phi.empty()) check_output_path(a.out_phi, OutputKind::kImage, "--out-phi");
     if (!a.out_mesh.empty()) check_output_path(a.out_mesh, OutputKind::kMesh, "--out-mesh");
@@ -52,6 +53,61 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (a.epsilon && a.epsilon_raw) throw UsageError("give --epsilon or --epsilon-raw, not both");
     if (a.seeds.empty() && a.seeds_mm.empty() && a.init_mask.empty())
         throw UsageError("give at least one --seed I,J,K[:R] (or --seed-mm, or --init-mask)");
+}
+
+// The segmentation request the options describe (seeds parsed and checked inside the image).
+SegmentRequest segment_request(const SegmentArgs& a, const Lattice& lattice, const std::optional<Roi>& roi,
+                               const std::optional<Grid<std::uint8_t>>& init, const Grid<std::uint8_t>* fit) {
+    SegmentRequest req;
+    for (const std::string& s : a.seeds) {
+        req.seeds.push_back(parse_seed_voxel(s, a.seed_radius));
+        check_seed_inside(req.seeds.back(), lattice, s);
+    }
+    for (const std::string& s : a.seeds_mm) {
+        req.seeds.push_back(parse_seed_mm(s, lattice, a.seed_radius));
+        check_seed_inside(req.seeds.back(), lattice, s + " (mm)");
+    }
+    if (roi) req.roi = &roi->mask;
+    if (init) req.initial_mask = &*init;
+    req.model_region = fit;
+    req.n = a.n;
+    req.alpha = a.alpha;
+    req.loop.max_iterations = a.iterations;
+    req.loop.step = sleeping_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
+    req.mu = a.mu;
+    req.epsilon = a.epsilon;
+    req.mu_raw = a.mu_raw;
+    req.epsilon_raw = a.epsilon_raw;
+    req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
+    req.window.model.classes = a.classes;
+    return req;
+}
+
+// The report: the segmentation's, the bias correction's, the ROI and what was written.
+nlohmann::json segment_report(const SegmentArgs& a, const SegmentOutcome& o, const Lattice& lattice, const std::optional<Roi>& roi,
+                              const std::optional<BiasCorrectionReport>& bias, bool auto_fit_region, std::size_t triangles) {
+    nlohmann::json j = segmentation_report(o, lattice);
+    if (bias) {
+        j["bias_correction"] = bias_correction_report(*bias);
+        j["bias_correction"]["mask"] = roi ? "roi" : auto_fit_region ? "auto brain mask" : "otsu";
+    }
+    j["image"] = a.image;
+    j["outputs"] = {{"mask", a.out_mask}};
+    if (roi) j["roi"] = roi_report(*roi);
+    if (!a.out_roi.empty()) j["outputs"]["roi"] = a.out_roi;
+    if (!a.out_phi.empty()) j["outputs"]["phi"] = a.out_phi;
+    if (!a.out_corrected.empty()) j["outputs"]["corrected"] = a.out_corrected;
+    if (!a.out_mesh.empty()) {
+        j["outputs"]["mesh"] = a.out_mesh;
+        j["mesh_triangles"] = triangles;
+    }
+    return j;
+}
+
+int run_segment(const SegmentArgs& a, int threads) {
+    const auto guard = limit_threads(threads);
+    const InterruptGuard interrupt;
+    check_segment_args(a);
 
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> init;
@@ -71,29 +127,7 @@ int run_segment(const SegmentArgs& a, int threads) {
         }
     }
 
-    SegmentRequest req;
-    for (const std::string& s : a.seeds) {
-        req.seeds.push_back(parse_seed_voxel(s, a.seed_radius));
-        check_seed_inside(req.seeds.back(), image.lattice(), s);
-    }
-    for (const std::string& s : a.seeds_mm) {
-        req.seeds.push_back(parse_seed_mm(s, image.lattice(), a.seed_radius));
-        check_seed_inside(req.seeds.back(), image.lattice(), s + " (mm)");
-    }
-    if (roi) req.roi = &roi->mask;
-    if (init) req.initial_mask = &*init;
-    req.model_region = fit;
-    req.n = a.n;
-    req.alpha = a.alpha;
-    req.loop.max_iterations = a.iterations;
-    req.loop.step = sleeping_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
-    req.mu = a.mu;
-    req.epsilon = a.epsilon;
-    req.mu_raw = a.mu_raw;
-    req.epsilon_raw = a.epsilon_raw;
-    req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
-    req.window.model.classes = a.classes;
-
+    const SegmentRequest req = segment_request(a, image.lattice(), roi, init, fit);
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} iterations; nothing written\n", run.outcome.result.iterations);
@@ -111,21 +145,7 @@ int run_segment(const SegmentArgs& a, int threads) {
         write_mesh(a.out_mesh, mesh.view(), image.lattice());
     }
 
-    nlohmann::json j = segmentation_report(o, image.lattice());
-    if (bias) {
-        j["bias_correction"] = bias_correction_report(*bias);
-        j["bias_correction"]["mask"] = roi ? "roi" : fit_region ? "auto brain mask" : "otsu";
-    }
-    j["image"] = a.image;
-    j["outputs"] = {{"mask", a.out_mask}};
-    if (roi) j["roi"] = roi_report(*roi);
-    if (!a.out_roi.empty()) j["outputs"]["roi"] = a.out_roi;
-    if (!a.out_phi.empty()) j["outputs"]["phi"] = a.out_phi;
-    if (!a.out_corrected.empty()) j["outputs"]["corrected"] = a.out_corrected;
-    if (!a.out_mesh.empty()) {
-        j["outputs"]["mesh"] = a.out_mesh;
-        j["mesh_triangles"] = triangles;
-    }
+    const nlohmann::json j = segment_report(a, o, image.lattice(), roi, bias, fit_region.has_value(), triangles);
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
@@ -163,7 +183,7 @@ int run_mesh(const MeshArgs& a, int threads) {
         fragments = static_cast<int>(m.fragment_count());
         mesh = weld_vertices(m.merged().view());
     } else {
-        mesh = marching_cubes_naive(phi);
+        mesh = marching_cubes_slabs(phi);  // == marching_cubes_naive(phi), sign bits + parallel z-slabs
     }
     if (mesh.triangle_count() == 0) throw UsageError(fmt::format("{} holds no surface (no voxel changes sign)", a.input));
     write_mesh(a.out, mesh.view(), input.lattice());

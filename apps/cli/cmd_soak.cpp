@@ -1,7 +1,7 @@
 // `liveset bench soak`: the long-run check. On a real surface (a φ or mask, e.g. the BrainWeb grey
 // matter), each iteration applies one random local edit (a Gaussian bump raised or lowered at a
-// random zero-layer point) and one swarm step of agents editing at random, both through the local
-// sparse-field update and the incremental mesher; every K iterations it runs the level-set
+// random zero-layer point) and one swarm step of agents editing at random, both through a Session
+// (the viewer's edit path: local sparse-field update, undo history, incremental mesher); every K iterations it runs the level-set
 // invariant checker and compares the fragment meshes with a whole-band marching cubes, and records
 // the resident memory. Exit status 1 on the first failed check.
 #include <fmt/core.h>
@@ -15,14 +15,14 @@
 #include <unistd.h>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/levelset/invariants.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
-#include "liveset/segment/intensity.hpp"
-#include "liveset/swarm/repair.hpp"
+#include "liveset/session/session.hpp"
 
 namespace liveset::cli {
 
@@ -57,16 +57,16 @@ int run_soak(const SoakArgs& a, int threads) {
     const Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> roi;
     if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
-    SparseField field = load_level_set(a.input, image.lattice());
-    const Grid<float> unit = normalise(image, robust_scale(image, roi ? &*roi : nullptr));
-    FragmentMesher mesher(image.lattice(), 8);
-    mesher.full_rebuild(field.phi(), field.zero_layer());
-
-    RepairOptions ro;
-    ro.swarm.decision = EditDecision::kRandom;
-    ro.swarm.act_probability = a.p;
-    ro.swarm.seed = a.seed;
-    RepairLoop swarm(field, unit, roi ? &*roi : nullptr, ro, &mesher);
+    // Everything goes through a Session, as in the viewer: edits, swarm steps, history, mesher.
+    SessionOptions so;
+    so.fragment_size = 8;
+    so.repair.swarm.decision = EditDecision::kRandom;
+    so.repair.swarm.act_probability = a.p;
+    so.repair.swarm.seed = a.seed;
+    Session session(image, so, roi);
+    load_level_set(session, a.input);
+    const SparseField& field = session.field();
+    const FragmentMesher& mesher = session.mesher();
     std::mt19937_64 rng(a.seed);
     const Lattice& lat = field.lattice();
 
@@ -84,14 +84,13 @@ int run_soak(const SoakArgs& a, int threads) {
         const auto zero = field.zero_layer();
         const Vec3i c = lat.coord(zero[rng() % zero.size()]);
         const float amplitude = (rng() & 1) ? 0.4f : -0.4f;
-        const ChangedPoints x = field.apply_in_box(c - Vec3i{2, 2, 2}, c + Vec3i{2, 2, 2}, [&](Vec3i q, float) {
+        session.edit_box(c - Vec3i{2, 2, 2}, c + Vec3i{2, 2, 2}, [&](Vec3i q, float) {
             const Vec3i d = q - c;
             return amplitude * static_cast<float>(std::exp(-0.5 * static_cast<double>(d.x * d.x + d.y * d.y + d.z * d.z)));
         });
-        mesher.update(field.phi(), x.points);
         // One swarm step, re-aimed at the edited point every 500 iterations.
-        if (it % 500 == 0) swarm.set_target(c.cast<double>());
-        swarm.step();
+        if (it % 500 == 0) session.set_target(c.cast<double>());
+        session.swarm_step();
         ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
 
         if ((it + 1) % a.check_every == 0 || it + 1 == a.iterations) {

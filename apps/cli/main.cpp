@@ -9,6 +9,7 @@
 #include <new>
 
 #include "cli_common.hpp"
+#include "commands.hpp"
 #include "liveset/io/image_io.hpp"
 #include "view_command.hpp"
 
@@ -25,7 +26,8 @@ int main(int argc, char** argv) {
     liveset::cli::add_eval_commands(app, threads);
     liveset::cli::add_repair_command(app, threads);
     liveset::cli::add_bench_commands(app, threads);
-    liveset::cli::add_demo_command(app, threads);
+    // The headless commands link no viewer code: the demo gets its live window from here.
+    liveset::cli::add_demo_command(app, threads, {liveset::cli::viewer_display_available, liveset::cli::open_demo_viewer});
     liveset::cli::add_view_command(app, threads);
     liveset::cli::add_batch_command(app);
 

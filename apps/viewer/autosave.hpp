@@ -12,6 +12,7 @@
 #include <string>
 #include <utility>
 
+#include "crash_recovery.hpp"
 #include "liveset/session/recovery.hpp"
 #include "liveset/session/session.hpp"
 

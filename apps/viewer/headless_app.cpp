@@ -1,11 +1,10 @@
-// Headless (EGL) runs: scripts, benchmarks and one-off renders.
+// Headless (EGL) runs: scripts and benchmarks.
 #include "headless_app.hpp"
 
 #include <fmt/core.h>
 
 #include "cli_common.hpp"
 #include "liveset/render/headless_context.hpp"
-#include "liveset/render/png_writer.hpp"
 #include "script_player.hpp"
 
 namespace liveset::viewer {
@@ -40,26 +39,6 @@ int run_headless(std::unique_ptr<Session> session, const std::string& image_name
     }
     viewer.request_quit("script done");
     return 0;
-}
-
-void render_surface_png(const FragmentMesher& mesher, const std::string& path, const std::string& view, int width, int height,
-                        int supersample) {
-    const auto context = make_context();
-    render::SurfaceBuffers buffers;
-    buffers.upload_all(mesher);
-    render::OrbitCamera camera;
-    render::CameraPose pose;
-    if (!render::OrbitCamera::named_pose(view, pose)) throw cli::UsageError("unknown view " + view);
-    camera.frame(render::surface_bounds(mesher), pose);
-    render::SceneRenderer renderer;
-    render::Framebuffer fb(width * supersample, height * supersample);
-    render::SceneContent content;
-    content.lattice = &mesher.lattice();
-    content.surface = &buffers;
-    render::SceneStyle style;
-    style.bounding_box = false;
-    renderer.render(fb, camera, content, style);
-    render::write_png(path, render::downsample(fb.read_color(), supersample));
 }
 
 }  // namespace liveset::viewer

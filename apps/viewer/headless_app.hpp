@@ -24,9 +24,4 @@ struct HeadlessOptions {
 int run_headless(std::unique_ptr<Session> session, const std::string& image_name, const ViewerConfig& config,
                  const HeadlessOptions& options);
 
-// Renders the surface in `mesher` (camera: a named view, framed on the surface) into a PNG, for
-// the demo's before/after pictures; creates its own headless context. Throws on failure.
-void render_surface_png(const FragmentMesher& mesher, const std::string& path, const std::string& view, int width, int height,
-                        int supersample);
-
 }  // namespace liveset::viewer

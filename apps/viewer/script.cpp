@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -109,16 +110,264 @@ void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
     }
 }
 
+// {"seed": ...} / {"remove_seed": ...}: a seed to add or remove, [i, j, k] with an optional radius.
+void parse_seed_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice& lattice) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name, "radius"}, err);
+    a.kind = name == "seed" ? K::kSeed : K::kRemoveSeed;
+    a.point = point(v, err, lattice, "the seed");
+    if (e.contains("radius")) a.radius = number(e["radius"], err, "radius");
+    if (a.radius <= 0) err.fail("radius must be positive");
+}
+
+// {"params": ...}: new threshold or swarm parameters.
+void parse_params_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = K::kParams;
+    parse_params(v, a, err);
+}
+
+// {"segment": ...}: a number of segmentation steps, or "converge".
+void parse_segment_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name, "max"}, err);
+    a.kind = K::kSegment;
+    if (v.is_string() && v == "converge") {
+        a.until_converged = true;
+        a.count = e.contains("max") ? whole(e["max"], err, "max", 1, 10'000'000) : 2000;
+    } else {
+        if (!v.is_number_integer()) err.fail("expected a number of steps or \"converge\"");
+        a.count = whole(v, err, "the number of steps", 1, 10'000'000);
+    }
+}
+
+// {"click": ...}: a click at pixel [x, y] of the 3D pane.
+void parse_click_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = K::kClick;
+    if (!v.is_array() || v.size() != 2) err.fail("expected [x, y] (pixels of the 3D pane)");
+    a.x = number(v[0], err, "x");
+    a.y = number(v[1], err, "y");
+    if (a.x < 0 || a.y < 0) err.fail("pixel coordinates must not be negative");
+}
+
+// {"target": ...} / {"cursor": ...}: the swarm target or the cursor at a voxel.
+void parse_point_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice& lattice) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = name == "target" ? K::kTarget : K::kCursor;
+    a.point = point(v, err, lattice, "the point");
+}
+
+// {"target_surface_near": ...}: the target on the surface nearest a voxel.
+void parse_target_near_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice& lattice) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name, "radius"}, err);
+    a.kind = K::kTargetSurfaceNear;
+    a.point = point(v, err, lattice, "the point");
+    a.radius = e.contains("radius") ? number(e["radius"], err, "radius") : 20.0;
+    if (a.radius <= 0) err.fail("radius must be positive");
+}
+
+// {"swarm": ...} / {"undo": ...} / {"redo": ...}: swarm steps, undos or redos: a count.
+void parse_counted_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = name == "swarm" ? K::kSwarm : (name == "undo" ? K::kUndo : K::kRedo);
+    a.count = whole(v, err, name == "swarm" ? "the number of steps" : "the count", 1, 10'000'000);
+}
+
+// {"camera": ...}: a named view, yaw, pitch, zoom, pan, centre or reset.
+void parse_camera_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice& lattice) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = K::kCamera;
+    if (!v.is_object()) err.fail("expected an object such as {\"view\": \"superior\"}");
+    only_keys(v, {"view", "yaw", "pitch", "zoom", "pan", "center", "reset"}, err);
+    if (v.contains("center")) a.center = point(v["center"], err, lattice, "center");
+    if (v.contains("view")) {
+        a.view = text(v["view"], err, "view");
+        render::CameraPose pose;
+        if (!render::OrbitCamera::named_pose(*a.view, pose))
+            err.fail("view must be superior, inferior, anterior, posterior, left, right or default");
+    }
+    if (v.contains("yaw")) a.yaw = number(v["yaw"], err, "yaw");
+    if (v.contains("pitch")) a.pitch = number(v["pitch"], err, "pitch");
+    if (v.contains("zoom")) a.zoom = number(v["zoom"], err, "zoom");
+    if (a.zoom && *a.zoom <= 0) err.fail("zoom must be positive");
+    if (v.contains("pan")) {
+        const json& p = v["pan"];
+        if (!p.is_array() || p.size() != 3) err.fail("pan must be [x, y, z] in mm");
+        a.pan = glm::dvec3(number(p[0], err, "pan"), number(p[1], err, "pan"), number(p[2], err, "pan"));
+    }
+    if (v.contains("reset")) {
+        if (!v["reset"].is_boolean()) err.fail("reset must be true or false");
+        a.reset = v["reset"].get<bool>();
+    }
+}
+
+// {"layout": ...}: four panes or one maximised.
+void parse_layout_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = K::kLayout;
+    const std::string l = text(v, err, "layout");
+    if (l != "four") {
+        a.pane = pane_from_name(l);
+        if (!a.pane) err.fail("layout must be four, 3d, axial, sagittal or coronal");
+    }
+}
+
+// {"tool": ...}: the mouse tool.
+void parse_tool_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = K::kTool;
+    const std::string t = text(v, err, "tool");
+    if (t == "crosshair") a.tool = Tool::kCrosshair;
+    else if (t == "seed") a.tool = Tool::kSeed;
+    else if (t == "target") a.tool = Tool::kTarget;
+    else err.fail("tool must be crosshair, seed or target");
+}
+
+// {"save_mask": ...} / {"save_phi": ...} / {"save_mesh": ...}: a mask, φ or mesh written to a path.
+void parse_save_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = name == "save_mask" ? K::kSaveMask : (name == "save_phi" ? K::kSavePhi : K::kSaveMesh);
+    a.path = text(v, err, "the path");
+    output_path(a.path, name == "save_mesh" ? cli::OutputKind::kMesh : cli::OutputKind::kImage, err);
+}
+
+// {"screenshot": ...}: a PNG of a pane or of the window.
+void parse_screenshot_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name, "pane", "size", "supersample", "overlays"}, err);
+    if (e.contains("overlays")) {
+        if (!e["overlays"].is_boolean()) err.fail("overlays must be true or false");
+        a.overlays = e["overlays"].get<bool>();
+    }
+    a.kind = K::kScreenshot;
+    a.path = text(v, err, "the path");
+    if (a.path.size() < 4 || a.path.substr(a.path.size() - 4) != ".png") err.fail("screenshots are .png files");
+    output_path(a.path, cli::OutputKind::kText, err);
+    a.pane = Pane::kView3d;
+    if (e.contains("pane")) {
+        const std::string p = text(e["pane"], err, "pane");
+        a.pane = p == "window" ? std::nullopt : pane_from_name(p);
+        if (p != "window" && !a.pane) err.fail("pane must be 3d, axial, sagittal, coronal or window");
+    }
+    if (e.contains("size")) {
+        const json& s = e["size"];
+        if (!s.is_array() || s.size() != 2) err.fail("size must be [width, height]");
+        a.width = whole(s[0], err, "width", 16, 8192);
+        a.height = whole(s[1], err, "height", 16, 8192);
+    }
+    if (e.contains("supersample")) a.supersample = whole(e["supersample"], err, "supersample", 1, 4);
+}
+
+// {"eval": ...}: Dice and topology against a truth image.
+void parse_eval_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = K::kEval;
+    if (!v.is_object() || !v.contains("truth")) err.fail("expected {\"truth\": path}");
+    only_keys(v, {"truth", "label"}, err);
+    a.path = text(v["truth"], err, "truth");
+    if (v.contains("label")) a.label = whole(v["label"], err, "label", 1, 255);
+}
+
+// {"clear_target": ...}: the swarm stops and forgets its target.
+void parse_clear_target_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = K::kClearTarget;
+    if (v != true) err.fail("expected true");
+}
+
+// {"perforations": ...}: the truth's perforations (optionally one as the target).
+void parse_perforations_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const std::string& name = a.name;
+    const json& v = e[name];
+    using K = ScriptAction::Kind;
+    only_keys(e, {name}, err);
+    a.kind = K::kPerforations;
+    if (!v.is_object() || !v.contains("labels")) err.fail("expected {\"labels\": path, \"truth_label\": 2, \"inner_label\": 3}");
+    only_keys(v, {"labels", "truth_label", "inner_label", "target"}, err);
+    a.path = text(v["labels"], err, "labels");
+    a.label = v.contains("truth_label") ? whole(v["truth_label"], err, "truth_label", 1, 255) : 2;
+    a.inner_label = v.contains("inner_label") ? whole(v["inner_label"], err, "inner_label", 1, 255) : 3;
+    if (a.label == a.inner_label) err.fail("truth_label and inner_label must differ");
+    if (v.contains("target")) a.rank = whole(v["target"], err, "target", 0, 1'000'000);
+}
+
+using EntryParser = void (*)(const json&, ScriptAction&, const EntryError&, const Lattice&);
+
+// Every action a script entry can name, with its parser.
+const std::map<std::string, EntryParser>& entry_parsers() {
+    static const std::map<std::string, EntryParser> parsers = {
+        {"seed", parse_seed_entry},
+        {"remove_seed", parse_seed_entry},
+        {"params", parse_params_entry},
+        {"segment", parse_segment_entry},
+        {"click", parse_click_entry},
+        {"target", parse_point_entry},
+        {"cursor", parse_point_entry},
+        {"target_surface_near", parse_target_near_entry},
+        {"swarm", parse_counted_entry},
+        {"undo", parse_counted_entry},
+        {"redo", parse_counted_entry},
+        {"camera", parse_camera_entry},
+        {"layout", parse_layout_entry},
+        {"tool", parse_tool_entry},
+        {"save_mask", parse_save_entry},
+        {"save_phi", parse_save_entry},
+        {"save_mesh", parse_save_entry},
+        {"screenshot", parse_screenshot_entry},
+        {"eval", parse_eval_entry},
+        {"clear_target", parse_clear_target_entry},
+        {"perforations", parse_perforations_entry},
+    };
+    return parsers;
+}
+
 ScriptAction parse_entry(const json& e, std::size_t entry, const std::string& path, const Lattice& lattice) {
     const EntryError bare(path, entry, "");
     if (!e.is_object() || e.empty()) bare.fail("expected an object such as {\"segment\": 100}");
-    static const std::set<std::string> kActions = {"seed", "remove_seed", "params", "segment", "click", "target",
-                                                   "target_surface_near", "swarm", "camera", "cursor", "layout", "tool",
-                                                   "undo", "redo", "save_mask", "save_phi", "save_mesh", "screenshot", "eval",
-                                                   "perforations", "clear_target"};
+    const auto& parsers = entry_parsers();
     std::string name;
     for (auto it = e.begin(); it != e.end(); ++it)
-        if (kActions.count(it.key())) {
+        if (parsers.count(it.key())) {
             if (!name.empty()) bare.fail(fmt::format("two actions (\"{}\" and \"{}\") in one entry", name, it.key()));
             name = it.key();
         }
@@ -127,140 +376,7 @@ ScriptAction parse_entry(const json& e, std::size_t entry, const std::string& pa
     ScriptAction a;
     a.entry = entry;
     a.name = name;
-    const json& v = e[name];
-    using K = ScriptAction::Kind;
-    if (name == "seed" || name == "remove_seed") {
-        only_keys(e, {name, "radius"}, err);
-        a.kind = name == "seed" ? K::kSeed : K::kRemoveSeed;
-        a.point = point(v, err, lattice, "the seed");
-        if (e.contains("radius")) a.radius = number(e["radius"], err, "radius");
-        if (a.radius <= 0) err.fail("radius must be positive");
-    } else if (name == "params") {
-        only_keys(e, {name}, err);
-        a.kind = K::kParams;
-        parse_params(v, a, err);
-    } else if (name == "segment") {
-        only_keys(e, {name, "max"}, err);
-        a.kind = K::kSegment;
-        if (v.is_string() && v == "converge") {
-            a.until_converged = true;
-            a.count = e.contains("max") ? whole(e["max"], err, "max", 1, 10'000'000) : 2000;
-        } else {
-            if (!v.is_number_integer()) err.fail("expected a number of steps or \"converge\"");
-            a.count = whole(v, err, "the number of steps", 1, 10'000'000);
-        }
-    } else if (name == "click") {
-        only_keys(e, {name}, err);
-        a.kind = K::kClick;
-        if (!v.is_array() || v.size() != 2) err.fail("expected [x, y] (pixels of the 3D pane)");
-        a.x = number(v[0], err, "x");
-        a.y = number(v[1], err, "y");
-        if (a.x < 0 || a.y < 0) err.fail("pixel coordinates must not be negative");
-    } else if (name == "target" || name == "cursor") {
-        only_keys(e, {name}, err);
-        a.kind = name == "target" ? K::kTarget : K::kCursor;
-        a.point = point(v, err, lattice, "the point");
-    } else if (name == "target_surface_near") {
-        only_keys(e, {name, "radius"}, err);
-        a.kind = K::kTargetSurfaceNear;
-        a.point = point(v, err, lattice, "the point");
-        a.radius = e.contains("radius") ? number(e["radius"], err, "radius") : 20.0;
-        if (a.radius <= 0) err.fail("radius must be positive");
-    } else if (name == "swarm" || name == "undo" || name == "redo") {
-        only_keys(e, {name}, err);
-        a.kind = name == "swarm" ? K::kSwarm : (name == "undo" ? K::kUndo : K::kRedo);
-        a.count = whole(v, err, name == "swarm" ? "the number of steps" : "the count", 1, 10'000'000);
-    } else if (name == "camera") {
-        only_keys(e, {name}, err);
-        a.kind = K::kCamera;
-        if (!v.is_object()) err.fail("expected an object such as {\"view\": \"superior\"}");
-        only_keys(v, {"view", "yaw", "pitch", "zoom", "pan", "center", "reset"}, err);
-        if (v.contains("center")) a.center = point(v["center"], err, lattice, "center");
-        if (v.contains("view")) {
-            a.view = text(v["view"], err, "view");
-            render::CameraPose pose;
-            if (!render::OrbitCamera::named_pose(*a.view, pose))
-                err.fail("view must be superior, inferior, anterior, posterior, left, right or default");
-        }
-        if (v.contains("yaw")) a.yaw = number(v["yaw"], err, "yaw");
-        if (v.contains("pitch")) a.pitch = number(v["pitch"], err, "pitch");
-        if (v.contains("zoom")) a.zoom = number(v["zoom"], err, "zoom");
-        if (a.zoom && *a.zoom <= 0) err.fail("zoom must be positive");
-        if (v.contains("pan")) {
-            const json& p = v["pan"];
-            if (!p.is_array() || p.size() != 3) err.fail("pan must be [x, y, z] in mm");
-            a.pan = glm::dvec3(number(p[0], err, "pan"), number(p[1], err, "pan"), number(p[2], err, "pan"));
-        }
-        if (v.contains("reset")) {
-            if (!v["reset"].is_boolean()) err.fail("reset must be true or false");
-            a.reset = v["reset"].get<bool>();
-        }
-    } else if (name == "layout") {
-        only_keys(e, {name}, err);
-        a.kind = K::kLayout;
-        const std::string l = text(v, err, "layout");
-        if (l != "four") {
-            a.pane = pane_from_name(l);
-            if (!a.pane) err.fail("layout must be four, 3d, axial, sagittal or coronal");
-        }
-    } else if (name == "tool") {
-        only_keys(e, {name}, err);
-        a.kind = K::kTool;
-        const std::string t = text(v, err, "tool");
-        if (t == "crosshair") a.tool = Tool::kCrosshair;
-        else if (t == "seed") a.tool = Tool::kSeed;
-        else if (t == "target") a.tool = Tool::kTarget;
-        else err.fail("tool must be crosshair, seed or target");
-    } else if (name == "save_mask" || name == "save_phi" || name == "save_mesh") {
-        only_keys(e, {name}, err);
-        a.kind = name == "save_mask" ? K::kSaveMask : (name == "save_phi" ? K::kSavePhi : K::kSaveMesh);
-        a.path = text(v, err, "the path");
-        output_path(a.path, name == "save_mesh" ? cli::OutputKind::kMesh : cli::OutputKind::kImage, err);
-    } else if (name == "screenshot") {
-        only_keys(e, {name, "pane", "size", "supersample", "overlays"}, err);
-        if (e.contains("overlays")) {
-            if (!e["overlays"].is_boolean()) err.fail("overlays must be true or false");
-            a.overlays = e["overlays"].get<bool>();
-        }
-        a.kind = K::kScreenshot;
-        a.path = text(v, err, "the path");
-        if (a.path.size() < 4 || a.path.substr(a.path.size() - 4) != ".png") err.fail("screenshots are .png files");
-        output_path(a.path, cli::OutputKind::kText, err);
-        a.pane = Pane::kView3d;
-        if (e.contains("pane")) {
-            const std::string p = text(e["pane"], err, "pane");
-            a.pane = p == "window" ? std::nullopt : pane_from_name(p);
-            if (p != "window" && !a.pane) err.fail("pane must be 3d, axial, sagittal, coronal or window");
-        }
-        if (e.contains("size")) {
-            const json& s = e["size"];
-            if (!s.is_array() || s.size() != 2) err.fail("size must be [width, height]");
-            a.width = whole(s[0], err, "width", 16, 8192);
-            a.height = whole(s[1], err, "height", 16, 8192);
-        }
-        if (e.contains("supersample")) a.supersample = whole(e["supersample"], err, "supersample", 1, 4);
-    } else if (name == "eval") {
-        only_keys(e, {name}, err);
-        a.kind = K::kEval;
-        if (!v.is_object() || !v.contains("truth")) err.fail("expected {\"truth\": path}");
-        only_keys(v, {"truth", "label"}, err);
-        a.path = text(v["truth"], err, "truth");
-        if (v.contains("label")) a.label = whole(v["label"], err, "label", 1, 255);
-    } else if (name == "clear_target") {
-        only_keys(e, {name}, err);
-        a.kind = K::kClearTarget;
-        if (v != true) err.fail("expected true");
-    } else if (name == "perforations") {
-        only_keys(e, {name}, err);
-        a.kind = K::kPerforations;
-        if (!v.is_object() || !v.contains("labels")) err.fail("expected {\"labels\": path, \"truth_label\": 2, \"inner_label\": 3}");
-        only_keys(v, {"labels", "truth_label", "inner_label", "target"}, err);
-        a.path = text(v["labels"], err, "labels");
-        a.label = v.contains("truth_label") ? whole(v["truth_label"], err, "truth_label", 1, 255) : 2;
-        a.inner_label = v.contains("inner_label") ? whole(v["inner_label"], err, "inner_label", 1, 255) : 3;
-        if (a.label == a.inner_label) err.fail("truth_label and inner_label must differ");
-        if (v.contains("target")) a.rank = whole(v["target"], err, "target", 0, 1'000'000);
-    }
+    parsers.at(name)(e, a, err, lattice);
     return a;
 }
 

@@ -19,7 +19,14 @@ public:
 
 private:
     [[noreturn]] void fail(const ScriptAction& a, const std::string& why) const;
+    // fail() with the viewer's message unless `ok`.
+    void check(Viewer& viewer, const ScriptAction& a, bool ok) const;
     void finish_entry(Viewer& viewer);
+    void apply_params(Viewer& viewer, const ScriptAction& a);
+    void move_camera(Viewer& viewer, const ScriptAction& a);
+    void take_screenshot(Viewer& viewer, const ScriptAction& a);
+    void report_perforations(Viewer& viewer, const ScriptAction& a);
+    void report_eval(Viewer& viewer, const ScriptAction& a);
 
     Script script_;
     std::size_t next_ = 0;

@@ -166,20 +166,6 @@ int open_demo_viewer(std::unique_ptr<Session> session, Vec3d target) {
     });
 }
 
-nlohmann::json write_before_after_pictures(const std::filesystem::path& dir, const Grid<float>& phi_before,
-                                           const FragmentMesher& after) {
-    try {
-        FragmentMesher before(phi_before.lattice(), after.fragment_size());
-        before.full_rebuild(phi_before);
-        viewer::render_surface_png(before, (dir / "before.png").string(), "superior", 800, 800, 2);
-        viewer::render_surface_png(after, (dir / "after.png").string(), "superior", 800, 800, 2);
-        return {{"before", "before.png"}, {"after", "after.png"}};
-    } catch (const std::exception& e) {
-        fmt::print(stderr, "liveset: warning: no before/after pictures: {}\n", e.what());
-        return nullptr;
-    }
-}
-
 void add_view_command(CLI::App& app, const int& threads) {
     static ViewArgs va;
     auto* v = app.add_subcommand("view", "interactive 3D viewer: segment, repair with agent swarms, undo, save (window or --headless)");

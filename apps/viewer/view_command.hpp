@@ -1,6 +1,6 @@
 // `liveset view`: registers the subcommand on the CLI, loads the inputs (image, --mask / --phi,
-// --roi, --seed), and runs the window, a headless script or the benchmark. Also the entry the demo
-// uses to open the viewer on a session it prepared.
+// --roi, --seed), and runs the window, a headless script or the benchmark. Also the demo's live
+// window (main.cpp hands open_demo_viewer to the demo command).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -32,12 +32,5 @@ int open_viewer_window(std::unique_ptr<Session> session, const std::string& titl
 // The demo's window: the viewer on `session` with the swarm aimed at `target` and running (the
 // phantom mid-repair). Returns the exit status when the user quits.
 int open_demo_viewer(std::unique_ptr<Session> session, Vec3d target);
-
-// The demo's pictures without a display: before.png (the surface of `phi_before`) and after.png
-// (the surface in `after`), superior view, rendered headless (EGL) into `dir`. Returns
-// {"before": ..., "after": ...}, or null with a one-line warning on stderr when no OpenGL context
-// can be had (the demo's other outputs do not depend on it).
-nlohmann::json write_before_after_pictures(const std::filesystem::path& dir, const Grid<float>& phi_before,
-                                           const FragmentMesher& after);
 
 }  // namespace liveset::cli

@@ -194,7 +194,15 @@ private:
     std::optional<Pane> pane_at(double x, double y) const;
     std::optional<Vec3i> voxel_at(Pane pane, double x, double y) const;
     // viewer_panel.cpp
-    void draw_panel();
+    void draw_panel();  // the sections below, in order
+    void draw_image_section();
+    void draw_tools_section();
+    void draw_segmentation_section();
+    void draw_repair_section();
+    void draw_status_section();
+    void draw_history_section();
+    void draw_save_section();
+    void draw_view_section();
     bool panel_button(const char* label, const char* name);
     void draw_pane_labels();
     void draw_recovery_offer();

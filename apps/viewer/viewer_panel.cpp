@@ -33,8 +33,27 @@ void Viewer::draw_panel() {
     ImGui::SetNextWindowSize(ImVec2(static_cast<float>(panel_rect_.w), static_cast<float>(panel_rect_.h)));
     ImGui::Begin("liveset", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
     ImGui::PushItemWidth(150.0f);
+    draw_image_section();
+    ImGui::Separator();
+    draw_tools_section();
+    if (session_ && ImGui::CollapsingHeader("Segmentation", ImGuiTreeNodeFlags_DefaultOpen)) draw_segmentation_section();
+    if (session_ && ImGui::CollapsingHeader("Repair (agent swarm)", ImGuiTreeNodeFlags_DefaultOpen)) draw_repair_section();
+    if (ImGui::CollapsingHeader("Status", ImGuiTreeNodeFlags_DefaultOpen)) draw_status_section();
+    if (session_ && ImGui::CollapsingHeader("History", ImGuiTreeNodeFlags_DefaultOpen)) draw_history_section();
+    if (session_ && ImGui::CollapsingHeader("Save")) draw_save_section();
+    if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) draw_view_section();
+    if (!message_.empty()) {
+        ImGui::Separator();
+        ImGui::PushStyleColor(ImGuiCol_Text, message_is_error_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f));
+        ImGui::TextWrapped("%s", message_.c_str());
+        ImGui::PopStyleColor();
+    }
+    ImGui::PopItemWidth();
+    ImGui::End();
+}
 
-    // --- image
+// The image: name, size, the cursor's voxel and intensity; a path to open another.
+void Viewer::draw_image_section() {
     if (session_) {
         const Lattice& l = session_->lattice();
         ImGui::Text("%s", image_name_.c_str());
@@ -48,9 +67,10 @@ void Viewer::draw_panel() {
     ImGui::InputText("##open", &open_path_);
     ImGui::SameLine();
     if (panel_button("Open", "open")) open_image(open_path_);
+}
 
-    // --- tools
-    ImGui::Separator();
+// The mouse tools (crosshair, seed, target) and the seed radius.
+void Viewer::draw_tools_section() {
     int tool = static_cast<int>(tool_);
     ImGui::RadioButton("Crosshair (1)", &tool, 0);
     ImGui::SameLine();
@@ -60,142 +80,140 @@ void Viewer::draw_panel() {
     if (tool != static_cast<int>(tool_)) set_tool(static_cast<Tool>(tool));
     float radius = static_cast<float>(seed_radius);
     if (ImGui::SliderFloat("seed radius", &radius, 0.5f, 10.0f, "%.1f vox")) seed_radius = radius;
+}
 
-    if (session_ && ImGui::CollapsingHeader("Segmentation", ImGuiTreeNodeFlags_DefaultOpen)) {
-        const SegmentStatus& st = session_->segment_status();
-        ImGui::Text("%zu seed(s), %d iterations%s", session_->seeds().size(), st.iterations, st.converged ? ", converged" : "");
-        bool edited = false, done = false;
-        ui_params_ = session_->params();  // edits apply at once: the session holds the truth
-        ui_auto_window_ = session_->window_from_seeds();
-        if (ImGui::Checkbox("mu, epsilon from the seeds", &ui_auto_window_)) edited = done = true;
-        ImGui::BeginDisabled(ui_auto_window_);
-        float mu = static_cast<float>(ui_params_.mu), eps = static_cast<float>(ui_params_.epsilon);
-        if (ImGui::DragFloat("mu", &mu, 0.002f, 0.0f, 1.0f, "%.3f")) ui_params_.mu = mu, edited = true;
-        done |= ImGui::IsItemDeactivatedAfterEdit();
-        ImGui::SameLine();
-        ImGui::TextDisabled("raw %.0f", session_->scale().to_raw(ui_params_.mu));
-        if (ImGui::DragFloat("epsilon", &eps, 0.002f, 0.005f, 1.0f, "%.3f")) ui_params_.epsilon = eps, edited = true;
-        done |= ImGui::IsItemDeactivatedAfterEdit();
-        ImGui::SameLine();
-        ImGui::TextDisabled("raw %.0f", session_->scale().raw_length(ui_params_.epsilon));
-        ImGui::EndDisabled();
-        float n = static_cast<float>(ui_params_.n), alpha = static_cast<float>(ui_params_.alpha);
-        if (ImGui::DragFloat("n", &n, 0.05f, 0.5f, 16.0f, "%.2f")) ui_params_.n = n, edited = true;
-        done |= ImGui::IsItemDeactivatedAfterEdit();
-        help_marker("steepness of the threshold speed at the window's edge (Eq. 3)");
-        if (ImGui::SliderFloat("alpha", &alpha, 0.0f, 0.95f, "%.2f")) ui_params_.alpha = alpha, edited = true;
-        done |= ImGui::IsItemDeactivatedAfterEdit();
-        help_marker("curvature weight (Eq. 2): smoother fronts that leak less");
-        if (edited) apply_params(ui_params_, ui_auto_window_);
-        if (done) session_->end_action();
-        if (panel_button(segment_running_ ? "Pause (Space)" : "Run (Space)", "run_segmentation")) set_segment_running(!segment_running_);
-        ImGui::SameLine();
-        if (panel_button("Step (S)", "step_segmentation")) {
-            segment_step();
-            session_->end_action();
-        }
+// µ, ε (or from the seeds), n, α; run, pause and step the segmentation.
+void Viewer::draw_segmentation_section() {
+    const SegmentStatus& st = session_->segment_status();
+    ImGui::Text("%zu seed(s), %d iterations%s", session_->seeds().size(), st.iterations, st.converged ? ", converged" : "");
+    bool edited = false, done = false;
+    ui_params_ = session_->params();  // edits apply at once: the session holds the truth
+    ui_auto_window_ = session_->window_from_seeds();
+    if (ImGui::Checkbox("mu, epsilon from the seeds", &ui_auto_window_)) edited = done = true;
+    ImGui::BeginDisabled(ui_auto_window_);
+    float mu = static_cast<float>(ui_params_.mu), eps = static_cast<float>(ui_params_.epsilon);
+    if (ImGui::DragFloat("mu", &mu, 0.002f, 0.0f, 1.0f, "%.3f")) ui_params_.mu = mu, edited = true;
+    done |= ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::SameLine();
+    ImGui::TextDisabled("raw %.0f", session_->scale().to_raw(ui_params_.mu));
+    if (ImGui::DragFloat("epsilon", &eps, 0.002f, 0.005f, 1.0f, "%.3f")) ui_params_.epsilon = eps, edited = true;
+    done |= ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::SameLine();
+    ImGui::TextDisabled("raw %.0f", session_->scale().raw_length(ui_params_.epsilon));
+    ImGui::EndDisabled();
+    float n = static_cast<float>(ui_params_.n), alpha = static_cast<float>(ui_params_.alpha);
+    if (ImGui::DragFloat("n", &n, 0.05f, 0.5f, 16.0f, "%.2f")) ui_params_.n = n, edited = true;
+    done |= ImGui::IsItemDeactivatedAfterEdit();
+    help_marker("steepness of the threshold speed at the window's edge (Eq. 3)");
+    if (ImGui::SliderFloat("alpha", &alpha, 0.0f, 0.95f, "%.2f")) ui_params_.alpha = alpha, edited = true;
+    done |= ImGui::IsItemDeactivatedAfterEdit();
+    help_marker("curvature weight (Eq. 2): smoother fronts that leak less");
+    if (edited) apply_params(ui_params_, ui_auto_window_);
+    if (done) session_->end_action();
+    if (panel_button(segment_running_ ? "Pause (Space)" : "Run (Space)", "run_segmentation")) set_segment_running(!segment_running_);
+    ImGui::SameLine();
+    if (panel_button("Step (S)", "step_segmentation")) {
+        segment_step();
+        session_->end_action();
     }
+}
 
-    if (session_ && ImGui::CollapsingHeader("Repair (agent swarm)", ImGuiTreeNodeFlags_DefaultOpen)) {
-        const auto& t = session_->target();
-        if (t) ImGui::Text("target (%.1f, %.1f, %.1f), %zu agents", t->x, t->y, t->z, session_->agents().size());
-        else ImGui::TextDisabled("no target: Target tool (3), click the surface");
-        bool done = false;
-        if (!ImGui::IsAnyItemActive()) ui_repair_ = session_->repair_options();  // applied when a slider is released
-        int agents = static_cast<int>(ui_repair_.swarm.agents);
-        if (ImGui::SliderInt("agents", &agents, 1, 2000)) ui_repair_.swarm.agents = static_cast<std::size_t>(agents);
+// The swarm: its target, agents, p, radius; start, stop, step, clear.
+void Viewer::draw_repair_section() {
+    const auto& t = session_->target();
+    if (t) ImGui::Text("target (%.1f, %.1f, %.1f), %zu agents", t->x, t->y, t->z, session_->agents().size());
+    else ImGui::TextDisabled("no target: Target tool (3), click the surface");
+    bool done = false;
+    if (!ImGui::IsAnyItemActive()) ui_repair_ = session_->repair_options();  // applied when a slider is released
+    int agents = static_cast<int>(ui_repair_.swarm.agents);
+    if (ImGui::SliderInt("agents", &agents, 1, 2000)) ui_repair_.swarm.agents = static_cast<std::size_t>(agents);
+    done |= ImGui::IsItemDeactivatedAfterEdit();
+    float p = static_cast<float>(ui_repair_.swarm.act_probability), r = static_cast<float>(ui_repair_.swarm.edit_radius);
+    if (ImGui::SliderFloat("p", &p, 0.0f, 1.0f, "%.2f")) ui_repair_.swarm.act_probability = p;
+    done |= ImGui::IsItemDeactivatedAfterEdit();
+    help_marker("probability that an agent edits the surface in a step");
+    if (ImGui::SliderFloat("radius", &r, 0.5f, 8.0f, "%.1f vox")) ui_repair_.swarm.edit_radius = r;
+    done |= ImGui::IsItemDeactivatedAfterEdit();
+    help_marker("support of an agent's Gaussian edit");
+    if (ImGui::TreeNode("more")) {
+        float range = static_cast<float>(ui_repair_.swarm.edit_range), expand = static_cast<float>(ui_repair_.swarm.expand_sigmas);
+        if (ImGui::SliderFloat("edit range", &range, 0.0f, 40.0f, "%.1f vox")) ui_repair_.swarm.edit_range = range;
         done |= ImGui::IsItemDeactivatedAfterEdit();
-        float p = static_cast<float>(ui_repair_.swarm.act_probability), r = static_cast<float>(ui_repair_.swarm.edit_radius);
-        if (ImGui::SliderFloat("p", &p, 0.0f, 1.0f, "%.2f")) ui_repair_.swarm.act_probability = p;
+        if (ImGui::SliderFloat("expand sigmas", &expand, 0.1f, 5.0f, "%.2f")) ui_repair_.swarm.expand_sigmas = expand;
         done |= ImGui::IsItemDeactivatedAfterEdit();
-        help_marker("probability that an agent edits the surface in a step");
-        if (ImGui::SliderFloat("radius", &r, 0.5f, 8.0f, "%.1f vox")) ui_repair_.swarm.edit_radius = r;
-        done |= ImGui::IsItemDeactivatedAfterEdit();
-        help_marker("support of an agent's Gaussian edit");
-        if (ImGui::TreeNode("more")) {
-            float range = static_cast<float>(ui_repair_.swarm.edit_range), expand = static_cast<float>(ui_repair_.swarm.expand_sigmas);
-            if (ImGui::SliderFloat("edit range", &range, 0.0f, 40.0f, "%.1f vox")) ui_repair_.swarm.edit_range = range;
-            done |= ImGui::IsItemDeactivatedAfterEdit();
-            if (ImGui::SliderFloat("expand sigmas", &expand, 0.1f, 5.0f, "%.2f")) ui_repair_.swarm.expand_sigmas = expand;
-            done |= ImGui::IsItemDeactivatedAfterEdit();
-            ImGui::SliderInt("steps/frame", &swarm_steps_per_frame, 1, 20);
-            ImGui::TreePop();
-        }
-        if (done) apply_repair_options(ui_repair_);
-        if (panel_button(swarm_running_ ? "Stop swarm (T)" : "Start swarm (T)", "swarm")) set_swarm_running(!swarm_running_);
-        ImGui::SameLine();
-        if (panel_button("Step##swarm", "step_swarm")) {
-            swarm_step();
-            session_->end_action();
-        }
-        ImGui::SameLine();
-        if (panel_button("Clear target", "clear_target")) clear_target();
+        ImGui::SliderInt("steps/frame", &swarm_steps_per_frame, 1, 20);
+        ImGui::TreePop();
     }
+    if (done) apply_repair_options(ui_repair_);
+    if (panel_button(swarm_running_ ? "Stop swarm (T)" : "Start swarm (T)", "swarm")) set_swarm_running(!swarm_running_);
+    ImGui::SameLine();
+    if (panel_button("Step##swarm", "step_swarm")) {
+        swarm_step();
+        session_->end_action();
+    }
+    ImGui::SameLine();
+    if (panel_button("Clear target", "clear_target")) clear_target();
+}
 
-    if (ImGui::CollapsingHeader("Status", ImGuiTreeNodeFlags_DefaultOpen)) {
-        const FrameStats& f = last_;
-        ImGui::Text("%.1f FPS, frame %.1f ms (%s)", fps_, f.total_ms(), renderer_.c_str());
-        ImGui::Text("level set %.2f  agents %.2f  mesh %.2f ms", f.level_set_ms, f.agents_ms, f.mesh_ms);
-        ImGui::Text("upload %.2f  draw %.2f ms", f.upload_ms, f.draw_ms);
-        ImGui::Text("fragments rebuilt %zu, uploaded %zu", f.fragments, f.uploaded);
-        ImGui::Text("triangles %zu", surface_.triangle_count());
-        if (f.segment_steps || f.swarm_steps) ImGui::TextDisabled("%d level-set / %d swarm steps this frame", f.segment_steps, f.swarm_steps);
-    }
-    if (session_ && ImGui::CollapsingHeader("History", ImGuiTreeNodeFlags_DefaultOpen)) {
-        ImGui::BeginDisabled(!session_->can_undo());
-        if (panel_button("Undo (Ctrl+Z)", "undo")) undo();
-        ImGui::EndDisabled();
-        ImGui::SameLine();
-        ImGui::BeginDisabled(!session_->can_redo());
-        if (panel_button("Redo (Ctrl+Y)", "redo")) redo();
-        ImGui::EndDisabled();
-        ImGui::TextDisabled("%zu to undo (%s), %zu to redo, %.1f MB", session_->undo_depth(), session_->next_undo_label().c_str(),
-                            session_->redo_depth(), static_cast<double>(session_->history_bytes()) / 1e6);
-    }
+// Frame rate and where the frame's time went.
+void Viewer::draw_status_section() {
+    const FrameStats& f = last_;
+    ImGui::Text("%.1f FPS, frame %.1f ms (%s)", fps_, f.total_ms(), renderer_.c_str());
+    ImGui::Text("level set %.2f  agents %.2f  mesh %.2f ms", f.level_set_ms, f.agents_ms, f.mesh_ms);
+    ImGui::Text("upload %.2f  draw %.2f ms", f.upload_ms, f.draw_ms);
+    ImGui::Text("fragments rebuilt %zu, uploaded %zu", f.fragments, f.uploaded);
+    ImGui::Text("triangles %zu", surface_.triangle_count());
+    if (f.segment_steps || f.swarm_steps) ImGui::TextDisabled("%d level-set / %d swarm steps this frame", f.segment_steps, f.swarm_steps);
+}
 
-    if (session_ && ImGui::CollapsingHeader("Save")) {
-        ImGui::InputText("##mask", &mask_path_);
-        ImGui::SameLine();
-        if (panel_button("Save mask", "save_mask")) save_mask(mask_path_);
-        ImGui::InputText("##phi", &phi_path_);
-        ImGui::SameLine();
-        if (panel_button("Save phi", "save_phi")) save_phi(phi_path_);
-        ImGui::InputText("##mesh", &mesh_path_);
-        ImGui::SameLine();
-        if (panel_button("Save mesh", "save_mesh")) save_mesh(mesh_path_);
-        ImGui::InputText("##shot", &screenshot_path_);
-        ImGui::SameLine();
-        if (panel_button("Screenshot", "screenshot")) save_screenshot(screenshot_path_, Pane::kView3d);
-    }
+// Undo and redo with what they would take back.
+void Viewer::draw_history_section() {
+    ImGui::BeginDisabled(!session_->can_undo());
+    if (panel_button("Undo (Ctrl+Z)", "undo")) undo();
+    ImGui::EndDisabled();
+    ImGui::SameLine();
+    ImGui::BeginDisabled(!session_->can_redo());
+    if (panel_button("Redo (Ctrl+Y)", "redo")) redo();
+    ImGui::EndDisabled();
+    ImGui::TextDisabled("%zu to undo (%s), %zu to redo, %.1f MB", session_->undo_depth(), session_->next_undo_label().c_str(),
+                        session_->redo_depth(), static_cast<double>(session_->history_bytes()) / 1e6);
+}
 
-    if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) {
-        if (panel_button("Reset view (R)", "reset_view") && session_) {
-            camera_.frame(render::surface_bounds(session_->mesher()));
+// Save the mask, φ, the mesh or a screenshot.
+void Viewer::draw_save_section() {
+    ImGui::InputText("##mask", &mask_path_);
+    ImGui::SameLine();
+    if (panel_button("Save mask", "save_mask")) save_mask(mask_path_);
+    ImGui::InputText("##phi", &phi_path_);
+    ImGui::SameLine();
+    if (panel_button("Save phi", "save_phi")) save_phi(phi_path_);
+    ImGui::InputText("##mesh", &mesh_path_);
+    ImGui::SameLine();
+    if (panel_button("Save mesh", "save_mesh")) save_mesh(mesh_path_);
+    ImGui::InputText("##shot", &screenshot_path_);
+    ImGui::SameLine();
+    if (panel_button("Screenshot", "screenshot")) save_screenshot(screenshot_path_, Pane::kView3d);
+}
+
+// Reset or maximise the 3D view; the six named views.
+void Viewer::draw_view_section() {
+    if (panel_button("Reset view (R)", "reset_view") && session_) {
+        camera_.frame(render::surface_bounds(session_->mesher()));
+        camera_changed();
+    }
+    ImGui::SameLine();
+    bool max3d = maximised_ == Pane::kView3d;
+    if (ImGui::Checkbox("3D only (F)", &max3d)) set_maximised(max3d ? std::optional<Pane>(Pane::kView3d) : std::nullopt);
+    for (const char* name : {"superior", "anterior", "left", "right", "posterior", "inferior"}) {
+        if (ImGui::SmallButton(name)) {
+            render::CameraPose pose;
+            render::OrbitCamera::named_pose(name, pose);
+            camera_.set_pose(pose);
             camera_changed();
+            log_.add("button", {{"name", std::string("view_") + name}});
         }
-        ImGui::SameLine();
-        bool max3d = maximised_ == Pane::kView3d;
-        if (ImGui::Checkbox("3D only (F)", &max3d)) set_maximised(max3d ? std::optional<Pane>(Pane::kView3d) : std::nullopt);
-        for (const char* name : {"superior", "anterior", "left", "right", "posterior", "inferior"}) {
-            if (ImGui::SmallButton(name)) {
-                render::CameraPose pose;
-                render::OrbitCamera::named_pose(name, pose);
-                camera_.set_pose(pose);
-                camera_changed();
-                log_.add("button", {{"name", std::string("view_") + name}});
-            }
-            if (std::string_view(name) != "right" && std::string_view(name) != "inferior") ImGui::SameLine();
-        }
+        if (std::string_view(name) != "right" && std::string_view(name) != "inferior") ImGui::SameLine();
     }
-
-    if (!message_.empty()) {
-        ImGui::Separator();
-        ImGui::PushStyleColor(ImGuiCol_Text, message_is_error_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f));
-        ImGui::TextWrapped("%s", message_.c_str());
-        ImGui::PopStyleColor();
-    }
-    ImGui::PopItemWidth();
-    ImGui::End();
 }
 
 // A recovery file was found for the image: ask (modal) whether to restore it.

@@ -133,6 +133,12 @@ TEST(SegmentCli, PhantomSegmentMeshEval) {
     ASSERT_EQ(mp.rc, 0) << mp.err;
     EXPECT_EQ(nlohmann::json::parse(mp.out)["input_kind"], "phi");
     EXPECT_GT(nlohmann::json::parse(mp.out)["triangles"].get<std::size_t>(), 1000u);
+    // The whole-volume path (marching_cubes_slabs) gives the fragment path's triangles and, once the
+    // fragments' border vertices are welded, the same vertices and topology.
+    const Result ms = run_cli("mesh " + phi.string() + " --json --out " + (work_dir() / "phi_whole.ply").string());
+    ASSERT_EQ(ms.rc, 0) << ms.err;
+    const nlohmann::json sj2 = nlohmann::json::parse(ms.out), fj = nlohmann::json::parse(mp.out);
+    for (const char* key : {"triangles", "vertices", "euler", "components"}) EXPECT_EQ(sj2[key], fj[key]) << key;
 }
 
 TEST(SegmentCli, EvalMatchesHandComputedOverlap) {

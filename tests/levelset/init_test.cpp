@@ -77,3 +77,26 @@ TEST(SparseFieldInit, RejectsBadParameters) {
     Grid<std::uint8_t> wrong(Lattice({8, 8, 8}), 0);
     EXPECT_THROW(f.init_from_mask(wrong), std::invalid_argument);
 }
+
+TEST(SparseFieldInit, AThrowingInitialisationLeavesTheFieldAsItWas) {
+    // Strong guarantee: a signed distance that is not finite somewhere, or that throws, is refused
+    // before anything of the field changes — φ, statuses and layers are those of the sphere before.
+    const Lattice lat({20, 20, 20});
+    SparseField f(lat, 2);
+    f.init_from_sdf(shapes::Sphere({10, 10, 10}, 5));
+    const std::vector<float> phi(f.phi().values().begin(), f.phi().values().end());
+    const std::vector<std::int8_t> status(f.status().values().begin(), f.status().values().end());
+    const std::size_t zero = f.zero_layer().size();
+    ASSERT_GT(zero, 0u);
+    const auto nan_at_corner = [](Vec3d p) { return p.x == 19 && p.y == 19 && p.z == 19 ? NAN : p.x - 10.0; };
+    const auto throws = [](Vec3d p) -> double {
+        if (p.z > 15) throw std::invalid_argument("refused by the caller");
+        return p.x - 10.0;
+    };
+    EXPECT_THROW(f.init_from_sdf(nan_at_corner), std::invalid_argument);
+    EXPECT_THROW(f.init_from_sdf(throws), std::invalid_argument);
+    expect_valid(f, "after the refused initialisations");
+    EXPECT_TRUE(std::equal(phi.begin(), phi.end(), f.phi().values().begin()));
+    EXPECT_TRUE(std::equal(status.begin(), status.end(), f.status().values().begin()));
+    EXPECT_EQ(f.zero_layer().size(), zero);
+}

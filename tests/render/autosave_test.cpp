@@ -136,7 +136,16 @@ TEST(Autosave, ATerminationSignalMidSegmentationWritesTheStateItHad) {
     while (recovery_files(rec).empty() && std::chrono::steady_clock::now() < deadline)
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
     ASSERT_FALSE(recovery_files(rec).empty()) << "no autosave within 2 minutes";
-    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    // Wait until an autosave shows segmentation steps (a loaded machine may take a while to get
+    // past the seeds), then interrupt the run mid-segmentation.
+    const auto stepping = [&] {
+        for (const fs::path& f : recovery_files(rec)) try {
+                if (read_recovery(f).marks.iterations > 0) return true;
+            } catch (const std::runtime_error&) {
+            }
+        return false;
+    };
+    while (!stepping() && std::chrono::steady_clock::now() < deadline) std::this_thread::sleep_for(std::chrono::milliseconds(20));
     ::kill(pid, SIGTERM);
     int status = 0;
     ::waitpid(pid, &status, 0);

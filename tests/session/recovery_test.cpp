@@ -1,7 +1,6 @@
 // Recovery files: a written state reads back bit for bit; every damaged file (each truncation, a
 // flipped byte, a wrong magic or version, bad geometry, NaN φ, a wrong voxel count) is refused
-// with a reason; a crash or termination signal writes the tracked state before the process dies;
-// and a session restored from a recovery file has the surface, seeds and parameters it had.
+// with a reason (the crash-signal writer is tested with the viewer: tests/render); and a session restored from a recovery file has the surface, seeds and parameters it had.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -18,61 +17,12 @@
 #include "liveset/session/recovery.hpp"
 #include "liveset/session/repair_presets.hpp"
 #include "liveset/session/session.hpp"
+#include "session/recovery_samples.hpp"
 
 namespace liveset {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path fresh_dir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() / ("liveset_recovery_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
-
-RecoveryState sample_state() {
-    const Mat3d flip{-1, 0, 0, 0, 0, 1, 0, 1, 0};
-    const Lattice lattice({7, 5, 4}, {0.9, 1.1, 2.5}, {-12.5, 30.0, 4.25}, flip);
-    RecoveryState s;
-    s.image = "/data/subject 01/t1.nii.gz";
-    s.unix_time = 1795000000;
-    s.marks.seeds = {{{1.5, 2.0, 3.0}, 2.0}, {{4.0, 1.0, 0.0}, 0.75}};
-    s.marks.params = {0.42, 0.07, 3.0, 0.2};
-    s.marks.window_from_seeds = false;
-    s.marks.pristine = false;
-    s.marks.iterations = 137;
-    s.phi = Grid<float>(lattice);
-    int k = 0;
-    for (float& v : s.phi.values()) v = static_cast<float>(k++ % 11) * 0.37f - 1.5f;
-    s.status = Grid<std::int8_t>(lattice);
-    k = 0;
-    for (std::int8_t& v : s.status.values()) v = static_cast<std::int8_t>(k++ % 7 - 3);
-    return s;
-}
-
-void expect_same(const RecoveryState& a, const RecoveryState& b) {
-    EXPECT_EQ(a.image, b.image);
-    EXPECT_EQ(a.signal, b.signal);
-    EXPECT_EQ(a.unix_time, b.unix_time);
-    ASSERT_EQ(a.marks.seeds.size(), b.marks.seeds.size());
-    for (std::size_t i = 0; i < a.marks.seeds.size(); ++i) {
-        EXPECT_EQ(a.marks.seeds[i].center, b.marks.seeds[i].center);
-        EXPECT_EQ(a.marks.seeds[i].radius, b.marks.seeds[i].radius);
-    }
-    EXPECT_EQ(a.marks.params.mu, b.marks.params.mu);
-    EXPECT_EQ(a.marks.params.epsilon, b.marks.params.epsilon);
-    EXPECT_EQ(a.marks.params.n, b.marks.params.n);
-    EXPECT_EQ(a.marks.params.alpha, b.marks.params.alpha);
-    EXPECT_EQ(a.marks.window_from_seeds, b.marks.window_from_seeds);
-    EXPECT_EQ(a.marks.iterations, b.marks.iterations);
-    EXPECT_TRUE(a.phi.lattice().same_geometry(b.phi.lattice(), 0.0));
-    ASSERT_EQ(a.phi.size(), b.phi.size());
-    for (std::size_t i = 0; i < a.phi.size(); ++i)
-        ASSERT_EQ(std::bit_cast<std::uint32_t>(a.phi.values()[i]), std::bit_cast<std::uint32_t>(b.phi.values()[i])) << i;
-    ASSERT_EQ(a.status.size(), b.status.size());
-    EXPECT_TRUE(std::equal(a.status.values().begin(), a.status.values().end(), b.status.values().begin()));
-}
 
 // Recomputes the trailing checksum after a deliberate edit, so the field checks are reached.
 void reseal(std::vector<std::uint8_t>& bytes) {
@@ -199,54 +149,6 @@ TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {
     }
     std::ofstream(dir / "empty.lsrecovery");
     EXPECT_THROW(read_recovery(dir / "empty.lsrecovery"), std::runtime_error);
-    fs::remove_all(dir);
-}
-
-// The child process dies by `sig` after the tracking was set up in the parent (no allocation after
-// fork); the parent then reads what the handler wrote.
-int die_by(int sig) {
-    const pid_t pid = ::fork();
-    if (pid == 0) {
-        ::raise(sig);
-        ::_exit(99);  // not reached: the signal's default action ends the process
-    }
-    int status = 0;
-    ::waitpid(pid, &status, 0);
-    return WIFSIGNALED(status) ? WTERMSIG(status) : -WEXITSTATUS(status);
-}
-
-TEST(Recovery, ACrashOrTerminationSignalWritesTheTrackedState) {
-    const fs::path dir = fresh_dir("crash");
-    const RecoveryState s = sample_state();
-    for (int sig : {SIGSEGV, SIGABRT, SIGTERM, SIGINT}) {
-        const fs::path path = dir / ("crash" + std::to_string(sig) + ".lsrecovery");
-        CrashRecovery crash(path);
-        crash.track(s.image, s.marks, s.phi, s.status);
-        ASSERT_EQ(die_by(sig), sig) << "signal " << sig;
-        ASSERT_TRUE(fs::exists(path)) << "signal " << sig << " wrote no recovery file";
-        EXPECT_FALSE(fs::exists(path.string() + ".part"));
-        const RecoveryState got = read_recovery(path);
-        EXPECT_EQ(got.signal, sig);
-        EXPECT_GT(got.unix_time, 1700000000);
-        RecoveryState expected = s;
-        expected.signal = sig;
-        expected.unix_time = got.unix_time;
-        expect_same(expected, got);
-    }
-    {  // untracked (the work was saved): the signal writes nothing
-        const fs::path path = dir / "untracked.lsrecovery";
-        CrashRecovery crash(path);
-        crash.track(s.image, s.marks, s.phi, s.status);
-        crash.untrack();
-        ASSERT_EQ(die_by(SIGTERM), SIGTERM);
-        EXPECT_FALSE(fs::exists(path));
-    }
-    EXPECT_THROW(
-        {
-            CrashRecovery a(dir / "a");
-            CrashRecovery b(dir / "b");
-        },
-        std::logic_error);
     fs::remove_all(dir);
 }
 

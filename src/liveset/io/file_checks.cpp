@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace liveset::io_detail {
@@ -62,17 +63,20 @@ std::string trim(const std::string& s) {
     return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
 }
 
-}  // namespace
+// Where a single-file NIfTI's voxel data lies and what it holds, read from its header (the
+// stream is left just after the header); nullopt when it is not one (ITK then has its say).
+struct NiftiLayout {
+    bool swap = false;
+    int datatype = 0;
+    std::uint64_t offset = 0, data_bytes = 0;
+    int header_bytes = 0;
+};
 
-DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values) {
-    DataCheck result;
-    std::unique_ptr<gzFile_s, GzClose> file(gzopen(path.c_str(), "rb"));
-    if (!file) return result;
-    gzFile f = file.get();
+std::optional<NiftiLayout> read_nifti_layout(gzFile f) {
     // Read exactly the header (348 bytes for NIfTI-1, 540 for NIfTI-2): the data starts later.
     unsigned char h[540] = {};
     int got = gzread(f, h, 348);
-    if (got < 348) return result;  // ITK reads the header; nothing to add here
+    if (got < 348) return std::nullopt;  // ITK reads the header; nothing to add here
     // NIfTI-1 (348-byte header) or NIfTI-2 (540), either byte order; single file only.
     const auto size_le = load<std::int32_t>(h, false), size_be = load<std::int32_t>(h, true);
     const bool swap = !(size_le == 348 || size_le == 540);
@@ -81,29 +85,45 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values
     int datatype = 0, bitpix = 0;
     double vox_offset = 0;
     if (sizeof_hdr == 348) {
-        if (std::memcmp(h + 344, "n+1", 4) != 0) return result;
+        if (std::memcmp(h + 344, "n+1", 4) != 0) return std::nullopt;
         for (int i = 0; i < 8; ++i) dim[i] = load<std::int16_t>(h + 40 + 2 * i, swap);
         datatype = load<std::int16_t>(h + 70, swap);
         bitpix = load<std::int16_t>(h + 72, swap);
         vox_offset = std::max<double>(352, load<float>(h + 108, swap));
     } else if (sizeof_hdr == 540) {
-        if (gzread(f, h + 348, 192) != 192) return result;
+        if (gzread(f, h + 348, 192) != 192) return std::nullopt;
         got = 540;
-        if (std::memcmp(h + 4, "n+2", 4) != 0) return result;
+        if (std::memcmp(h + 4, "n+2", 4) != 0) return std::nullopt;
         for (int i = 0; i < 8; ++i) dim[i] = load<std::int64_t>(h + 16 + 8 * i, swap);
         datatype = load<std::int16_t>(h + 12, swap);
         bitpix = load<std::int16_t>(h + 14, swap);
         vox_offset = std::max<double>(544, static_cast<double>(load<std::int64_t>(h + 168, swap)));
     } else {
-        return result;
+        return std::nullopt;
     }
-    if (dim[0] < 1 || dim[0] > 7 || bitpix <= 0 || bitpix % 8 != 0 || !(vox_offset < 1e15)) return result;
+    if (dim[0] < 1 || dim[0] > 7 || bitpix <= 0 || bitpix % 8 != 0 || !(vox_offset < 1e15)) return std::nullopt;
     std::uint64_t data_bytes = static_cast<std::uint64_t>(bitpix / 8);
     for (int i = 1; i <= dim[0]; ++i) {
-        if (dim[i] <= 0) return result;
+        if (dim[i] <= 0) return std::nullopt;
         data_bytes *= static_cast<std::uint64_t>(dim[i]);
     }
-    const auto offset = static_cast<std::uint64_t>(vox_offset);
+    return NiftiLayout{swap, datatype, static_cast<std::uint64_t>(vox_offset), data_bytes, got};
+}
+
+}  // namespace
+
+DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values) {
+    DataCheck result;
+    std::unique_ptr<gzFile_s, GzClose> file(gzopen(path.c_str(), "rb"));
+    if (!file) return result;
+    gzFile f = file.get();
+    const std::optional<NiftiLayout> layout = read_nifti_layout(f);
+    if (!layout) return result;
+    const bool swap = layout->swap;
+    const int datatype = layout->datatype;
+    const std::uint64_t data_bytes = layout->data_bytes;
+    const int got = layout->header_bytes;
+    const std::uint64_t offset = layout->offset;
     const std::uint64_t end = offset + data_bytes;
     const bool is_float = datatype == 16 || datatype == 64;  // FLOAT32, FLOAT64
     const bool scan_values = count_non_finite_values && is_float;

@@ -31,7 +31,7 @@
 #include <itkNiftiImageIOFactory.h>
 #include <itkNrrdImageIOFactory.h>
 
-#include "liveset/io/atomic_output.hpp"
+#include "liveset/base/atomic_file.hpp"
 #include "liveset/io/file_checks.hpp"
 #include "liveset/io/messages.hpp"
 #include "liveset/io/minc_world.hpp"
@@ -457,7 +457,7 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
     if (!fs::exists(dir_status)) fail_write(path, "folder " + quoted(dir.string()) + " does not exist");
     if (!fs::is_directory(dir_status)) fail_write(path, quoted(dir.string()) + " is not a folder");
     if (filename.empty() || fs::is_directory(target, ec)) fail_write(path, "is a folder, not a file name");
-    const std::string ext = io_detail::extension_of(filename);
+    const std::string ext = file_extension(filename);
     const char* formats = "use .nii.gz, .nii, .mha, .mhd, .nrrd, .nhdr or .mnc";
     if (ext.empty()) fail_write(path, std::string("no file extension to choose the format (") + formats + ")");
 
@@ -495,8 +495,8 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
                              bytes_text(double(space.available)) + " free, about " + bytes_text(bytes) + " needed)");
 
     // Written to a hidden temporary next to the target, checked, then renamed over the target.
-    // Every failure below removes the temporaries (AtomicOutput's destructor).
-    io_detail::AtomicOutput out(target);
+    // Every failure below removes the temporaries (AtomicFile's destructor).
+    AtomicFile out(target);
     const std::string tmp = out.temp_path().string();
     try {
         out.create();  // a clear reason (permissions, read-only file system) before ITK tries

@@ -89,9 +89,9 @@ void SparseField::list_remove(PointIndex i, int layer) {
 // Initialisation
 
 void SparseField::evaluate_sdf(const std::function<double(Vec3d)>& sdf) {
-    activity_.reset();  // a new front: everything awake again
-    for (auto& l : lists_) l.clear();
-    slot_.fill(kNoSlot);
+    // Evaluated into a new grid and checked before anything of the field changes, so a throw (a
+    // value that is not finite, or one from `sdf` itself) leaves the field as it was.
+    Grid<float> values(lattice());
     const Vec3i d = lattice().dims();
     const float far = static_cast<float>(layers_ + 1);
     // Evaluate the distance everywhere (clamped to the far value); zero layer = |φ| ≤ 0.5.
@@ -100,17 +100,19 @@ void SparseField::evaluate_sdf(const std::function<double(Vec3d)>& sdf) {
             for (int x = 0; x < d.x; ++x) {
                 const double v = sdf(Vec3d{static_cast<double>(x), static_cast<double>(y), static_cast<double>(z)});
                 const PointIndex i = lattice().index({x, y, z});
-                if (!std::isfinite(v)) {
-                    phi_[i] = std::numeric_limits<float>::quiet_NaN();
-                    continue;
-                }
-                phi_[i] = static_cast<float>(std::clamp(v, -static_cast<double>(far), static_cast<double>(far)));
+                values[i] = std::isfinite(v) ? static_cast<float>(std::clamp(v, -static_cast<double>(far), static_cast<double>(far)))
+                                             : std::numeric_limits<float>::quiet_NaN();
             }
     });
-    for (std::size_t i = 0; i < phi_.size(); ++i)
-        if (!std::isfinite(phi_[static_cast<PointIndex>(i)]))
+    for (std::size_t i = 0; i < values.size(); ++i)
+        if (!std::isfinite(values[static_cast<PointIndex>(i)]))
             throw std::invalid_argument("signed distance is not finite at " +
                                         point_text(lattice(), static_cast<PointIndex>(i)));
+    activity_.reset();  // a new front: everything awake again
+    for (auto& l : lists_) l.clear();
+    slot_.fill(kNoSlot);
+    // Copied, not moved: φ keeps its storage (the viewer's crash handler reads it in place).
+    std::copy(values.values().begin(), values.values().end(), phi_.values().begin());
 }
 
 void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {

@@ -35,6 +35,9 @@ Vertex make_edge_vertex(const Grid<float>& phi, Vec3i p, int axis) {
     const Lattice& l = phi.lattice();
     const std::size_t step = axis == 0 ? 1 : axis == 1 ? l.stride_y() : l.stride_z();
     const std::size_t i = l.index(p);
+    const Vec3i d = l.dims();
+    if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (axis == 0) <= d.x - 2 && p.y + (axis == 1) <= d.y - 2 && p.z + (axis == 2) <= d.z - 2)
+        return edge_vertex_interior(phi.values().data(), i, p, axis, l.stride_y(), l.stride_z());
     const float a = phi[static_cast<PointIndex>(i)];
     const float b = phi[static_cast<PointIndex>(i + step)];
     float t = a / (a - b);

@@ -4,7 +4,9 @@
 // lattice-edge vertex once and reusing it through G.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <climits>
 #include <cstdint>
 #include <span>
@@ -31,6 +33,33 @@ inline constexpr float kEdgeVertexMargin = 1e-3f;
 // where that vanishes, the edge direction from the inside endpoint to the outside one.
 // A pure function of (φ, p, axis): every fragment computes bit-identical border vertices.
 Vertex make_edge_vertex(const Grid<float>& phi, Vec3i p, int axis);
+
+// make_edge_vertex() for an edge whose two endpoints have all 6 neighbours inside the lattice, from
+// φ's values v, the linear index i of the start point p and the strides: the same arithmetic in the
+// same order, so bit-identical results (make_edge_vertex uses it for such edges).
+inline Vertex edge_vertex_interior(const float* v, std::size_t i, Vec3i p, int axis, std::size_t sy, std::size_t sz) {
+    const std::size_t step = axis == 0 ? 1 : axis == 1 ? sy : sz;
+    const std::size_t j = i + step;
+    const float a = v[i], b = v[j];
+    float t = a / (a - b);
+    if (!std::isfinite(t)) t = 0.5f;
+    t = std::clamp(t, kEdgeVertexMargin, 1.0f - kEdgeVertexMargin);
+    const float ga[3] = {(v[i + 1] - v[i - 1]) / 2.0f, (v[i + sy] - v[i - sy]) / 2.0f, (v[i + sz] - v[i - sz]) / 2.0f};
+    const float gb[3] = {(v[j + 1] - v[j - 1]) / 2.0f, (v[j + sy] - v[j - sy]) / 2.0f, (v[j + sz] - v[j - sz]) / 2.0f};
+    const float s = 1.0f - t;
+    const float n[3] = {s * ga[0] + t * gb[0], s * ga[1] + t * gb[1], s * ga[2] + t * gb[2]};
+    const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    Vertex out{};
+    if (std::isfinite(len) && len > 1e-20f) {
+        const float inv = 1.0f / len;
+        for (int k = 0; k < 3; ++k) out.normal[k] = n[k] * inv;
+    } else {
+        out.normal[axis] = is_inside(a) ? 1.0f : -1.0f;
+    }
+    for (int k = 0; k < 3; ++k) out.position[k] = static_cast<float>(p[k]);
+    out.position[axis] = static_cast<float>(p[axis]) + t;
+    return out;
+}
 
 // Marching-cubes case index of the cell with minimum corner c (bit k set when corner k is inside).
 int cell_case(const Grid<float>& phi, Vec3i c);

@@ -1,5 +1,7 @@
-// Mesh writers (PLY/OBJ/STL, world coordinates, atomic temp-file + rename) and bounded readers.
+// Mesh writers (PLY/OBJ/STL, world coordinates, through the atomic file writer) and bounded readers.
 #include "liveset/mesh/mesh_io.hpp"
+
+#include "liveset/base/atomic_file.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,8 +11,8 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <functional>
 #include <map>
-#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -172,52 +174,41 @@ void write_mesh(const fs::path& path, MeshView mesh, const Lattice& lattice) {
 void write_mesh(const fs::path& path, MeshView mesh, const Lattice& lattice, MeshFormat format) {
     check_indices(path, mesh);
     const std::vector<WorldVertex> world = to_world(mesh, lattice);
-    std::random_device rd;
-    fs::path tmp = path;
-    tmp += ".tmp-" + std::to_string(rd());
     try {
-        {
-            std::ofstream os(tmp, std::ios::binary | std::ios::trunc);
-            if (!os) fail(path, "cannot create temporary file " + tmp.string());
+        write_file_atomically(path, [&](std::ostream& os) {
             switch (format) {
                 case MeshFormat::ply: write_ply_body(os, world, mesh); break;
                 case MeshFormat::obj: write_obj_body(os, world, mesh); break;
                 case MeshFormat::stl: write_stl_body(os, world, mesh); break;
             }
-            os.flush();
-            if (!os) fail(path, "write error (disk full?)");
-            os.close();
-            if (os.fail()) fail(path, "error closing the file");
-        }
-        std::error_code ec;
-        fs::rename(tmp, path, ec);
-        if (ec) fail(path, "cannot rename temporary file (" + ec.message() + ")");
-    } catch (...) {
-        std::error_code ignore;
-        fs::remove(tmp, ignore);
-        throw;
+        });
+    } catch (const std::runtime_error& e) {
+        fail(path, e.what());
     }
 }
 
-Mesh read_ply(const fs::path& path) {
-    const std::string data = slurp(path);
-    const std::size_t header_end = data.find("end_header\n");
-    if (data.compare(0, 4, "ply\n") != 0 || header_end == std::string::npos || header_end > (1u << 16))
+namespace {
+
+// A binary PLY header: the element counts, the vertex properties and whether faces are lists.
+struct PlyProperty {
+    std::string name;
+    int size;
+    std::string type;
+};
+struct PlyHeader {
+    std::size_t end = 0;  // offset of "end_header\n"
+    std::uint64_t vertices = 0, faces = 0;
+    bool binary_le = false, face_list = false;
+    std::vector<PlyProperty> vertex_properties;
+};
+
+PlyHeader parse_ply_header(const fs::path& path, const std::string& data) {
+    PlyHeader h;
+    h.end = data.find("end_header\n");
+    if (data.compare(0, 4, "ply\n") != 0 || h.end == std::string::npos || h.end > (1u << 16))
         fail(path, "not a PLY file (missing 'ply' or 'end_header')");
-    std::istringstream header(data.substr(0, header_end));
-    std::string line;
-    std::uint64_t nv = 0, nf = 0;
-    bool binary_le = false;
-    std::string element;
-    struct Prop {
-        std::string name;
-        int size;
-        std::string type;
-    };
-    std::vector<Prop> vprops;
-    int list_count_size = 0, list_index_size = 0;
-    std::string list_index_type;
-    bool have_faces_list = false;
+    std::istringstream header(data.substr(0, h.end));
+    std::string line, element;
     while (std::getline(header, line)) {
         std::istringstream ls(line);
         std::string word;
@@ -225,13 +216,13 @@ Mesh read_ply(const fs::path& path) {
         if (word == "format") {
             std::string fmt, ver;
             ls >> fmt >> ver;
-            binary_le = fmt == "binary_little_endian";
+            h.binary_le = fmt == "binary_little_endian";
         } else if (word == "element") {
             std::uint64_t n = 0;
             ls >> element >> n;
             if (!ls) fail(path, "malformed element line");
-            if (element == "vertex") nv = n;
-            else if (element == "face") nf = n;
+            if (element == "vertex") h.vertices = n;
+            else if (element == "face") h.faces = n;
             else fail(path, "unsupported element '" + element + "'");
         } else if (word == "property") {
             std::string type;
@@ -241,17 +232,14 @@ Mesh read_ply(const fs::path& path) {
                 ls >> name;
                 const int sz = scalar_size(type);
                 if (!ls || sz == 0) fail(path, "malformed vertex property");
-                vprops.push_back({name, sz, type});
+                h.vertex_properties.push_back({name, sz, type});
             } else if (element == "face") {
                 std::string ct, it, name;
                 ls >> ct >> it >> name;
                 if (type != "list" || !ls) fail(path, "face property must be a list");
-                list_count_size = scalar_size(ct);
-                list_index_size = scalar_size(it);
-                list_index_type = it;
-                if (list_count_size != 1 || (list_index_size != 4 || it == "float" || it == "float32"))
+                if (scalar_size(ct) != 1 || (scalar_size(it) != 4 || it == "float" || it == "float32"))
                     fail(path, "unsupported face list types");
-                have_faces_list = true;
+                h.face_list = true;
             } else {
                 fail(path, "property outside an element");
             }
@@ -259,8 +247,19 @@ Mesh read_ply(const fs::path& path) {
             fail(path, "unexpected header line '" + line + "'");
         }
     }
-    if (!binary_le) fail(path, "only binary_little_endian PLY is supported");
-    if (nf > 0 && !have_faces_list) fail(path, "face element without a vertex list");
+    return h;
+}
+
+}  // namespace
+
+Mesh read_ply(const fs::path& path) {
+    const std::string data = slurp(path);
+    const PlyHeader h = parse_ply_header(path, data);
+    const std::uint64_t nv = h.vertices, nf = h.faces;
+    const std::vector<PlyProperty>& vprops = h.vertex_properties;
+    const std::size_t header_end = h.end;
+    if (!h.binary_le) fail(path, "only binary_little_endian PLY is supported");
+    if (nf > 0 && !h.face_list) fail(path, "face element without a vertex list");
     int ix[6] = {-1, -1, -1, -1, -1, -1};
     const char* names[6] = {"x", "y", "z", "nx", "ny", "nz"};
     std::size_t stride = 0;
@@ -311,70 +310,46 @@ Mesh read_ply(const fs::path& path) {
     return m;
 }
 
-Mesh read_obj(const fs::path& path) {
-    const std::string data = slurp(path);
-    std::vector<std::array<float, 3>> pos, nrm;
-    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> ids;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> corners;  // (v, vn) per triangle corner
-    Mesh m;
-    std::istringstream in(data);
-    std::string line;
-    std::size_t lineno = 0;
-    auto bad = [&](const std::string& what) { fail(path, "line " + std::to_string(lineno) + ": " + what); };
-    while (std::getline(in, line)) {
-        ++lineno;
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        std::istringstream ls(line);
-        std::string tag;
-        ls >> tag;
-        if (tag.empty() || tag[0] == '#' || tag == "o" || tag == "g" || tag == "s" || tag == "mtllib" || tag == "usemtl" ||
-            tag == "vt")
-            continue;
-        if (tag == "v" || tag == "vn") {
-            std::array<float, 3> v{};
-            for (float& c : v) {
-                std::string tok;
-                double d;
-                if (!(ls >> tok) || !parse_double(tok, d)) bad("malformed " + tag);
-                c = static_cast<float>(d);
-            }
-            (tag == "v" ? pos : nrm).push_back(v);
-        } else if (tag == "f") {
-            std::vector<std::pair<std::uint32_t, std::uint32_t>> poly;  // (v, vn) per corner
-            std::string tok;
-            while (ls >> tok) {
-                long long vi = 0, ni = 0;
-                const std::size_t s1 = tok.find('/');
-                auto to_int = [&](std::string_view sv, long long& out) {
-                    auto [p, ec] = std::from_chars(sv.data(), sv.data() + sv.size(), out);
-                    if (ec != std::errc() || p != sv.data() + sv.size()) bad("malformed face index '" + tok + "'");
-                };
-                to_int(std::string_view(tok).substr(0, s1), vi);
-                if (s1 != std::string::npos) {
-                    const std::size_t s2 = tok.find('/', s1 + 1);
-                    if (s2 != std::string::npos && s2 + 1 < tok.size()) to_int(std::string_view(tok).substr(s2 + 1), ni);
-                }
-                auto resolve = [&](long long i, std::size_t n) -> long long {
-                    if (i < 0) i += static_cast<long long>(n) + 1;
-                    if (i < 1 || i > static_cast<long long>(n)) bad("face index out of range");
-                    return i - 1;
-                };
-                const auto v = static_cast<std::uint32_t>(resolve(vi, pos.size()));
-                const std::uint32_t nn = ni == 0 ? UINT32_MAX : static_cast<std::uint32_t>(resolve(ni, nrm.size()));
-                poly.push_back({v, nn});
-            }
-            if (poly.size() < 3) bad("face with fewer than 3 vertices");
-            for (std::size_t i = 1; i + 1 < poly.size(); ++i) {
-                corners.push_back(poly[0]);
-                corners.push_back(poly[i]);
-                corners.push_back(poly[i + 1]);
-            }
-        } else {
-            bad("unsupported statement '" + tag + "'");
+namespace {
+
+using ObjCorner = std::pair<std::uint32_t, std::uint32_t>;  // (v, vn) of a face corner; vn UINT32_MAX: none
+
+// The corners of an OBJ face line ("f 1 2 3", "f 1//4 2//5 3//6", negative indices count back).
+std::vector<ObjCorner> parse_obj_face(std::istringstream& ls, std::size_t positions, std::size_t normals,
+                                      const std::function<void(const std::string&)>& bad) {
+    std::vector<ObjCorner> poly;
+    std::string tok;
+    while (ls >> tok) {
+        long long vi = 0, ni = 0;
+        const std::size_t s1 = tok.find('/');
+        auto to_int = [&](std::string_view sv, long long& out) {
+            auto [p, ec] = std::from_chars(sv.data(), sv.data() + sv.size(), out);
+            if (ec != std::errc() || p != sv.data() + sv.size()) bad("malformed face index '" + tok + "'");
+        };
+        to_int(std::string_view(tok).substr(0, s1), vi);
+        if (s1 != std::string::npos) {
+            const std::size_t s2 = tok.find('/', s1 + 1);
+            if (s2 != std::string::npos && s2 + 1 < tok.size()) to_int(std::string_view(tok).substr(s2 + 1), ni);
         }
+        auto resolve = [&](long long i, std::size_t n) -> long long {
+            if (i < 0) i += static_cast<long long>(n) + 1;
+            if (i < 1 || i > static_cast<long long>(n)) bad("face index out of range");
+            return i - 1;
+        };
+        const auto v = static_cast<std::uint32_t>(resolve(vi, positions));
+        const std::uint32_t nn = ni == 0 ? UINT32_MAX : static_cast<std::uint32_t>(resolve(ni, normals));
+        poly.push_back({v, nn});
     }
-    // Vertex i is position i with the first normal it is used with; other normals split it into
-    // extra vertices appended after all positions.
+    if (poly.size() < 3) bad("face with fewer than 3 vertices");
+    return poly;
+}
+
+// Vertex i is position i with the first normal it is used with; other normals split it into extra
+// vertices appended after all positions.
+Mesh assemble_obj(const std::vector<std::array<float, 3>>& pos, const std::vector<std::array<float, 3>>& nrm,
+                  const std::vector<ObjCorner>& corners) {
+    Mesh m;
+    std::map<ObjCorner, std::uint32_t> ids;
     m.vertices.resize(pos.size());
     std::vector<std::uint32_t> first_normal(pos.size(), UINT32_MAX - 1);
     for (std::size_t i = 0; i < pos.size(); ++i) std::memcpy(m.vertices[i].position, pos[i].data(), sizeof(float) * 3);
@@ -397,6 +372,50 @@ Mesh read_obj(const fs::path& path) {
         m.indices.push_back(id);
     }
     return m;
+}
+
+}  // namespace
+
+Mesh read_obj(const fs::path& path) {
+    const std::string data = slurp(path);
+    std::vector<std::array<float, 3>> pos, nrm;
+    std::vector<ObjCorner> corners;  // three per triangle (polygons are fanned)
+    std::istringstream in(data);
+    std::string line;
+    std::size_t lineno = 0;
+    const std::function<void(const std::string&)> bad = [&](const std::string& what) {
+        fail(path, "line " + std::to_string(lineno) + ": " + what);
+    };
+    while (std::getline(in, line)) {
+        ++lineno;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        std::istringstream ls(line);
+        std::string tag;
+        ls >> tag;
+        if (tag.empty() || tag[0] == '#' || tag == "o" || tag == "g" || tag == "s" || tag == "mtllib" || tag == "usemtl" ||
+            tag == "vt")
+            continue;
+        if (tag == "v" || tag == "vn") {
+            std::array<float, 3> v{};
+            for (float& c : v) {
+                std::string tok;
+                double d;
+                if (!(ls >> tok) || !parse_double(tok, d)) bad("malformed " + tag);
+                c = static_cast<float>(d);
+            }
+            (tag == "v" ? pos : nrm).push_back(v);
+        } else if (tag == "f") {
+            const std::vector<ObjCorner> poly = parse_obj_face(ls, pos.size(), nrm.size(), bad);
+            for (std::size_t i = 1; i + 1 < poly.size(); ++i) {
+                corners.push_back(poly[0]);
+                corners.push_back(poly[i]);
+                corners.push_back(poly[i + 1]);
+            }
+        } else {
+            bad("unsupported statement '" + tag + "'");
+        }
+    }
+    return assemble_obj(pos, nrm, corners);
 }
 
 Mesh read_stl(const fs::path& path) {

@@ -1,29 +1,17 @@
 // PNG encode/decode with stb (the compiled implementations come from libstb).
 #include "liveset/render/png_writer.hpp"
 
+#include "liveset/base/atomic_file.hpp"
+
 #include <stb_image.h>
 #include <stb_image_write.h>
-#include <unistd.h>
 
-#include <atomic>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
 
 namespace liveset::render {
-
-namespace {
-
-std::string temporary_name(const std::filesystem::path& target) {
-    static std::atomic<unsigned> counter{0};
-    std::string name(".");
-    name.append(target.stem().string()).append(".tmp-").append(std::to_string(::getpid()));
-    name.append("-").append(std::to_string(counter++)).append(".png");
-    return name;
-}
-
-}  // namespace
 
 void write_png(const std::string& path, const Image& image) {
     namespace fs = std::filesystem;
@@ -36,17 +24,18 @@ void write_png(const std::string& path, const Image& image) {
     if (image.width < 1 || image.height < 1 ||
         image.rgba.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 4)
         fail("empty or inconsistent image");
-    const fs::path temp = dir / temporary_name(target);
-    if (!stbi_write_png(temp.c_str(), image.width, image.height, 4, image.rgba.data(), image.width * 4)) {
-        const int err = errno;
-        fs::remove(temp, ec);
-        fail(err ? std::strerror(err) : "the PNG encoder failed");
+    std::string why;  // the reason of a failure; the temporary is gone when `file` is
+    try {
+        AtomicFile file(target);
+        errno = 0;
+        if (stbi_write_png(file.temp_path().c_str(), image.width, image.height, 4, image.rgba.data(), image.width * 4))
+            file.commit();
+        else
+            why = errno ? std::strerror(errno) : "the PNG encoder failed";
+    } catch (const std::runtime_error& e) {
+        why = e.what();
     }
-    fs::rename(temp, target, ec);
-    if (ec) {
-        fs::remove(temp, ec);
-        fail("cannot rename the temporary file into place");
-    }
+    if (!why.empty()) fail(why);
 }
 
 Image read_png(const std::string& path) {

@@ -1,23 +1,16 @@
-// Recovery files: encoding, strict decoding, atomic writes, and the crash-signal writer.
+// Recovery files: encoding, strict decoding, atomic writes (the crash-signal writer is the viewer's).
 #include "liveset/session/recovery.hpp"
 
-#include <fcntl.h>
-#include <signal.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <array>
-#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <ctime>
 #include <fstream>
-#include <memory>
 #include <stdexcept>
 #include <system_error>
 
+#include "liveset/base/atomic_file.hpp"
 #include "liveset/segment/threshold_speed.hpp"
 
 namespace liveset {
@@ -28,22 +21,8 @@ namespace {
 
 constexpr char kMagic[8] = {'L', 'S', 'R', 'E', 'C', 'O', 'V', '1'};
 constexpr std::uint32_t kVersion = 1;
-constexpr std::size_t kSignalOffset = 12;  // u32 signal, then i64 time
-constexpr std::size_t kTimeOffset = 16;
-constexpr std::size_t kFixedHead = 24;
 constexpr std::uint32_t kMaxPath = 4096;
 constexpr std::uint32_t kMaxSeeds = 100000;
-
-struct Fnv {
-    std::uint64_t h = 0xcbf29ce484222325ull;
-    void add(const void* data, std::size_t n) {
-        const auto* p = static_cast<const unsigned char*>(data);
-        for (std::size_t i = 0; i < n; ++i) {
-            h ^= p[i];
-            h *= 0x100000001b3ull;
-        }
-    }
-};
 
 template <class T>
 void put(std::vector<std::uint8_t>& out, T value) {
@@ -52,7 +31,10 @@ void put(std::vector<std::uint8_t>& out, T value) {
     std::memcpy(out.data() + at, &value, sizeof(T));
 }
 
-// The file up to and including the voxel count, with signal 0 and time 0.
+}  // namespace
+
+namespace recovery_format {
+
 std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, const Lattice& lattice) {
     if (image.size() > kMaxPath) throw std::runtime_error("recovery: the image path is too long");
     if (marks.seeds.size() > kMaxSeeds) throw std::runtime_error("recovery: too many seeds");
@@ -79,6 +61,15 @@ std::vector<std::uint8_t> encode_header(const std::string& image, const SessionM
     put(out, static_cast<std::uint64_t>(lattice.size()));
     return out;
 }
+
+}  // namespace recovery_format
+
+namespace {
+
+using recovery_format::Fnv;
+using recovery_format::kFixedHead;
+using recovery_format::kSignalOffset;
+using recovery_format::kTimeOffset;
 
 class Reader {
 public:
@@ -113,76 +104,6 @@ private:
     std::size_t pos_ = 0;
 };
 
-void write_all_or_throw(std::ofstream& out, const std::vector<std::uint8_t>& bytes, const std::filesystem::path& path) {
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-    out.flush();
-    if (!out) throw std::runtime_error(path.string() + ": write error (disk full?)");
-}
-
-// --- crash path: static storage only, read by the signal handler ----------------------------
-
-struct TrackedState {
-    std::unique_ptr<std::uint8_t[]> header;
-    std::size_t header_size = 0;
-    const float* phi = nullptr;
-    const std::int8_t* status = nullptr;
-    std::size_t voxels = 0;
-};
-
-constexpr std::array<int, 8> kSignals{SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTERM, SIGINT, SIGHUP};
-std::array<TrackedState, 2> g_slots;
-std::atomic<int> g_active{-1};
-std::atomic<bool> g_installed{false};
-std::atomic<bool> g_writing{false};
-std::array<char, 4200> g_path{};
-std::array<char, 4210> g_temp{};
-std::array<struct sigaction, kSignals.size()> g_previous{};
-
-bool write_fd(int fd, const void* data, std::size_t n, Fnv& hash) {
-    hash.add(data, n);
-    const auto* p = static_cast<const char*>(data);
-    while (n > 0) {
-        const ssize_t w = ::write(fd, p, n);
-        if (w < 0) {
-            if (errno == EINTR) continue;
-            return false;
-        }
-        p += w;
-        n -= static_cast<std::size_t>(w);
-    }
-    return true;
-}
-
-void write_from_handler(int sig) {
-    const int slot = g_active.load();
-    if (slot < 0 || g_writing.exchange(true)) return;
-    const TrackedState& s = g_slots[static_cast<std::size_t>(slot)];
-    const int fd = ::open(g_temp.data(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
-    if (fd < 0) return;
-    Fnv hash;
-    const auto signal_number = static_cast<std::uint32_t>(sig);
-    const auto now = static_cast<std::int64_t>(::time(nullptr));
-    bool ok = write_fd(fd, s.header.get(), kSignalOffset, hash) && write_fd(fd, &signal_number, sizeof signal_number, hash) &&
-              write_fd(fd, &now, sizeof now, hash) &&
-              write_fd(fd, s.header.get() + kFixedHead, s.header_size - kFixedHead, hash) &&
-              write_fd(fd, s.phi, s.voxels * sizeof(float), hash) && write_fd(fd, s.status, s.voxels, hash);
-    const std::uint64_t sum = hash.h;
-    Fnv ignored;
-    ok = ok && write_fd(fd, &sum, sizeof sum, ignored) && ::fsync(fd) == 0;
-    ::close(fd);
-    if (ok)
-        ::rename(g_temp.data(), g_path.data());
-    else
-        ::unlink(g_temp.data());
-}
-
-extern "C" void liveset_recovery_signal(int sig) {
-    write_from_handler(sig);
-    // SA_RESETHAND restored the default action: deliver the signal again to take it (a fault
-    // re-raises itself when the handler returns).
-    ::raise(sig);
-}
-
 }  // namespace
 
 std::filesystem::path recovery_path(const std::filesystem::path& dir, const std::string& image) {
@@ -201,7 +122,7 @@ std::filesystem::path recovery_path(const std::filesystem::path& dir, const std:
 
 std::vector<std::uint8_t> encode_recovery(const RecoveryView& state) {
     if (state.status.size() != state.phi.size()) throw std::runtime_error("recovery: status and phi differ in size");
-    std::vector<std::uint8_t> out = encode_header(state.image, state.marks, state.phi.lattice());
+    std::vector<std::uint8_t> out = recovery_format::encode_header(state.image, state.marks, state.phi.lattice());
     const auto sig = static_cast<std::uint32_t>(state.signal);
     std::memcpy(out.data() + kSignalOffset, &sig, sizeof sig);
     std::memcpy(out.data() + kTimeOffset, &state.unix_time, sizeof state.unix_time);
@@ -219,6 +140,8 @@ std::vector<std::uint8_t> encode_recovery(const RecoveryView& state) {
     return out;
 }
 
+// Reads the format field by field in file order (the layout in recovery.hpp), so that it can be read
+// side by side with that layout: a little over 80 lines on purpose.
 RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
     Reader r(data, size);
     if (std::memcmp(r.take(8, "magic"), kMagic, 8) != 0) throw std::runtime_error("not a liveset recovery file (wrong magic)");
@@ -305,25 +228,10 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
 
 void write_recovery(const std::filesystem::path& path, const RecoveryView& state) {
     const std::vector<std::uint8_t> bytes = encode_recovery(state);
-    std::filesystem::path temp = path;
-    temp += ".part";
-    {
-        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-        if (!out) throw std::runtime_error(path.string() + ": cannot write (" + std::strerror(errno) + ")");
-        try {
-            write_all_or_throw(out, bytes, path);
-        } catch (...) {
-            out.close();
-            std::error_code ec;
-            std::filesystem::remove(temp, ec);
-            throw;
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(temp, path, ec);
-    if (ec) {
-        std::filesystem::remove(temp, ec);
-        throw std::runtime_error(path.string() + ": cannot write (" + ec.message() + ")");
+    try {
+        write_file_atomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
+    } catch (const std::runtime_error& e) {
+        throw std::runtime_error(path.string() + ": cannot write (" + e.what() + ")");
     }
 }
 
@@ -342,47 +250,5 @@ RecoveryState read_recovery(const std::filesystem::path& path) {
         throw std::runtime_error(path.string() + ": " + e.what());
     }
 }
-
-// ---------------------------------------------------------------------------------------------
-
-CrashRecovery::CrashRecovery(std::filesystem::path path) : path_(std::move(path)) {
-    if (g_installed.exchange(true)) throw std::logic_error("CrashRecovery: one instance at a time");
-    // Its own temporary name: an autosave may be writing "<file>.part" when the signal comes.
-    const std::string p = path_.string(), t = p + ".crash.part";
-    if (t.size() >= g_temp.size()) {
-        g_installed = false;
-        throw std::runtime_error(p + ": path too long for a recovery file");
-    }
-    std::memcpy(g_path.data(), p.c_str(), p.size() + 1);
-    std::memcpy(g_temp.data(), t.c_str(), t.size() + 1);
-    struct sigaction action {};
-    action.sa_handler = liveset_recovery_signal;
-    sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND;
-    for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &action, &g_previous[i]);
-}
-
-CrashRecovery::~CrashRecovery() {
-    for (std::size_t i = 0; i < kSignals.size(); ++i) sigaction(kSignals[i], &g_previous[i], nullptr);
-    g_active = -1;
-    for (TrackedState& s : g_slots) s = {};
-    g_installed = false;
-}
-
-void CrashRecovery::track(const std::string& image, const SessionMarks& marks, const Grid<float>& phi, const Grid<std::int8_t>& status) {
-    if (status.size() != phi.size()) throw std::invalid_argument("CrashRecovery::track: status and phi differ in size");
-    const std::vector<std::uint8_t> header = encode_header(image, marks, phi.lattice());
-    const int slot = g_active.load() == 0 ? 1 : 0;
-    TrackedState& s = g_slots[static_cast<std::size_t>(slot)];
-    s.header = std::make_unique<std::uint8_t[]>(header.size());
-    std::memcpy(s.header.get(), header.data(), header.size());
-    s.header_size = header.size();
-    s.phi = phi.values().data();
-    s.status = status.values().data();
-    s.voxels = phi.size();
-    g_active = slot;
-}
-
-void CrashRecovery::untrack() { g_active = -1; }
 
 }  // namespace liveset

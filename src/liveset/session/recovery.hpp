@@ -8,9 +8,9 @@
 //   u64 voxels (= dims product)  f32 φ[voxels]  i8 sparse-field status[voxels]
 //   u64 FNV-1a of every byte before it
 //
-// The crash path (CrashRecovery) writes the same bytes with async-signal-safe calls only (open,
-// write, rename): the header is serialised beforehand, φ and status are read where they live. Every read is
-// checked (sizes, magic, checksum, geometry) and refused with one line. Standard library only.
+// The viewer's crash path (apps/viewer/crash_recovery) writes the same bytes with async-signal-safe
+// calls only, from the pieces in recovery_format. Every read is checked (sizes, magic, checksum,
+// geometry) and refused with one line. Standard library only.
 #pragma once
 
 #include <cstdint>
@@ -61,26 +61,28 @@ void write_recovery(const std::filesystem::path& path, const RecoveryView& state
 // Throws std::runtime_error (one line naming the file) when missing, unreadable or malformed.
 RecoveryState read_recovery(const std::filesystem::path& path);
 
-// Writes the recovery file of the registered level set when the process receives a fatal signal
-// (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT) or a termination request (SIGTERM, SIGINT, SIGHUP),
-// then lets the signal take its default course. One instance at a time (a second throws
-// std::logic_error); the destructor restores the previous handlers.
-class CrashRecovery {
-public:
-    explicit CrashRecovery(std::filesystem::path path);
-    ~CrashRecovery();
-    CrashRecovery(const CrashRecovery&) = delete;
-    CrashRecovery& operator=(const CrashRecovery&) = delete;
+// The format's pieces, for a writer that cannot allocate when it writes (a signal handler): the
+// file is encode_header()'s bytes with the signal (u32) and the time (i64) stored at kSignalOffset
+// and kTimeOffset, then φ, then the statuses, then the FNV-1a (Fnv) of every byte before it.
+namespace recovery_format {
+constexpr std::size_t kSignalOffset = 12;  // u32 signal, then i64 time
+constexpr std::size_t kTimeOffset = 16;
+constexpr std::size_t kFixedHead = 24;  // magic, version, signal, time
 
-    // What a crash would save: `phi` and `status` are read in place by the handler (they must
-    // outlive the registration or be replaced first); the image path and marks are serialised now.
-    // Call again whenever the marks change or the grids move.
-    void track(const std::string& image, const SessionMarks& marks, const Grid<float>& phi, const Grid<std::int8_t>& status);
-    void untrack();  // a crash now writes nothing (e.g. the work was saved)
-    const std::filesystem::path& path() const { return path_; }
-
-private:
-    std::filesystem::path path_;
+struct Fnv {
+    std::uint64_t h = 0xcbf29ce484222325ull;
+    void add(const void* data, std::size_t n) {
+        const auto* p = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < n; ++i) {
+            h ^= p[i];
+            h *= 0x100000001b3ull;
+        }
+    }
 };
+
+// The file up to and including the voxel count, with signal 0 and time 0. Throws
+// std::runtime_error when the path or the seed list is too long for the format.
+std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, const Lattice& lattice);
+}  // namespace recovery_format
 
 }  // namespace liveset

@@ -1,4 +1,4 @@
-// Session: every change of φ goes through one of these methods, then to the mesher and history.
+// Session: every change of φ goes through Session::edit, then to the history and the mesher.
 #include "liveset/session/session.hpp"
 
 #include <algorithm>
@@ -120,44 +120,32 @@ SessionUpdate Session::add_seed(SeedBall seed) {
     if (!all_finite(seed.center) || !lattice().contains(seed.center))
         throw std::invalid_argument("a seed lies outside the image");
     if (!std::isfinite(seed.radius) || seed.radius <= 0) throw std::invalid_argument("a seed's radius must be positive");
-    end_action();
-    history_.begin("seed", marks());
-    const auto t0 = Clock::now();
-    const shapes::Sphere ball(seed.center, std::max(seed.radius, 0.5));
-    const Grid<float>& phi = field_.phi();
-    const Lattice& lat = lattice();
-    // Union with the ball: min(φ, distance to the ball). Each evaluation reads only its own point.
-    field_.init_from_sdf([&](Vec3d p) { return std::min(static_cast<double>(phi[lat.index(p.cast<int>())]), ball(p)); });
-    ChangedPoints changed = history_.record_differences(field_);
-    const double ms = ms_since(t0);
-    marks_.seeds.push_back(seed);
-    refresh_window();
-    SessionUpdate u = finish_update(std::move(changed), ms);
-    history_.commit(field_, marks());
-    return u;
+    return edit("seed", Action::kOwn, [&] {
+        const shapes::Sphere ball(seed.center, std::max(seed.radius, 0.5));
+        const Grid<float>& phi = field_.phi();
+        const Lattice& lat = lattice();
+        // Union with the ball: min(φ, distance to the ball). Each evaluation reads only its own point.
+        field_.init_from_sdf([&](Vec3d p) { return std::min(static_cast<double>(phi[lat.index(p.cast<int>())]), ball(p)); });
+        marks_.seeds.push_back(seed);
+        refresh_window();
+        return Change{{}, true};
+    });
 }
 
 SessionUpdate Session::remove_seed(std::size_t index) {
     if (index >= marks_.seeds.size()) throw std::invalid_argument("no such seed");
-    end_action();
-    history_.begin("remove seed", marks());
-    marks_.seeds.erase(marks_.seeds.begin() + static_cast<std::ptrdiff_t>(index));
-    refresh_window();
-    SessionUpdate u;
-    if (marks_.pristine) {
-        const auto t0 = Clock::now();
+    return edit("remove seed", Action::kOwn, [&] {
+        marks_.seeds.erase(marks_.seeds.begin() + static_cast<std::ptrdiff_t>(index));
+        refresh_window();
+        if (!marks_.pristine) return Change{};  // grown regions stay: only the list changes
         if (marks_.seeds.empty()) {
             const double far = field_.layers() + 1.0;
             field_.init_from_sdf([far](Vec3d) { return far; });
         } else {
             init_from_seeds(field_, marks_.seeds);
         }
-        ChangedPoints changed = history_.record_differences(field_);
-        u = finish_update(std::move(changed), ms_since(t0));
-    }
-    ++revision_;
-    history_.commit(field_, marks());
-    return u;
+        return Change{{}, true};
+    });
 }
 
 std::optional<std::size_t> Session::seed_at(Vec3d p, double tolerance) const {
@@ -234,21 +222,19 @@ SessionUpdate Session::segment_step() {
         segment_.vanished = true;
         return {};
     }
-    begin_action("segment");
     if (!speed_) speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi());
     if (!convergence_) convergence_.emplace(field_.phi(), options_.segmentation);
-    const auto t0 = Clock::now();
-    StepResult step = field_.step(*speed_, options_.segmentation.step);
-    const double ms = ms_since(t0);
-    history_.record(step.changed);
-    segment_.flips = convergence_->record_step(field_.phi(), step.changed);
-    segment_.inside = convergence_->inside();
-    segment_.dt = step.dt;
-    segment_.iterations = ++marks_.iterations;
-    segment_.converged = convergence_->converged(field_.zero_layer().size());
-    segment_.vanished = field_.zero_layer().empty();
-    marks_.pristine = false;
-    return finish_update(std::move(step.changed), ms);
+    return edit("segment", Action::kContinued, [&] {
+        StepResult step = field_.step(*speed_, options_.segmentation.step);
+        segment_.flips = convergence_->record_step(field_.phi(), step.changed);
+        segment_.inside = convergence_->inside();
+        segment_.dt = step.dt;
+        segment_.iterations = ++marks_.iterations;
+        segment_.converged = convergence_->converged(field_.zero_layer().size());
+        segment_.vanished = field_.zero_layer().empty();
+        marks_.pristine = false;
+        return Change{std::move(step.changed)};
+    });
 }
 
 void Session::make_repair_loop() { repair_ = std::make_unique<RepairLoop>(field_, unit_, roi(), repair_options_, nullptr); }
@@ -300,17 +286,28 @@ std::optional<Vec3d> Session::nearest_surface_point(Vec3d p, double radius) cons
 
 SessionUpdate Session::swarm_step() {
     if (!repair_ || !repair_->spawned()) return {};
-    begin_action("repair");
-    RepairStep step = repair_->step();
-    const double level_set_ms = step.log.modified > 0 ? field_.last_update_ms() : 0.0;
-    history_.record(step.changed);
-    if (!step.changed.empty()) {
-        marks_.pristine = false;
-        convergence_.reset();
-    }
-    SessionUpdate u = finish_update(std::move(step.changed), level_set_ms);
-    u.agents_ms = std::max(0.0, step.log.ms - level_set_ms);
-    return u;
+    return edit("repair", Action::kContinued, [&] {
+        RepairStep step = repair_->step();
+        if (!step.changed.empty()) {
+            marks_.pristine = false;
+            convergence_.reset();
+        }
+        Change c{std::move(step.changed)};
+        c.level_set_ms = step.log.modified > 0 ? field_.last_update_ms() : 0.0;
+        c.agents_ms = std::max(0.0, step.log.ms - c.level_set_ms);
+        return c;
+    });
+}
+
+SessionUpdate Session::edit_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta) {
+    return edit("brush", Action::kOwn, [&] {
+        ChangedPoints changed = field_.apply_in_box(lo, hi, delta);
+        if (!changed.empty()) {
+            marks_.pristine = false;
+            convergence_.reset();
+        }
+        return Change{std::move(changed)};
+    });
 }
 
 const std::vector<Agent>& Session::agents() const {
@@ -342,21 +339,38 @@ void Session::adopt_marks(const SessionMarks& m) {
 SessionUpdate Session::undo() {
     end_action();
     if (!history_.can_undo()) return {};
-    const auto t0 = Clock::now();
-    HistoryStep step = history_.undo(field_);
-    const double ms = ms_since(t0);
-    adopt_marks(step.marks);
-    return finish_update(std::move(step.changed), ms);
+    return edit("undo", Action::kHistory, [&] {
+        HistoryStep step = history_.undo(field_);
+        adopt_marks(step.marks);
+        return Change{std::move(step.changed)};
+    });
 }
 
 SessionUpdate Session::redo() {
     end_action();
     if (!history_.can_redo()) return {};
+    return edit("redo", Action::kHistory, [&] {
+        HistoryStep step = history_.redo(field_);
+        adopt_marks(step.marks);
+        return Change{std::move(step.changed)};
+    });
+}
+
+// ---------------------------------------------------------------------------------------------
+// The one edit path
+
+SessionUpdate Session::edit(const char* label, Action action, const std::function<Change()>& change) {
+    if (action == Action::kOwn) end_action();
+    if (action != Action::kHistory) begin_action(label);  // continues an open action of the same label
     const auto t0 = Clock::now();
-    HistoryStep step = history_.redo(field_);
-    const double ms = ms_since(t0);
-    adopt_marks(step.marks);
-    return finish_update(std::move(step.changed), ms);
+    Change c = change();
+    if (c.whole_state) c.changed = history_.record_differences(field_);
+    else if (action != Action::kHistory) history_.record(c.changed);
+    const double level_set_ms = c.level_set_ms >= 0.0 ? c.level_set_ms : ms_since(t0);
+    SessionUpdate u = finish_update(std::move(c.changed), level_set_ms);
+    u.agents_ms = c.agents_ms;
+    if (action == Action::kOwn) history_.commit(field_, marks());
+    return u;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -1,15 +1,21 @@
 // One interactive editing session, shared by the viewer's window, its scripts and `liveset demo`:
 // the image (raw and normalised to [0, 1]), the seeds, the threshold parameters, the sparse-field
 // level set, the incremental fragment mesher, the threshold speed, the swarm repair loop and the
-// undo/redo history. Every change of φ goes through here, so every change reaches the mesher
-// (whose rebuilt fragments the renderer re-uploads) and the history:
+// undo/redo history. Every change of φ — seeds, segmentation steps, swarm steps, brush edits, undo
+// and redo — goes through one private path, Session::edit, which records X in the history, meshes
+// it, queues U for the renderer and bumps the revision once:
 //
-//   segment_step() / swarm_step() / add_seed() / undo() ...  ->  X  ->  FragmentMesher::update  ->  U
+//   add_seed() / segment_step() / swarm_step() / edit_box() / undo() ...  ->  edit()  ->  X
+//       ->  EditHistory::record  ->  FragmentMesher::update  ->  U  ->  take_dirty_fragments()
+//
+// (Loading a mask, φ or a recovery file replaces the state instead: it re-meshes everything and
+// starts a new history.)
 //
 // Standard library + oneTBB only (no GL, no ITK). Not thread-safe: one thread drives a session.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -130,6 +136,11 @@ public:
     SessionUpdate swarm_step();
     const std::vector<Agent>& agents() const;
 
+    // --- brush --------------------------------------------------------------------------------
+    // A local edit of the zero-layer points in the box [lo, hi] (SparseField::apply_in_box:
+    // delta(p, φ(p)) is each point's Δ); its own undoable action.
+    SessionUpdate edit_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta);
+
     // --- history ----------------------------------------------------------------------------
     // Closes the open action (a run paused, a script entry done, another kind of edit begins).
     void end_action();
@@ -158,6 +169,20 @@ public:
     Mesh surface_mesh() const;        // marching cubes of the zero layer (index space)
 
 private:
+    // What an edit's change did: X (or the whole state replaced, X found by comparison), and the
+    // time of its level-set part (< 0: the change's wall time) and of its agents.
+    struct Change {
+        ChangedPoints changed;
+        bool whole_state = false;
+        double level_set_ms = -1.0;
+        double agents_ms = 0.0;
+    };
+    // kOwn: an action of its own (seed, brush); kContinued: steps continue an open action of the
+    // same label (segmentation, swarm); kHistory: undo/redo (the history itself wrote the states).
+    enum class Action { kOwn, kContinued, kHistory };
+    // The one edit path: opens or continues the history action, runs `change`, records its X,
+    // meshes it, queues the rebuilt fragments and bumps the revision once.
+    SessionUpdate edit(const char* label, Action action, const std::function<Change()>& change);
     void begin_action(const char* label);  // continues an open action of the same label
     SessionUpdate finish_update(ChangedPoints changed, double level_set_ms);
     void adopt_marks(const SessionMarks& marks);

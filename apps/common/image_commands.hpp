@@ -12,6 +12,7 @@
 #include "liveset/segment/brain_mask.hpp"
 #include "liveset/preprocess/bias_correction.hpp"
 #include "liveset/segment/pipeline.hpp"
+#include "liveset/session/session.hpp"
 
 namespace liveset::cli {
 
@@ -44,6 +45,8 @@ Grid<std::uint8_t> to_mask(const Grid<float>& image);
 // A φ image (< 0 inside) or a 0/1 mask (stored as any pixel type) as a 2-layer sparse field on
 // `reference`'s lattice; UsageError when the sizes differ or it holds no surface.
 SparseField load_level_set(const std::string& path, const Lattice& reference);
+// The same loaded into `session` (Session::load_mask or load_phi: a new history).
+void load_level_set(Session& session, const std::string& path);
 
 struct SegmentRun {
     SegmentOutcome outcome;

@@ -222,13 +222,25 @@ void print_evaluation(const nlohmann::json& j, const std::string& in) {
 }
 
 // φ image or 0/1 mask -> sparse field on the image's lattice.
-SparseField load_level_set(const std::string& path, const Lattice& reference) {
-    const Grid<float> g = read_image(path);
+namespace {
+
+// A φ or mask read for `reference`'s lattice: the grid, and whether it is a 0/1 mask.
+Grid<float> read_level_set_image(const std::string& path, const Lattice& reference, bool& mask) {
+    Grid<float> g = read_image(path);
     if (!(g.dims() == reference.dims()))
         throw UsageError(fmt::format("{} ({}x{}x{}) does not match the image's size", path, g.dims().x, g.dims().y, g.dims().z));
-    const bool mask = is_binary_mask(g);
+    mask = is_binary_mask(g);
     std::size_t inside = 0;
     for (float v : g.values()) inside += mask ? v == 1.0f : v < 0.0f;
+    if (inside == 0) throw UsageError(fmt::format("{} holds no surface (nothing inside, or no voxel changes sign)", path));
+    return g;
+}
+
+}  // namespace
+
+SparseField load_level_set(const std::string& path, const Lattice& reference) {
+    bool mask = false;
+    const Grid<float> g = read_level_set_image(path, reference, mask);
     SparseField field(reference, 2);
     if (mask) {
         field.init_from_mask(to_mask(g));
@@ -238,8 +250,16 @@ SparseField load_level_set(const std::string& path, const Lattice& reference) {
             return static_cast<double>(g(q));
         });
     }
-    if (inside == 0 || field.zero_layer().empty()) throw UsageError(fmt::format("{} holds no surface (nothing inside, or no voxel changes sign)", path));
+    if (field.zero_layer().empty()) throw UsageError(fmt::format("{} holds no surface (nothing inside, or no voxel changes sign)", path));
     return field;
+}
+
+void load_level_set(Session& session, const std::string& path) {
+    bool mask = false;
+    const Grid<float> g = read_level_set_image(path, session.lattice(), mask);
+    if (mask) session.load_mask(to_mask(g));
+    else session.load_phi(g);
+    if (!session.has_surface()) throw UsageError(fmt::format("{} holds no surface (nothing inside, or no voxel changes sign)", path));
 }
 
 }  // namespace liveset::cli

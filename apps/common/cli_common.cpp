@@ -1,11 +1,12 @@
 // CLI helpers: validators, thread control and atomic file output.
 #include "cli_common.hpp"
 
+#include "liveset/base/atomic_file.hpp"
+
 #include <tbb/global_control.h>
 
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 
 namespace liveset::cli {
 
@@ -32,25 +33,10 @@ std::shared_ptr<void> limit_threads(int threads) {
 }
 
 void write_atomically(const std::string& path, const std::string& text) {
-    namespace fs = std::filesystem;
-    const fs::path target(path);
-    const fs::path tmp = target.parent_path() / (target.filename().string() + ".tmp");
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw UsageError("cannot write " + path);
-        out << text;
-        out.flush();
-        if (!out) {
-            out.close();
-            fs::remove(tmp);
-            throw UsageError("failed writing " + path);
-        }
-    }
-    std::error_code ec;
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw UsageError("cannot write " + path + ": " + ec.message());
+    try {
+        write_file_atomically(path, text);
+    } catch (const std::runtime_error& e) {
+        throw UsageError("cannot write " + path + ": " + e.what());
     }
 }
 
