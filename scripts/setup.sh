@@ -22,7 +22,9 @@ packages=(
   gnuplot-nox                                 # plots of the Figure 3 experiment
   minc-tools                                  # tests: MINC geometry checked with nii2mnc, mincinfo, worldtovoxel
   libinsighttoolkit5-dev zlib1g-dev           # image IO (NIfTI, MetaImage, NRRD, MINC, DICOM); N4 bias correction
-  python3-nibabel python3-numpy               # scripts/brainweb_bias_variant.py (bias-correction benchmark)
+  python3-nibabel python3-numpy               # scripts/brainweb_bias_variant.py; the Python module (python/)
+  python3-dev pybind11-dev python3-pytest     # the Python module `liveset` and its pytest suite (ctest runs it)
+  python3-distributed python3-dask openssl    # liveset batch: cohorts on Dask distributed (openssl: its TLS test)
   libglfw3-dev libepoxy-dev libimgui-dev      # viewer: window, OpenGL 3.3 loader, Dear ImGui
   libglm-dev libstb-dev                       # viewer: matrices, PNG screenshots
   libegl-dev libgl-dev libgl1-mesa-dri        # OpenGL / EGL (Mesa llvmpipe without a GPU; headless runs)
@@ -45,7 +47,7 @@ if ((${#missing[@]})); then
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_WERROR=ON >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_WERROR=ON -DLIVESET_BUILD_PYTHON=ON >/dev/null
 cmake --build build -j "$jobs"
 if ((peers)); then
   cmake -S . -B build-peer -G Ninja -DCMAKE_BUILD_TYPE=Release -DLIVESET_BUILD_PEER_BENCHMARKS=ON -DLIVESET_BUILD_TESTS=OFF >/dev/null

@@ -27,5 +27,6 @@ void add_demo_command(CLI::App& app, const int& threads, DemoWindow window = {})
 void add_repair_command(CLI::App& app, const int& threads);
 void add_holes_command(CLI::App& app, const int& threads);
 void add_soak_command(CLI::App* bench, const int& threads);  // `bench soak`
+void add_batch_command(CLI::App& app);  // runs python3 -m liveset.batch (python/)
 
 }  // namespace liveset::cli

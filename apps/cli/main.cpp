@@ -30,6 +30,7 @@ int main(int argc, char** argv) {
     // The headless commands link no viewer code: the demo gets its live window from here.
     liveset::cli::add_demo_command(app, threads, {liveset::cli::viewer_display_available, liveset::cli::open_demo_viewer});
     liveset::cli::add_view_command(app, threads);
+    liveset::cli::add_batch_command(app);
 
     try {
         app.parse(argc, argv);

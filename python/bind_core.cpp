@@ -1,0 +1,284 @@
+// The module's functions: image IO through the C++ readers/writers, segment (as `liveset segment`),
+// the tissue model and window estimate, mesh, evaluate. Long calls release the GIL and poll Ctrl-C.
+#include <pybind11/stl.h>
+
+#include <nlohmann/json.hpp>
+
+#include "bindings.hpp"
+#include "cli_common.hpp"
+#include "cli_support.hpp"
+#include "image_commands.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/levelset/sparse_field.hpp"
+#include "liveset/mesh/marching_cubes.hpp"
+#include "liveset/mesh/mesh_io.hpp"
+#include "liveset/preprocess/bias_correction.hpp"
+
+namespace liveset::py {
+
+namespace {
+
+using cli::UsageError;
+
+pyb::tuple image_tuple(Grid<float>&& g) {
+    const Lattice l = g.lattice();
+    return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l));
+}
+
+pyb::tuple read(const std::string& path, bool labels) {
+    if (labels) {
+        Grid<std::uint8_t> g = [&] { pyb::gil_scoped_release nogil; return read_label_image(path); }();
+        const Lattice l = g.lattice();
+        return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l));
+    }
+    Grid<float> g = [&] { pyb::gil_scoped_release nogil; return read_image(path); }();
+    return image_tuple(std::move(g));
+}
+
+void write(const pyb::array& values, const Lattice& lattice, const std::string& path, bool labels) {
+    if (labels) {
+        const Grid<std::uint8_t> g = mask_from_array(values, lattice);
+        pyb::gil_scoped_release nogil;
+        write_label_image(g, path);
+    } else {
+        const Grid<float> g = grid_from_array(values, lattice);
+        pyb::gil_scoped_release nogil;
+        write_image(g, path);
+    }
+}
+
+// The ROI as `liveset segment --roi` takes it: None, "auto" (the automatic brain mask) or a mask array.
+std::optional<cli::Roi> roi_of(const pyb::object& roi, const Grid<float>& image) {
+    if (roi.is_none()) return std::nullopt;
+    if (pyb::isinstance<pyb::str>(roi)) {
+        const std::string s = roi.cast<std::string>();
+        if (s != "auto") throw std::invalid_argument("roi must be None, 'auto' or a mask array, not '" + s + "'");
+        pyb::gil_scoped_release nogil;
+        return cli::load_roi("auto", image, "roi");
+    }
+    return cli::Roi{mask_from_array(roi.cast<pyb::array>(), image.lattice()), "array", std::nullopt};
+}
+
+struct SegmentArgs {
+    std::vector<std::string> seeds, seeds_mm;
+    double seed_radius = 2.0;
+    pyb::object roi = pyb::none(), init_mask = pyb::none();
+    std::optional<double> mu, epsilon, mu_raw, epsilon_raw;
+    std::string window_from = "model";
+    int classes = 3, iterations = 2000;
+    double n = 4.0, alpha = 0.1;
+    bool bias_correct = false;
+};
+
+// The request `liveset segment` builds from its options (cmd_segment.cpp), on an image in memory.
+SegmentRequest request_for(const SegmentArgs& a, const Lattice& lattice, bool need_seeds = true) {
+    if (a.mu && a.mu_raw) throw UsageError("give mu or mu_raw, not both");
+    if (a.epsilon && a.epsilon_raw) throw UsageError("give epsilon or epsilon_raw, not both");
+    if (a.window_from != "model" && a.window_from != "seeds") throw UsageError("window_from must be 'model' or 'seeds'");
+    if (a.iterations < 1) throw UsageError("iterations must be at least 1");
+    SegmentRequest req;
+    for (const std::string& s : a.seeds) {
+        req.seeds.push_back(cli::parse_seed_voxel(s, a.seed_radius));
+        cli::check_seed_inside(req.seeds.back(), lattice, s);
+    }
+    for (const std::string& s : a.seeds_mm) {
+        req.seeds.push_back(cli::parse_seed_mm(s, lattice, a.seed_radius));
+        cli::check_seed_inside(req.seeds.back(), lattice, s + " (mm)");
+    }
+    if (need_seeds && req.seeds.empty() && a.init_mask.is_none()) throw UsageError("give at least one seed I,J,K[:R] (or seeds_mm, or init_mask)");
+    req.n = a.n;
+    req.alpha = a.alpha;
+    req.loop.max_iterations = a.iterations;
+    req.loop.step = sleeping_step();
+    req.mu = a.mu;
+    req.epsilon = a.epsilon;
+    req.mu_raw = a.mu_raw;
+    req.epsilon_raw = a.epsilon_raw;
+    req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
+    req.window.model.classes = a.classes;
+    return req;
+}
+
+pyb::dict segment(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a, const pyb::object& progress) {
+    Grid<float> image = grid_from_array(values, lattice);
+    SegmentRequest req = request_for(a, lattice);
+    const std::optional<cli::Roi> roi = roi_of(a.roi, image);
+    std::optional<Grid<std::uint8_t>> init;
+    if (!a.init_mask.is_none()) init = mask_from_array(a.init_mask.cast<pyb::array>(), lattice);
+    Interrupt interrupt;
+    interrupt.callback = progress;
+    std::optional<Grid<std::uint8_t>> fit_region;
+    std::optional<BiasCorrectionReport> bias;
+    std::optional<SegmentOutcome> out;
+    {
+        pyb::gil_scoped_release nogil;
+        if (!roi) fit_region = cli::try_auto_brain_mask(image);
+        const Grid<std::uint8_t>* fit = roi ? &roi->mask : fit_region ? &*fit_region : nullptr;
+        if (a.bias_correct) image = correct_bias(image, fit, {}, &bias.emplace(), &interrupt.flag());
+        if (roi) req.roi = &roi->mask;
+        if (init) req.initial_mask = &*init;
+        req.model_region = fit;
+        const SegmentationHook hook = [&](const SegmentationProgress& p, const ChangedPoints&) {
+            return interrupt.poll_with([&]() -> pyb::object {
+                return pyb::dict(pyb::arg("iteration") = p.iteration, pyb::arg("zero_layer") = p.zero_layer,
+                                 pyb::arg("band") = p.band, pyb::arg("changed") = p.changed, pyb::arg("flips") = p.flips,
+                                 pyb::arg("inside") = p.inside, pyb::arg("dt") = p.dt, pyb::arg("ms") = p.ms);
+            });
+        };
+        if (!bias || !bias->interrupted) out.emplace(segment_image(image, req, hook, &interrupt.flag()));
+    }
+    if (interrupt.raised()) interrupt.rethrow();
+    if (!out || out->result.reason == StopReason::kInterrupted) throw pyb::error_already_set();  // a pending KeyboardInterrupt
+    nlohmann::json j = cli::segmentation_report(*out, lattice);
+    if (bias) {
+        j["bias_correction"] = cli::bias_correction_report(*bias);
+        j["bias_correction"]["mask"] = roi ? "roi" : fit_region ? "auto brain mask" : "otsu";
+    }
+    if (roi) j["roi"] = cli::roi_report(*roi);
+    pyb::dict r;
+    r["phi"] = array_from_grid(Grid<float>(out->field->phi()));
+    r["mask"] = array_from_grid(std::move(out->mask));
+    r["report"] = j.dump();
+    if (roi && pyb::isinstance<pyb::str>(a.roi)) r["roi"] = array_from_grid(Grid<std::uint8_t>(roi->mask));
+    if (bias) r["corrected"] = array_from_grid(std::move(image));
+    return r;
+}
+
+// The tissue model fitted where segment() fits it, and the window the seeds would get.
+std::string tissue_model(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a) {
+    const Grid<float> image = grid_from_array(values, lattice);
+    SegmentRequest req = request_for(a, lattice, false);
+    const std::optional<cli::Roi> roi = roi_of(a.roi, image);
+    pyb::gil_scoped_release nogil;
+    std::optional<Grid<std::uint8_t>> fit_region;
+    if (!roi) fit_region = cli::try_auto_brain_mask(image);
+    const Grid<std::uint8_t>* fit = roi ? &roi->mask : fit_region ? &*fit_region : nullptr;
+    const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
+    const IntensityScale scale = robust_scale(image, roi_mask, req.scale);
+    std::vector<std::string> warnings;
+    const Grid<std::uint8_t> region = model_region(image, fit, roi_mask, a.classes);
+    const std::optional<TissueModel> model = fit_window_model(image, region, req.window.model, warnings);
+    nlohmann::json j;
+    j["intensity_scale"] = {{"low", scale.low}, {"high", scale.high}};
+    if (!req.seeds.empty()) {
+        const WindowEstimate w = estimate_window(image, scale, req.seeds, roi_mask, model ? &*model : nullptr, req.window);
+        j["window"] = {{"mu", w.mu}, {"epsilon", w.epsilon}, {"mu_raw", scale.to_raw(w.mu)},
+                       {"epsilon_raw", scale.raw_length(w.epsilon)}, {"lower_raw", scale.to_raw(w.mu - w.epsilon)},
+                       {"upper_raw", scale.to_raw(w.mu + w.epsilon)}, {"source", to_string(w.source)}};
+        for (const std::string& s : w.warnings) warnings.push_back(s);
+        if (model) j["tissue_model"] = cli::tissue_model_report(*model, w.model_window ? &*w.model_window : nullptr);
+    } else if (model) {
+        j["tissue_model"] = cli::tissue_model_report(*model, nullptr);
+    }
+    j["warnings"] = warnings;
+    return j.dump();
+}
+
+// Marching cubes of φ (< 0 inside) or of a 0/1 mask (φ from the sparse field's mask initialisation,
+// as `liveset mesh`): vertices and normals in LPS mm, triangles as vertex indices; written too when
+// `out` is given (.ply/.obj/.stl).
+pyb::tuple mesh(const pyb::array& values, const Lattice& lattice, bool is_mask, const std::string& out) {
+    Grid<float> phi = grid_from_array(values, lattice);
+    Mesh m;
+    {
+        pyb::gil_scoped_release nogil;
+        if (is_mask) {
+            SparseField f(lattice, 2);
+            f.init_from_mask(cli::to_mask(phi));
+            phi = f.phi();
+        }
+        m = marching_cubes_naive(phi);
+        if (m.triangle_count() == 0) throw std::invalid_argument("the input holds no surface (no voxel changes sign)");
+        if (!out.empty()) write_mesh(out, m.view(), lattice);
+    }
+    const auto nv = static_cast<pyb::ssize_t>(m.vertices.size());
+    pyb::array_t<double> vertices({nv, pyb::ssize_t{3}}), normals({nv, pyb::ssize_t{3}});
+    auto vp = vertices.mutable_unchecked<2>();
+    auto np = normals.mutable_unchecked<2>();
+    for (pyb::ssize_t i = 0; i < nv; ++i) {
+        const Vertex& v = m.vertices[static_cast<std::size_t>(i)];
+        const Vec3d p = lattice.to_world({v.position[0], v.position[1], v.position[2]});
+        const Vec3d n = lattice.direction_to_world({v.normal[0], v.normal[1], v.normal[2]});
+        vp(i, 0) = p.x, vp(i, 1) = p.y, vp(i, 2) = p.z;
+        np(i, 0) = n.x, np(i, 1) = n.y, np(i, 2) = n.z;
+    }
+    const auto nt = static_cast<pyb::ssize_t>(m.triangle_count());
+    pyb::array_t<std::uint32_t> faces({nt, pyb::ssize_t{3}});
+    std::copy(m.indices.begin(), m.indices.end(), faces.mutable_data());
+    return pyb::make_tuple(vertices, faces, normals);
+}
+
+std::string evaluate(const pyb::array& mask, const pyb::array& truth, const Lattice& lattice) {
+    const Grid<std::uint8_t> m = mask_from_array(mask, lattice), t = mask_from_array(truth, lattice);
+    pyb::gil_scoped_release nogil;
+    return cli::evaluation_report(m, t).dump();
+}
+
+SegmentArgs segment_args(const pyb::kwargs& kw) {
+    SegmentArgs a;
+    for (const auto& [key, value] : kw) {
+        const std::string k = key.cast<std::string>();
+        if (k == "seeds") a.seeds = value.cast<std::vector<std::string>>();
+        else if (k == "seeds_mm") a.seeds_mm = value.cast<std::vector<std::string>>();
+        else if (k == "seed_radius") a.seed_radius = value.cast<double>();
+        else if (k == "roi") a.roi = pyb::reinterpret_borrow<pyb::object>(value);
+        else if (k == "init_mask") a.init_mask = pyb::reinterpret_borrow<pyb::object>(value);
+        else if (k == "mu") a.mu = value.cast<std::optional<double>>();
+        else if (k == "epsilon") a.epsilon = value.cast<std::optional<double>>();
+        else if (k == "mu_raw") a.mu_raw = value.cast<std::optional<double>>();
+        else if (k == "epsilon_raw") a.epsilon_raw = value.cast<std::optional<double>>();
+        else if (k == "window_from") a.window_from = value.cast<std::string>();
+        else if (k == "classes") a.classes = value.cast<int>();
+        else if (k == "iterations") a.iterations = value.cast<int>();
+        else if (k == "n") a.n = value.cast<double>();
+        else if (k == "alpha") a.alpha = value.cast<double>();
+        else if (k == "bias_correct") a.bias_correct = value.cast<bool>();
+        else throw std::invalid_argument("unknown segment option '" + k + "'");
+    }
+    if (a.classes < 2 || a.classes > 6) throw UsageError("classes must be in 2..6");
+    return a;
+}
+
+}  // namespace
+
+void register_core(pyb::module_& m) {
+    m.def("_read_header", [](const std::string& path) {
+        const ImageHeader h = [&] { pyb::gil_scoped_release nogil; return read_image_header(path); }();
+        pyb::dict d;
+        d["dims"] = pyb::make_tuple(h.dims.x, h.dims.y, h.dims.z);
+        d["spacing"] = pyb::make_tuple(h.spacing.x, h.spacing.y, h.spacing.z);
+        d["origin"] = pyb::make_tuple(h.origin.x, h.origin.y, h.origin.z);
+        d["direction"] = std::vector<double>(h.direction.begin(), h.direction.end());
+        d["dimension"] = h.dimension;
+        d["components"] = h.components;
+        d["pixel_type"] = h.pixel_type;
+        d["format"] = h.format;
+        return d;
+    }, pyb::arg("path"));
+    m.def("_read", &read, pyb::arg("path"), pyb::arg("labels") = false);
+    m.def("_write", [](const pyb::array& v, const pyb::tuple& geo, const std::string& path, bool labels) {
+        if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
+        write(v, lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]), path, labels);
+    });
+    m.def("_segment", [](const pyb::array& v, const pyb::tuple& geo, const pyb::object& progress, const pyb::kwargs& kw) {
+        if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
+        const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
+        return segment(v, l, segment_args(kw), progress);
+    });
+    m.def("_tissue_model", [](const pyb::array& v, const pyb::tuple& geo, const pyb::kwargs& kw) {
+        if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
+        const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
+        SegmentArgs a = segment_args(kw);
+        return tissue_model(v, l, a);
+    });
+    m.def("_mesh", [](const pyb::array& v, const pyb::tuple& geo, bool is_mask, const std::string& out) {
+        if (v.ndim() != 3) throw std::invalid_argument("the input must be a 3D array");
+        return mesh(v, lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]), is_mask, out);
+    });
+    m.def("_evaluate", [](const pyb::array& mask, const pyb::array& truth, const pyb::tuple& geo) {
+        if (mask.ndim() != 3) throw std::invalid_argument("the mask must be a 3D array");
+        return evaluate(mask, truth, lattice_from(pyb::make_tuple(mask.shape(0), mask.shape(1), mask.shape(2)), geo[0], geo[1], geo[2]));
+    });
+}
+
+}  // namespace liveset::py

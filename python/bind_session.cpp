@@ -1,0 +1,125 @@
+// `liveset.Session`: the interactive editing session (seeds, segmentation steps, swarm repair,
+// undo/redo) for scripts. Runs of steps release the GIL and stop on Ctrl-C between steps.
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "cli_common.hpp"
+#include "liveset/session/session.hpp"
+
+namespace liveset::py {
+
+namespace {
+
+std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi, double n,
+                                      double alpha, int layers, int fragment_size, std::size_t history,
+                                      int agents, double p, std::uint64_t seed, bool sleeping) {
+    if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
+    const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
+    Grid<float> image = grid_from_array(v, l);
+    std::optional<Grid<std::uint8_t>> r;
+    if (!roi.is_none()) r = mask_from_array(roi.cast<pyb::array>(), l);
+    SessionOptions o;
+    o.layers = layers;
+    o.fragment_size = fragment_size;
+    o.history = history;
+    o.params.n = n;
+    o.params.alpha = alpha;
+    if (agents < 1) throw std::invalid_argument("agents must be at least 1");
+    o.repair.swarm.agents = static_cast<std::size_t>(agents);
+    o.repair.swarm.act_probability = p;
+    o.repair.swarm.seed = seed;
+    if (sleeping) o.segmentation.step = sleeping_step();
+    pyb::gil_scoped_release nogil;
+    return std::make_unique<Session>(std::move(image), o, std::move(r));
+}
+
+pyb::dict status_of(const Session& s) {
+    const SegmentStatus& st = s.segment_status();
+    return pyb::dict(pyb::arg("iterations") = st.iterations, pyb::arg("converged") = st.converged,
+                     pyb::arg("vanished") = st.vanished, pyb::arg("flips") = st.flips, pyb::arg("inside") = st.inside,
+                     pyb::arg("dt") = st.dt, pyb::arg("zero_layer") = s.field().zero_layer().size());
+}
+
+// `count` calls of `one` (a segment or swarm step); segment runs stop early once converged.
+pyb::dict run_steps(Session& s, int count, bool segment, bool until_converged) {
+    if (count < 0) throw std::invalid_argument("steps must be >= 0");
+    Interrupt interrupt;
+    int done = 0;
+    {
+        pyb::gil_scoped_release nogil;
+        for (; done < count && interrupt.poll(); ++done) {
+            if (segment) {
+                s.segment_step();
+                if (until_converged && (s.segment_status().converged || s.segment_status().vanished)) {
+                    ++done;
+                    break;
+                }
+            } else {
+                s.swarm_step();
+            }
+        }
+        s.end_action();
+    }
+    if (interrupt.raised()) interrupt.rethrow();
+    pyb::dict d = status_of(s);
+    d["steps"] = done;
+    return d;
+}
+
+Vec3d point(const std::vector<double>& p) {
+    if (p.size() != 3) throw std::invalid_argument("a point needs 3 index coordinates (i, j, k)");
+    return {p[0], p[1], p[2]};
+}
+
+}  // namespace
+
+void register_session(pyb::module_& m) {
+    pyb::class_<Session>(m, "_Session")
+        .def(pyb::init(&make_session), pyb::arg("image"), pyb::arg("geometry"), pyb::arg("roi"), pyb::arg("n"),
+             pyb::arg("alpha"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
+             pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"))
+        .def("add_seed", [](Session& s, const std::vector<double>& c, double r) {
+            if (!s.lattice().contains(point(c))) throw std::invalid_argument("the seed lies outside the image");
+            s.add_seed({point(c), r});
+        })
+        .def("remove_seed", [](Session& s, std::size_t i) {
+            if (i >= s.seeds().size()) throw std::out_of_range("no seed with that index");
+            s.remove_seed(i);
+        })
+        .def("seeds", [](const Session& s) {
+            std::vector<std::tuple<double, double, double, double>> out;
+            for (const SeedBall& b : s.seeds()) out.emplace_back(b.center.x, b.center.y, b.center.z, b.radius);
+            return out;
+        })
+        .def("set_params", [](Session& s, double mu, double epsilon, double n, double alpha, bool from_seeds) {
+            s.set_params({mu, epsilon, n, alpha}, from_seeds);
+        })
+        .def("params", [](const Session& s) {
+            const ThresholdParams& p = s.params();
+            return pyb::dict(pyb::arg("mu") = p.mu, pyb::arg("epsilon") = p.epsilon, pyb::arg("n") = p.n,
+                             pyb::arg("alpha") = p.alpha, pyb::arg("window_from_seeds") = s.window_from_seeds(),
+                             pyb::arg("mu_raw") = s.scale().to_raw(p.mu), pyb::arg("epsilon_raw") = s.scale().raw_length(p.epsilon));
+        })
+        .def("segment_steps", [](Session& s, int count, bool until) { return run_steps(s, count, true, until); })
+        .def("swarm_steps", [](Session& s, int count) { return run_steps(s, count, false, false); })
+        .def("status", &status_of)
+        .def("set_target", [](Session& s, const std::vector<double>& t) { s.set_target(point(t)); })
+        .def("clear_target", &Session::clear_target)
+        .def("agents", [](const Session& s) {
+            std::vector<std::tuple<double, double, double>> out;
+            for (const Agent& a : s.agents()) out.emplace_back(a.position.x, a.position.y, a.position.z);
+            return out;
+        })
+        .def("undo", [](Session& s) { return !s.undo().changed.empty(); })
+        .def("redo", [](Session& s) { return !s.redo().changed.empty(); })
+        .def("can_undo", &Session::can_undo)
+        .def("can_redo", &Session::can_redo)
+        .def("undo_depth", &Session::undo_depth)
+        .def("next_undo_label", &Session::next_undo_label)
+        .def("load_mask", [](Session& s, const pyb::array& v) { s.load_mask(mask_from_array(v, s.lattice())); })
+        .def("load_phi", [](Session& s, const pyb::array& v) { s.load_phi(grid_from_array(v, s.lattice())); })
+        .def("mask", [](const Session& s) { return array_from_grid(s.mask()); })
+        .def("phi", [](const Session& s) { return array_from_grid(Grid<float>(s.field().phi())); });
+}
+
+}  // namespace liveset::py

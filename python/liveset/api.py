@@ -1,0 +1,167 @@
+"""liveset's functions on images in memory: read/write through the C++ IO, segment (as
+``liveset segment``), the tissue model and window, mesh, evaluate and repair."""
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Callable, Optional, Sequence
+
+import numpy as np
+
+from . import _liveset
+from .image import Image, as_image
+
+ImageIOError = _liveset.ImageIOError
+
+
+def read(path: str, labels: bool = False) -> Image:
+    """Read a 3D image (NIfTI, MetaImage, NRRD, MINC, a DICOM folder) through liveset's C++ IO.
+
+    Returns float32 intensities, or uint8 labels with ``labels=True`` (values must be 0..255).
+    Raises ImageIOError (an OSError) with a one-line message on missing, corrupt, 2D, RGB, ...
+    files."""
+    array, (spacing, origin, direction) = _liveset._read(str(path), labels)
+    return Image(array, spacing, origin, direction)
+
+
+def read_header(path: str) -> dict:
+    """What an image file says about itself, without reading the voxels: dims, spacing, origin
+    (LPS), direction (9 numbers, row-major), dimension, components, pixel_type, format."""
+    return _liveset._read_header(str(path))
+
+
+def write(image, path: str, labels: bool = False) -> None:
+    """Write an image atomically (temporary + rename) with its full geometry; the format follows
+    the extension (.nii.gz, .nii, .mha, .nrrd, .mnc, ...). ``labels=True`` writes uint8 0..255 (a
+    mask: non-zero -> 1); otherwise float32."""
+    img = as_image(image)
+    _liveset._write(img.array, img.geometry, str(path), labels)
+
+
+def _seed_text(seed) -> str:
+    if isinstance(seed, str):
+        return seed
+    s = [float(v) for v in seed]
+    if len(s) not in (3, 4):
+        raise ValueError(f"a seed is (i, j, k) or (i, j, k, radius), not {seed!r}")
+    text = ",".join(repr(v) for v in s[:3])
+    return text + (f":{s[3]!r}" if len(s) == 4 else "")
+
+
+@dataclass
+class Segmentation:
+    """What ``segment`` returns: ``mask`` (uint8 0/1, φ < 0 within the ROI), ``phi`` (float32,
+    < 0 inside), ``report`` (the dict ``liveset segment --json`` prints: iterations, stop, window,
+    tissue model, volume, ...), ``roi`` when one was used, ``corrected`` with bias_correct."""
+    mask: Image
+    phi: Image
+    report: dict
+    roi: Optional[Image] = None
+    corrected: Optional[Image] = None
+
+
+def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius: float = 2.0,
+            roi=None, init_mask=None, mu: Optional[float] = None, epsilon: Optional[float] = None,
+            mu_raw: Optional[float] = None, epsilon_raw: Optional[float] = None,
+            window_from: str = "model", classes: int = 3, n: float = 4.0, alpha: float = 0.1,
+            iterations: int = 2000, bias_correct: bool = False,
+            progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
+    """Threshold level-set segmentation from seeds (paper Eq. 2-3), exactly as ``liveset segment``
+    with the same options (the same image and options give the same mask, bit for bit).
+
+    image: a liveset.Image, a nibabel image or (array, RAS affine).
+    seeds: voxel indices ``(i, j, k)``, ``(i, j, k, radius)`` or the CLI's ``"I,J,K[:R]"``
+        strings (0-based, radius in voxels); seeds_mm: LPS mm ``"X,Y,Z[:R]"`` (radius in mm).
+    roi: None, ``"auto"`` (the automatic brain mask) or a mask (Image/nibabel/array) the front
+        may not leave. init_mask: start from this region instead of seeds.
+    mu/epsilon: the window in normalised units, or mu_raw/epsilon_raw in the image's own; by
+        default the tissue model's window for the seeds' class (``window_from="seeds"``: their
+        statistics). n, alpha, iterations, classes, bias_correct: as the CLI.
+    progress: called with a dict (iteration, zero_layer, band, changed, flips, inside, dt, ms)
+        after every step; an exception it raises stops the run and propagates.
+
+    The GIL is released while it runs; Ctrl-C raises KeyboardInterrupt within a step. Bad input
+    raises ValueError (ImageIOError for files) with a one-line message."""
+    img = as_image(image)
+    kw = dict(seeds=[_seed_text(s) for s in seeds], seeds_mm=[_seed_text(s) for s in seeds_mm],
+              seed_radius=float(seed_radius), mu=mu, epsilon=epsilon, mu_raw=mu_raw,
+              epsilon_raw=epsilon_raw, window_from=window_from, classes=int(classes), n=float(n),
+              alpha=float(alpha), iterations=int(iterations), bias_correct=bool(bias_correct))
+    kw["roi"] = _mask_arg(roi, img, "roi", allow_auto=True)
+    kw["init_mask"] = _mask_arg(init_mask, img, "init_mask")
+    r = _liveset._segment(img.array, img.geometry, progress, **kw)
+    return Segmentation(mask=img.like(r["mask"]), phi=img.like(r["phi"]), report=json.loads(r["report"]),
+                        roi=img.like(r["roi"]) if "roi" in r else None,
+                        corrected=img.like(r["corrected"]) if "corrected" in r else None)
+
+
+def _mask_arg(mask, img: Image, what: str, allow_auto: bool = False):
+    if mask is None:
+        return None
+    if isinstance(mask, str):
+        if allow_auto and mask == "auto":
+            return mask
+        raise ValueError(f"{what} must be {'auto, ' if allow_auto else ''}a mask image or array, not {mask!r}")
+    if isinstance(mask, np.ndarray):
+        arr = mask
+    else:
+        m = as_image(mask, what)
+        if not m.same_geometry(img):
+            raise ValueError(f"{what} does not overlay the image (shape, spacing, origin or direction differ)")
+        arr = m.array
+    if arr.shape != img.shape:
+        raise ValueError(f"{what} has shape {arr.shape}, the image {img.shape}")
+    return np.asarray(arr)
+
+
+def tissue_model(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius: float = 2.0,
+                 roi=None, classes: int = 3, window_from: str = "model") -> dict:
+    """The tissue model (CSF/GM/WM mixture with partial volume) fitted where ``segment`` fits it,
+    and, with seeds, the threshold window ``segment`` would use: a dict with ``intensity_scale``,
+    ``tissue_model`` (classes: name, mean, sigma, weight; seed_class), ``window`` (mu, epsilon
+    normalised; mu_raw, epsilon_raw, lower_raw, upper_raw; source) and ``warnings``."""
+    img = as_image(image)
+    kw = dict(seeds=[_seed_text(s) for s in seeds], seeds_mm=[_seed_text(s) for s in seeds_mm],
+              seed_radius=float(seed_radius), classes=int(classes), window_from=window_from,
+              roi=_mask_arg(roi, img, "roi", allow_auto=True))
+    return json.loads(_liveset._tissue_model(img.array, img.geometry, **kw))
+
+
+@dataclass
+class Mesh:
+    """A triangle mesh in LPS millimetres: vertices (N, 3), faces (M, 3) vertex indices, unit
+    normals (N, 3) pointing outwards (towards φ > 0)."""
+    vertices: np.ndarray
+    faces: np.ndarray
+    normals: np.ndarray
+
+
+def mesh(phi_or_mask, out: Optional[str] = None, kind: str = "auto") -> Mesh:
+    """Marching cubes of a φ image (< 0 inside) or of a 0/1 mask (as ``liveset mesh``), in LPS mm.
+    ``out``: also write it (.ply, .obj or .stl). kind: "auto", "phi" or "mask"."""
+    img = as_image(phi_or_mask)
+    if kind not in ("auto", "phi", "mask"):
+        raise ValueError(f"kind must be auto, phi or mask, not {kind!r}")
+    a = img.array
+    is_mask = kind == "mask" or (kind == "auto" and (a.dtype == bool or np.all((a == 0) | (a == 1))))
+    v, f, nrm = _liveset._mesh(a, img.geometry, bool(is_mask), "" if out is None else str(out))
+    return Mesh(v, f, nrm)
+
+
+def evaluate(mask, truth, label: Optional[int] = None) -> dict:
+    """``liveset eval``'s metrics of a mask against a truth: dice, jaccard, volume_difference,
+    hausdorff95_mm, hausdorff_mm, mean_surface_mm, components, euler, genus, cavities, holes and
+    the truth's topology. ``label``: use truth == label (e.g. 2 = grey matter in BrainWeb)."""
+    m, t = as_image(mask, "mask"), as_image(truth, "truth")
+    if not m.same_geometry(t):
+        raise ValueError("the mask and the truth do not share a geometry (shape, spacing, origin or direction)")
+    ta = np.asarray(t.array)
+    ta = (ta == label) if label is not None else (ta != 0)
+    if label is not None and not ta.any():
+        raise ValueError(f"the truth has no voxel with label {label}")
+    return json.loads(_liveset._evaluate(np.asarray(m.array) != 0, ta, m.geometry))
+
+
+def set_threads(threads: int) -> None:
+    """Limit liveset's worker threads (0: all cores). Results are identical for any count."""
+    _liveset.set_threads(int(threads))

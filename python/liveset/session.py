@@ -1,0 +1,145 @@
+"""Scripted interactive work: ``Session`` (seeds, segmentation steps, swarm repair, undo/redo),
+the same session the viewer drives, and ``repair`` on top of it."""
+from __future__ import annotations
+
+from typing import Optional, Sequence
+
+import numpy as np
+
+from . import _liveset
+from .image import Image, as_image
+
+
+class Session:
+    """An editing session on one image: seeds, threshold parameters, the sparse-field level set,
+    the swarm and an undo history of at least 20 actions (bit-identical undo).
+
+    >>> s = liveset.Session(img, roi=brain)      # img: Image or nibabel image
+    >>> s.add_seed((60, 64, 64)); s.run(500)     # grow until converged (or 500 steps)
+    >>> s.set_target((70, 64, 64)); s.swarm(100) # repair where you point
+    >>> s.undo(); m = s.mask()
+
+    Coordinates are voxel indices (i, j, k). Runs release the GIL and stop on Ctrl-C between
+    steps (KeyboardInterrupt; the steps taken so far stay and can be undone)."""
+
+    def __init__(self, image, roi=None, *, n: float = 4.0, alpha: float = 0.1, layers: int = 2,
+                 fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
+                 seed: int = 1, sleeping: bool = True):
+        img = as_image(image)
+        self.image = img
+        r = None
+        if roi is not None:
+            r = np.asarray(roi) if isinstance(roi, np.ndarray) else as_image(roi, "roi").array
+        self._s = _liveset._Session(img.array, img.geometry, r, float(n), float(alpha), int(layers),
+                                    int(fragment_size), int(history), int(agents), float(p), int(seed),
+                                    bool(sleeping))
+
+    # seeds and parameters
+    def add_seed(self, ijk: Sequence[float], radius: float = 2.0) -> None:
+        """Add a seed ball (undoable); the window follows the seeds unless set_params fixed it."""
+        self._s.add_seed([float(v) for v in ijk], float(radius))
+
+    def remove_seed(self, index: int) -> None:
+        self._s.remove_seed(int(index))
+
+    @property
+    def seeds(self):
+        """[(i, j, k, radius), ...]"""
+        return self._s.seeds()
+
+    def set_params(self, mu: Optional[float] = None, epsilon: Optional[float] = None,
+                   n: Optional[float] = None, alpha: Optional[float] = None) -> None:
+        """Set n, alpha and the window (normalised units). Without mu and epsilon the window keeps
+        following the seeds (the tissue model's window, as ``liveset segment``)."""
+        p = self.params
+        from_seeds = mu is None and epsilon is None
+        self._s.set_params(p["mu"] if mu is None else float(mu), p["epsilon"] if epsilon is None else float(epsilon),
+                           p["n"] if n is None else float(n), p["alpha"] if alpha is None else float(alpha),
+                           from_seeds)
+
+    @property
+    def params(self) -> dict:
+        """mu, epsilon (normalised), mu_raw, epsilon_raw, n, alpha, window_from_seeds."""
+        return self._s.params()
+
+    # segmentation and repair
+    def step(self, steps: int = 1) -> dict:
+        """Take `steps` segmentation steps (one undoable action); returns the status."""
+        return self._s.segment_steps(int(steps), False)
+
+    def run(self, max_steps: int = 2000) -> dict:
+        """Segmentation steps until the front converges (or vanishes), at most max_steps."""
+        return self._s.segment_steps(int(max_steps), True)
+
+    @property
+    def status(self) -> dict:
+        """iterations, converged, vanished, flips, inside, dt, zero_layer."""
+        return self._s.status()
+
+    def set_target(self, ijk: Sequence[float]) -> None:
+        """Aim the swarm at a point (voxel indices) near the surface, e.g. a hole."""
+        self._s.set_target([float(v) for v in ijk])
+
+    def clear_target(self) -> None:
+        self._s.clear_target()
+
+    def swarm(self, steps: int = 1) -> dict:
+        """`steps` swarm steps towards the target (one undoable action)."""
+        return self._s.swarm_steps(int(steps))
+
+    @property
+    def agents(self) -> np.ndarray:
+        """Agent positions (voxel indices), shape (N, 3)."""
+        return np.asarray(self._s.agents(), dtype=float).reshape(-1, 3)
+
+    # history
+    def undo(self) -> bool:
+        """Undo the last action; False when there was nothing to undo."""
+        return self._s.undo()
+
+    def redo(self) -> bool:
+        return self._s.redo()
+
+    @property
+    def can_undo(self) -> bool:
+        return self._s.can_undo()
+
+    @property
+    def can_redo(self) -> bool:
+        return self._s.can_redo()
+
+    # level set in and out
+    def load_mask(self, mask) -> None:
+        """Start from a mask (non-zero inside; clears the history)."""
+        self._s.load_mask(np.asarray(mask.array if isinstance(mask, Image) else mask))
+
+    def load_phi(self, phi) -> None:
+        """Start from a level-set function (< 0 inside; clears the history)."""
+        self._s.load_phi(np.asarray(phi.array if isinstance(phi, Image) else phi))
+
+    def mask(self) -> Image:
+        """φ < 0 within the ROI, uint8 0/1."""
+        return self.image.like(self._s.mask())
+
+    def phi(self) -> Image:
+        return self.image.like(self._s.phi())
+
+
+def repair(phi_or_mask, image, targets: Sequence[Sequence[float]], *, steps: int = 300, roi=None,
+           agents: int = 200, p: float = 0.1, seed: int = 1) -> Image:
+    """Agent-swarm repair (paper §4) of a segmentation at the given targets (voxel indices), one
+    after the other, `steps` swarm steps each; returns the repaired φ (< 0 inside). ``image`` is
+    the intensity image the swarm's decisions read. Uses Session (exact step, not the CLI's
+    ``liveset repair`` option set: no @STEP schedule, no log)."""
+    img = as_image(image)
+    s = Session(img, roi=roi, agents=agents, p=p, seed=seed)
+    src = as_image(phi_or_mask, "phi_or_mask")
+    a = np.asarray(src.array)
+    if np.all((a == 0) | (a == 1)):
+        s.load_mask(a)
+    else:
+        s.load_phi(a)
+    for t in targets:
+        s.set_target(t)
+        s.swarm(steps)
+    return s.phi()

@@ -1,0 +1,219 @@
+"""The Python API against independent answers: nibabel for geometry, the CLI for segment/eval,
+numpy brute force for overlap, an analytic sphere for mesh positions."""
+import json
+import os
+import signal
+import threading
+
+import nibabel as nib
+import numpy as np
+import pytest
+
+import liveset
+from conftest import cli
+
+# An oblique, anisotropic geometry (LPS): rotation about z by 30 degrees, then about x by 20.
+_C, _S = np.cos(np.radians(30)), np.sin(np.radians(30))
+_CX, _SX = np.cos(np.radians(20)), np.sin(np.radians(20))
+DIRECTION = np.array([[1, 0, 0], [0, _CX, -_SX], [0, _SX, _CX]]) @ np.array([[_C, -_S, 0], [_S, _C, 0], [0, 0, 1]])
+SPACING = (0.9, 1.1, 1.7)
+ORIGIN = (12.5, -40.0, 7.25)
+
+
+def ras_affine(spacing, origin, direction):
+    """Expected nibabel affine, written out independently of liveset.Image."""
+    a = np.eye(4)
+    a[:3, :3] = direction @ np.diag(spacing)
+    a[:3, 3] = origin
+    a[0, :] *= -1
+    a[1, :] *= -1
+    return a
+
+
+def test_write_then_nibabel_reads_same_voxels_and_geometry(tmp_path):
+    rng = np.random.default_rng(3)
+    data = rng.normal(100, 20, size=(7, 9, 5)).astype(np.float32)
+    img = liveset.Image(data, SPACING, ORIGIN, DIRECTION)
+    liveset.write(img, tmp_path / "x.nii.gz")
+    back = nib.load(str(tmp_path / "x.nii.gz"))
+    np.testing.assert_allclose(back.affine, ras_affine(SPACING, ORIGIN, DIRECTION), atol=1e-4)
+    assert np.array_equal(np.asarray(back.dataobj), data)
+    # a label image stays integer, non-zero -> 1 for masks
+    liveset.write(img.like(data > 100), tmp_path / "m.nii.gz", labels=True)
+    m = nib.load(str(tmp_path / "m.nii.gz"))
+    assert m.get_data_dtype() == np.uint8 and np.array_equal(np.asarray(m.dataobj), (data > 100).astype(np.uint8))
+
+
+def test_nibabel_file_read_by_liveset_and_back(tmp_path):
+    data = np.arange(6 * 4 * 3, dtype=np.int16).reshape(6, 4, 3)
+    affine = ras_affine(SPACING, ORIGIN, DIRECTION)
+    nib.save(nib.Nifti1Image(data, affine), str(tmp_path / "n.nii.gz"))
+    img = liveset.read(tmp_path / "n.nii.gz")
+    assert img.array.shape == (6, 4, 3) and img.array.dtype == np.float32
+    assert np.array_equal(img.array, data.astype(np.float32))
+    np.testing.assert_allclose(img.spacing, SPACING, atol=1e-5)
+    np.testing.assert_allclose(img.origin, ORIGIN, atol=1e-4)
+    np.testing.assert_allclose(img.direction, DIRECTION, atol=1e-5)
+    # zero copy out: a Fortran-ordered view on the C++ grid
+    assert img.array.flags.f_contiguous and not img.array.flags.owndata
+    # nibabel interop in memory: Image <-> Nifti1Image keeps the affine
+    via = liveset.Image.from_nibabel(nib.load(str(tmp_path / "n.nii.gz")))
+    np.testing.assert_allclose(via.affine, affine, atol=1e-5)
+    np.testing.assert_allclose(via.to_nibabel().affine, affine, atol=1e-5)
+
+
+def test_segment_equals_cli_bitwise(phantom, cli_segmentation):
+    img = liveset.Image.from_nibabel(nib.load(phantom["image"]))
+    seg = liveset.segment(img, phantom["seeds"])
+    cli_mask = np.asarray(nib.load(cli_segmentation["mask"]).dataobj)
+    cli_phi = np.asarray(nib.load(cli_segmentation["phi"]).dataobj)
+    assert seg.mask.array.dtype == np.uint8 and np.array_equal(seg.mask.array, cli_mask)
+    assert np.array_equal(seg.phi.array.view(np.uint32), cli_phi.astype(np.float32).view(np.uint32))
+    rep = cli_segmentation["report"]
+    for k in ("iterations", "stop", "voxels", "mu_raw", "epsilon_raw"):
+        assert seg.report[k] == rep[k], k
+    # masks/phi go out with the input's affine
+    np.testing.assert_allclose(seg.mask.to_nibabel().affine, nib.load(phantom["image"]).affine, atol=1e-6)
+    # the tissue model gives the window segment used
+    tm = liveset.tissue_model(img, phantom["seeds"])
+    assert tm["window"]["mu_raw"] == pytest.approx(rep["mu_raw"], abs=1e-9)
+    assert tm["window"]["source"] == rep["window"]["source"]
+    means = [c["mean"] for c in tm["tissue_model"]["classes"]]
+    assert means == sorted(means)
+
+
+def test_evaluate_matches_brute_force_and_cli(phantom, cli_segmentation):
+    mask, truth = liveset.read(cli_segmentation["mask"], labels=True), liveset.read(phantom["truth"], labels=True)
+    ev = liveset.evaluate(mask, truth)
+    m, t = mask.array != 0, truth.array != 0
+    assert ev["dice"] == pytest.approx(2 * np.sum(m & t) / (m.sum() + t.sum()), rel=1e-12)
+    assert ev["jaccard"] == pytest.approx(np.sum(m & t) / np.sum(m | t), rel=1e-12)
+    ref = json.loads(cli("eval", "--mask", cli_segmentation["mask"], "--truth", phantom["truth"], "--json").stdout)
+    for k in ("dice", "hausdorff95_mm", "genus", "components"):
+        assert ev[k] == ref[k], k
+
+
+def test_mesh_of_analytic_sphere_lies_on_it_in_lps_mm(tmp_path):
+    shape, centre, radius = (30, 26, 18), np.array([20.0, -5.0, 14.0]), 8.0
+    img = liveset.Image(np.zeros(shape, np.float32), SPACING, ORIGIN, DIRECTION)
+    ijk = np.stack(np.meshgrid(*[np.arange(n) for n in shape], indexing="ij"), -1).reshape(-1, 3)
+    world = (img.affine_lps @ np.c_[ijk, np.ones(len(ijk))].T).T[:, :3]
+    centre = world.mean(axis=0)
+    phi = (np.linalg.norm(world - centre, axis=1) - radius).reshape(shape, order="C").astype(np.float32)
+    m = liveset.mesh(img.like(phi), out=tmp_path / "s.ply")
+    d = np.linalg.norm(m.vertices - centre, axis=1)
+    assert len(m.faces) > 100 and np.max(np.abs(d - radius)) < 0.05 * radius
+    outward = np.einsum("ij,ij->i", m.normals, m.vertices - centre)
+    assert np.all(outward > 0)
+    assert os.path.getsize(tmp_path / "s.ply") > 0
+
+
+def test_bad_input_raises_one_line_errors(tmp_path, phantom):
+    with pytest.raises(liveset.ImageIOError, match="no-such.nii.gz") as e:
+        liveset.read(tmp_path / "no-such.nii.gz")
+    assert isinstance(e.value, OSError) and "\n" not in str(e.value)
+    (tmp_path / "bad.nii.gz").write_bytes(b"\x1f\x8b not really gzip")
+    with pytest.raises(liveset.ImageIOError):
+        liveset.read(tmp_path / "bad.nii.gz")
+    img = liveset.read(phantom["image"])
+    with pytest.raises(ValueError, match="lies outside the image"):
+        liveset.segment(img, [(500, 1, 1)])
+    with pytest.raises(ValueError, match="not both"):
+        liveset.segment(img, phantom["seeds"], mu=0.5, mu_raw=100)
+    with pytest.raises(ValueError, match="bad seed|seed"):
+        liveset.segment(img, ["1,2"])
+    with pytest.raises(ValueError, match="at least one seed"):
+        liveset.segment(img, [])
+    with pytest.raises(ValueError, match="roi"):
+        liveset.segment(img, phantom["seeds"], roi=np.ones((3, 3, 3)))
+    with pytest.raises(ValueError, match="3D"):
+        liveset.Image(np.zeros((4, 4)))
+    with pytest.raises(ValueError, match="NaN"):
+        liveset.segment(img.like(np.full(img.shape, np.nan, np.float32)), phantom["seeds"])
+    with pytest.raises(ValueError, match="geometry"):
+        liveset.evaluate(img.like(img.array > 0), liveset.Image(img.array > 0, (2, 2, 2)))
+    with pytest.raises(liveset.ImageIOError, match="does not exist"):
+        liveset.write(img, tmp_path / "missing-folder" / "x.nii.gz")
+
+
+def test_sigint_stops_a_segmentation_within_a_step(phantom):
+    """A real SIGINT to this process while segment runs with the GIL released: KeyboardInterrupt,
+    and no further step is taken after the signal arrived."""
+    img = liveset.read(phantom["image"])
+    steps = []
+
+    def progress(p):
+        steps.append(p["iteration"])
+        if p["iteration"] == 3:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    with pytest.raises(KeyboardInterrupt):
+        liveset.segment(img, phantom["seeds"], progress=progress, iterations=100000)
+    assert steps == [1, 2, 3]
+
+
+def test_sigint_while_the_gil_is_released_stops_a_long_segmentation():
+    """SIGINT from another thread while segment runs in C++ without a callback: the run stops
+    (KeyboardInterrupt) long before the front could have crossed the 160^3 image."""
+    rng = np.random.default_rng(1)
+    img = liveset.Image(rng.uniform(0, 1, size=(160, 160, 160)).astype(np.float32))
+    timer = threading.Timer(0.3, signal.pthread_kill, (threading.main_thread().ident, signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            liveset.segment(img, [(2, 2, 2)], mu=0.5, epsilon=0.7, alpha=0.0, iterations=100000)
+    finally:
+        timer.cancel()
+
+
+def test_gil_released_during_segment(phantom):
+    img = liveset.read(phantom["image"])
+    done, ticks = threading.Event(), []
+    t = threading.Thread(target=lambda: (liveset.segment(img, phantom["seeds"], iterations=400), done.set()))
+    t.start()
+    while not done.is_set():  # this loop only runs while the C++ side has let go of the GIL
+        ticks.append(1)
+        done.wait(0.001)
+    t.join()
+    assert len(ticks) > 5
+
+
+def test_session_steps_undo_redo_and_swarm(phantom):
+    img = liveset.read(phantom["image"])
+    s = liveset.Session(img)
+    seeds = [tuple(map(float, x.split(","))) for x in phantom["seeds"]]
+    for seed in seeds:
+        s.add_seed(seed)
+    assert len(s.seeds) == len(seeds)
+    before = s.mask().array.copy()
+    st = s.run(300)
+    assert st["steps"] > 0 and s.status["iterations"] == st["steps"]
+    grown = s.mask().array.copy()
+    assert grown.sum() > before.sum()
+    assert s.undo() and np.array_equal(s.mask().array, before)
+    assert s.redo() and np.array_equal(s.mask().array, grown)
+    s.set_target(phantom["info"]["weak_spots"][0])  # a hole the phantom's bias field opens
+    s.swarm(60)
+    assert s.agents.shape[1] == 3 and len(s.agents) > 0
+    repaired = s.mask().array.copy()
+    assert not np.array_equal(repaired, grown)  # the swarm edited the surface there
+    assert s.undo() and np.array_equal(s.mask().array, grown)
+    # repair() is the same swarm run on a loaded level set
+    phi = liveset.repair(liveset.Image(grown, img.spacing, img.origin, img.direction), img,
+                         [phantom["info"]["weak_spots"][0]], steps=60)
+    assert phi.array.shape == img.shape and np.sum((phi.array < 0) != (grown != 0)) > 0
+    with pytest.raises(ValueError, match="outside"):
+        s.add_seed((1e4, 0, 0))
+
+
+def test_docs_example_runs(tmp_path):
+    """docs/python_example.py end to end on a small phantom."""
+    import subprocess
+    import sys
+    script = os.path.join(os.path.dirname(__file__), "..", "..", "docs", "python_example.py")
+    r = subprocess.run([sys.executable, script, "--size", "48", "--out", str(tmp_path)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    result = json.loads(r.stdout.strip().splitlines()[-1])
+    assert result["dice"] > 0.8 and result["triangles"] > 0
+    seg = nib.load(str(tmp_path / "seg.nii.gz"))
+    np.testing.assert_allclose(seg.affine, nib.load(str(tmp_path / "t1.nii.gz")).affine, atol=1e-6)
