@@ -50,7 +50,7 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 // --repair-rule sheet: the sheet rule (EditDecision::kSheet) with the grey matter's band from the
 // tissue model of the phantom, shifted to the sheet's intensity around each target.
-RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, RepairOptions& ro) {
+RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, const SparseField& repaired, RepairOptions& ro) {
     std::vector<std::string> warnings;
     TissueModel model;
     const std::optional<ModelWindow> w = sheet_window(image, o.mask, nullptr, TissueModelOptions{}, warnings, &model);
@@ -61,13 +61,76 @@ RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, R
     ro.swarm.sheet_lower = lo;
     ro.swarm.sheet_upper = hi;
     ro.swarm.edit_radius = 2.0;
-    const SparseField* field = &*o.field;
+    const SparseField* field = &repaired;
     auto unit = std::make_shared<Grid<float>>(normalise(image, o.scale));
     return [=](RepairOptions& r, const HoleSite& t) {
         const auto [l, u] = local_sheet_band(*unit, field->phi(), t.position, 10.0, lo, hi, mean);
         r.swarm.sheet_lower = l;
         r.swarm.sheet_upper = u;
     };
+}
+
+// The demo's repair, through `session`: each round points the swarm at the largest perforation left
+// (found from the truth, as a user would see it) with the brush (edit range) sized to that hole, and
+// runs round_steps swarm steps. Returns the report's "repair" object (without the triangles) and
+// the first hole (where the live window aims the swarm).
+nlohmann::json run_demo_repair(const DemoArgs& a, const Phantom& ph, const SegmentOutcome& o, Session& session,
+                               std::optional<Vec3d>& first_hole) {
+    Grid<std::uint8_t> white(ph.labels.lattice(), 0);
+    for (PointIndex i = 0; i < white.size(); ++i) white[i] = ph.labels[i] == kWhiteMatter;
+    RepairOptions ro = demo_repair_options();
+    ro.swarm.seed = a.seed;
+    // The holes a user would point at: perforations first, then spurious cavities (bubbles).
+    const HoleSiteFinder holes_left = [&](const SparseField& field) {
+        const Grid<std::uint8_t> m = inside_mask(field.phi());
+        std::vector<Perforation> h = find_perforations(m, ph.truth, white);
+        if (h.empty()) h = find_cavities(m, white);
+        std::vector<HoleSite> sites;
+        for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
+        return sites;
+    };
+    const std::vector<HoleSite> first = holes_left(session.field());
+    first_hole = first.empty() ? std::nullopt : std::optional<Vec3d>(first.front().position);
+    RepairScheduleOptions so;
+    so.rounds = a.rounds;
+    so.round_steps = a.round_steps;
+    RoundSetup setup;
+    if (a.rule == "sheet") setup = sheet_rule_setup(ph.image, o, session.field(), ro);
+    SessionRepairDriver driver(session);
+    const RepairScheduleResult sched = run_repair_schedule(driver, ro, so, holes_left, setup);
+    nlohmann::json rounds = nlohmann::json::array();
+    std::size_t steps = 0, fragments = 0, modified = 0;
+    double repair_ms = 0.0;
+    for (const RepairRoundLog& r : sched.rounds) {
+        const Vec3d t = r.target.position;
+        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", r.target.voxels}, {"holes", r.holes}, {"edit_range", r.edit_range}});
+        steps += static_cast<std::size_t>(r.steps);
+        fragments += r.fragments;
+        modified += r.modified;
+        repair_ms += r.ms;
+    }
+    return {{"rule", a.rule}, {"agents", ro.swarm.agents}, {"p", ro.swarm.act_probability}, {"rounds", rounds}, {"steps", steps},
+            {"holes_left", sched.holes_left}, {"points_modified", modified}, {"fragments_rebuilt", fragments},
+            {"ms_per_step", steps ? repair_ms / static_cast<double>(steps) : 0.0}, {"ms", repair_ms}};
+}
+
+// The text summary (the report `j` holds every figure).
+void print_demo_summary(const DemoArgs& a, const nlohmann::json& j, std::size_t seeds) {
+    const nlohmann::json &t = j["timings_ms"], &r = j["repair"], &ev = j["before"], &after = j["after"];
+    fmt::print("liveset demo: threshold level-set segmentation of the grey matter of a {}^3 synthetic cortex phantom\n", a.size);
+    fmt::print("  phantom      {:.0f} ms ({} seeds in grey matter)\n", t["phantom"].get<double>(), seeds);
+    print_segmentation_summary(j["segmentation"]);
+    fmt::print("  mesh         {} triangles in {} fragments of 16^3 cells, {:.1f} ms\n", j["mesh"]["triangles"].get<std::size_t>(),
+               j["mesh"]["fragments"].get<std::size_t>(), t["mesh"].get<double>());
+    fmt::print("  evaluation   against the phantom's ground truth ({:.0f} ms):\n", t["eval"].get<double>());
+    print_evaluation(ev, "               ");
+    fmt::print("  repair       {} rounds, each {} agents for {} steps at the largest hole left (p = {}): {} steps, {:.3f} ms/step,\n"
+               "               {} fragment rebuilds; perforations/cavities left {}\n",
+               r["rounds"].size(), r["agents"].get<std::size_t>(), a.round_steps, r["p"].get<double>(), r["steps"].get<std::size_t>(),
+               r["ms_per_step"].get<double>(), r["fragments_rebuilt"].get<std::size_t>(), r["holes_left"].get<std::size_t>());
+    fmt::print("  before       dice {:.4f}  holes {}\n", ev["dice"].get<double>(), ev["holes"].get<long>());
+    fmt::print("  after        dice {:.4f}  holes {}\n", after["dice"].get<double>(), after["holes"].get<long>());
+    fmt::print("  outputs      {}/ (t1, truth_gm, seg, phi, seg_repaired, phi_repaired .nii.gz; surface(_repaired).ply; before/after.png; report.json)\n", a.out);
 }
 
 int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
@@ -102,9 +165,16 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     }
     const SegmentOutcome& o = run.outcome;
 
+    // Everything after the segmentation edits through a Session (the viewer's edit path): it takes
+    // over the segmentation's level set bit for bit and its intensity scale, meshes it (16³-cell
+    // fragments), and meshes and records every swarm step of the repair.
     t0 = clock::now();
-    FragmentMesher mesher(ph.image.lattice(), 16);
-    mesher.full_rebuild(o.field->phi(), o.field->zero_layer());
+    SessionOptions session_options;
+    session_options.given_scale = o.scale;
+    Session session(ph.image, session_options);
+    if (!session.load_recovered(o.field->phi(), o.field->status(), SessionMarks{}))
+        throw std::logic_error("the session did not take the segmentation's level set over exactly");
+    const FragmentMesher& mesher = session.mesher();
     const double mesh_ms = ms_since(t0);
     const Mesh surface = weld_vertices(mesher.merged().view());
     const Grid<float> phi_before = o.field->phi();
@@ -113,44 +183,11 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     nlohmann::json ev = evaluation_report(o.mask, ph.truth);
     const double eval_ms = ms_since(t0);
 
-    // Repair: each round points the swarm at the largest perforation left (found from the truth,
-    // as a user would see it) with the brush (edit range) sized to that hole, and runs round_steps
-    // swarm steps through the incremental mesher.
-    Grid<std::uint8_t> white(ph.labels.lattice(), 0);
-    for (PointIndex i = 0; i < white.size(); ++i) white[i] = ph.labels[i] == kWhiteMatter;
-    const Grid<float> unit = normalise(ph.image, o.scale);
-    RepairOptions ro = demo_repair_options();
-    ro.swarm.seed = a.seed;
-    // The holes a user would point at: perforations first, then spurious cavities (bubbles).
-    const HoleSiteFinder holes_left = [&](const SparseField& field) {
-        const Grid<std::uint8_t> m = inside_mask(field.phi());
-        std::vector<Perforation> h = find_perforations(m, ph.truth, white);
-        if (h.empty()) h = find_cavities(m, white);
-        std::vector<HoleSite> sites;
-        for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
-        return sites;
-    };
-    const std::vector<HoleSite> first = holes_left(*o.field);
-    const std::optional<Vec3d> first_hole = first.empty() ? std::nullopt : std::optional<Vec3d>(first.front().position);
-    RepairScheduleOptions so;
-    so.rounds = a.rounds;
-    so.round_steps = a.round_steps;
-    RoundSetup setup;
-    if (a.rule == "sheet") setup = sheet_rule_setup(ph.image, o, ro);
-    const RepairScheduleResult sched = run_repair_schedule(*o.field, unit, nullptr, ro, so, holes_left, setup, &mesher);
-    nlohmann::json rounds = nlohmann::json::array();
-    std::size_t steps = 0, fragments = 0, modified = 0;
-    double repair_ms = 0.0;
-    for (const RepairRoundLog& r : sched.rounds) {
-        const Vec3d t = r.target.position;
-        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", r.target.voxels}, {"holes", r.holes}, {"edit_range", r.edit_range}});
-        steps += static_cast<std::size_t>(r.steps);
-        fragments += r.fragments;
-        modified += r.modified;
-        repair_ms += r.ms;
-    }
-    const Grid<std::uint8_t> repaired = inside_mask(o.field->phi());
-    const std::size_t left = sched.holes_left;
+    std::optional<Vec3d> first_hole;
+    nlohmann::json repair = run_demo_repair(a, ph, o, session, first_hole);
+    const double repair_ms = repair["ms"].get<double>();
+    repair.erase("ms");
+    const Grid<std::uint8_t> repaired = inside_mask(session.field().phi());
     nlohmann::json after = evaluation_report(repaired, ph.truth);
     const Mesh repaired_surface = weld_vertices(mesher.merged().view());
 
@@ -160,7 +197,7 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     write_image(phi_before, (dir / "phi.nii.gz").string());
     write_mesh(dir / "surface.ply", surface.view(), ph.image.lattice());
     write_label_image(repaired, (dir / "seg_repaired.nii.gz").string());
-    write_image(o.field->phi(), (dir / "phi_repaired.nii.gz").string());
+    write_image(session.field().phi(), (dir / "phi_repaired.nii.gz").string());
     write_mesh(dir / "surface_repaired.ply", repaired_surface.view(), ph.image.lattice());
 
     nlohmann::json j;
@@ -174,10 +211,8 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     j["after"] = after;
     j["dice"] = after["dice"];
     j["holes"] = after["holes"];
-    j["repair"] = {{"rule", a.rule}, {"agents", ro.swarm.agents}, {"p", ro.swarm.act_probability}, {"rounds", rounds}, {"steps", steps},
-                   {"holes_left", left}, {"points_modified", modified}, {"fragments_rebuilt", fragments},
-                   {"ms_per_step", steps ? repair_ms / static_cast<double>(steps) : 0.0},
-                   {"triangles", repaired_surface.triangle_count()}};
+    j["repair"] = repair;
+    j["repair"]["triangles"] = repaired_surface.triangle_count();
     j["timings_ms"] = {{"phantom", phantom_ms}, {"segment", 1000.0 * o.result.seconds}, {"mesh", mesh_ms}, {"eval", eval_ms},
                        {"repair", repair_ms}};
     j["outputs"] = a.out;
@@ -186,20 +221,7 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
-        fmt::print("liveset demo: threshold level-set segmentation of the grey matter of a {}^3 synthetic cortex phantom\n", a.size);
-        fmt::print("  phantom      {:.0f} ms ({} seeds in grey matter)\n", phantom_ms, ph.seeds.size());
-        print_segmentation_summary(j["segmentation"]);
-        fmt::print("  mesh         {} triangles in {} fragments of 16^3 cells, {:.1f} ms\n", surface.triangle_count(),
-                   mesher.fragment_count(), mesh_ms);
-        fmt::print("  evaluation   against the phantom's ground truth ({:.0f} ms):\n", eval_ms);
-        print_evaluation(ev, "               ");
-        fmt::print("  repair       {} rounds, each {} agents for {} steps at the largest hole left (p = {}): {} steps, {:.3f} ms/step,\n"
-                   "               {} fragment rebuilds; perforations/cavities left {}\n",
-                   rounds.size(), ro.swarm.agents, a.round_steps, ro.swarm.act_probability, steps, j["repair"]["ms_per_step"].get<double>(),
-                   fragments, left);
-        fmt::print("  before       dice {:.4f}  holes {}\n", ev["dice"].get<double>(), ev["holes"].get<long>());
-        fmt::print("  after        dice {:.4f}  holes {}\n", after["dice"].get<double>(), after["holes"].get<long>());
-        fmt::print("  outputs      {}/ (t1, truth_gm, seg, phi, seg_repaired, phi_repaired .nii.gz; surface(_repaired).ply; before/after.png; report.json)\n", a.out);
+        print_demo_summary(a, j, ph.seeds.size());
     }
     // With a display: the viewer on the segmented phantom, the swarm repairing the first hole live.
     if (!a.no_view && !a.json && first_hole && window.available && window.open && window.available()) {

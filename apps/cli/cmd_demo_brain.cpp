@@ -143,21 +143,27 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     const nlohmann::json ev = evaluation_report(o.mask, truth);
     const double eval_ms = ms_since(t0);
     nlohmann::json repair, after;
-    FragmentMesher mesher(t1.lattice(), 16);
-    mesher.full_rebuild(o.field->phi(), o.field->zero_layer());
+    // The rest edits through a Session (the viewer's edit path), which takes the segmentation over
+    // bit for bit with its intensity scale, and meshes it (16³-cell fragments).
+    SessionOptions session_options;
+    session_options.given_scale = o.scale;
+    Session session(t1, session_options, roi);
+    if (!session.load_recovered(o.field->phi(), o.field->status(), SessionMarks{}))
+        throw std::logic_error("the session did not take the segmentation's level set over exactly");
+    const FragmentMesher& mesher = session.mesher();
     const Grid<float> phi_before = o.field->phi();
     if (a.repair) {
         if (!a.quiet && !a.json) fmt::print("  segmented with a low threshold (epsilon x {}); repairing...\n", brain_repair_epsilon_scale());
         rin.scale = o.scale;
-        repair = repair_brain_holes(rin, *o.field, mesher, true);
-        after = evaluation_report(inside_mask(o.field->phi(), &roi), truth);
+        repair = repair_brain_holes(rin, session, true);
+        after = evaluation_report(inside_mask(session.field().phi(), &roi), truth);
     }
 
     write_label_image(o.mask, (dir / "seg.nii.gz").string());
     write_image(phi_before, (dir / "phi.nii.gz").string());
     if (a.repair) {
-        write_label_image(inside_mask(o.field->phi(), &roi), (dir / "seg_repaired.nii.gz").string());
-        write_image(o.field->phi(), (dir / "phi_repaired.nii.gz").string());
+        write_label_image(inside_mask(session.field().phi(), &roi), (dir / "seg_repaired.nii.gz").string());
+        write_image(session.field().phi(), (dir / "phi_repaired.nii.gz").string());
     }
     write_mesh(dir / "surface.ply", surface.view(), t1.lattice());
     nlohmann::json j;

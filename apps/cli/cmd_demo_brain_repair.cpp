@@ -16,7 +16,6 @@
 #include "liveset/eval/holes.hpp"
 #include "liveset/eval/topology.hpp"
 #include "liveset/io/image_io.hpp"
-#include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/window.hpp"
 #include "liveset/swarm/repair_schedule.hpp"
@@ -67,7 +66,8 @@ Verdicts verdicts(const std::vector<HoleSite>& targets, const Grid<std::uint8_t>
 }  // namespace
 
 // The repair half of the demo (cmd_demo_brain.cpp segments with ctx.epsilon_scale first).
-nlohmann::json repair_brain_holes(const BrainRepairInput& in, SparseField& field, FragmentMesher& mesher, bool quiet) {
+nlohmann::json repair_brain_holes(const BrainRepairInput& in, Session& session, bool quiet) {
+    const SparseField& field = session.field();
     HoleFinderOptions fo;
     fo.sheet_lower = in.band_lower;
     fo.sheet_upper = in.band_upper;
@@ -76,7 +76,7 @@ nlohmann::json repair_brain_holes(const BrainRepairInput& in, SparseField& field
     const std::vector<HoleCandidate> found = find_holes(mask_before, in.t1, &in.roi, fo);
     const std::vector<HoleSite> targets = pick_targets(found);
 
-    const Grid<float> unit = normalise(in.t1, in.scale);
+    const Grid<float>& unit = session.unit_image();  // the segmentation's normalisation (in.scale)
     const double lo = in.scale.to_unit(in.band_lower), hi = in.scale.to_unit(in.band_upper);
     const double mean = in.scale.to_unit(in.sheet_mean);
     RepairOptions ro;  // 200 agents as in the paper
@@ -100,7 +100,8 @@ nlohmann::json repair_brain_holes(const BrainRepairInput& in, SparseField& field
         r.swarm.sheet_upper = u;
         ++next;
     };
-    const RepairScheduleResult sched = run_repair_schedule(field, unit, &in.roi, ro, so, queue, setup, &mesher);
+    SessionRepairDriver driver(session);
+    const RepairScheduleResult sched = run_repair_schedule(driver, ro, so, queue, setup);
 
     const Grid<std::uint8_t> mask_after = inside_mask(field.phi(), &in.roi);
     const Grid<std::uint8_t> holes_after = hole_voxels(mask_after, in.t1, &in.roi, fo);

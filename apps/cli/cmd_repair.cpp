@@ -3,6 +3,10 @@
 // incremental mesh; one JSON line per step in --log.
 #include <fmt/core.h>
 
+#include <algorithm>
+
+#include <chrono>
+
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -11,6 +15,7 @@
 #include "commands.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
+#include "liveset/session/session.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_io.hpp"
@@ -108,6 +113,24 @@ void print_verdicts(const nlohmann::json& verdicts, bool have_band) {
     }
 }
 
+// The swarm steps of `liveset repair` through the session: target k becomes the swarm's target from
+// its step on (as run_repair does on a bare field); stops early on Ctrl-C.
+std::vector<RepairStepLog> run_targets(Session& session, std::vector<RepairTarget> order, int steps, const std::atomic<bool>& interrupt) {
+    std::stable_sort(order.begin(), order.end(), [](const RepairTarget& x, const RepairTarget& y) { return x.step < y.step; });
+    std::vector<RepairStepLog> log;
+    std::size_t next = 0;
+    for (int step = 0; step < steps; ++step) {
+        if (interrupt.load(std::memory_order_relaxed)) break;
+        const auto t0 = std::chrono::steady_clock::now();
+        while (next < order.size() && order[next].step <= step) session.set_target(order[next++].position);
+        RepairStepLog rec = session.swarm_step().swarm;
+        rec.step = step;
+        rec.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        log.push_back(rec);
+    }
+    return log;
+}
+
 int run_repair_command(RepairArgs a, int threads) {
     const auto guard = limit_threads(threads);
     const InterruptGuard interrupt;
@@ -138,10 +161,15 @@ int run_repair_command(RepairArgs a, int threads) {
     std::vector<RepairTarget> targets;
     for (const std::string& t : a.targets) targets.push_back(parse_target(t, image.lattice(), false));
     for (const std::string& t : a.targets_mm) targets.push_back(parse_target(t, image.lattice(), true));
-    SparseField field = load_level_set(a.input, image.lattice());
+    // The repair edits through a Session (the viewer's edit path: local update, history, mesher of
+    // 8³-cell fragments); the session's scale is robust_scale(image, roi), as before.
+    SessionOptions so;
+    so.fragment_size = 8;
+    Session session(image, so, roi);
+    load_level_set(session, a.input);
+    const SparseField& field = session.field();
     check_targets(targets, field, roi ? &*roi : nullptr, a.options);
-    const IntensityScale scale = robust_scale(image, roi ? &*roi : nullptr);
-    const Grid<float> unit = normalise(image, scale);
+    const IntensityScale scale = session.scale();
     const Grid<std::uint8_t> mask_before = inside_mask(field.phi(), roi ? &*roi : nullptr);
     const std::optional<HoleFinderOptions> band = sheet_band(a, image, mask_before, roi ? &*roi : nullptr);
     if (a.options.swarm.decision == EditDecision::kSheet) {
@@ -150,10 +178,8 @@ int run_repair_command(RepairArgs a, int threads) {
         a.options.swarm.sheet_upper = scale.to_unit(band->sheet_upper);
     }
 
-    FragmentMesher mesher(image.lattice(), 8);
-    mesher.full_rebuild(field.phi(), field.zero_layer());
-    const std::vector<RepairStepLog> log =
-        run_repair(field, unit, roi ? &*roi : nullptr, targets, a.options, &mesher, &interrupt.flag());
+    session.set_repair_options(a.options);
+    const std::vector<RepairStepLog> log = run_targets(session, targets, a.options.steps, interrupt.flag());
     if (interrupt.interrupted()) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} steps; nothing written\n", log.size());
         return 130;

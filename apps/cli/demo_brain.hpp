@@ -6,9 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "liveset/grid/grid.hpp"
-#include "liveset/levelset/sparse_field.hpp"
-#include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/segment/intensity.hpp"
+#include "liveset/session/session.hpp"
 
 namespace liveset::cli {
 
@@ -30,9 +29,9 @@ struct BrainRepairInput {
     double sheet_mean = 0;              // the grey matter's class mean (raw)
 };
 
-// Finder -> targets -> one 200-agent sheet-rule round per target -> verdicts; returns the report's
-// "repair" object (targets, verdicts, counts).
-nlohmann::json repair_brain_holes(const BrainRepairInput& in, SparseField& field, FragmentMesher& mesher, bool quiet);
+// Finder -> targets -> one 200-agent sheet-rule round per target, through `session` (which holds
+// the segmentation) -> verdicts; returns the report's "repair" object (targets, verdicts, counts).
+nlohmann::json repair_brain_holes(const BrainRepairInput& in, Session& session, bool quiet);
 // The demo's sub-optimally low threshold: ε = this × the tissue model window's half width.
 double brain_repair_epsilon_scale();
 

@@ -36,7 +36,7 @@ Session::Session(Grid<float> image, const SessionOptions& options, std::optional
     : options_(checked(options)),
       image_(std::move(image)),
       roi_(std::move(roi)),
-      scale_(robust_scale(image_, roi_ ? &*roi_ : nullptr, options.scale)),
+      scale_(options.given_scale ? *options.given_scale : robust_scale(image_, roi_ ? &*roi_ : nullptr, options.scale)),
       unit_(normalise(image_, scale_)),
       field_(image_.lattice(), options.layers),
       mesher_(image_.lattice(), options.fragment_size),
@@ -240,7 +240,7 @@ SessionUpdate Session::segment_step() {
     });
 }
 
-void Session::make_repair_loop() { repair_ = std::make_unique<RepairLoop>(field_, unit_, roi(), repair_options_, nullptr); }
+void Session::make_repair_loop() { repair_ = std::make_unique<RepairLoop>(field_, unit_, roi(), repair_options_); }
 
 void Session::set_repair_options(const RepairOptions& options) {
     validate(options.swarm);
@@ -254,6 +254,17 @@ void Session::set_repair_options(const RepairOptions& options) {
             target_.reset();  // the surface moved away from the old target (e.g. undone)
         }
     }
+    ++revision_;
+}
+
+void Session::aim_swarm(const RepairOptions& options, Vec3d target) {
+    validate(options.swarm);
+    if (!all_finite(target) || !lattice().contains(target)) throw std::invalid_argument("the target lies outside the image");
+    end_action();  // each round is its own undoable action
+    repair_options_ = options;
+    make_repair_loop();
+    repair_->set_target(target);  // a fresh loop: spawns the swarm on the surface nearest the target
+    target_ = target;
     ++revision_;
 }
 
@@ -289,7 +300,7 @@ std::optional<Vec3d> Session::nearest_surface_point(Vec3d p, double radius) cons
 
 SessionUpdate Session::swarm_step() {
     if (!repair_ || !repair_->spawned()) return {};
-    return edit("repair", Action::kContinued, [&] {
+    SessionUpdate u = edit("repair", Action::kContinued, [&] {
         RepairStep step = repair_->step();
         if (!step.changed.empty()) {
             marks_.pristine = false;
@@ -298,8 +309,11 @@ SessionUpdate Session::swarm_step() {
         Change c{std::move(step.changed)};
         c.level_set_ms = step.log.modified > 0 ? field_.last_update_ms() : 0.0;
         c.agents_ms = std::max(0.0, step.log.ms - c.level_set_ms);
+        c.swarm = step.log;
         return c;
     });
+    u.swarm.fragments = u.fragments.size();  // the mesher's U for this step's X
+    return u;
 }
 
 SessionUpdate Session::edit_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta) {
@@ -372,6 +386,7 @@ SessionUpdate Session::edit(const char* label, Action action, const std::functio
     const double level_set_ms = c.level_set_ms >= 0.0 ? c.level_set_ms : ms_since(t0);
     SessionUpdate u = finish_update(std::move(c.changed), level_set_ms);
     u.agents_ms = c.agents_ms;
+    u.swarm = c.swarm;
     if (action == Action::kOwn) history_.commit(field_, marks());
     return u;
 }

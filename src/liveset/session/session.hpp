@@ -28,6 +28,7 @@
 #include "liveset/segment/window.hpp"
 #include "liveset/session/edit_history.hpp"
 #include "liveset/swarm/repair.hpp"
+#include "liveset/swarm/repair_schedule.hpp"
 
 namespace liveset {
 
@@ -36,6 +37,9 @@ struct SessionOptions {
     int fragment_size = 16;       // cells per mesh fragment edge (one GPU buffer each)
     std::size_t history = 32;     // undoable actions kept (at least 20)
     ScaleOptions scale;           // intensity normalisation
+    // The normalisation to use instead of robust_scale(image, roi, scale): a segmentation's, so a
+    // session continuing it sees the same [0, 1] image.
+    std::optional<IntensityScale> given_scale;
     WindowOptions window;         // how µ, ε are estimated from the seeds (as `liveset segment`)
     SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
     RepairOptions repair;              // swarm settings (steps unused: the caller steps)
@@ -49,6 +53,7 @@ struct SessionUpdate {
     double level_set_ms = 0.0;          // sparse-field update (step, edits, restore, re-init)
     double agents_ms = 0.0;             // swarm move and edit proposals
     double mesh_ms = 0.0;               // incremental marching cubes
+    RepairStepLog swarm;                // a swarm step's log (fragments = |U|); zeros otherwise
 };
 
 struct SegmentStatus {
@@ -131,6 +136,10 @@ public:
     const std::optional<Vec3d>& target() const { return target_; }
     // The zero-layer point nearest `p` within `radius` voxels (nullopt: none).
     std::optional<Vec3d> nearest_surface_point(Vec3d p, double radius) const;
+    // A fresh swarm with `options` (the session's swarm settings from now on), spawned on the
+    // surface nearest `target` and aimed there: a repair round of a schedule. Throws
+    // std::invalid_argument like set_repair_options and set_target.
+    void aim_swarm(const RepairOptions& options, Vec3d target);
     // One swarm step (move, edits, local level-set update); consecutive steps form one action.
     // A no-op without a target.
     SessionUpdate swarm_step();
@@ -176,6 +185,7 @@ private:
         bool whole_state = false;
         double level_set_ms = -1.0;
         double agents_ms = 0.0;
+        RepairStepLog swarm{};  // a swarm step's log
     };
     // kOwn: an action of its own (seed, brush); kContinued: steps continue an open action of the
     // same label (segmentation, swarm); kHistory: undo/redo (the history itself wrote the states).
@@ -209,6 +219,19 @@ private:
     std::vector<std::uint8_t> dirty_flags_;
     std::vector<FragmentId> dirty_;
     std::uint64_t revision_ = 0;
+};
+
+// A repair schedule (swarm/repair_schedule.hpp) run through a session: each round aims a fresh
+// swarm (Session::aim_swarm) and every step goes through the session's edit path (history, mesher).
+class SessionRepairDriver : public RepairDriver {
+public:
+    explicit SessionRepairDriver(Session& session) : session_(session) {}
+    const SparseField& field() const override { return session_.field(); }
+    void aim(const RepairOptions& options, Vec3d target) override { session_.aim_swarm(options, target); }
+    RepairStepLog step() override { return session_.swarm_step().swarm; }
+
+private:
+    Session& session_;
 };
 
 }  // namespace liveset

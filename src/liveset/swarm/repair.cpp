@@ -106,13 +106,12 @@ std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>&
 }
 
 RepairLoop::RepairLoop(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
-                       const RepairOptions& options, FragmentMesher* mesher)
-    : field_(field), image_unit_(image_unit), roi_(roi), options_(options), mesher_(mesher), swarm_(options.swarm) {
+                       const RepairOptions& options)
+    : field_(field), image_unit_(image_unit), roi_(roi), options_(options), swarm_(options.swarm) {
     if (!(options.respawn_distance >= 0)) throw std::invalid_argument("the respawn distance must be >= 0");
     if (!(options.spawn_radius > 0)) throw std::invalid_argument("the spawn radius must be > 0");
     if (!(image_unit.dims() == field.lattice().dims())) throw std::invalid_argument("image and level set differ in size");
     if (roi && !(roi->dims() == field.lattice().dims())) throw std::invalid_argument("region of interest and level set differ in size");
-    if (mesher && !(mesher->lattice().dims() == field.lattice().dims())) throw std::invalid_argument("mesher and level set differ in size");
 }
 
 void RepairLoop::set_target(Vec3d target) {
@@ -166,10 +165,6 @@ RepairStep RepairLoop::step() {
         if (!edits.empty()) {
             out.changed = field_.apply_edits(edits, RepairScope::kLocal);
             out.log.changed = out.changed.size();
-            if (mesher_) {
-                out.fragments = mesher_->update(field_.phi(), out.changed.points);
-                out.log.fragments = out.fragments.size();
-            }
         }
     }
     out.log.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
@@ -178,7 +173,7 @@ RepairStep RepairLoop::step() {
 
 std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                                       std::span<const RepairTarget> targets, const RepairOptions& options,
-                                      FragmentMesher* mesher, const std::atomic<bool>* interrupt) {
+                                      const std::atomic<bool>* interrupt) {
     validate(options.swarm);
     if (options.steps < 0) throw std::invalid_argument("the number of repair steps must not be negative");
     if (targets.empty()) throw std::invalid_argument("repair needs at least one target");
@@ -189,7 +184,7 @@ std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& ima
     }
     std::stable_sort(order.begin(), order.end(), [](const RepairTarget& a, const RepairTarget& b) { return a.step < b.step; });
 
-    RepairLoop loop(field, image_unit, roi, options, mesher);
+    RepairLoop loop(field, image_unit, roi, options);
     std::size_t next = 0;
     std::vector<RepairStepLog> log;
     for (int step = 0; step < options.steps; ++step) {

@@ -1,6 +1,6 @@
 // Headless hole repair (paper §4): a swarm spawned at the user's target walks the zero level set,
 // proposes local edits each step, the edits go through the sparse field's *local* update, and the
-// changed points X go to the incremental mesher — nothing else is recomputed. Targets can change
+// changed points X are returned for the caller to mesh (the Session does) — nothing else is recomputed. Targets can change
 // over time (a user moving the mouse): target k takes effect from its step on.
 #pragma once
 
@@ -9,7 +9,6 @@
 #include <span>
 #include <vector>
 
-#include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/swarm/swarm.hpp"
 
 namespace liveset {
@@ -38,7 +37,7 @@ struct RepairStepLog {
     std::size_t modified = 0;    // zero-layer points edited this step
     std::size_t guarded = 0;     // edits dropped by the topology guard
     std::size_t changed = 0;     // |X| reported by the local update
-    std::size_t fragments = 0;   // fragments re-polygonised (0 without a mesher)
+    std::size_t fragments = 0;   // fragments re-polygonised (filled by whoever meshes X: the Session)
     double ms = 0.0;             // wall time of move + edits + level set + mesh
 };
 
@@ -49,24 +48,20 @@ struct RepairStepLog {
 // cavity is kept. Flips already accepted count for the later points. Returns the number dropped.
 std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits);
 
-// One repair step's outcome: the log line plus what a renderer needs (the changed points X and the
-// fragments the mesher rebuilt for them, sorted).
+// One repair step's outcome: the log line plus the changed points X (for the mesher).
 struct RepairStep {
     RepairStepLog log;
     ChangedPoints changed;
-    std::vector<FragmentId> fragments;
 };
 
-// The interactive repair loop, one step at a time (the viewer calls step() once per frame, the CLI
-// in a loop): swarm move -> surface edits (ROI and topology guard applied) -> local level-set
-// update -> incremental mesh. The swarm is spawned on the surface nearest the first target; later
+// The interactive repair loop, one step at a time (the Session calls step() and meshes X): swarm
+// move -> surface edits (ROI and topology guard applied) -> local level-set update. The swarm is spawned on the surface nearest the first target; later
 // targets re-aim it (respawn() moves it at once, as a click far from the swarm would).
 class RepairLoop {
 public:
-    // `field`, `image_unit`, `roi` and `mesher` must outlive the loop; `mesher` (optional) must have
-    // been full_rebuild() on field.phi(). Throws std::invalid_argument on bad options or sizes.
-    RepairLoop(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
-               const RepairOptions& options, FragmentMesher* mesher = nullptr);
+    // `field`, `image_unit` and `roi` must outlive the loop. Throws std::invalid_argument on bad
+    // options or sizes.
+    RepairLoop(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi, const RepairOptions& options);
 
     // Aims the swarm at `target` (index space, inside the lattice); spawns it there first if it
     // has no agents yet or the target is farther than options.respawn_distance from its centroid. Throws std::invalid_argument outside the lattice or when no surface lies
@@ -86,7 +81,6 @@ private:
     const Grid<float>& image_unit_;
     const Grid<std::uint8_t>* roi_;
     RepairOptions options_;
-    FragmentMesher* mesher_;
     Swarm swarm_;
     bool spawned_ = false;
     int steps_ = 0;
@@ -96,6 +90,6 @@ private:
 // Stops early when `interrupt` turns true. Throws std::invalid_argument on bad targets/options.
 std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                                       std::span<const RepairTarget> targets, const RepairOptions& options,
-                                      FragmentMesher* mesher = nullptr, const std::atomic<bool>* interrupt = nullptr);
+                                      const std::atomic<bool>* interrupt = nullptr);
 
 }  // namespace liveset

@@ -3,6 +3,7 @@
 #include "liveset/swarm/repair_schedule.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -24,17 +25,26 @@ void RepairScheduleOptions::validate() const {
     hole_brush_range(0, shell_thickness, max_range);  // throws on a bad brush sizing
 }
 
-RepairScheduleResult run_repair_schedule(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
-                                         const RepairOptions& base, const RepairScheduleOptions& schedule,
-                                         const HoleSiteFinder& find, const RoundSetup& setup, FragmentMesher* mesher,
-                                         const std::atomic<bool>* interrupt) {
+void FieldRepairDriver::aim(const RepairOptions& options, Vec3d target) {
+    loop_ = std::make_unique<RepairLoop>(field_, image_unit_, roi_, options);
+    loop_->set_target(target);
+}
+
+RepairStepLog FieldRepairDriver::step() {
+    if (!loop_) throw std::logic_error("FieldRepairDriver::step before aim");
+    return loop_->step().log;
+}
+
+RepairScheduleResult run_repair_schedule(RepairDriver& driver, const RepairOptions& base, const RepairScheduleOptions& schedule,
+                                         const HoleSiteFinder& find, const RoundSetup& setup, const std::atomic<bool>* interrupt) {
     schedule.validate();
     validate(base.swarm);
     if (!find) throw std::invalid_argument("repair schedule: no hole finder");
+    const auto interrupted = [&] { return interrupt && interrupt->load(std::memory_order_relaxed); };
     RepairScheduleResult out;
-    std::vector<HoleSite> holes = find(field);
+    std::vector<HoleSite> holes = find(driver.field());
     for (int r = 0; r < schedule.rounds && !holes.empty(); ++r) {
-        if (interrupt && interrupt->load(std::memory_order_relaxed)) {
+        if (interrupted()) {
             out.interrupted = true;
             break;
         }
@@ -47,19 +57,27 @@ RepairScheduleResult run_repair_schedule(SparseField& field, const Grid<float>& 
         ro.swarm.edit_range = hole_brush_range(round.target.voxels, schedule.shell_thickness, schedule.max_range);
         if (setup) setup(ro, round.target);
         round.edit_range = ro.swarm.edit_range;
-        const RepairTarget target{round.target.position, 0};
-        const std::vector<RepairStepLog> log = run_repair(field, image_unit, roi, {&target, 1}, ro, mesher, interrupt);
-        for (const RepairStepLog& l : log) {
+        driver.aim(ro, round.target.position);
+        for (int step = 0; step < ro.steps && !interrupted(); ++step) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const RepairStepLog l = driver.step();
             round.modified += l.modified;
             round.fragments += l.fragments;
-            round.ms += l.ms;
+            round.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            ++round.steps;
         }
-        round.steps = static_cast<int>(log.size());
         out.rounds.push_back(round);
-        holes = find(field);
+        holes = find(driver.field());
     }
     out.holes_left = holes.size();
     return out;
+}
+
+RepairScheduleResult run_repair_schedule(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
+                                         const RepairOptions& base, const RepairScheduleOptions& schedule,
+                                         const HoleSiteFinder& find, const RoundSetup& setup, const std::atomic<bool>* interrupt) {
+    FieldRepairDriver driver(field, image_unit, roi);
+    return run_repair_schedule(driver, base, schedule, find, setup, interrupt);
 }
 
 std::pair<double, double> local_sheet_band(const Grid<float>& image_unit, const Grid<float>& phi, Vec3d site, double radius,

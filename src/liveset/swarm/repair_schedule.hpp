@@ -6,6 +6,7 @@
 #include <atomic>
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "liveset/swarm/repair.hpp"
@@ -48,18 +49,50 @@ struct RepairScheduleResult {
     bool interrupted = false;
 };
 
+// What a schedule drives: the level set it reads and a swarm it aims and steps. The Session is one
+// (session/session.hpp: its edit path records, meshes and reports every step); FieldRepairDriver
+// drives a bare SparseField (tests, experiments).
+class RepairDriver {
+public:
+    virtual ~RepairDriver() = default;
+    virtual const SparseField& field() const = 0;
+    // A fresh swarm with `options`, spawned on the surface nearest `target` and aimed there.
+    virtual void aim(const RepairOptions& options, Vec3d target) = 0;
+    virtual RepairStepLog step() = 0;  // one swarm step, its edits applied
+};
+
+// A RepairLoop on a bare field (nothing meshed, no history).
+class FieldRepairDriver : public RepairDriver {
+public:
+    FieldRepairDriver(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi)
+        : field_(field), image_unit_(image_unit), roi_(roi) {}
+    const SparseField& field() const override { return field_; }
+    void aim(const RepairOptions& options, Vec3d target) override;
+    RepairStepLog step() override;
+
+private:
+    SparseField& field_;
+    const Grid<float>& image_unit_;
+    const Grid<std::uint8_t>* roi_;
+    std::unique_ptr<RepairLoop> loop_;
+};
+
 // The holes left on the current surface, the one to aim at first.
 using HoleSiteFinder = std::function<std::vector<HoleSite>(const SparseField& field)>;
 // Adjusts a round's options for its target (e.g. the sheet band sampled there); may be empty.
 using RoundSetup = std::function<void(RepairOptions& round, const HoleSite& target)>;
 
 // Round r: holes = find(field); none left -> stop; else aim a fresh swarm (seed base.seed + r) at
-// holes.front() with edit_range = hole_brush_range(its voxels) and run round_steps steps
-// (run_repair). Throws std::invalid_argument on bad options.
+// holes.front() with edit_range = hole_brush_range(its voxels) and run round_steps steps. Throws
+// std::invalid_argument on bad options.
+RepairScheduleResult run_repair_schedule(RepairDriver& driver, const RepairOptions& base, const RepairScheduleOptions& schedule,
+                                         const HoleSiteFinder& find, const RoundSetup& setup = {},
+                                         const std::atomic<bool>* interrupt = nullptr);
+// The same on a bare field (a FieldRepairDriver).
 RepairScheduleResult run_repair_schedule(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                                          const RepairOptions& base, const RepairScheduleOptions& schedule,
                                          const HoleSiteFinder& find, const RoundSetup& setup = {},
-                                         FragmentMesher* mesher = nullptr, const std::atomic<bool>* interrupt = nullptr);
+                                         const std::atomic<bool>* interrupt = nullptr);
 
 // The sheet's own band around a hole: the model's band [lower, upper) of the sheet tissue (class
 // mean `mean`; normalised units) shifted by (m − mean), m the median intensity of the voxels inside
