@@ -8,11 +8,13 @@
 #include "cli_common.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
+#include "liveset/eval/holes.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/levelset/sparse_field.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_io.hpp"
 #include "liveset/preprocess/bias_correction.hpp"
+#include "liveset/segment/window.hpp"
 
 namespace liveset::py {
 
@@ -214,6 +216,41 @@ std::string evaluate(const pyb::array& mask, const pyb::array& truth, const Latt
     return cli::evaluation_report(m, t).dump();
 }
 
+// `liveset holes` (apps/cli/cmd_holes.cpp) on arrays: the sheet's band given or from the tissue
+// model (sheet_window), the candidates largest first. Returns the JSON text.
+std::string find_holes_json(const pyb::array& mask, const pyb::array& image, const pyb::object& roi, const Lattice& lattice,
+                            const std::optional<std::pair<double, double>>& band, std::size_t min_voxels, double min_sheet_share) {
+    const Grid<std::uint8_t> m = mask_from_array(mask, lattice);
+    const Grid<float> img = grid_from_array(image, lattice);
+    std::optional<Grid<std::uint8_t>> r;
+    if (!roi.is_none()) r = mask_from_array(roi.cast<pyb::array>(), lattice);
+    pyb::gil_scoped_release nogil;
+    HoleFinderOptions fo;
+    fo.min_voxels = min_voxels;
+    fo.min_sheet_share = min_sheet_share;
+    std::vector<std::string> warnings;
+    if (band) {
+        fo.sheet_lower = band->first;
+        fo.sheet_upper = band->second;
+    } else {
+        const std::optional<ModelWindow> w = sheet_window(img, m, r ? &*r : nullptr, TissueModelOptions{}, warnings);
+        if (!w) throw std::invalid_argument("cannot tell the sheet's tissue from the image (" +
+                                            (warnings.empty() ? std::string("no tissue model") : warnings.back()) +
+                                            "); give sheet_band=(lower, upper)");
+        fo.sheet_lower = w->lower;
+        fo.sheet_upper = w->upper;
+    }
+    fo.validate();
+    const std::vector<HoleCandidate> holes = find_holes(m, img, r ? &*r : nullptr, fo);
+    nlohmann::json sites = nlohmann::json::array();
+    for (const HoleCandidate& h : holes)
+        sites.push_back({{"voxels", h.voxels}, {"rim", h.rim}, {"sheet", h.sheet}, {"target", {h.site.x, h.site.y, h.site.z}},
+                         {"centroid", {h.centroid.x, h.centroid.y, h.centroid.z}}});
+    return nlohmann::json{{"sheet_band", {fo.sheet_lower, fo.sheet_upper}}, {"band_from", band ? "user" : "tissue model"},
+                          {"holes", sites}, {"warnings", warnings}}
+        .dump();
+}
+
 SegmentArgs segment_args(const pyb::kwargs& kw) {
     SegmentArgs a;
     for (const auto& [key, value] : kw) {
@@ -274,6 +311,12 @@ void register_core(pyb::module_& m) {
     m.def("_mesh", [](const pyb::array& v, const pyb::tuple& geo, bool is_mask, const std::string& out) {
         if (v.ndim() != 3) throw std::invalid_argument("the input must be a 3D array");
         return mesh(v, lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]), is_mask, out);
+    });
+    m.def("_find_holes", [](const pyb::array& mask, const pyb::array& image, const pyb::object& roi, const pyb::tuple& geo,
+                            const std::optional<std::pair<double, double>>& band, std::size_t min_voxels, double min_sheet_share) {
+        if (mask.ndim() != 3) throw std::invalid_argument("the mask must be a 3D array");
+        const Lattice l = lattice_from(pyb::make_tuple(mask.shape(0), mask.shape(1), mask.shape(2)), geo[0], geo[1], geo[2]);
+        return find_holes_json(mask, image, roi, l, band, min_voxels, min_sheet_share);
     });
     m.def("_evaluate", [](const pyb::array& mask, const pyb::array& truth, const pyb::tuple& geo) {
         if (mask.ndim() != 3) throw std::invalid_argument("the mask must be a 3D array");

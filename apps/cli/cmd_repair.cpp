@@ -131,9 +131,8 @@ std::vector<RepairStepLog> run_targets(Session& session, std::vector<RepairTarge
     return log;
 }
 
-int run_repair_command(RepairArgs a, int threads) {
-    const auto guard = limit_threads(threads);
-    const InterruptGuard interrupt;
+// Every option checked before any work starts (the sheet band, when given, checked with the rest).
+void check_repair_args(RepairArgs& a) {
     if (a.out_phi.empty() && a.out_mask.empty()) throw UsageError("give --out-phi and/or --out-mask");
     if (!a.out_phi.empty()) check_output_path(a.out_phi, OutputKind::kImage, "--out-phi");
     if (!a.out_mask.empty()) check_output_path(a.out_mask, OutputKind::kImage, "--out-mask");
@@ -154,6 +153,12 @@ int run_repair_command(RepairArgs a, int threads) {
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
     }
+}
+
+int run_repair_command(RepairArgs a, int threads) {
+    const auto guard = limit_threads(threads);
+    const InterruptGuard interrupt;
+    check_repair_args(a);
 
     const Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> roi;

@@ -162,6 +162,30 @@ def evaluate(mask, truth, label: Optional[int] = None) -> dict:
     return json.loads(_liveset._evaluate(np.asarray(m.array) != 0, ta, m.geometry))
 
 
+def find_holes(mask, image, roi=None, sheet_band=None, min_voxels: int = 10, min_sheet_share: float = 0.1) -> dict:
+    """``liveset holes``: holes of a segmented sheet found without ground truth — unsegmented voxels
+    that look like the sheet's tissue where the tissue it encloses meets the outside.
+
+    ``mask`` the segmentation (non-zero inside) or a φ image (< 0 inside is not assumed: pass a
+    mask), ``image`` the raw image on the same grid, ``roi`` optional. ``sheet_band=(lower, upper)``
+    in raw intensities; by default the tissue model's band of the sheet's class. Returns
+    ``{"sheet_band", "band_from", "holes": [{"voxels", "rim", "sheet", "target": [i, j, k],
+    "centroid"}, ...] (largest first), "warnings"}``; a ``target`` is what ``repair`` and
+    ``liveset repair --target`` take."""
+    m, img = as_image(mask, "mask"), as_image(image, "image")
+    if not m.same_geometry(img):
+        raise ValueError("the mask and the image do not share a geometry (shape, spacing, origin or direction)")
+    r = None
+    if roi is not None:
+        ri = as_image(roi, "roi")
+        if not ri.same_geometry(img):
+            raise ValueError("the roi and the image do not share a geometry (shape, spacing, origin or direction)")
+        r = np.asarray(ri.array) != 0
+    band = None if sheet_band is None else (float(sheet_band[0]), float(sheet_band[1]))
+    return json.loads(_liveset._find_holes(np.asarray(m.array) != 0, np.asarray(img.array, dtype=np.float32), r,
+                                           m.geometry, band, int(min_voxels), float(min_sheet_share)))
+
+
 def set_threads(threads: int) -> None:
     """Limit liveset's worker threads (0: all cores). Results are identical for any count."""
     _liveset.set_threads(int(threads))

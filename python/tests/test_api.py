@@ -217,3 +217,25 @@ def test_docs_example_runs(tmp_path):
     assert result["dice"] > 0.8 and result["triangles"] > 0
     seg = nib.load(str(tmp_path / "seg.nii.gz"))
     np.testing.assert_allclose(seg.affine, nib.load(str(tmp_path / "t1.nii.gz")).affine, atol=1e-6)
+
+
+def test_find_holes_finds_exactly_a_drilled_hole():
+    # A grey-matter shell (0.5) between white matter (1.0) and CSF (0.1), segmented except for a
+    # 4x4 shaft drilled through the top: the finder's one candidate is exactly the drilled voxels.
+    n, c = 40, 19.5
+    ijk = np.stack(np.meshgrid(*[np.arange(n)] * 3, indexing="ij"), -1).astype(float)
+    r = np.linalg.norm(ijk - c, axis=-1)
+    image = np.where(r < 8, 1.0, np.where(r < 12, 0.5, 0.1)).astype(np.float32)
+    shell = (r >= 8) & (r < 12)
+    drilled = shell & (np.abs(ijk[..., 0] - c) < 2) & (np.abs(ijk[..., 1] - c) < 2) & (ijk[..., 2] > c)
+    img = liveset.Image(image, SPACING, ORIGIN, DIRECTION)
+    found = liveset.find_holes(img.like((shell & ~drilled).astype(np.uint8)), img, sheet_band=(0.3, 0.75), min_voxels=1)
+    assert found["band_from"] == "user"
+    assert len(found["holes"]) == 1
+    hole = found["holes"][0]
+    assert hole["voxels"] == int(drilled.sum())
+    assert drilled[tuple(hole["target"])]
+    intact = liveset.find_holes(img.like(shell.astype(np.uint8)), img, sheet_band=(0.3, 0.75), min_voxels=1)
+    assert intact["holes"] == []
+    with pytest.raises(ValueError):
+        liveset.find_holes(img.like(shell.astype(np.uint8)), img, sheet_band=(0.75, 0.3))

@@ -276,15 +276,30 @@ StepReport Swarm::move(const SparseField& field) {
     return report;
 }
 
-std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const Grid<float>& image_unit) {
-    require(image_unit.dims() == field.lattice().dims(), "swarm: image and level set dimensions differ");
-    const std::size_t n_agents = agents_.size();
-    if (n_agents == 0) return {};
-    const Grid<float>& phi = field.phi();
-    const Lattice& lat = field.lattice();
-    const std::uint64_t frame = edit_steps_++;
+namespace {
 
-    // Population statistics (summed in agent order: deterministic).
+// The agents' edits merged per point (summed, clamped to ±0.5), in point order.
+std::vector<ZeroLayerEdit> merge_edits(const std::vector<std::vector<ZeroLayerEdit>>& per_agent) {
+    std::vector<ZeroLayerEdit> all;
+    for (const auto& v : per_agent) all.insert(all.end(), v.begin(), v.end());
+    std::stable_sort(all.begin(), all.end(),
+                     [](const ZeroLayerEdit& a, const ZeroLayerEdit& b) { return a.point < b.point; });
+    std::vector<ZeroLayerEdit> merged;
+    for (std::size_t k = 0; k < all.size();) {
+        const PointIndex p = all[k].point;
+        double total = 0.0;
+        for (; k < all.size() && all[k].point == p; ++k) total += all[k].delta;
+        merged.push_back({p, static_cast<float>(std::clamp(total, -0.5, 0.5))});
+    }
+    return merged;
+}
+
+}  // namespace
+
+// The population's intensity mean and spread (summed in agent order: deterministic), smoothed
+// over the steps; returns {µ, σ}.
+std::pair<double, double> Swarm::population_statistics(const Grid<float>& phi, const Grid<float>& image_unit) {
+    const std::size_t n_agents = agents_.size();
     double sum = 0.0, sum2 = 0.0;
     for (const Agent& a : agents_) {
         Vec3d where = a.position;
@@ -307,8 +322,19 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
         mean_ = (1 - a) * mean_ + a * m;
         second_ = (1 - a) * second_ + a * s;
     }
-    const double mu = mean_;
-    const double sigma = std::max(std::sqrt(std::max(second_ - mean_ * mean_, 0.0)), options_.min_sigma);
+
+    return {mean_, std::max(std::sqrt(std::max(second_ - mean_ * mean_, 0.0)), options_.min_sigma)};
+}
+
+std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const Grid<float>& image_unit) {
+    require(image_unit.dims() == field.lattice().dims(), "swarm: image and level set dimensions differ");
+    const std::size_t n_agents = agents_.size();
+    if (n_agents == 0) return {};
+    const Grid<float>& phi = field.phi();
+    const Lattice& lat = field.lattice();
+    const std::uint64_t frame = edit_steps_++;
+
+    const auto [mu, sigma] = population_statistics(phi, image_unit);
 
     const double support = options_.edit_radius;
     const double sg = support / 2.0;
@@ -362,18 +388,7 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
         }
     });
 
-    std::vector<ZeroLayerEdit> all;
-    for (const auto& v : per_agent) all.insert(all.end(), v.begin(), v.end());
-    std::stable_sort(all.begin(), all.end(),
-                     [](const ZeroLayerEdit& a, const ZeroLayerEdit& b) { return a.point < b.point; });
-    std::vector<ZeroLayerEdit> merged;
-    for (std::size_t k = 0; k < all.size();) {
-        const PointIndex p = all[k].point;
-        double total = 0.0;
-        for (; k < all.size() && all[k].point == p; ++k) total += all[k].delta;
-        merged.push_back({p, static_cast<float>(std::clamp(total, -0.5, 0.5))});
-    }
-    return merged;
+    return merge_edits(per_agent);
 }
 
 std::optional<double> Swarm::intensity_mean() const {

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
@@ -94,6 +95,8 @@ public:
     std::optional<double> intensity_sigma() const;
 
 private:
+    // The population's intensity {µ, σ}, smoothed over the steps (surface_edits' decision rule).
+    std::pair<double, double> population_statistics(const Grid<float>& phi, const Grid<float>& image_unit);
     SwarmOptions options_;
     std::vector<Agent> agents_;
     std::optional<Vec3d> target_;
