@@ -334,7 +334,10 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
     const Lattice& lat = field.lattice();
     const std::uint64_t frame = edit_steps_++;
 
-    const auto [mu, sigma] = population_statistics(phi, image_unit);
+    // Plain variables, not a structured binding: the parallel loop below captures them (clang 14,
+    // the fuzz preset's compiler, cannot capture structured bindings).
+    const std::pair<double, double> stats = population_statistics(phi, image_unit);
+    const double mu = stats.first, sigma = stats.second;
 
     const double support = options_.edit_radius;
     const double sg = support / 2.0;
