@@ -79,25 +79,8 @@ SegmentRequest request_for(const SegmentArgs& a, const Lattice& lattice, bool ne
     if (a.window_from != "model" && a.window_from != "seeds") throw UsageError("window_from must be 'model' or 'seeds'");
     if (a.iterations < 1) throw UsageError("iterations must be at least 1");
     SegmentRequest req;
-    for (const std::string& s : a.seeds) {
-        req.seeds.push_back(cli::parse_seed_voxel(s, a.seed_radius));
-        cli::check_seed_inside(req.seeds.back(), lattice, s);
-    }
-    for (const std::string& s : a.seeds_mm) {
-        req.seeds.push_back(cli::parse_seed_mm(s, lattice, a.seed_radius));
-        cli::check_seed_inside(req.seeds.back(), lattice, s + " (mm)");
-    }
+    cli::fill_segment_request(req, a, lattice);
     if (need_seeds && req.seeds.empty() && a.init_mask.is_none()) throw UsageError("give at least one seed I,J,K[:R] (or seeds_mm, or init_mask)");
-    req.n = a.n;
-    req.alpha = a.alpha;
-    req.loop.max_iterations = a.iterations;
-    req.loop.step = sleeping_step();
-    req.mu = a.mu;
-    req.epsilon = a.epsilon;
-    req.mu_raw = a.mu_raw;
-    req.epsilon_raw = a.epsilon_raw;
-    req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
-    req.window.model.classes = a.classes;
     return req;
 }
 

@@ -82,12 +82,7 @@ nlohmann::json run_demo_repair(const DemoArgs& a, const Phantom& ph, const Segme
     ro.swarm.seed = a.seed;
     // The holes a user would point at: perforations first, then spurious cavities (bubbles).
     const HoleSiteFinder holes_left = [&](const SparseField& field) {
-        const Grid<std::uint8_t> m = inside_mask(field.phi());
-        std::vector<Perforation> h = find_perforations(m, ph.truth, white);
-        if (h.empty()) h = find_cavities(m, white);
-        std::vector<HoleSite> sites;
-        for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
-        return sites;
+        return truth_hole_sites(inside_mask(field.phi()), ph.truth, white);
     };
     const std::vector<HoleSite> first = holes_left(session.field());
     first_hole = first.empty() ? std::nullopt : std::optional<Vec3d>(first.front().position);

@@ -59,27 +59,10 @@ void check_segment_args(const SegmentArgs& a) {
 SegmentRequest segment_request(const SegmentArgs& a, const Lattice& lattice, const std::optional<Roi>& roi,
                                const std::optional<Grid<std::uint8_t>>& init, const Grid<std::uint8_t>* fit) {
     SegmentRequest req;
-    for (const std::string& s : a.seeds) {
-        req.seeds.push_back(parse_seed_voxel(s, a.seed_radius));
-        check_seed_inside(req.seeds.back(), lattice, s);
-    }
-    for (const std::string& s : a.seeds_mm) {
-        req.seeds.push_back(parse_seed_mm(s, lattice, a.seed_radius));
-        check_seed_inside(req.seeds.back(), lattice, s + " (mm)");
-    }
+    fill_segment_request(req, a, lattice);
     if (roi) req.roi = &roi->mask;
     if (init) req.initial_mask = &*init;
     req.model_region = fit;
-    req.n = a.n;
-    req.alpha = a.alpha;
-    req.loop.max_iterations = a.iterations;
-    req.loop.step = sleeping_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
-    req.mu = a.mu;
-    req.epsilon = a.epsilon;
-    req.mu_raw = a.mu_raw;
-    req.epsilon_raw = a.epsilon_raw;
-    req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
-    req.window.model.classes = a.classes;
     return req;
 }
 

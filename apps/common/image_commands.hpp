@@ -7,6 +7,7 @@
 #include <string>
 
 #include "liveset/eval/holes.hpp"
+#include "cli_support.hpp"
 #include "liveset/eval/overlap.hpp"
 #include "liveset/eval/surface_distance.hpp"
 #include "liveset/eval/topology.hpp"
@@ -82,5 +83,30 @@ void print_evaluation(const nlohmann::json& report, const std::string& indent = 
 // One repair target's verdict: {"target": [i,j,k], "hole_voxels", "closed", "finder_voxels_near":
 // {before, after}, "local_genus": {before, after}} (hole_voxels omitted when 0).
 nlohmann::json verdict_json(Vec3i target, std::size_t hole_voxels, const HoleVerdict& verdict);
+
+// What `liveset segment`'s options put into a request: the seeds (voxel and mm, parsed and checked
+// inside the image) and the speed, window and loop settings. Shared by the CLI and the Python module,
+// so both segment alike; `Options` is the command's (or the binding's) argument struct.
+template <class Options>
+void fill_segment_request(SegmentRequest& req, const Options& a, const Lattice& lattice) {
+    for (const std::string& s : a.seeds) {
+        req.seeds.push_back(parse_seed_voxel(s, a.seed_radius));
+        check_seed_inside(req.seeds.back(), lattice, s);
+    }
+    for (const std::string& s : a.seeds_mm) {
+        req.seeds.push_back(parse_seed_mm(s, lattice, a.seed_radius));
+        check_seed_inside(req.seeds.back(), lattice, s + " (mm)");
+    }
+    req.n = a.n;
+    req.alpha = a.alpha;
+    req.loop.max_iterations = a.iterations;
+    req.loop.step = sleeping_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
+    req.mu = a.mu;
+    req.epsilon = a.epsilon;
+    req.mu_raw = a.mu_raw;
+    req.epsilon_raw = a.epsilon_raw;
+    req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
+    req.window.model.classes = a.classes;
+}
 
 }  // namespace liveset::cli

@@ -114,12 +114,7 @@ TEST(Repair, SwarmClosesThePhantomPerforations) {
     RepairOptions ro = demo_repair_options();  // 200 agents, p = 0.3, 2 sigmas, radius 3, brush 8
     ro.swarm.seed = 1;
     const HoleSiteFinder holes_left = [&](const SparseField& field) {  // perforations, then bubbles, as the demo
-        const Grid<std::uint8_t> m = inside_mask(field.phi());
-        std::vector<Perforation> h = find_perforations(m, ph.truth, white);
-        if (h.empty()) h = find_cavities(m, white);
-        std::vector<HoleSite> sites;
-        for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
-        return sites;
+        return truth_hole_sites(inside_mask(field.phi()), ph.truth, white);
     };
     RepairScheduleOptions so;  // 20 rounds of 100 steps, the brush sized to each hole
     const RepairScheduleResult sched = run_repair_schedule(*o.field, unit, nullptr, ro, so, holes_left);

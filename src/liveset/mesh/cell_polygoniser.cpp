@@ -121,24 +121,6 @@ void CellPolygoniser::enter_layer(int z) {
     layer_ = z;
 }
 
-namespace {
-
-// Per cell edge e: the offset of its start corner and its axis, as used to index G.
-struct EdgeStart {
-    int dx, dy, dz, axis;
-};
-constexpr std::array<EdgeStart, mc::kEdges> kEdgeStarts = [] {
-    std::array<EdgeStart, mc::kEdges> t{};
-    for (int e = 0; e < mc::kEdges; ++e) {
-        const mc::EdgeInfo info = mc::edge_info(e);
-        t[static_cast<std::size_t>(e)] = {mc::corner_offset(info.start_corner, 0), mc::corner_offset(info.start_corner, 1),
-                                          mc::corner_offset(info.start_corner, 2), info.axis};
-    }
-    return t;
-}();
-
-}  // namespace
-
 void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& out) {
     const auto& tables = mc::kTables;
     // G offset of the cell's minimum corner; a corner (dx, dy, dz) adds dx*3 + dy*px*3 and picks the
@@ -150,7 +132,7 @@ void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& o
     std::uint32_t v[mc::kEdges];
     for (unsigned mask = tables.edges[static_cast<std::size_t>(cs)]; mask != 0; mask &= mask - 1) {
         const int e = std::countr_zero(mask);
-        const EdgeStart& es = kEdgeStarts[static_cast<std::size_t>(e)];
+        const mc::EdgeStart& es = mc::kEdgeStarts[static_cast<std::size_t>(e)];
         const int slot = slot0 ^ es.dz;
         const std::size_t gi = static_cast<std::size_t>(slot) * slice_ + row + static_cast<std::size_t>(es.dy) * row_step +
                                static_cast<std::size_t>(es.dx) * 3 + static_cast<std::size_t>(es.axis);

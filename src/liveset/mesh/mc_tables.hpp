@@ -56,6 +56,20 @@ constexpr EdgeInfo edge_info(int edge) {
     return {axis, start, start | (1 << axis)};
 }
 
+// Each edge as the offset of its start corner from the cell origin and its axis (the marchers' lookup).
+struct EdgeStart {
+    int dx, dy, dz, axis;
+};
+inline constexpr std::array<EdgeStart, kEdges> kEdgeStarts = [] {
+    std::array<EdgeStart, kEdges> t{};
+    for (int e = 0; e < kEdges; ++e) {
+        const EdgeInfo info = edge_info(e);
+        t[static_cast<std::size_t>(e)] = {corner_offset(info.start_corner, 0), corner_offset(info.start_corner, 1),
+                                          corner_offset(info.start_corner, 2), info.axis};
+    }
+    return t;
+}();
+
 // The edge joining two corners that differ along exactly one axis.
 constexpr int edge_between(int c1, int c2) {
     const int diff = c1 ^ c2;

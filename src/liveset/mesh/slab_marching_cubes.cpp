@@ -44,20 +44,6 @@ inline std::uint64_t pack_signs(const float* v, int n) {
 
 inline int bit(const std::uint64_t* row, int x) { return static_cast<int>((row[x >> 6] >> (x & 63)) & 1u); }
 
-// The G offset (start corner dx, dy, dz; axis) of every cube edge.
-struct EdgeStart {
-    int dx, dy, dz, axis;
-};
-constexpr std::array<EdgeStart, mc::kEdges> kEdgeStarts = [] {
-    std::array<EdgeStart, mc::kEdges> t{};
-    for (int e = 0; e < mc::kEdges; ++e) {
-        const mc::EdgeInfo info = mc::edge_info(e);
-        t[static_cast<std::size_t>(e)] = {mc::corner_offset(info.start_corner, 0), mc::corner_offset(info.start_corner, 1),
-                                          mc::corner_offset(info.start_corner, 2), info.axis};
-    }
-    return t;
-}();
-
 // The four point rows around cell row (y, z): corner bit k of a cell = row k>>1 at x + (k & 1).
 struct CellRows {
     const std::uint64_t* r[4];  // (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1)
@@ -186,7 +172,7 @@ SlabCount SlabWorker::run(const Grid<float>& phi, const SignBits& s, int z0, int
                     std::uint32_t v[mc::kEdges];
                     for (unsigned mask = tables.edges[static_cast<std::size_t>(cs)]; mask != 0; mask &= mask - 1) {
                         const int e = std::countr_zero(mask);
-                        const EdgeStart& es = kEdgeStarts[static_cast<std::size_t>(e)];
+                        const mc::EdgeStart& es = mc::kEdgeStarts[static_cast<std::size_t>(e)];
                         const Vec3i p{x + es.dx, y + es.dy, z + es.dz};
                         const std::size_t pidx = static_cast<std::size_t>(p.y) * sy + static_cast<std::size_t>(p.x);
                         if (bottom_external && es.dz == 0 && es.axis < 2) {

@@ -2,6 +2,8 @@
 // repair's local band.
 #include "liveset/swarm/repair_schedule.hpp"
 
+#include "liveset/eval/perforations.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -23,6 +25,14 @@ void RepairScheduleOptions::validate() const {
     if (rounds < 0) throw std::invalid_argument("repair schedule: rounds must be >= 0");
     if (round_steps < 1) throw std::invalid_argument("repair schedule: round_steps must be >= 1");
     hole_brush_range(0, shell_thickness, max_range);  // throws on a bad brush sizing
+}
+
+std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner) {
+    std::vector<Perforation> h = find_perforations(mask, truth, inner);
+    if (h.empty()) h = find_cavities(mask, inner);
+    std::vector<HoleSite> sites;
+    for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
+    return sites;
 }
 
 void FieldRepairDriver::aim(const RepairOptions& options, Vec3d target) {

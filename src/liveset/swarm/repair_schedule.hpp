@@ -79,6 +79,11 @@ private:
 
 // The holes left on the current surface, the one to aim at first.
 using HoleSiteFinder = std::function<std::vector<HoleSite>(const SparseField& field)>;
+// The holes a user who sees the truth points at, largest first: the perforations of `mask` between
+// `truth` and `inner` (eval/perforations.hpp), and when none is left, its spurious cavities
+// (bubbles) in `inner`. The phantom demo's finder (and its test's).
+std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner);
+
 // Adjusts a round's options for its target (e.g. the sheet band sampled there); may be empty.
 using RoundSetup = std::function<void(RepairOptions& round, const HoleSite& target)>;
 
