@@ -208,6 +208,7 @@ private:
     void draw_cursor_section();
     void draw_display_section();
     void draw_edge_letters(Pane pane, const Rect& r);
+    void remember_item(const char* name, bool field);
     // viewer_input.cpp
     void process_events();
     bool routes_to_imgui(const InputEvent& e) const;

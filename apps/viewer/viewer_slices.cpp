@@ -181,6 +181,14 @@ void Viewer::slice_drag_end(const Drag& d) {
     if (d.button == 0 && (d.mods & GLFW_MOD_SHIFT)) set_display_window(slices_.window);
 }
 
+// The last item's rectangle for the event log's "ready" line (a driving test clicks there); a
+// field's without its label.
+void Viewer::remember_item(const char* name, bool field) {
+    const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
+    const float w = field ? std::min(ImGui::CalcItemWidth(), hi.x - lo.x) : hi.x - lo.x;
+    button_rects_[name] = {static_cast<int>(lo.x), static_cast<int>(lo.y), static_cast<int>(w), static_cast<int>(hi.y - lo.y)};
+}
+
 // --- cursor ------------------------------------------------------------------------------------
 
 void Viewer::log_cursor(const char* how) {
@@ -209,8 +217,7 @@ void Viewer::draw_cursor_section() {
     const Vec3d lps = render::lps_of(l, cursor_), ras = render::ras_of(l, cursor_);
     const auto field = [&](const char* label, const char* name, std::string& text, bool& editing) {
         const bool enter = ImGui::InputText(label, &text, ImGuiInputTextFlags_EnterReturnsTrue | ImGuiInputTextFlags_AutoSelectAll);
-        const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
-        button_rects_[name] = {static_cast<int>(lo.x), static_cast<int>(lo.y), static_cast<int>(hi.x - lo.x), static_cast<int>(hi.y - lo.y)};
+        remember_item(name, true);
         editing = ImGui::IsItemActive();
         return enter;
     };
@@ -234,10 +241,7 @@ void Viewer::draw_cursor_section() {
 // Window/level (presets, level and width typed), the label overlay's opacity, the contour, the
 // ROI and the speed preview.
 void Viewer::draw_display_section() {
-    const auto remember = [&](const char* name) {
-        const ImVec2 lo = ImGui::GetItemRectMin(), hi = ImGui::GetItemRectMax();
-        button_rects_[name] = {static_cast<int>(lo.x), static_cast<int>(lo.y), static_cast<int>(hi.x - lo.x), static_cast<int>(hi.y - lo.y)};
-    };
+    const auto remember = [&](const char* name, bool field = false) { remember_item(name, field); };
     ImGui::Text("window");
     for (const char* preset : render::kWindowPresets) {
         ImGui::SameLine();
@@ -252,12 +256,12 @@ void Viewer::draw_display_section() {
         if (lw[1] > 0.0f) set_display_window(render::DisplayWindow::from_level_width(lw[0], lw[1]));
         else fail("the window's width must be positive");
     }
-    remember("window_level_width");
+    remember("window_level_width", true);
     ImGui::TextDisabled("%.4g (black) to %.4g (white); Shift+drag", slices_.window.low, slices_.window.high);
     render::OverlayStyle style = slices_.overlay;
     bool contour = slices_.contour, changed = false;
     changed |= ImGui::SliderFloat("label opacity", &style.label_opacity, 0.0f, 1.0f, "%.2f");
-    remember("label_opacity");
+    remember("label_opacity", true);
     changed |= ImGui::Checkbox("contour", &contour);
     ImGui::SameLine();
     changed |= ImGui::Checkbox("speed preview", &style.preview);
@@ -285,6 +289,8 @@ void Viewer::draw_edge_letters(Pane pane, const Rect& r) {
     const float cx = static_cast<float>(r.x) + 0.5f * static_cast<float>(r.w), cy = static_cast<float>(r.y) + 0.5f * static_cast<float>(r.h);
     const auto put = [&](char c, float x, float y) {
         const char text[2] = {c, '\0'};
+        for (const ImVec2 d : {ImVec2(-1, 0), ImVec2(1, 0), ImVec2(0, -1), ImVec2(0, 1)})  // dark rim: legible on white
+            draw->AddText(ImVec2(x + d.x, y + d.y), IM_COL32(0, 0, 0, 255), text);
         draw->AddText(ImVec2(x, y), colour, text);
     };
     put(e.left, static_cast<float>(r.x) + 5.0f, cy - 7.0f);

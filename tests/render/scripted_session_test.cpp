@@ -149,6 +149,14 @@ TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
         {"[{\"screenshot\": \"x.jpg\"}]", ".png"},
         {"[{\"camera\": {\"view\": \"sideways\"}}]", "view must be"},
         {"[{\"seed\": [10, 10, 10], \"segment\": 3}]", "two actions"},
+        {"[{\"display\": {\"window\": [5, 2]}}]", "window must be [low, high]"},
+        {"[{\"display\": {\"window\": \"bone\"}}]", "window must be auto, minmax, narrow"},
+        {"[{\"display\": {\"zoom\": 2}}]", "need a \"pane\""},
+        {"[{\"display\": {\"pane\": \"3d\", \"zoom\": 2}}]", "pane must be axial, sagittal or coronal"},
+        {"[{\"display\": {\"pane\": \"axial\", \"center\": [1, 2, 300]}}]", "lies outside"},
+        {"[{\"display\": {\"roi\": \"dotted\"}}]", "roi must be off, outline or tint"},
+        {"[{\"display\": {\"label_opacity\": 2}}]", "label_opacity must be in [0, 1]"},
+        {"[{\"display\": {\"preview\": 1}}]", "preview must be true or false"},
     };
     for (const Case& c : cases) {
         write_text(dir / "bad.json", c.script);
