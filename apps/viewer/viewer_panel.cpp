@@ -42,7 +42,6 @@ void Viewer::draw_panel() {
     if (session_ && ImGui::CollapsingHeader("History", ImGuiTreeNodeFlags_DefaultOpen)) draw_history_section();
     if (session_ && ImGui::CollapsingHeader("Save")) draw_save_section();
     if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) draw_view_section();
-    if (session_ && ImGui::CollapsingHeader("Cursor", ImGuiTreeNodeFlags_DefaultOpen)) draw_cursor_section();
     if (session_ && ImGui::CollapsingHeader("Slice display", ImGuiTreeNodeFlags_DefaultOpen)) draw_display_section();
     if (!message_.empty()) {
         ImGui::Separator();
@@ -54,15 +53,15 @@ void Viewer::draw_panel() {
     ImGui::End();
 }
 
-// The image: name, size, the cursor's voxel and intensity; a path to open another.
+// The image: name, size, the intensity at the cursor, the cursor (1-based voxels, LPS and RAS mm, typed); a path to open another.
 void Viewer::draw_image_section() {
     if (session_) {
         const Lattice& l = session_->lattice();
         ImGui::Text("%s", image_name_.c_str());
         ImGui::TextDisabled("%dx%dx%d, %.2gx%.2gx%.2g mm", l.dims().x, l.dims().y, l.dims().z, l.spacing().x, l.spacing().y, l.spacing().z);
         const float raw = session_->image()(cursor_), unit = session_->unit_image()(cursor_);
-        ImGui::Text("cursor %d %d %d (1-based)  phi %.2f", cursor_.x + 1, cursor_.y + 1, cursor_.z + 1, session_->field().phi()(cursor_));
-        ImGui::Text("intensity %.4g (normalised %.3f)", raw, unit);
+        ImGui::Text("intensity %.4g (normalised %.3f)  phi %.2f", raw, unit, session_->field().phi()(cursor_));
+        draw_cursor_section();
     } else {
         ImGui::TextWrapped("No image. Give a path (NIfTI, MetaImage, NRRD, MINC, DICOM folder):");
     }

@@ -234,7 +234,7 @@ void Viewer::draw_cursor_section() {
         else fail("type three coordinates in millimetres (e.g. -12.5 30 40)");
     }
     ImGui::SameLine();
-    if (ImGui::SmallButton(slices_.mm_units == 0 ? "RAS?" : "LPS?")) slices_.mm_units = 1 - slices_.mm_units;
+    if (ImGui::SmallButton(slices_.mm_units == 0 ? "use RAS" : "use LPS")) slices_.mm_units = 1 - slices_.mm_units;
     ImGui::TextDisabled("LPS %.1f %.1f %.1f  RAS %.1f %.1f %.1f", lps.x, lps.y, lps.z, ras.x, ras.y, ras.z);
 }
 

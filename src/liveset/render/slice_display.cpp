@@ -74,6 +74,11 @@ namespace {
 void over(std::uint8_t* px, const std::array<std::uint8_t, 3>& c, float a) {
     if (a <= 0.0f) return;
     a = std::min(a, 1.0f);
+    if (px[3] == 0) {  // nothing below
+        px[0] = c[0], px[1] = c[1], px[2] = c[2];
+        px[3] = static_cast<std::uint8_t>(std::lround(255.0f * a));
+        return;
+    }
     const float below = px[3] / 255.0f, out = a + below * (1.0f - a);
     for (int k = 0; k < 3; ++k)
         px[k] = static_cast<std::uint8_t>(std::lround((c[static_cast<std::size_t>(k)] * a + px[k] * below * (1.0f - a)) / out));
@@ -85,25 +90,33 @@ void over(std::uint8_t* px, const std::array<std::uint8_t, 3>& c, float a) {
 std::vector<std::uint8_t> overlay_texels(const SliceGeometry& g, int slice, const OverlayStyle& style, const Grid<float>* phi,
                                          const Grid<std::uint8_t>* roi, const Grid<float>* unit_image,
                                          const ThresholdParams* params) {
-    std::vector<std::uint8_t> out(4 * static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height), 0);
+    const auto w = static_cast<std::size_t>(g.width), h = static_cast<std::size_t>(g.height);
+    std::vector<std::uint8_t> out(4 * w * h, 0);
     slice = std::clamp(slice, 0, g.slices - 1);
-    const auto in_roi = [&](int c, int r) {
-        if (c < 0 || r < 0 || c >= g.width || r >= g.height) return false;
-        return (*roi)(g.voxel(c, r, slice)) != 0;
+    std::vector<std::uint8_t> in_roi(w * h, 1);  // the ROI on this slice (all 1 without one)
+    if (roi)
+        for (int r = 0; r < g.height; ++r)
+            for (int c = 0; c < g.width; ++c) in_roi[static_cast<std::size_t>(r) * w + static_cast<std::size_t>(c)] = (*roi)(g.voxel(c, r, slice)) != 0;
+    const bool preview = style.preview && unit_image && params, fill = phi && style.label_opacity > 0.0f;
+    const auto roi_at = [&](int c, int r) {
+        return c >= 0 && r >= 0 && c < g.width && r < g.height && in_roi[static_cast<std::size_t>(r) * w + static_cast<std::size_t>(c)];
     };
     for (int r = 0; r < g.height; ++r)
         for (int c = 0; c < g.width; ++c) {
-            std::uint8_t* px = &out[4 * (static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(c))];
+            const std::size_t k = static_cast<std::size_t>(r) * w + static_cast<std::size_t>(c);
+            std::uint8_t* px = &out[4 * k];
+            const bool inside_roi = in_roi[k] != 0;
+            if (!(preview && inside_roi) && !fill && !(roi && inside_roi && style.roi != RoiStyle::kOff)) continue;
             const Vec3i v = g.voxel(c, r, slice);
-            const bool inside_roi = !roi || (*roi)(v) != 0;
-            if (style.preview && unit_image && params && inside_roi) {
+            // D < 0 exactly where |µ - I| < ε (D = (r - 1) / (r + 1), r = (|µ - I| / ε)^n): pow only there.
+            if (preview && inside_roi && std::abs(params->mu - (*unit_image)(v)) < params->epsilon) {
                 const double d = threshold_term((*unit_image)(v), *params);
                 if (d < 0.0) over(px, style.preview_colour, static_cast<float>(-d) * style.preview_opacity);
             }
-            if (phi && style.label_opacity > 0.0f && (*phi)(v) < 0.0f) over(px, style.label_colour, style.label_opacity);
+            if (fill && (*phi)(v) < 0.0f) over(px, style.label_colour, style.label_opacity);
             if (roi && inside_roi && style.roi == RoiStyle::kTint) over(px, style.roi_colour, style.roi_tint_opacity);
             if (roi && inside_roi && style.roi == RoiStyle::kOutline &&
-                (!in_roi(c - 1, r) || !in_roi(c + 1, r) || !in_roi(c, r - 1) || !in_roi(c, r + 1)))
+                (!roi_at(c - 1, r) || !roi_at(c + 1, r) || !roi_at(c, r - 1) || !roi_at(c, r + 1)))
                 over(px, style.roi_colour, 1.0f);
         }
     return out;
