@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "liveset/io/image_io.hpp"
@@ -242,6 +243,38 @@ TEST(CursorCoordinates, MillimetresAndLettersAgreeWithNibabel) {
         EXPECT_NEAR(ours.y, ras.y, 1e-4);
         EXPECT_NEAR(ours.z, ras.z, 1e-4);
         EXPECT_EQ(render::voxel_from(l, ras, render::CursorUnits::kRas), v);
+    }
+    std::filesystem::remove_all(dir);
+}
+
+// An image stored in other orientations (nibabel re-orients the phantom to PIR and to RAS axes, an
+// independent tool): read back, every pane shows the same picture as of the LPS original, with the
+// same letters.
+TEST(EdgeLetters, ReorientedCopiesShowTheSameAnatomy) {
+    if (std::system("/usr/bin/python3 -c 'import nibabel' >/dev/null 2>&1") != 0) GTEST_SKIP() << "needs /usr/bin/python3 with nibabel";
+    const auto dir = std::filesystem::temp_directory_path() / ("liveset_slice_reorient_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    const Grid<float>& original = testing::phantom64().image;
+    write_image(original, (dir / "lps.nii.gz").string());
+    const std::string cmd = "cd " + dir.string() +
+                            " && /usr/bin/python3 -c \"import nibabel as nib; from nibabel.orientations import *; i = nib.load('lps.nii.gz'); "
+                            "[nib.save(i.as_reoriented(ornt_transform(io_orientation(i.affine), axcodes2ornt(c))), ''.join(c) + '.nii.gz') "
+                            "for c in [('P', 'I', 'R'), ('R', 'A', 'S')]]\"";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    const Vec3d world = original.lattice().to_world({32, 30, 21});
+    for (const char* name : {"PIR", "RAS"}) {
+        const Grid<float> copy = read_image((dir / (std::string(name) + ".nii.gz")).string());
+        ASSERT_FALSE(copy.lattice().same_geometry(original.lattice())) << name;
+        for (const SliceAxis view : {SliceAxis::kAxial, SliceAxis::kCoronal, SliceAxis::kSagittal}) {
+            const auto g0 = render::slice_geometry(original.lattice(), view), g1 = render::slice_geometry(copy.lattice(), view);
+            const render::EdgeLetters a = render::edge_letters(original.lattice(), g0), b = render::edge_letters(copy.lattice(), g1);
+            EXPECT_EQ((std::string{a.left, a.right, a.top, a.bottom}), (std::string{b.left, b.right, b.top, b.bottom})) << name;
+            const render::DisplayWindow w = render::preset_window("minmax", original, nullptr);
+            const int s0 = g0.slice_of(original.lattice().to_index(world)), s1 = g1.slice_of(copy.lattice().to_index(world));
+            const auto t0 = render::window_texels(original, g0, s0, w);
+            EXPECT_GT(std::set<std::uint8_t>(t0.begin(), t0.end()).size(), 10u);  // a picture, not a flat slice
+            EXPECT_EQ(t0, render::window_texels(copy, g1, s1, w)) << name << " " << to_string(view);
+        }
     }
     std::filesystem::remove_all(dir);
 }
