@@ -25,16 +25,18 @@ wait_count() {  # wait_count PATTERN N SECONDS: until N log lines match PATTERN
     kill "$app" 2>/dev/null
     exit 90
 }
-screenshot() {  # screenshot N: F12 until the log has N screenshots (a key right after a slider's
-    # release can land in the frame where ImGui still holds the slider, and is then ImGui's)
+screenshot() {  # F12 until the log has one more screenshot (a key right after a slider's release
+    # can land in the frame where ImGui still holds the slider, and is then ImGui's)
+    local before
+    before=$(grep -c '"type":"screenshot"' "$log")
     for _ in 1 2 3 4 5 6; do
         xdotool key F12
         for _ in $(seq 1 30); do
-            [ "$(grep -c '"type":"screenshot"' "$log" 2>/dev/null)" -ge "$1" ] && return 0
+            [ "$(grep -c '"type":"screenshot"' "$log" 2>/dev/null)" -gt "$before" ] && sleep 0.3 && return 0
             sleep 0.1
         done
     done
-    echo "timed out waiting for screenshot $1" >&2
+    echo "timed out waiting for a screenshot" >&2
     kill "$app" 2>/dev/null
     exit 90
 }
@@ -88,13 +90,13 @@ xdotool mousemove --window "$window" $((ox + ow - 1)) $((oy + oh / 2))
 sleep 0.2
 xdotool click 1
 wait_count '"type":"display"' 1 30
-screenshot 1
+screenshot
 cp screenshot.png opaque.png
 xdotool mousemove --window "$window" $((ox + 1)) $((oy + oh / 2))
 sleep 0.2
 xdotool click 1
 wait_count '"type":"display"' 2 30
-screenshot 2
+screenshot
 cp screenshot.png clear.png
 
 # Typed cursor entry: 1-based voxels, then LPS millimetres.
