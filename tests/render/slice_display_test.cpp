@@ -95,6 +95,11 @@ TEST(DisplayWindow, AutoIsTheFirstToNinetyNinthPercentileInsideTheRoi) {
     EXPECT_LE(w.low, in[static_cast<std::size_t>(std::ceil(0.01 * n))]);
     EXPECT_GE(w.high, in[static_cast<std::size_t>(std::floor(0.99 * n))]);
     EXPECT_LE(w.high, in[static_cast<std::size_t>(std::ceil(0.99 * n))]);
+    const auto narrow = render::preset_window("narrow", image, &roi);
+    EXPECT_GE(narrow.low, in[static_cast<std::size_t>(std::floor(0.05 * n))]);
+    EXPECT_LE(narrow.low, in[static_cast<std::size_t>(std::ceil(0.05 * n))]);
+    EXPECT_GE(narrow.high, in[static_cast<std::size_t>(std::floor(0.95 * n))]);
+    EXPECT_LE(narrow.high, in[static_cast<std::size_t>(std::ceil(0.95 * n))]);
     const auto mm = render::preset_window("minmax", image, &roi);
     EXPECT_DOUBLE_EQ(mm.low, 0.0);
     EXPECT_DOUBLE_EQ(mm.high, 999.0);
@@ -146,6 +151,10 @@ TEST(SliceOverlay, LabelOpacityRoiOutlineAndPreviewWhereTheDataTermIsNegative) {
     EXPECT_EQ(texel(t, g, {16, 2, 10})[3], 255);   // a corner
     EXPECT_EQ(texel(t, g, {8, 10, 10})[3], 0);     // inside, off the edge
     EXPECT_EQ(texel(t, g, {1, 10, 10})[3], 0);     // outside
+    style.roi = render::RoiStyle::kTint;
+    t = render::overlay_texels(g, 10, style, &s.phi, &s.roi, nullptr, nullptr);
+    EXPECT_EQ(texel(t, g, {8, 10, 10}), (std::array<int, 4>{255, 210, 40, 51}));  // inside: 0.2 of the ROI colour
+    EXPECT_EQ(texel(t, g, {1, 10, 10})[3], 0);
     // Preview: tinted exactly where threshold_term < 0 inside the ROI, more where D is lower.
     style = {};
     style.label_opacity = 0.0f;
