@@ -331,6 +331,39 @@ void parse_perforations_entry(const json& e, ScriptAction& a, const EntryError& 
     if (v.contains("target")) a.rank = whole(v["target"], err, "target", 0, 1'000'000);
 }
 
+// {"display": ...}: a slice pane's zoom, the window/level, the overlay.
+void parse_display_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice& lattice) {
+    const json& v = e[a.name];
+    only_keys(e, {a.name}, err);
+    a.kind = ScriptAction::Kind::kDisplay;
+    if (!v.is_object()) err.fail("expected an object such as {\"window\": \"auto\", \"label_opacity\": 0.5}");
+    only_keys(v, {"pane", "zoom", "center", "window", "label_opacity", "roi", "preview", "contour"}, err);
+    if (v.contains("zoom") || v.contains("center")) {
+        if (!v.contains("pane")) err.fail("zoom and center need a \"pane\"");
+        const auto pane = pane_from_name(text(v["pane"], err, "pane"));
+        if (!pane || *pane == Pane::kView3d) err.fail("pane must be axial, sagittal or coronal");
+        if (v.contains("zoom") && !(number(v["zoom"], err, "zoom") > 0)) err.fail("zoom must be positive");
+        if (v.contains("center")) point(v["center"], err, lattice, "center");
+    }
+    if (v.contains("window")) {
+        const json& w = v["window"];
+        if (w.is_array()) {
+            if (w.size() != 2 || !(number(w[0], err, "window") < number(w[1], err, "window")))
+                err.fail("window must be [low, high] with low < high, or auto, minmax or narrow");
+        } else if (const std::string p = text(w, err, "window"); p != "auto" && p != "minmax" && p != "narrow") {
+            err.fail("window must be auto, minmax, narrow or [low, high]");
+        }
+    }
+    if (v.contains("label_opacity")) {
+        const double o = number(v["label_opacity"], err, "label_opacity");
+        if (o < 0 || o > 1) err.fail("label_opacity must be in [0, 1]");
+    }
+    if (v.contains("roi") && !render::roi_style_from_name(text(v["roi"], err, "roi"))) err.fail("roi must be off, outline or tint");
+    for (const char* k : {"preview", "contour"})
+        if (v.contains(k) && !v[k].is_boolean()) err.fail(fmt::format("{} must be true or false", k));
+    a.display = v;
+}
+
 using EntryParser = void (*)(const json&, ScriptAction&, const EntryError&, const Lattice&);
 
 // Every action a script entry can name, with its parser.
@@ -357,6 +390,7 @@ const std::map<std::string, EntryParser>& entry_parsers() {
         {"eval", parse_eval_entry},
         {"clear_target", parse_clear_target_entry},
         {"perforations", parse_perforations_entry},
+        {"display", parse_display_entry},
     };
     return parsers;
 }

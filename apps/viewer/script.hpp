@@ -15,6 +15,10 @@
 //               "reset": true}}                 ("center": orbit around this voxel instead of the surface's centre)
 //   {"cursor": [i, j, k]}  {"layout": "four" | "3d" | "axial" | "sagittal" | "coronal"}  {"tool": "seed"}
 //   {"undo": 1}  {"redo": 1}
+//   {"display": {"pane": "axial", "zoom": 3, "center": [i, j, k], "window": "auto" | "minmax" | "narrow" | [low, high],
+//                "label_opacity": 0.4, "roi": "off" | "outline" | "tint", "preview": true, "contour": true}}
+//        slice panes: a pane's zoom (about a voxel, default the slice's centre), window/level,
+//        the overlay; only the given fields change
 //   {"save_mask": path}  {"save_phi": path}  {"save_mesh": path}
 //   {"screenshot": path, "pane": "3d" | "axial" | ... | "window", "size": [w, h], "supersample": 2}
 //   {"eval": {"truth": path, "label": 2}}      prints {"entry": k, "eval": {dice, holes, ...}}
@@ -39,7 +43,7 @@ namespace liveset::viewer {
 struct ScriptAction {
     enum class Kind {
         kSeed, kRemoveSeed, kParams, kSegment, kClick, kTarget, kTargetSurfaceNear, kSwarm, kCamera, kCursor, kLayout,
-        kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval, kPerforations, kClearTarget
+        kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval, kPerforations, kClearTarget, kDisplay
     };
     Kind kind = Kind::kSeed;
     std::size_t entry = 0;  // 1-based position in the script
@@ -67,6 +71,7 @@ struct ScriptAction {
     int inner_label = 0;           // perforations: the tissue the shell encloses
     std::optional<int> rank;       // perforations: target the rank-th largest
     bool overlays = true;          // screenshot: bounding box and crosshair
+    nlohmann::json display;        // display: the validated object
 };
 
 struct Script {

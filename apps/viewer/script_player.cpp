@@ -104,6 +104,29 @@ void ScriptPlayer::report_eval(Viewer& viewer, const ScriptAction& a) {
     viewer.log().add("eval", {{"entry", a.entry}, {"dice", report["dice"]}, {"holes", report["holes"]}});
 }
 
+// A "display" entry; false (the viewer's message says why) when the window cannot be set.
+bool apply_display(Viewer& viewer, const ScriptAction& a) {
+    const nlohmann::json& v = a.display;
+    if (v.contains("pane")) {
+        const Pane pane = *pane_from_name(v["pane"].get<std::string>());
+        std::optional<Vec3d> centre;
+        if (v.contains("center")) centre = Vec3d{v["center"][0].get<double>(), v["center"][1].get<double>(), v["center"][2].get<double>()};
+        viewer.set_slice_view(pane, v.value("zoom", 1.0), centre);
+    }
+    if (v.contains("window")) {
+        const nlohmann::json& w = v["window"];
+        const bool ok = w.is_array() ? viewer.set_display_window({w[0].get<double>(), w[1].get<double>()})
+                                     : viewer.set_window_preset(w.get<std::string>());
+        if (!ok) return false;
+    }
+    render::OverlayStyle style = viewer.slice_display().overlay;
+    if (v.contains("label_opacity")) style.label_opacity = v["label_opacity"].get<float>();
+    if (v.contains("roi")) style.roi = *render::roi_style_from_name(v["roi"].get<std::string>());
+    style.preview = v.value("preview", style.preview);
+    viewer.set_overlay_style(style, v.value("contour", viewer.slice_display().contour));
+    return true;
+}
+
 void ScriptPlayer::advance(Viewer& viewer) {
     if (done()) return;
     const ScriptAction& a = script_.actions[next_];
@@ -158,6 +181,7 @@ void ScriptPlayer::advance(Viewer& viewer) {
         case K::kScreenshot: take_screenshot(viewer, a); break;
         case K::kPerforations: report_perforations(viewer, a); break;
         case K::kEval: report_eval(viewer, a); break;
+        case K::kDisplay: check(viewer, a, apply_display(viewer, a)); break;
     }
     finish_entry(viewer);
 }

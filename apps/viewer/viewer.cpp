@@ -81,6 +81,8 @@ void Viewer::show_session() {
     camera_.frame(render::surface_bounds(session_->mesher()));
     const Vec3i d = session_->lattice().dims();
     cursor_ = {d.x / 2, d.y / 2, d.z / 2};
+    reset_slice_views();
+    set_window_preset("auto");
     ui_params_ = session_->params();
     ui_auto_window_ = session_->window_from_seeds();
     ui_repair_ = session_->repair_options();
@@ -275,12 +277,6 @@ void Viewer::upload() {
     }
 }
 
-render::SliceViewport Viewer::slice_viewport(Pane pane, int width, int height) const {
-    static constexpr render::SliceAxis kAxes[3] = {render::SliceAxis::kAxial, render::SliceAxis::kSagittal,
-                                                   render::SliceAxis::kCoronal};
-    return render::SliceViewport::fit(render::slice_geometry(session_->lattice(), kAxes[static_cast<int>(pane)]), width, height);
-}
-
 render::SceneContent Viewer::scene_content() {
     render::SceneContent c;
     std::vector<glm::vec3>& agents = agent_points_;
@@ -318,29 +314,7 @@ void Viewer::render_pane(Pane pane) {
         current_.draw_ms += ms_since(t0);
         return;
     }
-    const render::SliceViewport vp = slice_viewport(pane, r.w, r.h);
-    const render::SliceGeometry& g = vp.geometry;
-    const int slice = g.slice_of(cursor_.cast<double>());
-    if (slice_shown_[i] != slice) {
-        const std::vector<std::uint8_t> texels = render::slice_texels(session_->unit_image(), g, slice);
-        slice_renderers_[i]->set_texels(g.width, g.height, texels);
-        slice_shown_[i] = slice;
-    }
-    if (contour_slice_[i] != slice || contour_revision_[i] != session_->revision()) {
-        contours_[i] = render::zero_contour(session_->field().phi(), g, slice);
-        contour_slice_[i] = slice;
-        contour_revision_[i] = session_->revision();
-    }
-    render::SliceOverlay overlay;
-    overlay.contour = contours_[i];
-    overlay.cursor = g.to_uv(cursor_.cast<double>());
-    const double texel_mm = std::min(g.u_mm, g.v_mm);
-    for (const SeedBall& s : session_->seeds()) {
-        const double d = std::abs(s.center[g.normal_axis] - slice);
-        if (d <= s.radius) overlay.seeds.push_back({g.to_uv(s.center), std::sqrt(s.radius * s.radius - d * d) * texel_mm});
-    }
-    if (const auto& t = session_->target(); t && std::abs((*t)[g.normal_axis] - slice) <= 2.0) overlay.target = g.to_uv(*t);
-    slice_renderers_[i]->render(fb, vp, overlay, render::SliceStyle{});
+    render_slice_pane(pane, fb, r);
 }
 
 void Viewer::render_dirty_panes() {

@@ -19,6 +19,7 @@
 
 #include "autosave.hpp"
 #include "event_log.hpp"
+#include "slice_panes.hpp"
 #include "liveset/render/framebuffer.hpp"
 #include "liveset/render/orbit_camera.hpp"
 #include "liveset/render/picking.hpp"
@@ -153,6 +154,19 @@ public:
     // screenshot path.
     void request_window_screenshot() { window_shot_pending_ = true; request_redraw(); }
 
+    // --- slice panes (viewer_slices.cpp) ---------------------------------------------------
+    const SliceDisplay& slice_display() const { return slices_; }
+    // Zoom pane `pane` by `factor` about window pixel (x, y); pan it by (dx, dy) pixels.
+    void zoom_slice(Pane pane, double x, double y, double factor);
+    void pan_slice(Pane pane, double dx, double dy);
+    void set_slice_view(Pane pane, double zoom, std::optional<Vec3d> centre);  // centre: a voxel
+    void reset_slice_views();
+    bool set_display_window(const render::DisplayWindow& window);  // a custom window
+    bool set_window_preset(const std::string& preset);
+    void set_overlay_style(const render::OverlayStyle& style, bool contour);
+    // Moves the cursor to the voxel given as 1-based voxel numbers or millimetres (LPS, RAS).
+    bool set_cursor_from(Vec3d value, render::CursorUnits units);
+
     // Renders the 3D pane now if it is out of date (picking reads its depth buffer).
     void ensure_3d_rendered();
 
@@ -185,6 +199,16 @@ private:
     render::SliceViewport slice_viewport(Pane pane, int width, int height) const;
     render::SceneContent scene_content();
     bool fail(const std::string& what);
+    // viewer_slices.cpp
+    void render_slice_pane(Pane pane, render::Framebuffer& fb, const Rect& r);
+    bool slice_drag(const Drag& d, double x, double y, double dx, double dy);  // true: handled
+    void slice_drag_end(const Drag& d);
+    void log_slice_view(Pane pane, const char* gesture);
+    void log_cursor(const char* how);
+    void draw_cursor_section();
+    void draw_display_section();
+    void draw_edge_letters(Pane pane, const Rect& r);
+    void remember_item(const char* name, bool field);
     // viewer_input.cpp
     void process_events();
     bool routes_to_imgui(const InputEvent& e) const;
@@ -255,6 +279,7 @@ private:
     ThresholdParams ui_params_;
     bool ui_auto_window_ = true;
     RepairOptions ui_repair_;
+    SliceDisplay slices_;
 };
 
 }  // namespace liveset::viewer

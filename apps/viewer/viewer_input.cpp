@@ -5,7 +5,9 @@
 // left click (no drag) picks the surface: it moves the crosshair there, and with the target tool
 // aims the swarm there. Slice panes: wheel / Page Up / Page Down / arrow keys change the slice; a
 // left click moves the crosshair (crosshair tool), places a seed (seed tool; right click removes
-// the seed under the pointer) or aims the swarm at the surface point nearest the click (target).
+// the seed under the pointer) or aims the swarm at the surface point nearest the click (target);
+// right drag zooms about the press point, middle drag pans, Ctrl+wheel zooms about the pointer,
+// Shift+left drag sets window/level (viewer_slices.cpp); R resets the 3D view and the slices' zoom.
 #define GLFW_INCLUDE_NONE  // key codes only; epoxy declares OpenGL
 #include <GLFW/glfw3.h>
 #include <fmt/core.h>
@@ -63,8 +65,9 @@ void Viewer::process_events() {
         const InputEvent e = events_.front();
         const bool to_imgui = routes_to_imgui(e);
         const bool button = e.type == InputEvent::Type::kPress || e.type == InputEvent::Type::kRelease;
-        if (to_imgui && button) {
-            // One button change per frame, so ImGui sees a quick click's press and release.
+        if (to_imgui && (button || e.type == InputEvent::Type::kKey)) {
+            // One button or key change per frame, so ImGui sees a quick click's (or a key's, e.g.
+            // Enter in a text field) press and release.
             if (imgui_button_changed) break;
             imgui_button_changed = true;
         }
@@ -107,6 +110,7 @@ void Viewer::handle_pane_event(const InputEvent& e) {
                 else if (drag_.button == 1)
                     camera_.zoom(std::pow(1.01, -dy));
                 camera_changed();
+            } else if (slice_drag(drag_, e.x, e.y, dx, dy)) {
             } else if (drag_.button == 0 && tool_ == Tool::kCrosshair) {
                 if (const auto v = voxel_at(drag_.pane, e.x, e.y)) set_cursor(*v);  // ITK-SNAP: drag the crosshair
             }
@@ -118,7 +122,9 @@ void Viewer::handle_pane_event(const InputEvent& e) {
             drag_.active = false;
             if (!d.moved) {
                 pane_click(d.pane, e.x, e.y, d.button, d.mods);
-            } else if (d.pane == Pane::kView3d) {
+            } else if (d.pane != Pane::kView3d) {
+                slice_drag_end(d);
+            } else {
                 const render::CameraPose& p = camera_.pose();
                 log_.add("camera", {{"gesture", d.button == 1 ? "zoom" : ((d.button == 2 || (d.mods & GLFW_MOD_SHIFT)) ? "pan" : "rotate")},
                                     {"yaw", p.yaw_deg}, {"pitch", p.pitch_deg}, {"zoom", p.zoom}});
@@ -131,6 +137,9 @@ void Viewer::handle_pane_event(const InputEvent& e) {
             if (*pane == Pane::kView3d) {
                 camera_.zoom(std::pow(1.1, e.scroll));
                 camera_changed();
+            } else if (e.mods & GLFW_MOD_CONTROL) {
+                zoom_slice(*pane, e.x, e.y, std::pow(1.2, e.scroll));
+                log_slice_view(*pane, "wheel");
             } else {
                 const int axis = slice_viewport(*pane, 1, 1).geometry.normal_axis;
                 Vec3i c = cursor_;
@@ -156,7 +165,10 @@ void Viewer::pane_click(Pane pane, double x, double y, int button, int mods) {
     const Vec3d p = v->cast<double>();
     switch (tool_) {
         case Tool::kCrosshair:
-            if (button == 0) set_cursor(*v);
+            if (button == 0 && !(mods & GLFW_MOD_SHIFT)) {
+                set_cursor(*v);
+                log_cursor("click");
+            }
             break;
         case Tool::kSeed:
             if (button == 0) add_seed(p, seed_radius);
@@ -208,6 +220,7 @@ void Viewer::handle_key(const InputEvent& e) {
         key_log("reset view");
         if (session_) camera_.frame(render::surface_bounds(session_->mesher()));
         camera_changed();
+        reset_slice_views();
     } else if (e.key == GLFW_KEY_F12) {
         key_log("window screenshot");
         request_window_screenshot();

@@ -42,6 +42,7 @@ void Viewer::draw_panel() {
     if (session_ && ImGui::CollapsingHeader("History", ImGuiTreeNodeFlags_DefaultOpen)) draw_history_section();
     if (session_ && ImGui::CollapsingHeader("Save")) draw_save_section();
     if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) draw_view_section();
+    if (session_ && ImGui::CollapsingHeader("Slice display", ImGuiTreeNodeFlags_DefaultOpen)) draw_display_section();
     if (!message_.empty()) {
         ImGui::Separator();
         ImGui::PushStyleColor(ImGuiCol_Text, message_is_error_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f));
@@ -52,15 +53,15 @@ void Viewer::draw_panel() {
     ImGui::End();
 }
 
-// The image: name, size, the cursor's voxel and intensity; a path to open another.
+// The image: name, size, the intensity at the cursor, the cursor (1-based voxels, LPS and RAS mm, typed); a path to open another.
 void Viewer::draw_image_section() {
     if (session_) {
         const Lattice& l = session_->lattice();
         ImGui::Text("%s", image_name_.c_str());
         ImGui::TextDisabled("%dx%dx%d, %.2gx%.2gx%.2g mm", l.dims().x, l.dims().y, l.dims().z, l.spacing().x, l.spacing().y, l.spacing().z);
         const float raw = session_->image()(cursor_), unit = session_->unit_image()(cursor_);
-        ImGui::Text("cursor (%d, %d, %d)  phi %.2f", cursor_.x, cursor_.y, cursor_.z, session_->field().phi()(cursor_));
-        ImGui::Text("intensity %.4g (normalised %.3f)", raw, unit);
+        ImGui::Text("intensity %.4g (normalised %.3f)  phi %.2f", raw, unit, session_->field().phi()(cursor_));
+        draw_cursor_section();
     } else {
         ImGui::TextWrapped("No image. Give a path (NIfTI, MetaImage, NRRD, MINC, DICOM folder):");
     }
@@ -200,6 +201,7 @@ void Viewer::draw_view_section() {
     if (panel_button("Reset view (R)", "reset_view") && session_) {
         camera_.frame(render::surface_bounds(session_->mesher()));
         camera_changed();
+        reset_slice_views();
     }
     ImGui::SameLine();
     bool max3d = maximised_ == Pane::kView3d;
@@ -275,6 +277,7 @@ void Viewer::draw_pane_labels() {
                                g.slice_of(cursor_.cast<double>()) + 1, g.slices);
         }
         draw->AddText(ImVec2(static_cast<float>(r.x + 6), static_cast<float>(r.y + 4)), IM_COL32(230, 230, 230, 255), text.c_str());
+        draw_edge_letters(pane, r);
         draw->AddRect(ImVec2(static_cast<float>(r.x), static_cast<float>(r.y)), ImVec2(static_cast<float>(r.x + r.w), static_cast<float>(r.y + r.h)),
                       IM_COL32(60, 60, 70, 255));
     }

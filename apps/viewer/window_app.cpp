@@ -54,6 +54,8 @@ void on_scroll(GLFWwindow* w, double, double dy) {
     scaled_cursor(w, x, y);
     InputEvent e{InputEvent::Type::kScroll, x, y};
     e.scroll = dy;
+    if (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
+        e.mods |= GLFW_MOD_CONTROL;  // GLFW gives a wheel event no modifiers: Ctrl+wheel zooms a slice
     viewer_of(w).push_event(e);
 }
 

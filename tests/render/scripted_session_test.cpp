@@ -3,7 +3,8 @@
 // a script aims the swarm at the largest hole left (perforations, then sealed-off cavities, found
 // from the truth as the demo does) with the demo's swarm settings, until `holes` = 0 without losing
 // more than 0.005 of Dice. Also:
-// a bad script is refused with one line naming the entry, before anything runs.
+// a bad script is refused with one line naming the entry, before anything runs; a "display" entry's
+// zoom and window/level reach the slice pane's pixels (a second window re-grades the same slice).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -15,6 +16,7 @@
 #include "liveset/eval/perforations.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
+#include "liveset/render/png_writer.hpp"
 
 namespace liveset {
 namespace {
@@ -127,6 +129,33 @@ TEST(ScriptedSession, SegmentsThePhantomThenTheSwarmRepairsItToNoHoles) {
     EXPECT_GE(run.after["dice"].get<double>(), run.before["dice"].get<double>() - 0.005);
 }
 
+// At zoom 4 about voxel (20, 20, 24) the axial pane's centre pixel is that voxel's centre: its grey
+// is the window's mapping of the voxel's intensity (mid-grey, then a tenth of the way up).
+TEST(ScriptedSession, DisplayWindowAndZoomReachTheSlicePixels) {
+    const fs::path dir = work_dir();
+    PhantomOptions o;
+    o.size = 48;
+    const Phantom ph = make_phantom(o);
+    const std::string image = (dir / "display.nii.gz").string();
+    write_image(ph.image, image);
+    const double v = read_image(image)({20, 20, 24});
+    write_text(dir / "display.json",
+               fmt::format(R"([{{"cursor": [24, 24, 24]}}, {{"display": {{"label_opacity": 0, "contour": false, "roi": "off"}}}},
+        {{"display": {{"pane": "axial", "zoom": 4, "center": [20, 20, 24], "window": [{}, {}]}}}},
+        {{"screenshot": "{}", "pane": "axial", "size": [200, 200]}},
+        {{"display": {{"window": [{}, {}]}}}}, {{"screenshot": "{}", "pane": "axial", "size": [200, 200]}}])",
+                           v - 50.0, v + 50.0, (dir / "mid.png").string(), v - 10.0, v + 90.0, (dir / "tenth.png").string()));
+    const CliResult r = run_cli("view " + image + " --headless --no-autosave --script " + (dir / "display.json").string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const auto centre = [](const std::string& path) {
+        const render::Image img = render::read_png(path);
+        const std::size_t k = 4 * (100 * static_cast<std::size_t>(img.width) + 100);
+        return std::array<int, 3>{img.rgba[k], img.rgba[k + 1], img.rgba[k + 2]};
+    };
+    EXPECT_EQ(centre((dir / "mid.png").string()), (std::array<int, 3>{128, 128, 128}));  // 127.5 rounds up
+    EXPECT_EQ(centre((dir / "tenth.png").string()), (std::array<int, 3>{26, 26, 26}));   // 25.5
+}
+
 TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
     const fs::path dir = work_dir();
     PhantomOptions o;
@@ -149,6 +178,14 @@ TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
         {"[{\"screenshot\": \"x.jpg\"}]", ".png"},
         {"[{\"camera\": {\"view\": \"sideways\"}}]", "view must be"},
         {"[{\"seed\": [10, 10, 10], \"segment\": 3}]", "two actions"},
+        {"[{\"display\": {\"window\": [5, 2]}}]", "window must be [low, high]"},
+        {"[{\"display\": {\"window\": \"bone\"}}]", "window must be auto, minmax, narrow"},
+        {"[{\"display\": {\"zoom\": 2}}]", "need a \"pane\""},
+        {"[{\"display\": {\"pane\": \"3d\", \"zoom\": 2}}]", "pane must be axial, sagittal or coronal"},
+        {"[{\"display\": {\"pane\": \"axial\", \"center\": [1, 2, 300]}}]", "lies outside"},
+        {"[{\"display\": {\"roi\": \"dotted\"}}]", "roi must be off, outline or tint"},
+        {"[{\"display\": {\"label_opacity\": 2}}]", "label_opacity must be in [0, 1]"},
+        {"[{\"display\": {\"preview\": 1}}]", "preview must be true or false"},
     };
     for (const Case& c : cases) {
         write_text(dir / "bad.json", c.script);

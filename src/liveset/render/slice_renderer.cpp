@@ -19,8 +19,12 @@ void main() { v_texcoord = a_texcoord; gl_Position = u_projection * vec4(a_pixel
 constexpr const char* kImageFragment = R"(#version 330 core
 in vec2 v_texcoord;
 uniform sampler2D u_image;
+uniform int u_rgba;  // 0: grey texels (R8), 1: straight-alpha RGBA overlay
 out vec4 colour;
-void main() { float g = texture(u_image, v_texcoord).r; colour = vec4(g, g, g, 1.0); }
+void main() {
+    vec4 t = texture(u_image, v_texcoord);
+    colour = u_rgba == 1 ? t : vec4(t.r, t.r, t.r, 1.0);
+}
 )";
 
 constexpr const char* kLineVertex = R"(#version 330 core
@@ -44,6 +48,12 @@ SliceRenderer::SliceRenderer() : image_(kImageVertex, kImageFragment), lines_(kL
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glGenTextures(1, &overlay_);
+    glBindTexture(GL_TEXTURE_2D, overlay_);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glGenVertexArrays(1, &quad_vao_);
     glGenBuffers(1, &quad_vbo_);
     glBindVertexArray(quad_vao_);
@@ -63,6 +73,7 @@ SliceRenderer::SliceRenderer() : image_(kImageVertex, kImageFragment), lines_(kL
 
 SliceRenderer::~SliceRenderer() {
     glDeleteTextures(1, &texture_);
+    glDeleteTextures(1, &overlay_);
     glDeleteVertexArrays(1, &quad_vao_);
     glDeleteBuffers(1, &quad_vbo_);
     glDeleteVertexArrays(1, &line_vao_);
@@ -73,6 +84,12 @@ void SliceRenderer::set_texels(int width, int height, std::span<const std::uint8
     glBindTexture(GL_TEXTURE_2D, texture_);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_R8, width, height, 0, GL_RED, GL_UNSIGNED_BYTE, texels.data());
+}
+
+void SliceRenderer::set_overlay(int width, int height, std::span<const std::uint8_t> rgba) {
+    glBindTexture(GL_TEXTURE_2D, overlay_);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA8, width, height, 0, GL_RGBA, GL_UNSIGNED_BYTE, rgba.data());
 }
 
 void SliceRenderer::draw_lines(std::span<const glm::vec2> pixels, const glm::vec4& colour, const glm::mat4& projection) {
@@ -105,16 +122,22 @@ void SliceRenderer::render(const Framebuffer& target, const SliceViewport& vp, c
     image_.use();
     image_.set("u_projection", projection);
     image_.set("u_image", 0);
+    image_.set("u_rgba", 0);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, texture_);
     glBindVertexArray(quad_vao_);
     glBindBuffer(GL_ARRAY_BUFFER, quad_vbo_);
     glBufferData(GL_ARRAY_BUFFER, sizeof(quad), quad, GL_STREAM_DRAW);
     glDrawArrays(GL_TRIANGLES, 0, 6);
-    glBindVertexArray(0);
 
     glEnable(GL_BLEND);
     glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    if (overlay.layer) {
+        image_.set("u_rgba", 1);
+        glBindTexture(GL_TEXTURE_2D, overlay_);
+        glDrawArrays(GL_TRIANGLES, 0, 6);
+    }
+    glBindVertexArray(0);
     std::vector<glm::vec2> px;
     if (overlay.cursor) {  // ITK-SNAP's crosshair: full-width lines, a gap at the centre
         const glm::dvec2 c = vp.to_pixel(*overlay.cursor);

@@ -1,4 +1,5 @@
-// One slice pane: the image slice as a texture, the zero contour of φ, the crosshair linked to the
+// One slice pane: the image slice as a texture, an RGBA overlay texture (label fill, ROI, speed
+// preview: slice_display.hpp) blended over it, the zero contour of φ, the crosshair linked to the
 // 3D view, the seeds (circles where their balls cut the slice) and the swarm's target, drawn into
 // the pane's framebuffer in pane pixels (SliceViewport).
 #pragma once
@@ -24,6 +25,7 @@ struct SliceOverlay {
     std::optional<glm::dvec2> cursor;     // crosshair, texel space
     std::vector<SliceCircle> seeds;
     std::optional<glm::dvec2> target;
+    bool layer = false;  // blend the RGBA overlay texture (set_overlay) over the image
 };
 
 struct SliceStyle {
@@ -43,13 +45,15 @@ public:
 
     // Uploads the slice's grey texels (slice_texels()).
     void set_texels(int width, int height, std::span<const std::uint8_t> texels);
+    // Uploads the RGBA overlay texels (overlay_texels(), straight alpha), same size as the slice.
+    void set_overlay(int width, int height, std::span<const std::uint8_t> rgba);
     void render(const Framebuffer& target, const SliceViewport& viewport, const SliceOverlay& overlay, const SliceStyle& style);
 
 private:
     void draw_lines(std::span<const glm::vec2> pixels, const glm::vec4& colour, const glm::mat4& projection);
 
     ShaderProgram image_, lines_;
-    GLuint texture_ = 0;
+    GLuint texture_ = 0, overlay_ = 0;
     GLuint quad_vao_ = 0, quad_vbo_ = 0;
     GLuint line_vao_ = 0, line_vbo_ = 0;
 };
