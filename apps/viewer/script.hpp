@@ -16,6 +16,7 @@
 //   {"cursor": [i, j, k]}  {"layout": "four" | "3d" | "axial" | "sagittal" | "coronal"}  {"tool": "seed"}
 //   {"undo": 1}  {"redo": 1}
 //   {"save_mask": path}  {"save_phi": path}  {"save_mesh": path}
+//   {"save_workspace": path}  {"save_seeds": path}  {"load_seeds": path}   (workspace.hpp, seed_file.hpp)
 //   {"screenshot": path, "pane": "3d" | "axial" | ... | "window", "size": [w, h], "supersample": 2}
 //   {"eval": {"truth": path, "label": 2}}      prints {"entry": k, "eval": {dice, holes, ...}}
 //   {"perforations": {"labels": path, "truth_label": 2, "inner_label": 3, "target": 0}}
@@ -39,7 +40,8 @@ namespace liveset::viewer {
 struct ScriptAction {
     enum class Kind {
         kSeed, kRemoveSeed, kParams, kSegment, kClick, kTarget, kTargetSurfaceNear, kSwarm, kCamera, kCursor, kLayout,
-        kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval, kPerforations, kClearTarget
+        kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval, kPerforations, kClearTarget,
+        kSaveWorkspace, kSaveSeeds, kLoadSeeds
     };
     Kind kind = Kind::kSeed;
     std::size_t entry = 0;  // 1-based position in the script

@@ -75,7 +75,9 @@ void Viewer::process_events() {
         }
         if (e.type == InputEvent::Type::kMove || to_imgui) ImGuiBridge::feed(e);
         if (e.type == InputEvent::Type::kKey) {
-            if (e.down && !ImGuiBridge::wants_keyboard()) handle_key(e);
+            // Ctrl+Q reaches the viewer also while the quit dialog holds the keyboard: twice quits.
+            const bool quit_key = e.key == GLFW_KEY_Q && (e.mods & GLFW_MOD_CONTROL) && quit_prompt_;
+            if (e.down && (!ImGuiBridge::wants_keyboard() || quit_key)) handle_key(e);
         } else if (!to_imgui || (e.type == InputEvent::Type::kMove && drag_.active)) {
             handle_pane_event(e);
         }
@@ -185,10 +187,13 @@ void Viewer::handle_key(const InputEvent& e) {
     const auto key_log = [&](const char* action) { log_.add("key", {{"key", e.key}, {"action", action}}); };
     if (ctrl && e.key == GLFW_KEY_Q) {
         key_log("quit");
-        request_quit("ctrl+q");
+        ask_quit("ctrl+q");
     } else if (ctrl && (e.key == GLFW_KEY_Y || (e.key == GLFW_KEY_Z && shift))) {
         key_log("redo");
         redo();
+    } else if (ctrl && e.key == GLFW_KEY_S) {
+        key_log("save workspace");
+        save_workspace(workspace_path_);
     } else if (ctrl && e.key == GLFW_KEY_Z) {
         key_log("undo");
         undo();
@@ -206,8 +211,7 @@ void Viewer::handle_key(const InputEvent& e) {
         set_swarm_running(!swarm_running_);
     } else if (e.key == GLFW_KEY_R) {
         key_log("reset view");
-        if (session_) camera_.frame(render::surface_bounds(session_->mesher()));
-        camera_changed();
+        frame_3d();  // the home direction, fitted to the surface
     } else if (e.key == GLFW_KEY_F12) {
         key_log("window screenshot");
         request_window_screenshot();
