@@ -103,7 +103,7 @@ void Viewer::request_quit(const std::string& reason) {
     quit_ = true;
     autosave_->at_exit();
     report_autosave();
-    nlohmann::json fields{{"reason", reason}, {"frames", frames_}};
+    nlohmann::json fields{{"reason", reason}, {"frames", frames_}, {"fps", fps_}, {"frame_ms", frame_ms_}};
     if (session_) {
         fields["seeds"] = session_->seeds().size();
         fields["undo_depth"] = session_->undo_depth();

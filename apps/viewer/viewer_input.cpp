@@ -63,8 +63,9 @@ void Viewer::process_events() {
         const InputEvent e = events_.front();
         const bool to_imgui = routes_to_imgui(e);
         const bool button = e.type == InputEvent::Type::kPress || e.type == InputEvent::Type::kRelease;
-        if (to_imgui && button) {
-            // One button change per frame, so ImGui sees a quick click's press and release.
+        if (to_imgui && (button || e.type == InputEvent::Type::kKey)) {
+            // One button or key change per frame, so ImGui (1.86: state, not events) sees a quick
+            // click's press and release, and a key pressed and released at once (Enter in a field).
             if (imgui_button_changed) break;
             imgui_button_changed = true;
         }

@@ -94,16 +94,19 @@ void Viewer::draw_segmentation_section() {
     // µ and ε in the image's own units, typed (Enter or leaving the field applies); normalised after.
     const IntensityScale& sc = session_->scale();
     if (!ImGui::IsAnyItemActive()) ui_mu_raw_ = sc.to_raw(ui_params_.mu), ui_epsilon_raw_ = sc.raw_length(ui_params_.epsilon);
-    ImGui::BeginDisabled(ui_auto_window_);
+    // Typing a value takes the window off the seeds (the box unticks).
     ImGui::InputDouble("mu", &ui_mu_raw_, 0.0, 0.0, "%.5g");
-    if (ImGui::IsItemDeactivatedAfterEdit()) ui_params_.mu = (ui_mu_raw_ - sc.low) / (sc.high - sc.low), edited = done = true;
+    const ImVec2 mu_lo = ImGui::GetItemRectMin(), mu_hi = ImGui::GetItemRectMax();  // for a driving test
+    button_rects_["mu_field"] = {static_cast<int>(mu_lo.x), static_cast<int>(mu_lo.y), static_cast<int>(mu_hi.x - mu_lo.x),
+                                 static_cast<int>(mu_hi.y - mu_lo.y)};
+    if (ImGui::IsItemDeactivatedAfterEdit())
+        ui_params_.mu = (ui_mu_raw_ - sc.low) / (sc.high - sc.low), ui_auto_window_ = false, edited = done = true;
     ImGui::SameLine();
     ImGui::TextDisabled("%.3f", ui_params_.mu);
     ImGui::InputDouble("epsilon", &ui_epsilon_raw_, 0.0, 0.0, "%.5g");
-    if (ImGui::IsItemDeactivatedAfterEdit()) ui_params_.epsilon = sc.unit_length(ui_epsilon_raw_), edited = done = true;
+    if (ImGui::IsItemDeactivatedAfterEdit()) ui_params_.epsilon = sc.unit_length(ui_epsilon_raw_), ui_auto_window_ = false, edited = done = true;
     ImGui::SameLine();
     ImGui::TextDisabled("%.3f", ui_params_.epsilon);
-    ImGui::EndDisabled();
     help_marker("mu, epsilon in the image's units (grey: normalised to [0, 1]); the front grows where |I - mu| < epsilon");
     if (!params_note_.empty()) ImGui::TextDisabled("%s", params_note_.c_str());
     float n = static_cast<float>(ui_params_.n), alpha = static_cast<float>(ui_params_.alpha);

@@ -157,7 +157,12 @@ void Viewer::draw_quit_prompt() {
             log_.add("quit_prompt", {{"file", autosave_->file().string()}, {"buttons", {{"quit", {q.x, q.y, q.w, q.h}}, {"cancel", {c.x, c.y, c.w, c.h}}}}});
         }
     }
-    if (quit || (save && save_workspace(workspace_path_))) {
+    const bool saved = save && save_workspace(workspace_path_);
+    if (save && !saved && !overwrite_path_.empty()) {  // the save asks first: that dialog instead of this one
+        quit_prompt_.reset();
+        button_rects_.erase("quit_prompt_logged");
+        ImGui::CloseCurrentPopup();
+    } else if (quit || saved) {
         log_.add("quit_prompt", {{"answer", save ? "save" : "quit"}});
         ImGui::CloseCurrentPopup();
         request_quit(*quit_prompt_);

@@ -190,6 +190,38 @@ TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
     EXPECT_NE(r.err.find("outside the region of interest"), std::string::npos) << r.err;
 }
 
+// Scripts save and load seed files: what load_seeds read, save_seeds writes back; a file with a
+// seed outside the ROI loads the others and fails the entry naming the refused seed.
+TEST(ViewCommand, ScriptsSaveAndLoadSeedFiles) {
+    const Fixture& f = fixture();
+    const std::string out = (f.dir / "seeds_out.txt").string();
+    CliResult r = run_cli(fmt::format("view {} --headless --script {}", f.image,
+                                      script("l.json", R"([{"load_seeds": ")" + f.seeds + R"("}, {"save_seeds": ")" + out + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    std::ifstream in(out);
+    std::vector<std::string> saved;
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty() && line[0] != '#') saved.push_back(line);
+    ASSERT_EQ(saved.size(), f.ph.seeds.size());
+    for (std::size_t i = 0; i < saved.size(); ++i)
+        EXPECT_EQ(saved[i], fmt::format("{},{},{}:2", f.ph.seeds[i].x, f.ph.seeds[i].y, f.ph.seeds[i].z));
+    Grid<std::uint8_t> roi(f.ph.image.lattice());
+    const Vec3i s0 = f.ph.seeds[0];
+    const Vec3i d = roi.dims();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x <= s0.x + 2; ++x) roi({x, y, z}) = 1;  // the first seed inside, 5 voxels along x outside
+    const std::string roi_path = (f.dir / "slab.nii.gz").string();
+    write_label_image(roi, roi_path);
+    const std::string two = (f.dir / "two_seeds.txt").string();
+    std::ofstream(two) << fmt::format("{},{},{}\n{},{},{}:3\n", s0.x, s0.y, s0.z, s0.x + 5, s0.y, s0.z);
+    r = run_cli(fmt::format("view {} --roi {} --headless --script {}", f.image, roi_path, script("m.json", R"([{"load_seeds": ")" + two + R"("}])")));
+    EXPECT_NE(r.rc, 0);
+    EXPECT_NE(r.err.find("loaded 1 of 2 seed(s)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(fmt::format("refused {},{},{}:3", s0.x + 5, s0.y, s0.z)), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("outside the region of interest"), std::string::npos) << r.err;
+}
+
 // --- real windows -----------------------------------------------------------------------------
 
 bool have(const char* tool) { return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0; }
@@ -248,10 +280,15 @@ TEST(WindowWorkspace, SavedReopenedAndContinuedBitForBitUnderXvfb) {
     EXPECT_EQ(exit1["camera"], exit2["camera"]);
     EXPECT_EQ(exit2["iterations"], 8);
     EXPECT_EQ(exit1["reason"], "ctrl+q");  // saved: no question asked
+    // The status's FPS and frame time agree: FPS x mean frame time <= 1 s.
+    for (const auto& e : {exit1, exit2}) {
+        EXPECT_GT(e["frame_ms"].get<double>(), 0.0);
+        EXPECT_LE(e["fps"].get<double>() * e["frame_ms"].get<double>(), 1000.0 + 1e-6) << e.dump();
+    }
     EXPECT_TRUE(last_of(first, "quit_prompt").is_null());
 }
 
-// A seed click outside the ROI is refused, one inside placed; Ctrl+Q asks (the prompt names the
+// A seed click outside the ROI is refused, one inside placed; µ typed in raw units applies; Ctrl+Q asks (the prompt names the
 // recovery file), Cancel keeps the window, Quit quits with status 0 and the work in the file.
 TEST(WindowWorkspace, SeedOutsideTheRoiRefusedAndQuitAsksFirstUnderXvfb) {
     if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
@@ -266,8 +303,11 @@ TEST(WindowWorkspace, SeedOutsideTheRoiRefusedAndQuitAsksFirstUnderXvfb) {
             for (int x = c.x - 4; x <= c.x + 4; ++x) roi({x, y, z}) = 1;  // a 9^3 cube at the centre
     const std::string roi_path = (dir / "cube.nii.gz").string();
     write_label_image(roi, roi_path);
+    const IntensityScale scale = robust_scale(f.ph.image, &roi);  // the session's: inside the ROI
+    const int mu = static_cast<int>(std::lround(scale.low + 0.4 * (scale.high - scale.low)));
     int rc = 0;
-    const std::string out = run_driver(dir, "window_prompts.sh", f.image + " " + roi_path + " " + (dir / "events.jsonl").string(), rc);
+    const std::string out =
+        run_driver(dir, "window_prompts.sh", f.image + " " + roi_path + " " + (dir / "events.jsonl").string() + " " + std::to_string(mu), rc);
     ASSERT_EQ(rc, 0) << out;
     const auto ev = events(dir / "events.jsonl");
     const auto error = last_of(ev, "error");
@@ -278,6 +318,12 @@ TEST(WindowWorkspace, SeedOutsideTheRoiRefusedAndQuitAsksFirstUnderXvfb) {
     EXPECT_EQ(seed["seeds"], 1);
     const Vec3d s{seed["index"][0].get<double>(), seed["index"][1].get<double>(), seed["index"][2].get<double>()};
     EXPECT_NE(roi({static_cast<int>(s.x), static_cast<int>(s.y), static_cast<int>(s.z)}), 0);
+    // µ typed in raw units: the normalised value is it mapped through the image's scale.
+    const auto params = last_of(ev, "params");
+    ASSERT_FALSE(params.is_null()) << out;
+    EXPECT_NEAR(params["mu_raw"].get<double>(), mu, 1e-9);
+    EXPECT_FALSE(params["auto_window"].get<bool>());
+    EXPECT_NEAR(params["mu"].get<double>(), (mu - scale.low) / (scale.high - scale.low), 1e-12);
     std::size_t prompts = 0, cancels = 0;
     std::string file;
     for (const auto& e : ev)

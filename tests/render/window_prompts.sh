@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Drives `liveset view` in a real X window (run under xvfb-run) with xdotool: a seed clicked outside
-# the ROI is refused (the event log's error names the ROI), one inside is placed; Ctrl+Q then asks
+# the ROI is refused (the event log's error names the ROI), one inside is placed; µ is typed in raw
+# units into the panel's field (a single click, no hidden gesture); Ctrl+Q then asks
 # (unsaved work): Cancel keeps the viewer open, a second Ctrl+Q asks again and its Quit button quits.
-# Usage: window_prompts.sh LIVESET IMAGE ROI LOG  (exit status: the viewer's, or 90+)
+# Usage: window_prompts.sh LIVESET IMAGE ROI LOG MU  (MU: a whole number; exit status: the viewer's, or 90+)
 set -u
-liveset=$1 image=$2 roi=$3 log=$4
+liveset=$1 image=$2 roi=$3 log=$4 mu=$5
 rm -f "$log"
 "$liveset" view "$image" --roi "$roi" --log-events "$log" --recovery-dir "$(dirname "$log")/recovery" &
 app=$!
@@ -33,6 +34,16 @@ click_at $((ax + aw / 2 - ah * 3 / 10)) $((ay + ah / 2 - ah * 3 / 10))  # inside
 wait_for 'outside the region of interest' 30
 click_at $((ax + aw / 2)) $((ay + ah / 2))  # the centre: inside the ROI
 wait_for '"type":"seed"' 30
+
+# µ typed in raw units: one click in the field, select all, type, Enter.
+read -r mx my mw mh <<<"$(rect mu_field)"
+click_at $((mx + mw / 2)) $((my + mh / 2))
+xdotool key ctrl+a
+xdotool type --delay 50 "$mu"
+xdotool key Return
+wait_for "\"mu_raw\":$mu.0" 30
+xdotool mousemove --window "$window" $((ax + aw / 2)) $((ay + ah / 2))
+sleep 0.3
 
 xdotool key ctrl+q
 wait_for '"buttons".*"type":"quit_prompt"' 30
