@@ -11,6 +11,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_common.hpp"
+#include "render/render_test_util.hpp"
+#include "viewer.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/repair_presets.hpp"
 #include "seed_file.hpp"
@@ -251,6 +253,36 @@ TEST(SeedFile, RoundTripIsBitExactInTheCliFormat) {
     const std::string bad = error_of([] { cli::parse_seed_file("1,2,3\n1,2\n", "s.txt", 2.0); });
     EXPECT_NE(bad.find("s.txt line 2:"), std::string::npos) << bad;
     EXPECT_NE(error_of([] { cli::read_seed_file("/nonexistent/seeds.txt", 2.0); }).find("cannot read the seed file"), std::string::npos);
+}
+
+// The viewer's save: an existing file it did not load or write is not overwritten without the
+// answer "overwrite" (the panel asks); once written it is its own. Work counts as unsaved from the
+// first change until the workspace is saved; a headless quit does not ask.
+TEST(ViewerWorkspace, NothingOverwrittenWithoutAskingAndUnsavedTracksTheWork) {
+    testing::gl_context();
+    viewer::ViewerConfig config;
+    config.headless = true;
+    auto session = std::make_unique<Session>(phantom48().image, options());
+    viewer::Viewer v(std::move(session), "t1", config);
+    EXPECT_FALSE(v.unsaved());
+    ASSERT_TRUE(v.add_seed(phantom48().seeds[0].cast<double>(), 2.0));
+    EXPECT_TRUE(v.unsaved());
+    const fs::path foreign = work_dir() / "foreign.json";
+    std::ofstream(foreign) << "someone else's file\n";
+    EXPECT_FALSE(v.save_workspace(foreign.string()));
+    EXPECT_EQ(testing_slurp(foreign), "someone else's file\n");
+    EXPECT_FALSE(fs::exists(viewer::workspace_state_path(foreign)));
+    EXPECT_TRUE(v.unsaved());
+    ASSERT_TRUE(v.save_workspace(foreign.string(), true)) << v.message();  // the user said "overwrite"
+    EXPECT_FALSE(v.unsaved());
+    EXPECT_EQ(viewer::read_workspace(foreign).marks.seeds.size(), 1u);
+    ASSERT_TRUE(v.add_seed(phantom48().seeds[1].cast<double>(), 2.0));
+    EXPECT_TRUE(v.unsaved());
+    ASSERT_TRUE(v.save_workspace(foreign.string())) << v.message();  // its own file now: no question
+    EXPECT_EQ(viewer::read_workspace(foreign).marks.seeds.size(), 2u);
+    EXPECT_FALSE(v.unsaved());
+    v.ask_quit("test");
+    EXPECT_TRUE(v.quit_requested());
 }
 
 }  // namespace
