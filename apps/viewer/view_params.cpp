@@ -63,7 +63,7 @@ std::string choose_start_params(Session& s, const StartParams& start) {
             throw cli::UsageError(fmt::format("threshold parameters: {} (µ {:.4g}, ε {:.4g} raw)", e.what(), s.scale().to_raw(p.mu),
                                               s.scale().raw_length(p.epsilon)));
         }
-        s.end_action();
+        s.clear_history();  // Ctrl+Z must not go back to the defaults these replaced
     }
     return source;
 }

@@ -18,7 +18,8 @@ struct StartParams {
     std::string workspace;                      // the workspace applied (empty: none)
 };
 
-// Sets the session's parameters (Session::set_params, a closed action) and returns where they came
+// Sets the session's parameters (Session::set_params; the undo history is then cleared, so the
+// set-up cannot be undone into the defaults it replaced) and returns where they came
 // from ("" when nothing was chosen: no level set, no seeds, nothing given). Throws cli::UsageError
 // on values the speed refuses (as `liveset segment` does).
 std::string choose_start_params(Session& session, const StartParams& start);

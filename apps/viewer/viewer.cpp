@@ -47,7 +47,6 @@ Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const V
         apply_workspace_view(*config.workspace_view);
         own_files_.push_back(workspace_path_);
     }
-    if (!params_note_.empty() && message_.empty()) message_ = params_note_;
 }
 
 Viewer::~Viewer() {

@@ -5,6 +5,9 @@
 #include <imgui_stdlib.h>
 
 #include <cmath>
+#include <string>
+#include <string_view>
+#include <utility>
 
 #include "viewer.hpp"
 
@@ -108,7 +111,14 @@ void Viewer::draw_segmentation_section() {
     ImGui::SameLine();
     ImGui::TextDisabled("%.3f", ui_params_.epsilon);
     help_marker("mu, epsilon in the image's units (grey: normalised to [0, 1]); the front grows where |I - mu| < epsilon");
-    if (!params_note_.empty()) ImGui::TextDisabled("%s", params_note_.c_str());
+    if (!params_note_.empty()) {  // where the values came from (the panel's font has no Greek)
+        std::string note = params_note_;
+        for (const auto& [greek, latin] : {std::pair{"µ", "mu"}, std::pair{"ε", "epsilon"}, std::pair{"α", "alpha"}})
+            for (std::size_t at; (at = note.find(greek)) != std::string::npos;) note.replace(at, std::string_view(greek).size(), latin);
+        ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+        ImGui::TextWrapped("%s", note.c_str());
+        ImGui::PopStyleColor();
+    }
     float n = static_cast<float>(ui_params_.n), alpha = static_cast<float>(ui_params_.alpha);
     if (ImGui::DragFloat("n", &n, 0.05f, 0.5f, 16.0f, "%.2f")) ui_params_.n = n, edited = true;
     done |= ImGui::IsItemDeactivatedAfterEdit();

@@ -256,6 +256,29 @@ TEST(Session, RefusesASeedOutsideTheRoi) {
     EXPECT_NO_THROW(free.add_seed({outside, 2.0}));
 }
 
+// clear_history forgets the actions (nothing to undo) and keeps φ, seeds and parameters; later
+// actions undo back to that state, not to what came before it.
+TEST(Session, ClearHistoryKeepsTheStateAndForgetsTheActions) {
+    const Phantom& ph = phantom64();
+    Session s(ph.image, options());
+    s.add_seed({ph.seeds[0].cast<double>(), 2.0});
+    ThresholdParams p = s.params();
+    p.mu = 0.61;
+    p.epsilon = 0.07;
+    s.set_params(p, false);
+    const State before = state_of(s);
+    s.clear_history();
+    EXPECT_FALSE(s.can_undo());
+    EXPECT_TRUE(state_of(s) == before);
+    EXPECT_EQ(s.params().mu, 0.61);
+    s.add_seed({ph.seeds[1].cast<double>(), 2.0});
+    s.undo();
+    EXPECT_TRUE(state_of(s) == before);
+    EXPECT_EQ(s.params().mu, 0.61);
+    EXPECT_EQ(s.params().epsilon, 0.07);
+    EXPECT_FALSE(s.can_undo());
+}
+
 TEST(Session, LoadedMaskStartsTheHistoryAfresh) {
     const Phantom& ph = phantom64();
     Session s(ph.image, options());

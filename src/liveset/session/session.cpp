@@ -355,6 +355,11 @@ void Session::end_action() {
     if (history_.action_open()) history_.commit(field_, marks());
 }
 
+void Session::clear_history() {
+    end_action();
+    history_.reset(field_);
+}
+
 void Session::adopt_marks(const SessionMarks& m) {
     marks_ = m;
     speed_.reset();

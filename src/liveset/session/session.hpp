@@ -163,6 +163,9 @@ public:
     std::string next_undo_label() const { return history_.next_undo_label(); }
     std::string next_redo_label() const { return history_.next_redo_label(); }
     std::size_t history_bytes() const { return history_.bytes(); }
+    // Forgets every undoable action (the set-up of a session - what was loaded, the start
+    // parameters - cannot be undone into hard-coded defaults). φ, seeds and parameters stay.
+    void clear_history();
     // Each closes the open action first; a no-op (empty update) when there is nothing to undo/redo.
     SessionUpdate undo();
     SessionUpdate redo();
