@@ -18,18 +18,17 @@
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
 #include "liveset/preprocess/bias_correction.hpp"
+#include "threshold_args.hpp"
 
 namespace liveset::cli {
 
 namespace {
 
-struct SegmentArgs {
+struct SegmentArgs : ThresholdArgs {
     std::string image;
     std::vector<std::string> seeds, seeds_mm;
     double seed_radius = 2.0;
     std::string init_mask, roi;
-    std::optional<double> mu, epsilon, mu_raw, epsilon_raw;
-    double n = 4.0, alpha = 0.1;
     std::string window_from = "model";
     int classes = 3;
     int iterations = 2000;
@@ -49,8 +48,7 @@ void check_segment_args(const SegmentArgs& a) {
     if (!a.out_roi.empty() && a.roi.empty()) throw UsageError("--out-roi needs --roi (a mask or auto)");
     if (!a.out_corrected.empty() && !a.bias_correct) throw UsageError("--out-corrected needs --bias-correct");
     if (!a.out_corrected.empty()) check_output_path(a.out_corrected, OutputKind::kImage, "--out-corrected");
-    if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");
-    if (a.epsilon && a.epsilon_raw) throw UsageError("give --epsilon or --epsilon-raw, not both");
+    check_threshold_args(a);
     if (a.seeds.empty() && a.seeds_mm.empty() && a.init_mask.empty())
         throw UsageError("give at least one --seed I,J,K[:R] (or --seed-mm, or --init-mask)");
 }
@@ -194,14 +192,9 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--seed-radius", sa.seed_radius, "default seed radius")->check(finite_number() & CLI::Range(0.5, 100.0))->capture_default_str();
     seg->add_option("--init-mask", sa.init_mask, "start from this mask instead of seeds (needs --mu/--epsilon)");
     seg->add_option("--roi", sa.roi, "region-of-interest mask the front may not leave (e.g. a brain mask), or 'auto': a brain mask computed from the T1");
-    seg->add_option("--mu", sa.mu, "ideal intensity, normalised to [0,1] (default: the tissue model's window for the seeds' class)")->check(finite_number());
-    seg->add_option("--epsilon", sa.epsilon, "half window, normalised units (default: from the tissue model)")->check(finite_number());
-    seg->add_option("--mu-raw", sa.mu_raw, "ideal intensity in the image's own units")->check(finite_number());
-    seg->add_option("--epsilon-raw", sa.epsilon_raw, "half window in the image's own units")->check(finite_number());
+    add_threshold_options(*seg, sa);  // --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
     seg->add_option("--window-from", sa.window_from, "estimate the window from the tissue model of the image (the seeds pick the class) or from the seeds' statistics")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     seg->add_option("--classes", sa.classes, "tissue classes of the model (T1 brain: CSF, GM, WM)")->check(CLI::Range(2, 6))->capture_default_str();
-    seg->add_option("--n", sa.n, "steepness of the threshold term")->check(finite_number())->capture_default_str();
-    seg->add_option("--alpha", sa.alpha, "curvature weight in [0,1)")->check(finite_number())->capture_default_str();
     seg->add_option("--iterations", sa.iterations, "iteration limit")->check(CLI::Range(1, 10'000'000))->capture_default_str();
     seg->add_option("--out-mask", sa.out_mask, "output mask (0/1, uint8), e.g. seg.nii.gz")->required();
     seg->add_option("--out-phi", sa.out_phi, "output level-set function phi (float, <0 inside)");

@@ -1,6 +1,6 @@
 // Dear ImGui (1.86) for the viewer without a platform backend: the viewer feeds ImGui's input
-// itself from its own event queue (identically in a GLFW window and headless, one button change
-// per frame so quick clicks are never lost), and draws with the OpenGL 3 renderer backend.
+// itself from its own event queue (identically in a GLFW window and headless, one button or key
+// change per frame so quick clicks and key presses are never lost), and draws with the OpenGL 3 renderer backend.
 #pragma once
 
 #include "viewer.hpp"

@@ -263,6 +263,15 @@ void parse_save_entry(const json& e, ScriptAction& a, const EntryError& err, con
     output_path(a.path, name == "save_mesh" ? cli::OutputKind::kMesh : cli::OutputKind::kImage, err);
 }
 
+// {"save_workspace": ...} / {"save_seeds": ...} / {"load_seeds": ...}: the workspace or the seeds.
+void parse_file_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    using K = ScriptAction::Kind;
+    only_keys(e, {a.name}, err);
+    a.kind = a.name == "save_workspace" ? K::kSaveWorkspace : (a.name == "save_seeds" ? K::kSaveSeeds : K::kLoadSeeds);
+    a.path = text(e[a.name], err, "the path");
+    if (a.kind != K::kLoadSeeds) output_path(a.path, cli::OutputKind::kText, err);
+}
+
 // {"screenshot": ...}: a PNG of a pane or of the window.
 void parse_screenshot_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
     const std::string& name = a.name;
@@ -386,6 +395,9 @@ const std::map<std::string, EntryParser>& entry_parsers() {
         {"save_mask", parse_save_entry},
         {"save_phi", parse_save_entry},
         {"save_mesh", parse_save_entry},
+        {"save_workspace", parse_file_entry},
+        {"save_seeds", parse_file_entry},
+        {"load_seeds", parse_file_entry},
         {"screenshot", parse_screenshot_entry},
         {"eval", parse_eval_entry},
         {"clear_target", parse_clear_target_entry},

@@ -20,6 +20,7 @@
 //        slice panes: a pane's zoom (about a voxel, default the slice's centre), window/level,
 //        the overlay; only the given fields change
 //   {"save_mask": path}  {"save_phi": path}  {"save_mesh": path}
+//   {"save_workspace": path}  {"save_seeds": path}  {"load_seeds": path}   (workspace.hpp, seed_file.hpp)
 //   {"screenshot": path, "pane": "3d" | "axial" | ... | "window", "size": [w, h], "supersample": 2}
 //   {"eval": {"truth": path, "label": 2}}      prints {"entry": k, "eval": {dice, holes, ...}}
 //   {"perforations": {"labels": path, "truth_label": 2, "inner_label": 3, "target": 0}}
@@ -43,7 +44,8 @@ namespace liveset::viewer {
 struct ScriptAction {
     enum class Kind {
         kSeed, kRemoveSeed, kParams, kSegment, kClick, kTarget, kTargetSurfaceNear, kSwarm, kCamera, kCursor, kLayout,
-        kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval, kPerforations, kClearTarget, kDisplay
+        kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval, kPerforations, kClearTarget, kDisplay,
+        kSaveWorkspace, kSaveSeeds, kLoadSeeds
     };
     Kind kind = Kind::kSeed;
     std::size_t entry = 0;  // 1-based position in the script

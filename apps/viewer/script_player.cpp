@@ -178,6 +178,9 @@ void ScriptPlayer::advance(Viewer& viewer) {
         case K::kSaveMask: check(viewer, a, viewer.save_mask(a.path)); break;
         case K::kSavePhi: check(viewer, a, viewer.save_phi(a.path)); break;
         case K::kSaveMesh: check(viewer, a, viewer.save_mesh(a.path)); break;
+        case K::kSaveWorkspace: check(viewer, a, viewer.save_workspace(a.path, true)); break;
+        case K::kSaveSeeds: check(viewer, a, viewer.save_seeds(a.path)); break;
+        case K::kLoadSeeds: check(viewer, a, viewer.load_seeds(a.path)); break;
         case K::kScreenshot: take_screenshot(viewer, a); break;
         case K::kPerforations: report_perforations(viewer, a); break;
         case K::kEval: report_eval(viewer, a); break;

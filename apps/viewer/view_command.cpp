@@ -11,14 +11,19 @@
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/session/repair_presets.hpp"
+#include "seed_file.hpp"
+#include "view_params.hpp"
 #include "window_app.hpp"
+#include "workspace.hpp"
 
 namespace liveset::cli {
 
 namespace {
 
-struct ViewArgs {
+struct ViewArgs : ThresholdArgs {
     std::string image, mask, phi, roi, script, log_events, size = "1280x720", layout = "four";
+    std::string workspace, seeds_file;
+    bool n_given = false, alpha_given = false;
     std::vector<std::string> seeds;
     double seed_radius = 2.0;
     bool headless = false, bench = false, json = false;
@@ -55,34 +60,88 @@ std::unique_ptr<Session> load_session(const ViewArgs& a) {
     so.fragment_size = a.fragment_size;
     so.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
     so.repair = demo_repair_options();
-    const Lattice lattice = image.lattice();
-    std::unique_ptr<Session> s;
     try {
-        s = std::make_unique<Session>(std::move(image), so, std::move(roi));
+        return std::make_unique<Session>(std::move(image), so, std::move(roi));
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{}: {}", a.image, e.what()));
     }
+}
+
+// --mask / --phi, then --seed and --seeds (a seed outside the image or the ROI is refused).
+void load_inputs(Session& s, const ViewArgs& a) {
+    const Lattice& lattice = s.lattice();
     if (!a.mask.empty()) {
-        s->load_mask(load_mask_like(a.mask, lattice, "--mask"));
-        if (!s->has_surface()) throw UsageError(fmt::format("--mask {} holds no surface (empty or full)", a.mask));
+        s.load_mask(load_mask_like(a.mask, lattice, "--mask"));
+        if (!s.has_surface()) throw UsageError(fmt::format("--mask {} holds no surface (empty or full)", a.mask));
     } else if (!a.phi.empty()) {
         const Grid<float> phi = read_image(a.phi);
         if (!phi.lattice().same_geometry(lattice, 1e-3))
             throw UsageError(fmt::format("--phi {} ({}) does not overlay the image ({})", a.phi, phi.lattice().describe(), lattice.describe()));
-        s->load_phi(phi);
-        if (!s->has_surface()) throw UsageError(fmt::format("--phi {} holds no surface (no sign change)", a.phi));
+        s.load_phi(phi);
+        if (!s.has_surface()) throw UsageError(fmt::format("--phi {} holds no surface (no sign change)", a.phi));
     }
-    for (const std::string& text : a.seeds) {
-        const SeedBall b = parse_seed_voxel(text, a.seed_radius);
-        check_seed_inside(b, lattice, "--seed " + text);
-        s->add_seed(b);
+    std::vector<std::pair<SeedBall, std::string>> seeds;
+    for (const std::string& text : a.seeds) seeds.emplace_back(parse_seed_voxel(text, a.seed_radius), "--seed " + text);
+    if (!a.seeds_file.empty())
+        for (const SeedBall& b : read_seed_file(a.seeds_file, a.seed_radius)) seeds.emplace_back(b, "in " + a.seeds_file + " " + format_seed(b));
+    for (const auto& [b, given_as] : seeds) {
+        check_seed_inside(b, lattice, given_as);
+        try {
+            s.add_seed(b);
+        } catch (const std::invalid_argument& e) {
+            throw UsageError(fmt::format("seed {}: {}", given_as, e.what()));
+        }
     }
-    s->end_action();
+    s.end_action();
+}
+
+// --workspace W: read and check it; on any problem one line on stderr and the viewer opens
+// without it. Fills in the image and the ROI from it when the command line gives none.
+std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
+    if (a.workspace.empty()) return std::nullopt;
+    try {
+        viewer::Workspace ws = viewer::read_workspace(a.workspace);
+        if (a.image.empty() && !std::filesystem::exists(ws.image))
+            throw std::runtime_error(fmt::format("workspace {}: its image {} is gone", a.workspace, ws.image));
+        if (a.image.empty()) a.image = ws.image;
+        if (a.roi.empty()) a.roi = ws.roi;
+        return ws;
+    } catch (const std::runtime_error& e) {
+        fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
+        return std::nullopt;
+    }
+}
+
+// The session of the command line: the image, the workspace continued (when it fits the image),
+// the level set and seeds given, the start parameters; `note` says where the parameters came from.
+std::unique_ptr<Session> open_session(ViewArgs& a, std::optional<viewer::Workspace>& ws, std::string& note) {
+    std::unique_ptr<Session> s = load_session(a);
+    if (ws) {
+        try {
+            viewer::check_workspace_image(*ws, a.workspace, s->image());
+            viewer::apply_workspace(*s, *ws);
+        } catch (const std::exception& e) {
+            fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
+            ws.reset();
+            s = load_session(a);
+        }
+    }
+    load_inputs(*s, a);
+    viewer::StartParams sp;
+    sp.args = &a;
+    sp.n_given = a.n_given;
+    sp.alpha_given = a.alpha_given;
+    sp.level_set_loaded = !a.mask.empty() || !a.phi.empty();
+    if (ws) sp.workspace = a.workspace;
+    note = viewer::choose_start_params(*s, sp);
+    if (!note.empty()) fmt::print(stderr, "liveset: note: {}\n", note);
     return s;
 }
 
-int run_view(const ViewArgs& a, int threads) {
+int run_view(ViewArgs& a, int threads) {
     const auto guard = limit_threads(threads);
+    check_threshold_args(a);
+    std::optional<viewer::Workspace> ws = read_workspace_arg(a);
     int width = 1280, height = 720;
     parse_size(a.size, width, height);
     std::optional<viewer::Pane> maximised;
@@ -98,11 +157,12 @@ int run_view(const ViewArgs& a, int threads) {
     if (a.recover && (a.no_autosave || (a.headless && a.recovery_dir.empty())))
         throw UsageError("--recover needs autosave (a --recovery-dir, or a window without --no-autosave)");
     if (a.recover && a.image.empty()) throw UsageError("--recover needs an IMAGE");
-    if (a.image.empty() && (!a.mask.empty() || !a.phi.empty() || !a.seeds.empty() || !a.roi.empty() || !a.script.empty()))
-        throw UsageError("--mask, --phi, --roi, --seed and --script need an IMAGE");
+    if (a.image.empty() && (!a.mask.empty() || !a.phi.empty() || !a.seeds.empty() || !a.roi.empty() || !a.script.empty() || !a.seeds_file.empty()))
+        throw UsageError("--mask, --phi, --roi, --seed, --seeds and --script need an IMAGE");
 
     std::unique_ptr<Session> session;
-    if (!a.image.empty()) session = load_session(a);
+    std::string note;
+    if (!a.image.empty()) session = open_session(a, ws, note);
     std::optional<viewer::Script> script;
     if (!a.script.empty()) script = viewer::parse_script(a.script, session->lattice());
     viewer::ViewerConfig config;
@@ -110,6 +170,10 @@ int run_view(const ViewArgs& a, int threads) {
     config.session.fragment_size = a.fragment_size;
     config.session.repair = demo_repair_options();
     config.image_path = a.image;
+    config.roi_path = a.roi;
+    config.params_note = note;
+    config.workspace_path = a.workspace;
+    if (ws) config.workspace_view = ws->view;
     // Windows autosave by default; headless runs (scripts, tests) only into an explicit --recovery-dir.
     if (!a.no_autosave) config.autosave.dir = !a.recovery_dir.empty() ? std::filesystem::path(a.recovery_dir)
                                                 : (a.headless ? std::filesystem::path() : viewer::default_recovery_dir());
@@ -175,6 +239,9 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave");
     v->add_option("--seed", va.seeds, "seed I,J,K[:R] (voxels); repeatable");
     v->add_option("--window-from", va.window_from, "estimate the window from the tissue model (the seeds pick the class) or from the seeds' statistics, as `segment`")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
+    v->add_option("--seeds", va.seeds_file, "seed file: one I,J,K[:R] per line (the --seed format; the panel saves them)");
+    v->add_option("--workspace", va.workspace, "continue a saved workspace (image, ROI, phi, seeds, parameters, swarm, camera); the panel saves it");
+    add_threshold_options(*v, va);  // as `liveset segment`: --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
     v->add_option("--seed-radius", va.seed_radius, "default seed radius, voxels")->check(CLI::PositiveNumber)->capture_default_str();
     v->add_flag("--headless", va.headless, "no window: render with EGL into an offscreen framebuffer (needs --script or --bench)");
     v->add_option("--script", va.script, "replay a session: JSON list of actions (see README)");
@@ -197,7 +264,9 @@ void add_view_command(CLI::App& app, const int& threads) {
                   "headless runs autosave only when it is given)");
     v->add_flag("--no-autosave", va.no_autosave, "no autosave, no recovery offer");
     v->add_flag("--recover", va.recover, "restore the image's recovery file (unsaved work of an earlier run) without asking");
-    v->callback([&threads] {
+    v->callback([&threads, v] {
+        va.n_given = v->count("--n") > 0;
+        va.alpha_given = v->count("--alpha") > 0;
         const int rc = run_view(va, threads);
         if (rc != 0) std::exit(rc);
     });

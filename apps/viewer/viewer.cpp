@@ -40,7 +40,13 @@ Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const V
     imgui_ = std::make_unique<ImGuiBridge>();
     scene_renderer_ = std::make_unique<render::SceneRenderer>();
     for (auto& r : slice_renderers_) r = std::make_unique<render::SliceRenderer>();
+    params_note_ = config.params_note;
+    if (!config.workspace_path.empty()) workspace_path_ = config.workspace_path;
     attach_session();
+    if (config.workspace_view && session_) {
+        apply_workspace_view(*config.workspace_view);
+        own_files_.push_back(workspace_path_);
+    }
 }
 
 Viewer::~Viewer() {
@@ -51,6 +57,8 @@ Viewer::~Viewer() {
 void Viewer::attach_session() {
     autosave_->attach(session_.get(), image_path_);
     show_session();
+    // What was loaded is on disk; restored unsaved work is not (it lives in the recovery file).
+    saved_revision_ = session_ && !autosave_->restored() ? session_->revision() : ~std::uint64_t{0};
     report_autosave();
     if (autosave_->restored()) log_.add("restore", {{"file", autosave_->file().string()}});
     if (autosave_->offer_pending() && config_.headless)
@@ -79,6 +87,7 @@ void Viewer::show_session() {
     surface_.upload_all(session_->mesher());
     session_->take_dirty_fragments();
     camera_.frame(render::surface_bounds(session_->mesher()));
+    fit_3d_pending_ = true;  // once the 3D pane has its size (frame_3d)
     const Vec3i d = session_->lattice().dims();
     cursor_ = {d.x / 2, d.y / 2, d.z / 2};
     reset_slice_views();
@@ -95,7 +104,7 @@ void Viewer::request_quit(const std::string& reason) {
     quit_ = true;
     autosave_->at_exit();
     report_autosave();
-    nlohmann::json fields{{"reason", reason}, {"frames", frames_}};
+    nlohmann::json fields{{"reason", reason}, {"frames", frames_}, {"fps", fps_}, {"frame_ms", frame_ms_}};
     if (session_) {
         fields["seeds"] = session_->seeds().size();
         fields["undo_depth"] = session_->undo_depth();
@@ -175,6 +184,7 @@ void Viewer::push_event(const InputEvent& event) {
 void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     const auto t0 = Clock::now();
     set_window_size(width, height);
+    fit_3d_if_pending();
     log_.set_frame(frames_);
     process_events();  // current_ already holds what scripts or the bench did since the last frame
     advance();
@@ -210,9 +220,8 @@ void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
         }
         log_.add("ready", {{"width", width}, {"height", height}, {"buttons", rects}, {"panes", panes}});
     }
-    const double wall_ms = ms_since(t0);
-    const double now_fps = 1000.0 / std::max(wall_ms, 1e-3);
-    fps_ = fps_ <= 0.0 ? now_fps : 0.8 * fps_ + 0.2 * now_fps;
+    if (offer_closed_frames_ > 0 && --offer_closed_frames_ == 0) log_.add("recovery_closed");  // drawn without the dialog
+    after_frame_timing(ms_since(t0));
     (void)dt_seconds;
     ++frames_;
     if (redraw_frames_ > 0) --redraw_frames_;
@@ -343,7 +352,11 @@ void Viewer::compose(GLuint target, int width, int height) {
     imgui_->new_frame(width, height, 1.0 / 60.0);
     draw_panel();
     draw_pane_labels();
-    if (!config_.headless) draw_recovery_offer();
+    if (!config_.headless) {
+        draw_recovery_offer();
+        draw_quit_prompt();
+        draw_overwrite_prompt();
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, target);
     glViewport(0, 0, width, height);
     imgui_->render();

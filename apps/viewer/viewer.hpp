@@ -27,6 +27,7 @@
 #include "liveset/render/slice_renderer.hpp"
 #include "liveset/render/surface_buffers.hpp"
 #include "liveset/session/session.hpp"
+#include "workspace.hpp"
 
 namespace liveset::viewer {
 
@@ -78,6 +79,10 @@ struct ViewerConfig {
     float segment_budget_ms = 40.0f;  // level-set time per frame while segmentation runs
     std::string image_path;  // the session's image as given (the key of its recovery file)
     AutosaveConfig autosave;  // recovery files (dir empty: none)
+    std::string roi_path;     // the session's ROI as given (saved in workspaces)
+    std::string params_note;  // where the start parameters came from (panel and stderr)
+    std::string workspace_path;                   // the panel's workspace file (--workspace)
+    std::optional<WorkspaceView> workspace_view;  // camera, cursor, ... of the workspace continued
 };
 
 class Viewer {
@@ -100,10 +105,17 @@ public:
     // evolution, upload of the rebuilt fragments, dirty panes, then panes + panel composed.
     void frame(GLuint target, int width, int height, double dt_seconds);
     const FrameStats& last_frame() const { return last_; }
+    // Over the frames of the last second: frames shown per second (0 when idle: the viewer draws
+    // only on change) and their mean work in ms (input to composed panes); fps() * frame_ms() <= 1000.
     double fps() const { return fps_; }
+    double frame_ms() const { return frame_ms_; }
     std::uint64_t frames() const { return frames_; }
     bool quit_requested() const { return quit_; }
     void request_quit(const std::string& reason);
+    // Ctrl+Q and the window's close button: quits at once when nothing is unsaved (or headless),
+    // else asks first (the dialog names the recovery file that keeps the work).
+    void ask_quit(const std::string& reason);
+    bool unsaved() const { return session_ && session_->revision() != saved_revision_; }
 
     // --- state ----------------------------------------------------------------------------
     Session* session() { return session_.get(); }
@@ -145,6 +157,12 @@ public:
     bool save_mask(const std::string& path);
     bool save_phi(const std::string& path);
     bool save_mesh(const std::string& path);
+    // The workspace (workspace.hpp) of this session and view; an existing file this viewer did not
+    // load or write is overwritten only with `overwrite` (the panel asks).
+    bool save_workspace(const std::string& path, bool overwrite = false);
+    bool save_seeds(const std::string& path);  // the --seed format, one per line
+    bool load_seeds(const std::string& path);  // adds them (each refused outside the image or ROI)
+    void frame_3d();  // fits the 3D view to the surface (key R)
     // Screenshot of a pane at its layout size (or width x height, supersampled) or of the whole
     // window (pane = nullopt) as the last frame laid it out.
     bool save_screenshot(const std::string& path, std::optional<Pane> pane, int width = 0, int height = 0, int supersample = 1);
@@ -230,6 +248,13 @@ private:
     bool panel_button(const char* label, const char* name);
     void draw_pane_labels();
     void draw_recovery_offer();
+    // viewer_workspace.cpp
+    void draw_files_section();  // seeds and workspace: save / load
+    void draw_quit_prompt();
+    void draw_overwrite_prompt();
+    void fit_3d_if_pending();
+    void apply_workspace_view(const WorkspaceView& view);
+    void after_frame_timing(double wall_ms);
 
     ViewerConfig config_;
     std::unique_ptr<Session> session_;
@@ -270,12 +295,21 @@ private:
     std::string renderer_;  // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
     bool message_is_error_ = false;
     FrameStats current_, last_;
-    double fps_ = 0.0, fps_clock_ = 0.0;
-    int fps_frames_ = 0;
+    double fps_ = 0.0, frame_ms_ = 0.0;
+    std::deque<double> frame_starts_, frame_work_ms_;  // the frames of the last second: start (s), work (ms)
+    std::uint64_t saved_revision_ = 0;  // the session's revision when its work was last on disk
+    bool fit_3d_pending_ = true;        // frame the 3D view once the pane has its size
+    std::optional<std::string> quit_prompt_;  // the quit request awaiting an answer
+    std::string overwrite_path_;              // a workspace save awaiting "overwrite?"
+    std::vector<std::string> own_files_;      // workspaces this viewer loaded or wrote
+    int offer_closed_frames_ = 0;             // counts down to the first frame drawn without the recovery dialog
+    std::string params_note_;
     std::uint64_t frames_ = 0;
     // Panel fields (kept between frames).
     std::string open_path_, mask_path_ = "segmentation.nii.gz", phi_path_ = "phi.nii.gz", mesh_path_ = "surface.ply",
                                 screenshot_path_ = "screenshot.png";
+    std::string workspace_path_ = "workspace.json", seeds_path_ = "seeds.txt";
+    double ui_mu_raw_ = 0.0, ui_epsilon_raw_ = 0.0;
     ThresholdParams ui_params_;
     bool ui_auto_window_ = true;
     RepairOptions ui_repair_;

@@ -66,8 +66,8 @@ void Viewer::process_events() {
         const bool to_imgui = routes_to_imgui(e);
         const bool button = e.type == InputEvent::Type::kPress || e.type == InputEvent::Type::kRelease;
         if (to_imgui && (button || e.type == InputEvent::Type::kKey)) {
-            // One button or key change per frame, so ImGui sees a quick click's (or a key's, e.g.
-            // Enter in a text field) press and release.
+            // One button or key change per frame, so ImGui (1.86: state, not events) sees a quick
+            // click's press and release, and a key pressed and released at once (Enter in a field).
             if (imgui_button_changed) break;
             imgui_button_changed = true;
         }
@@ -78,7 +78,9 @@ void Viewer::process_events() {
         }
         if (e.type == InputEvent::Type::kMove || to_imgui) ImGuiBridge::feed(e);
         if (e.type == InputEvent::Type::kKey) {
-            if (e.down && !ImGuiBridge::wants_keyboard()) handle_key(e);
+            // Ctrl+Q reaches the viewer also while the quit dialog holds the keyboard: twice quits.
+            const bool quit_key = e.key == GLFW_KEY_Q && (e.mods & GLFW_MOD_CONTROL) && quit_prompt_;
+            if (e.down && (!ImGuiBridge::wants_keyboard() || quit_key)) handle_key(e);
         } else if (!to_imgui || (e.type == InputEvent::Type::kMove && drag_.active)) {
             handle_pane_event(e);
         }
@@ -197,10 +199,13 @@ void Viewer::handle_key(const InputEvent& e) {
     const auto key_log = [&](const char* action) { log_.add("key", {{"key", e.key}, {"action", action}}); };
     if (ctrl && e.key == GLFW_KEY_Q) {
         key_log("quit");
-        request_quit("ctrl+q");
+        ask_quit("ctrl+q");
     } else if (ctrl && (e.key == GLFW_KEY_Y || (e.key == GLFW_KEY_Z && shift))) {
         key_log("redo");
         redo();
+    } else if (ctrl && e.key == GLFW_KEY_S) {
+        key_log("save workspace");
+        save_workspace(workspace_path_);
     } else if (ctrl && e.key == GLFW_KEY_Z) {
         key_log("undo");
         undo();
@@ -218,8 +223,7 @@ void Viewer::handle_key(const InputEvent& e) {
         set_swarm_running(!swarm_running_);
     } else if (e.key == GLFW_KEY_R) {
         key_log("reset view");
-        if (session_) camera_.frame(render::surface_bounds(session_->mesher()));
-        camera_changed();
+        frame_3d();  // the home direction, fitted to the surface
         reset_slice_views();
     } else if (e.key == GLFW_KEY_F12) {
         key_log("window screenshot");

@@ -22,6 +22,7 @@ bool Viewer::save_mask(const std::string& path) {
     message_is_error_ = false;
     log_.add("save", {{"what", "mask"}, {"path", path}});
     autosave_->mark_saved();
+    saved_revision_ = session_->revision();
     return true;
 }
 
@@ -37,6 +38,7 @@ bool Viewer::save_phi(const std::string& path) {
     message_is_error_ = false;
     log_.add("save", {{"what", "phi"}, {"path", path}});
     autosave_->mark_saved();
+    saved_revision_ = session_->revision();
     return true;
 }
 

@@ -5,6 +5,9 @@
 #include <imgui_stdlib.h>
 
 #include <cmath>
+#include <string>
+#include <string_view>
+#include <utility>
 
 #include "viewer.hpp"
 
@@ -36,13 +39,15 @@ void Viewer::draw_panel() {
     draw_image_section();
     ImGui::Separator();
     draw_tools_section();
+    // The most used first, so a 720-pixel window shows them without scrolling (the panel scrolls).
+    if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) draw_view_section();
     if (session_ && ImGui::CollapsingHeader("Segmentation", ImGuiTreeNodeFlags_DefaultOpen)) draw_segmentation_section();
     if (session_ && ImGui::CollapsingHeader("Repair (agent swarm)", ImGuiTreeNodeFlags_DefaultOpen)) draw_repair_section();
-    if (ImGui::CollapsingHeader("Status", ImGuiTreeNodeFlags_DefaultOpen)) draw_status_section();
-    if (session_ && ImGui::CollapsingHeader("History", ImGuiTreeNodeFlags_DefaultOpen)) draw_history_section();
-    if (session_ && ImGui::CollapsingHeader("Save")) draw_save_section();
-    if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) draw_view_section();
     if (session_ && ImGui::CollapsingHeader("Slice display", ImGuiTreeNodeFlags_DefaultOpen)) draw_display_section();
+    if (ImGui::CollapsingHeader("Status", ImGuiTreeNodeFlags_DefaultOpen)) draw_status_section();
+    if (session_ && ImGui::CollapsingHeader("History (Ctrl+Z, Ctrl+Y)")) draw_history_section();
+    if (session_ && ImGui::CollapsingHeader("Seeds and workspace (Ctrl+S)")) draw_files_section();
+    if (session_ && ImGui::CollapsingHeader("Save")) draw_save_section();
     if (!message_.empty()) {
         ImGui::Separator();
         ImGui::PushStyleColor(ImGuiCol_Text, message_is_error_ ? ImVec4(1.0f, 0.45f, 0.4f, 1.0f) : ImVec4(0.6f, 0.9f, 0.6f, 1.0f));
@@ -90,18 +95,32 @@ void Viewer::draw_segmentation_section() {
     bool edited = false, done = false;
     ui_params_ = session_->params();  // edits apply at once: the session holds the truth
     ui_auto_window_ = session_->window_from_seeds();
-    if (ImGui::Checkbox("mu, epsilon from the seeds", &ui_auto_window_)) edited = done = true;
-    ImGui::BeginDisabled(ui_auto_window_);
-    float mu = static_cast<float>(ui_params_.mu), eps = static_cast<float>(ui_params_.epsilon);
-    if (ImGui::DragFloat("mu", &mu, 0.002f, 0.0f, 1.0f, "%.3f")) ui_params_.mu = mu, edited = true;
-    done |= ImGui::IsItemDeactivatedAfterEdit();
+    if (ImGui::Checkbox("mu, epsilon from the seeds (tissue model)", &ui_auto_window_)) edited = done = true;
+    // µ and ε in the image's own units, typed (Enter or leaving the field applies); normalised after.
+    const IntensityScale& sc = session_->scale();
+    if (!ImGui::IsAnyItemActive()) ui_mu_raw_ = sc.to_raw(ui_params_.mu), ui_epsilon_raw_ = sc.raw_length(ui_params_.epsilon);
+    // Typing a value takes the window off the seeds (the box unticks).
+    ImGui::InputDouble("mu", &ui_mu_raw_, 0.0, 0.0, "%.5g");
+    const ImVec2 mu_lo = ImGui::GetItemRectMin(), mu_hi = ImGui::GetItemRectMax();  // for a driving test
+    button_rects_["mu_field"] = {static_cast<int>(mu_lo.x), static_cast<int>(mu_lo.y), static_cast<int>(mu_hi.x - mu_lo.x),
+                                 static_cast<int>(mu_hi.y - mu_lo.y)};
+    if (ImGui::IsItemDeactivatedAfterEdit())
+        ui_params_.mu = (ui_mu_raw_ - sc.low) / (sc.high - sc.low), ui_auto_window_ = false, edited = done = true;
     ImGui::SameLine();
-    ImGui::TextDisabled("raw %.0f", session_->scale().to_raw(ui_params_.mu));
-    if (ImGui::DragFloat("epsilon", &eps, 0.002f, 0.005f, 1.0f, "%.3f")) ui_params_.epsilon = eps, edited = true;
-    done |= ImGui::IsItemDeactivatedAfterEdit();
+    ImGui::TextDisabled("%.3f", ui_params_.mu);
+    ImGui::InputDouble("epsilon", &ui_epsilon_raw_, 0.0, 0.0, "%.5g");
+    if (ImGui::IsItemDeactivatedAfterEdit()) ui_params_.epsilon = sc.unit_length(ui_epsilon_raw_), ui_auto_window_ = false, edited = done = true;
     ImGui::SameLine();
-    ImGui::TextDisabled("raw %.0f", session_->scale().raw_length(ui_params_.epsilon));
-    ImGui::EndDisabled();
+    ImGui::TextDisabled("%.3f", ui_params_.epsilon);
+    help_marker("mu, epsilon in the image's units (grey: normalised to [0, 1]); the front grows where |I - mu| < epsilon");
+    if (!params_note_.empty()) {  // where the values came from (the panel's font has no Greek)
+        std::string note = params_note_;
+        for (const auto& [greek, latin] : {std::pair{"µ", "mu"}, std::pair{"ε", "epsilon"}, std::pair{"α", "alpha"}})
+            for (std::size_t at; (at = note.find(greek)) != std::string::npos;) note.replace(at, std::string_view(greek).size(), latin);
+        ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyleColorVec4(ImGuiCol_TextDisabled));
+        ImGui::TextWrapped("%s", note.c_str());
+        ImGui::PopStyleColor();
+    }
     float n = static_cast<float>(ui_params_.n), alpha = static_cast<float>(ui_params_.alpha);
     if (ImGui::DragFloat("n", &n, 0.05f, 0.5f, 16.0f, "%.2f")) ui_params_.n = n, edited = true;
     done |= ImGui::IsItemDeactivatedAfterEdit();
@@ -109,7 +128,12 @@ void Viewer::draw_segmentation_section() {
     if (ImGui::SliderFloat("alpha", &alpha, 0.0f, 0.95f, "%.2f")) ui_params_.alpha = alpha, edited = true;
     done |= ImGui::IsItemDeactivatedAfterEdit();
     help_marker("curvature weight (Eq. 2): smoother fronts that leak less");
-    if (edited) apply_params(ui_params_, ui_auto_window_);
+    if (edited && apply_params(ui_params_, ui_auto_window_)) {
+        params_note_.clear();  // the user's own values from now on
+        const ThresholdParams& p = session_->params();
+        log_.add("params", {{"mu", p.mu}, {"epsilon", p.epsilon}, {"mu_raw", sc.to_raw(p.mu)}, {"epsilon_raw", sc.raw_length(p.epsilon)},
+                            {"n", p.n}, {"alpha", p.alpha}, {"auto_window", session_->window_from_seeds()}});
+    }
     if (done) session_->end_action();
     if (panel_button(segment_running_ ? "Pause (Space)" : "Run (Space)", "run_segmentation")) set_segment_running(!segment_running_);
     ImGui::SameLine();
@@ -159,8 +183,11 @@ void Viewer::draw_repair_section() {
 // Frame rate and where the frame's time went.
 void Viewer::draw_status_section() {
     const FrameStats& f = last_;
-    ImGui::Text("%.1f FPS, frame %.1f ms (%s)", fps_, f.total_ms(), renderer_.c_str());
-    ImGui::Text("level set %.2f  agents %.2f  mesh %.2f ms", f.level_set_ms, f.agents_ms, f.mesh_ms);
+    if (fps_ > 0.0) ImGui::Text("%.1f FPS, frame %.1f ms (%s)", fps_, frame_ms_, renderer_.c_str());
+    else ImGui::Text("idle, last frame %.1f ms (%s)", frame_ms_, renderer_.c_str());
+    help_marker("over the last second: frames drawn per second, and their mean work (input to screen); the rest of the "
+                "second is spent waiting, so FPS x frame <= 1 s. The viewer draws only when something changes.");
+    ImGui::Text("last frame: level set %.2f  agents %.2f  mesh %.2f ms", f.level_set_ms, f.agents_ms, f.mesh_ms);
     ImGui::Text("upload %.2f  draw %.2f ms", f.upload_ms, f.draw_ms);
     ImGui::Text("fragments rebuilt %zu, uploaded %zu", f.fragments, f.uploaded);
     ImGui::Text("triangles %zu", surface_.triangle_count());
@@ -199,8 +226,7 @@ void Viewer::draw_save_section() {
 // Reset or maximise the 3D view; the six named views.
 void Viewer::draw_view_section() {
     if (panel_button("Reset view (R)", "reset_view") && session_) {
-        camera_.frame(render::surface_bounds(session_->mesher()));
-        camera_changed();
+        frame_3d();
         reset_slice_views();
     }
     ImGui::SameLine();
@@ -246,6 +272,7 @@ void Viewer::draw_recovery_offer() {
     if (pressed_restore) {
         if (autosave_->restore()) {
             show_session();
+            saved_revision_ = ~std::uint64_t{0};  // the restored work is still unsaved
             log_.add("restore", {{"file", autosave_->file().string()}});
         }
         done = true;
@@ -257,6 +284,10 @@ void Viewer::draw_recovery_offer() {
     if (done) {
         report_autosave();
         mark_all_panes();
+        // The dialog leaves the screen only in the next frames: draw them now, without waiting
+        // for input (the window sleeps until an event otherwise).
+        redraw_frames_ = std::max(redraw_frames_, 3);
+        offer_closed_frames_ = 2;  // this frame still shows it; the next one is the first without
         ImGui::CloseCurrentPopup();
     }
     ImGui::EndPopup();

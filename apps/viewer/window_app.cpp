@@ -130,9 +130,10 @@ int run_window(std::unique_ptr<Session> session, const std::string& image_name, 
             glfwPollEvents();
         else
             glfwWaitEventsTimeout(0.5);  // sleep until input: nothing changes on its own
-        if (glfwWindowShouldClose(window)) {
-            viewer.request_quit("window closed");
-            break;
+        if (glfwWindowShouldClose(window)) {  // the close button: asks first when work is unsaved
+            glfwSetWindowShouldClose(window, GLFW_FALSE);
+            viewer.ask_quit("window closed");
+            if (viewer.quit_requested()) break;
         }
         if (playing) {
             try {

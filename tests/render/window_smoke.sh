@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Drives `liveset view` in a real X window (run under xvfb-run) with real input events from
 # xdotool: rotate the 3D view by dragging, pick the surface with the target tool, run and stop
-# the swarm, press the panel's "Reset view" button, quit with Ctrl+Q (the swarm's unsaved edits go
-# to a recovery file next to the log). Each step waits until the viewer's event log shows the
+# the swarm, press the panel's "Reset view" button, quit with Ctrl+Q twice (the first asks: the
+# swarm's unsaved edits go to a recovery file next to the log). Each step waits until the viewer's event log shows the
 # reaction, so a slow software renderer only makes it slower.
 # Usage: window_smoke.sh LIVESET IMAGE MASK LOG  (exit status: the viewer's, or 90+ on a timeout)
 set -u
@@ -54,5 +54,8 @@ sleep 0.3
 xdotool click 1
 wait_for '"name":"reset_view"' 30
 
+# Ctrl+Q with the swarm's edits unsaved: the viewer asks first; a second Ctrl+Q means it.
+xdotool key ctrl+q
+wait_for '"buttons".*"type":"quit_prompt"' 30
 xdotool key ctrl+q
 wait "$app"

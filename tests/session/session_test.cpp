@@ -226,6 +226,59 @@ TEST(Session, RejectsBadInputWithoutChangingAnything) {
     EXPECT_THROW(s.load_mask(wrong), std::invalid_argument);
 }
 
+// With a ROI, a seed whose centre voxel lies outside it is refused by the session (the one edit
+// path the CLI, Python and the viewer share) with a message naming the voxel; nothing changes.
+// A seed on a ROI voxel next to it is accepted.
+TEST(Session, RefusesASeedOutsideTheRoi) {
+    const Phantom& ph = phantom64();
+    Grid<std::uint8_t> roi(ph.image.lattice());
+    const Vec3i d = roi.dims();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x / 2; ++x) roi({x, y, z}) = 1;  // the ROI: the half with x < d.x / 2
+    Session s(ph.image, options(), roi);
+    const Vec3d outside{d.x / 2.0, d.y / 2.0, d.z / 2.0}, inside{d.x / 2.0 - 1.0, d.y / 2.0, d.z / 2.0};
+    try {
+        s.add_seed({outside, 2.0});
+        FAIL() << "a seed outside the ROI was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("outside the region of interest"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("(32, 32, 32)"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(s.seeds().empty());
+    EXPECT_FALSE(s.has_surface());
+    EXPECT_FALSE(s.can_undo());
+    s.add_seed({inside, 2.0});
+    EXPECT_EQ(s.seeds().size(), 1u);
+    EXPECT_TRUE(s.has_surface());
+    // Without a ROI the same voxel is fine.
+    Session free(ph.image, options());
+    EXPECT_NO_THROW(free.add_seed({outside, 2.0}));
+}
+
+// clear_history forgets the actions (nothing to undo) and keeps φ, seeds and parameters; later
+// actions undo back to that state, not to what came before it.
+TEST(Session, ClearHistoryKeepsTheStateAndForgetsTheActions) {
+    const Phantom& ph = phantom64();
+    Session s(ph.image, options());
+    s.add_seed({ph.seeds[0].cast<double>(), 2.0});
+    ThresholdParams p = s.params();
+    p.mu = 0.61;
+    p.epsilon = 0.07;
+    s.set_params(p, false);
+    const State before = state_of(s);
+    s.clear_history();
+    EXPECT_FALSE(s.can_undo());
+    EXPECT_TRUE(state_of(s) == before);
+    EXPECT_EQ(s.params().mu, 0.61);
+    s.add_seed({ph.seeds[1].cast<double>(), 2.0});
+    s.undo();
+    EXPECT_TRUE(state_of(s) == before);
+    EXPECT_EQ(s.params().mu, 0.61);
+    EXPECT_EQ(s.params().epsilon, 0.07);
+    EXPECT_FALSE(s.can_undo());
+}
+
 TEST(Session, LoadedMaskStartsTheHistoryAfresh) {
     const Phantom& ph = phantom64();
     Session s(ph.image, options());

@@ -120,6 +120,7 @@ SessionUpdate Session::add_seed(SeedBall seed) {
     if (!all_finite(seed.center) || !lattice().contains(seed.center))
         throw std::invalid_argument("a seed lies outside the image");
     if (!std::isfinite(seed.radius) || seed.radius <= 0) throw std::invalid_argument("a seed's radius must be positive");
+    check_seed_in_roi(seed);
     return edit("seed", Action::kOwn, [&] {
         // Union with the ball, min(φ, distance to the ball), re-initialised only around it: beyond
         // N + 1 voxels from the ball the distance cannot undercut φ.
@@ -149,6 +150,15 @@ SessionUpdate Session::remove_seed(std::size_t index) {
         }
         return Change{{}, true};
     });
+}
+
+void Session::check_seed_in_roi(const SeedBall& seed) const {
+    if (!roi_) return;
+    const Vec3i c{static_cast<int>(std::lround(seed.center.x)), static_cast<int>(std::lround(seed.center.y)),
+                  static_cast<int>(std::lround(seed.center.z))};
+    if (lattice().contains(c) && (*roi_)(c) != 0) return;
+    throw std::invalid_argument("the seed at (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z) +
+                                ") lies outside the region of interest (the front may not grow there)");
 }
 
 std::optional<std::size_t> Session::seed_at(Vec3d p, double tolerance) const {
@@ -343,6 +353,11 @@ void Session::begin_action(const char* label) {
 
 void Session::end_action() {
     if (history_.action_open()) history_.commit(field_, marks());
+}
+
+void Session::clear_history() {
+    end_action();
+    history_.reset(field_);
 }
 
 void Session::adopt_marks(const SessionMarks& m) {

@@ -95,8 +95,11 @@ public:
 
     // --- seeds (undoable) -------------------------------------------------------------------
     const std::vector<SeedBall>& seeds() const { return marks_.seeds; }
-    // Adds a seed ball (index space; centre inside the image) and unites it with the level set.
+    // Adds a seed ball (index space; centre inside the image and, with a ROI, on a ROI voxel) and
+    // unites it with the level set. Throws std::invalid_argument (changing nothing) otherwise.
     SessionUpdate add_seed(SeedBall seed);
+    // Throws std::invalid_argument when the seed's centre voxel lies outside the ROI (none: no-op).
+    void check_seed_in_roi(const SeedBall& seed) const;
     // Removes seed `index`. While the level set is still the union of the seeds (no step taken
     // since), it is re-initialised from the remaining ones; later, only the list (and the window
     // estimate) changes - undo takes back grown regions.
@@ -160,6 +163,9 @@ public:
     std::string next_undo_label() const { return history_.next_undo_label(); }
     std::string next_redo_label() const { return history_.next_redo_label(); }
     std::size_t history_bytes() const { return history_.bytes(); }
+    // Forgets every undoable action (the set-up of a session - what was loaded, the start
+    // parameters - cannot be undone into hard-coded defaults). φ, seeds and parameters stay.
+    void clear_history();
     // Each closes the open action first; a no-op (empty update) when there is nothing to undo/redo.
     SessionUpdate undo();
     SessionUpdate redo();

@@ -1,0 +1,32 @@
+// The shared threshold-speed options: registration, the pair rule, raw -> normalised units.
+#include "threshold_args.hpp"
+
+#include "cli_common.hpp"
+
+namespace liveset::cli {
+
+void add_threshold_options(CLI::App& cmd, ThresholdArgs& a) {
+    cmd.add_option("--mu", a.mu, "ideal intensity, normalised to [0,1] (default: the tissue model's window for the seeds' class)")->check(finite_number());
+    cmd.add_option("--epsilon", a.epsilon, "half window, normalised units (default: from the tissue model)")->check(finite_number());
+    cmd.add_option("--mu-raw", a.mu_raw, "ideal intensity in the image's own units")->check(finite_number());
+    cmd.add_option("--epsilon-raw", a.epsilon_raw, "half window in the image's own units")->check(finite_number());
+    cmd.add_option("--n", a.n, "steepness of the threshold term")->check(finite_number())->capture_default_str();
+    cmd.add_option("--alpha", a.alpha, "curvature weight in [0,1)")->check(finite_number())->capture_default_str();
+}
+
+void check_threshold_args(const ThresholdArgs& a) {
+    if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");
+    if (a.epsilon && a.epsilon_raw) throw UsageError("give --epsilon or --epsilon-raw, not both");
+}
+
+std::optional<double> unit_mu(const ThresholdArgs& a, const IntensityScale& scale) {
+    if (a.mu_raw) return (*a.mu_raw - scale.low) / (scale.high - scale.low);
+    return a.mu;
+}
+
+std::optional<double> unit_epsilon(const ThresholdArgs& a, const IntensityScale& scale) {
+    if (a.epsilon_raw) return scale.unit_length(*a.epsilon_raw);
+    return a.epsilon;
+}
+
+}  // namespace liveset::cli

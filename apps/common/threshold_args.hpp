@@ -1,0 +1,29 @@
+// The threshold-speed options `liveset segment` and `liveset view` share (--mu, --epsilon, --mu-raw,
+// --epsilon-raw, --n, --alpha): one registration with the same help and checks, one rule for the
+// pairs, and the mapping of raw values to the normalised units the speed uses.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <optional>
+
+#include "liveset/segment/intensity.hpp"
+#include "liveset/segment/threshold_speed.hpp"
+
+namespace liveset::cli {
+
+struct ThresholdArgs {
+    std::optional<double> mu, epsilon, mu_raw, epsilon_raw;  // the window, normalised or raw units
+    double n = 4.0, alpha = 0.1;
+};
+
+// Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n and --alpha on `cmd`.
+void add_threshold_options(CLI::App& cmd, ThresholdArgs& a);
+// UsageError "give --mu or --mu-raw, not both" (and the same for ε).
+void check_threshold_args(const ThresholdArgs& a);
+// The window's µ / ε in normalised units through `scale` (raw values mapped as segment_image maps
+// them); nullopt where not given.
+std::optional<double> unit_mu(const ThresholdArgs& a, const IntensityScale& scale);
+std::optional<double> unit_epsilon(const ThresholdArgs& a, const IntensityScale& scale);
+
+}  // namespace liveset::cli

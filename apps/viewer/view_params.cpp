@@ -1,0 +1,71 @@
+// Start parameters of `liveset view` and their source.
+#include "view_params.hpp"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+
+#include "cli_common.hpp"
+#include "liveset/segment/window.hpp"
+
+namespace liveset::viewer {
+
+namespace {
+
+// µ, ε of a level set loaded with no seeds: the tissue model's window for the class most of its
+// inside voxels fall in (as the hole finder picks the sheet's class).
+std::string model_window_for_level_set(const Session& s, ThresholdParams& p, bool& from_seeds) {
+    std::vector<std::string> warnings;
+    const std::optional<ModelWindow> w = sheet_window(s.image(), s.mask(), s.roi(), TissueModelOptions{}, warnings);
+    const IntensityScale& sc = s.scale();
+    if (!w) {
+        return fmt::format("µ, ε: no usable tissue model ({}); µ {:.4g}, ε {:.4g} (raw) are defaults: set them (panel or --mu-raw/--epsilon-raw)",
+                           warnings.empty() ? "no reason given" : warnings.front(), sc.to_raw(p.mu), sc.raw_length(p.epsilon));
+    }
+    p.mu = std::clamp((w->mu() - sc.low) / (sc.high - sc.low), 0.0, 1.0);
+    p.epsilon = sc.unit_length(w->epsilon());
+    from_seeds = false;
+    return fmt::format("µ, ε from the tissue model: the window of class {} (most of the level set's inside), µ {:.4g}, ε {:.4g} (raw)",
+                       w->seed_class + 1, w->mu(), w->epsilon());
+}
+
+}  // namespace
+
+std::string choose_start_params(Session& s, const StartParams& start) {
+    const cli::ThresholdArgs& a = *start.args;
+    ThresholdParams p = s.params();
+    bool from_seeds = s.window_from_seeds();
+    std::string source;
+    bool changed = false;
+    if (!start.workspace.empty()) {
+        source = "µ, ε, n, α from the workspace " + start.workspace;
+    } else if (start.level_set_loaded && s.seeds().empty()) {
+        source = model_window_for_level_set(s, p, from_seeds);
+        changed = true;
+    } else if (!s.seeds().empty() && from_seeds) {
+        source = "µ, ε from the tissue model's window for the seeds' class";
+    }
+    const std::optional<double> mu = cli::unit_mu(a, s.scale()), epsilon = cli::unit_epsilon(a, s.scale());
+    if (mu) p.mu = *mu;
+    if (epsilon) p.epsilon = *epsilon;
+    if (start.n_given) p.n = a.n;
+    if (start.alpha_given) p.alpha = a.alpha;
+    if (mu || epsilon) {
+        from_seeds = false;
+        const std::string given = mu && epsilon ? "µ, ε" : (mu ? "µ" : "ε");
+        source = given + " from the command line" + (source.empty() || (mu && epsilon) ? "" : "; " + source);
+    }
+    if (start.n_given || start.alpha_given) source += (source.empty() ? "" : "; ") + std::string("n, α from the command line");
+    if (changed || mu || epsilon || start.n_given || start.alpha_given) {
+        try {
+            s.set_params(p, from_seeds);
+        } catch (const std::invalid_argument& e) {
+            throw cli::UsageError(fmt::format("threshold parameters: {} (µ {:.4g}, ε {:.4g} raw)", e.what(), s.scale().to_raw(p.mu),
+                                              s.scale().raw_length(p.epsilon)));
+        }
+        s.clear_history();  // Ctrl+Z must not go back to the defaults these replaced
+    }
+    return source;
+}
+
+}  // namespace liveset::viewer

@@ -1,0 +1,255 @@
+// Workspace files: W (JSON) + W.state (φ and layers, the recovery format), written and checked.
+#include "workspace.hpp"
+
+#include <fmt/core.h>
+
+#include <bit>
+#include <chrono>
+#include <cstring>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "liveset/base/atomic_file.hpp"
+#include "liveset/session/recovery.hpp"
+
+namespace liveset::viewer {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+json vec(Vec3d v) { return {v.x, v.y, v.z}; }
+
+// One field of the workspace, of the expected type; std::runtime_error naming it otherwise.
+const json& field(const json& j, const char* key) {
+    if (!j.is_object() || !j.contains(key)) throw std::runtime_error(fmt::format("missing field '{}'", key));
+    return j[key];
+}
+
+double number(const json& j, const char* key) {
+    const json& v = field(j, key);
+    if (!v.is_number()) throw std::runtime_error(fmt::format("field '{}' is not a number", key));
+    return v.get<double>();
+}
+
+std::vector<double> numbers(const json& j, const char* key, std::size_t n) {
+    const json& v = field(j, key);
+    if (!v.is_array() || v.size() != n) throw std::runtime_error(fmt::format("field '{}' is not a list of {} numbers", key, n));
+    std::vector<double> out;
+    for (const json& x : v) {
+        if (!x.is_number()) throw std::runtime_error(fmt::format("field '{}' is not a list of {} numbers", key, n));
+        out.push_back(x.get<double>());
+    }
+    return out;
+}
+
+Vec3d vec3(const json& j, const char* key) {
+    const auto v = numbers(j, key, 3);
+    return {v[0], v[1], v[2]};
+}
+
+json swarm_json(const RepairOptions& r) {
+    const SwarmOptions& s = r.swarm;
+    return {{"agents", s.agents}, {"pull_back", s.pull_back}, {"attraction", s.attraction}, {"random_walk", s.random_walk},
+            {"separation", s.separation}, {"separation_radius", s.separation_radius}, {"max_step", s.max_step},
+            {"p", s.act_probability}, {"edit_radius", s.edit_radius}, {"edit_amount", s.edit_amount}, {"seed", s.seed},
+            {"expand_sigmas", s.expand_sigmas}, {"contract_sigmas", s.contract_sigmas}, {"min_sigma", s.min_sigma},
+            {"stats_smoothing", s.stats_smoothing}, {"sample_depth", s.sample_depth}, {"edit_range", s.edit_range},
+            {"decision", static_cast<int>(s.decision)}, {"sheet_lower", s.sheet_lower}, {"sheet_upper", s.sheet_upper},
+            {"spawn_radius", r.spawn_radius}, {"respawn_distance", r.respawn_distance}, {"topology_guard", r.topology_guard}};
+}
+
+RepairOptions swarm_from(const json& j, RepairOptions r) {
+    SwarmOptions& s = r.swarm;
+    s.agents = static_cast<std::size_t>(number(j, "agents"));
+    s.pull_back = number(j, "pull_back");
+    s.attraction = number(j, "attraction");
+    s.random_walk = number(j, "random_walk");
+    s.separation = number(j, "separation");
+    s.separation_radius = number(j, "separation_radius");
+    s.max_step = number(j, "max_step");
+    s.act_probability = number(j, "p");
+    s.edit_radius = number(j, "edit_radius");
+    s.edit_amount = number(j, "edit_amount");
+    s.seed = field(j, "seed").get<std::uint64_t>();
+    s.expand_sigmas = number(j, "expand_sigmas");
+    s.contract_sigmas = number(j, "contract_sigmas");
+    s.min_sigma = number(j, "min_sigma");
+    s.stats_smoothing = number(j, "stats_smoothing");
+    s.sample_depth = number(j, "sample_depth");
+    s.edit_range = number(j, "edit_range");
+    const int decision = static_cast<int>(number(j, "decision"));
+    if (decision < 0 || decision > static_cast<int>(EditDecision::kSheet)) throw std::runtime_error("unknown swarm decision rule");
+    s.decision = static_cast<EditDecision>(decision);
+    s.sheet_lower = number(j, "sheet_lower");
+    s.sheet_upper = number(j, "sheet_upper");
+    r.spawn_radius = number(j, "spawn_radius");
+    r.respawn_distance = number(j, "respawn_distance");
+    r.topology_guard = field(j, "topology_guard").get<bool>();
+    return r;
+}
+
+// The FNV-1a a recovery-format file ends with (its last 8 bytes).
+std::uint64_t trailing_checksum(const std::vector<std::uint8_t>& bytes) {
+    std::uint64_t h = 0;
+    std::memcpy(&h, bytes.data() + bytes.size() - sizeof h, sizeof h);
+    return h;
+}
+
+std::string read_text(const fs::path& path) {
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw std::runtime_error("no such file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot read it");
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+Workspace parse_workspace(const json& j) {
+    if (!j.is_object() || !j.contains("liveset_workspace")) throw std::runtime_error("not a liveset workspace (no 'liveset_workspace' version)");
+    const int version = static_cast<int>(number(j, "liveset_workspace"));
+    if (version != kWorkspaceVersion)
+        throw std::runtime_error(fmt::format("workspace version {}; this liveset reads version {}", version, kWorkspaceVersion));
+    Workspace ws;
+    ws.image = field(j, "image").get<std::string>();
+    ws.roi = field(j, "roi").get<std::string>();
+    const json& g = field(j, "geometry");
+    const auto d = numbers(g, "dims", 3), dir = numbers(g, "direction", 9);
+    Mat3d direction{};
+    std::copy(dir.begin(), dir.end(), direction.begin());
+    try {
+        ws.lattice = Lattice({static_cast<int>(d[0]), static_cast<int>(d[1]), static_cast<int>(d[2])}, vec3(g, "spacing"), vec3(g, "origin"), direction);
+    } catch (const std::invalid_argument& e) {
+        throw std::runtime_error(std::string("bad geometry: ") + e.what());
+    }
+    ws.image_checksum = field(j, "image_fnv").get<std::uint64_t>();
+    if (!field(j, "seeds").is_array()) throw std::runtime_error("field 'seeds' is not a list");
+    for (const json& s : field(j, "seeds")) {
+        if (!s.is_array() || s.size() != 4) throw std::runtime_error("a seed is not [i, j, k, radius]");
+        ws.marks.seeds.push_back({{s[0].get<double>(), s[1].get<double>(), s[2].get<double>()}, s[3].get<double>()});
+    }
+    const json& p = field(j, "params");
+    ws.marks.params = {number(p, "mu"), number(p, "epsilon"), number(p, "n"), number(p, "alpha")};
+    ws.marks.window_from_seeds = field(p, "window_from_seeds").get<bool>();
+    ws.marks.iterations = static_cast<int>(number(j, "iterations"));
+    ws.marks.pristine = false;
+    ws.repair = swarm_from(field(j, "swarm"), ws.repair);
+    if (!field(j, "target").is_null()) ws.target = vec3(j, "target");
+    const json& v = field(j, "view");
+    const json& c = field(v, "camera");
+    const Vec3d pan = vec3(c, "pan");
+    ws.view.camera = {number(c, "yaw"), number(c, "pitch"), number(c, "zoom"), glm::dvec3(pan.x, pan.y, pan.z)};
+    const Vec3d cursor = vec3(v, "cursor");
+    ws.view.cursor = {static_cast<int>(cursor.x), static_cast<int>(cursor.y), static_cast<int>(cursor.z)};
+    ws.view.swarm_steps_per_frame = static_cast<int>(number(v, "swarm_steps_per_frame"));
+    return ws;
+}
+
+}  // namespace
+
+std::uint64_t image_checksum(const Grid<float>& image) {
+    recovery_format::Fnv h;
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        const std::uint32_t bits = std::bit_cast<std::uint32_t>(image[static_cast<PointIndex>(i)]);
+        h.add(&bits, sizeof bits);
+    }
+    return h.h;
+}
+
+fs::path workspace_state_path(const fs::path& workspace) { return fs::path(workspace.string() + ".state"); }
+
+void save_workspace(const fs::path& path, const Session& session, const std::string& image, const std::string& roi,
+                    const WorkspaceView& view) {
+    const SessionMarks& m = session.marks();
+    const auto now = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    const std::vector<std::uint8_t> state =
+        encode_recovery(RecoveryView(image, 0, static_cast<std::int64_t>(now), m, session.field().phi(), session.field().status()));
+    const Lattice& l = session.lattice();
+    json seeds = json::array();
+    for (const SeedBall& s : m.seeds) seeds.push_back({s.center.x, s.center.y, s.center.z, s.radius});
+    json j{{"liveset_workspace", kWorkspaceVersion},
+           {"image", image.empty() ? std::string() : fs::absolute(image).string()},
+           {"roi", roi.empty() ? std::string() : fs::absolute(roi).string()},
+           {"geometry", {{"dims", {l.dims().x, l.dims().y, l.dims().z}}, {"spacing", vec(l.spacing())}, {"origin", vec(l.origin())},
+                         {"direction", l.direction()}}},
+           {"image_fnv", image_checksum(session.image())},
+           {"state", {{"file", workspace_state_path(path).filename().string()}, {"fnv", trailing_checksum(state)}}},
+           {"seeds", seeds},
+           {"params", {{"mu", m.params.mu}, {"epsilon", m.params.epsilon}, {"n", m.params.n}, {"alpha", m.params.alpha},
+                       {"window_from_seeds", m.window_from_seeds},
+                       {"mu_raw", session.scale().to_raw(m.params.mu)}, {"epsilon_raw", session.scale().raw_length(m.params.epsilon)}}},
+           {"iterations", m.iterations},
+           {"swarm", swarm_json(session.repair_options())},
+           {"target", session.target() ? vec(*session.target()) : json(nullptr)},
+           {"view", {{"camera", {{"yaw", view.camera.yaw_deg}, {"pitch", view.camera.pitch_deg}, {"zoom", view.camera.zoom},
+                                 {"pan", {view.camera.pan.x, view.camera.pan.y, view.camera.pan.z}}}},
+                     {"cursor", {view.cursor.x, view.cursor.y, view.cursor.z}},
+                     {"swarm_steps_per_frame", view.swarm_steps_per_frame}}}};
+    try {
+        write_file_atomically(workspace_state_path(path), std::string_view(reinterpret_cast<const char*>(state.data()), state.size()));
+        write_file_atomically(path, j.dump(2) + "\n");
+    } catch (const std::exception& e) {
+        throw std::runtime_error(fmt::format("cannot write the workspace {}: {}", path.string(), e.what()));
+    }
+}
+
+Workspace read_workspace(const fs::path& path) {
+    Workspace ws;
+    std::uint64_t state_fnv = 0;
+    try {
+        const std::string text = read_text(path);
+        json j;
+        try {
+            j = json::parse(text);
+        } catch (const json::parse_error& e) {
+            throw std::runtime_error(fmt::format("not a liveset workspace: invalid or truncated JSON (byte {})", e.byte));
+        }
+        ws = parse_workspace(j);
+        state_fnv = field(field(j, "state"), "fnv").get<std::uint64_t>();
+    } catch (const json::exception& e) {  // a field of the wrong type
+        throw std::runtime_error(fmt::format("workspace {}: a field has the wrong type ({})", path.string(), e.what()));
+    } catch (const std::runtime_error& e) {
+        throw std::runtime_error(fmt::format("workspace {}: {}", path.string(), e.what()));
+    }
+    const fs::path state_path = workspace_state_path(path);
+    RecoveryState state;
+    try {
+        state = read_recovery(state_path);
+    } catch (const std::runtime_error& e) {
+        throw std::runtime_error(fmt::format("workspace {}: its level set {}", path.string(), e.what()));
+    }
+    std::vector<std::uint8_t> tail(8);
+    std::ifstream in(state_path, std::ios::binary);
+    in.seekg(-8, std::ios::end);
+    in.read(reinterpret_cast<char*>(tail.data()), 8);
+    if (!in || trailing_checksum(tail) != state_fnv)
+        throw std::runtime_error(fmt::format("workspace {}: {} belongs to another save (its checksum differs)", path.string(), state_path.string()));
+    if (!state.phi.lattice().same_geometry(ws.lattice, 1e-6))
+        throw std::runtime_error(fmt::format("workspace {}: its level set ({}) does not match its image ({})", path.string(),
+                                             state.phi.lattice().describe(), ws.lattice.describe()));
+    ws.phi = std::move(state.phi);
+    ws.status = std::move(state.status);
+    return ws;
+}
+
+void check_workspace_image(const Workspace& ws, const fs::path& path, const Grid<float>& image) {
+    if (!image.lattice().same_geometry(ws.lattice, 1e-6))
+        throw std::runtime_error(fmt::format("workspace {} was saved for another image: {} there, {} here (size, spacing, origin or direction)",
+                                             path.string(), ws.lattice.describe(), image.lattice().describe()));
+    if (image_checksum(image) != ws.image_checksum)
+        throw std::runtime_error(fmt::format("workspace {} was saved for another image: same geometry, other voxel values", path.string()));
+}
+
+void apply_workspace(Session& session, const Workspace& ws) {
+    validate(ws.repair.swarm);
+    if (!session.load_recovered(ws.phi, ws.status, ws.marks))
+        throw std::invalid_argument("the workspace's level set is not a consistent sparse field");
+    session.set_repair_options(ws.repair);
+    if (ws.target) session.set_target(*ws.target);
+}
+
+}  // namespace liveset::viewer

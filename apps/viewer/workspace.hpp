@@ -1,0 +1,57 @@
+// The viewer's workspace: everything needed to continue where the user left off, in one versioned
+// JSON file W (image and ROI paths, the image's geometry and a checksum of its voxels, seeds, µ, ε,
+// n, α, the iteration count, swarm settings and target, camera, cursor) plus φ and the sparse
+// field's layers bit for bit in W.state next to it (the recovery file's checksummed binary format,
+// liveset/session/recovery.hpp). Both are written atomically, the state first; W records the
+// state's checksum, so a W paired with another state is refused. Every read is checked and refused
+// with one line (std::runtime_error): missing, truncated, another version, another image.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "liveset/render/orbit_camera.hpp"
+#include "liveset/session/session.hpp"
+
+namespace liveset::viewer {
+
+inline constexpr int kWorkspaceVersion = 1;
+
+// The viewer's part of a workspace.
+struct WorkspaceView {
+    render::CameraPose camera = render::OrbitCamera::default_pose();
+    Vec3i cursor{};
+    int swarm_steps_per_frame = 1;
+};
+
+struct Workspace {
+    std::string image, roi;          // absolute paths (roi empty: none)
+    Lattice lattice;                 // the image's geometry when saved
+    std::uint64_t image_checksum = 0;  // image_checksum() of its voxels
+    SessionMarks marks;              // seeds, parameters, iterations
+    RepairOptions repair;            // swarm settings
+    std::optional<Vec3d> target;     // the swarm's target (the swarm respawns there)
+    WorkspaceView view;
+    Grid<float> phi;                 // bit for bit as saved
+    Grid<std::int8_t> status;
+};
+
+// FNV-1a of the image's voxel values (float bits, in index order).
+std::uint64_t image_checksum(const Grid<float>& image);
+// The state file next to a workspace file: "<W>.state".
+std::filesystem::path workspace_state_path(const std::filesystem::path& workspace);
+
+// Writes W.state then W atomically. `image` and `roi` are made absolute. Throws std::runtime_error.
+void save_workspace(const std::filesystem::path& path, const Session& session, const std::string& image, const std::string& roi,
+                    const WorkspaceView& view);
+// Reads and checks W and W.state. Throws std::runtime_error with one line naming the file.
+Workspace read_workspace(const std::filesystem::path& path);
+// Throws std::runtime_error when `ws` was saved for another image (geometry or voxels differ).
+void check_workspace_image(const Workspace& ws, const std::filesystem::path& path, const Grid<float>& image);
+// Continues the workspace in `session` (the image it was saved for): φ and the layers bit for bit,
+// seeds, parameters and iteration count, swarm settings and target. Throws std::invalid_argument.
+void apply_workspace(Session& session, const Workspace& ws);
+
+}  // namespace liveset::viewer

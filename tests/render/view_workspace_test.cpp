@@ -1,0 +1,345 @@
+// `liveset view` with workspaces, seed files and threshold options, end to end through the CLI
+// (headless scripts) and in a real window under Xvfb driven by xdotool (window_workspace.sh,
+// window_prompts.sh): a workspace continues bit for bit where it was saved; a φ loaded alone takes
+// µ, ε from the tissue model (checked against sheet_window) and says so; --mu-raw/--epsilon-raw
+// mean what they mean for `liveset segment`; a bad workspace is one line and the viewer still
+// runs; a seed outside the ROI is refused; Ctrl+Q with unsaved work asks first.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <bit>
+#include <filesystem>
+#include <fmt/core.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "cli/cli_run.hpp"
+#include "liveset/io/image_io.hpp"
+#include "liveset/phantom/phantom.hpp"
+#include "liveset/segment/intensity.hpp"
+#include "liveset/segment/window.hpp"
+#include "workspace.hpp"
+
+namespace liveset {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CliResult;
+using testing::run_cli;
+
+struct Fixture {
+    fs::path dir;
+    Phantom ph;
+    std::string image, seeds;  // seeds: a seed file of the phantom's seeds
+};
+
+const Fixture& fixture() {
+    static const Fixture f = [] {
+        Fixture x;
+        x.dir = fs::temp_directory_path() / ("liveset_view_workspace_" + std::to_string(::getpid()));
+        fs::remove_all(x.dir);
+        fs::create_directories(x.dir);
+        PhantomOptions o;
+        o.size = 48;
+        x.ph = make_phantom(o);
+        x.image = (x.dir / "t1.nii.gz").string();
+        write_image(x.ph.image, x.image);
+        x.seeds = (x.dir / "seeds.txt").string();
+        std::ofstream out(x.seeds);
+        for (const Vec3i& s : x.ph.seeds) out << s.x << "," << s.y << "," << s.z << "\n";
+        return x;
+    }();
+    return f;
+}
+
+std::string script(const std::string& name, const std::string& json) {
+    const fs::path p = fixture().dir / name;
+    std::ofstream(p) << json;
+    return p.string();
+}
+
+bool same_bits(const Grid<float>& a, const Grid<float>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (std::bit_cast<std::uint32_t>(a[static_cast<PointIndex>(i)]) != std::bit_cast<std::uint32_t>(b[static_cast<PointIndex>(i)]))
+            return false;
+    return true;
+}
+
+std::size_t lines(const std::string& text) { return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')); }
+
+TEST(ViewCommand, HelpListsTheWindowAndWorkspaceOptions) {
+    const CliResult r = run_cli("view --help");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    for (const char* option : {"--mu-raw", "--epsilon-raw", "--workspace", "--mu ", "--epsilon ", "--n ", "--alpha", "--seeds"})
+        EXPECT_NE(r.out.find(option), std::string::npos) << option;
+}
+
+// Segment 20 steps and save a workspace; reopen it and take 10 more: φ is bit for bit what 30
+// steps in one run give (the level set, the parameters and the iteration count continue).
+TEST(ViewCommand, AWorkspaceContinuesBitForBit) {
+    const Fixture& f = fixture();
+    const std::string w = (f.dir / "cont.json").string(), p2 = (f.dir / "cont_phi.nii.gz").string(), p3 = (f.dir / "one_phi.nii.gz").string();
+    CliResult r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
+                                      script("a.json", R"([{"segment": 20}, {"save_workspace": ")" + w + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    r = run_cli(fmt::format("view --workspace {} --headless --script {}", w, script("b.json", R"([{"segment": 10}, {"save_phi": ")" + p2 + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("from the workspace " + w), std::string::npos) << r.err;
+    r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
+                            script("c.json", R"([{"segment": 30}, {"save_phi": ")" + p3 + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_TRUE(same_bits(read_image(p2), read_image(p3)));
+    EXPECT_EQ(viewer::read_workspace(w).marks.iterations, 20);
+}
+
+// A φ loaded alone: µ, ε from the tissue model's window of the class most of its inside falls in,
+// said on stderr; with --workspace, the workspace's; with --mu-raw/--epsilon-raw, those.
+TEST(ViewCommand, APhiLoadedAloneSaysWhereItsParametersCameFrom) {
+    const Fixture& f = fixture();
+    const std::string phi = (f.dir / "alone_phi.nii.gz").string(), w = (f.dir / "alone.json").string();
+    CliResult r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
+                                      script("d.json", R"([{"segment": 40}, {"save_phi": ")" + phi + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    r = run_cli(fmt::format("view {} --phi {} --headless --script {}", f.image, phi, script("e.json", R"([{"undo": 1}, {"save_workspace": ")" + w + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("µ, ε from the tissue model"), std::string::npos) << r.err;
+    // The same window computed here from the library: the class of the φ's inside.
+    const Grid<float> phi_image = read_image(phi);
+    Grid<std::uint8_t> inside(phi_image.lattice());
+    for (std::size_t i = 0; i < inside.size(); ++i) inside[static_cast<PointIndex>(i)] = phi_image[static_cast<PointIndex>(i)] < 0.0f;
+    std::vector<std::string> warnings;
+    const auto window = sheet_window(f.ph.image, inside, nullptr, TissueModelOptions{}, warnings);
+    ASSERT_TRUE(window.has_value());
+    const IntensityScale scale = robust_scale(f.ph.image);
+    viewer::Workspace ws = viewer::read_workspace(w);
+    EXPECT_NEAR(scale.to_raw(ws.marks.params.mu), window->mu(), 1e-6 * window->mu());
+    EXPECT_NEAR(scale.raw_length(ws.marks.params.epsilon), window->epsilon(), 1e-6 * window->epsilon());
+    // (after an undo: the start parameters are not an undoable action that Ctrl+Z would take back)
+
+    r = run_cli(fmt::format("view {} --phi {} --workspace {} --headless --script {}", f.image, phi, w,
+                            script("f.json", "[]")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("µ, ε, n, α from the workspace"), std::string::npos) << r.err;
+
+    r = run_cli(fmt::format("view {} --phi {} --mu-raw 500 --epsilon-raw 120 --alpha 0.2 --headless --script {}", f.image, phi,
+                            script("g.json", R"([{"save_workspace": ")" + w + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("µ, ε from the command line"), std::string::npos) << r.err;
+    ws = viewer::read_workspace(w);
+    EXPECT_NEAR(scale.to_raw(ws.marks.params.mu), 500.0, 1e-9);
+    EXPECT_NEAR(scale.raw_length(ws.marks.params.epsilon), 120.0, 1e-9);
+    EXPECT_EQ(ws.marks.params.alpha, 0.2);
+    EXPECT_FALSE(ws.marks.window_from_seeds);
+
+    // The same validation as `liveset segment`: one line and a non-zero status.
+    for (const std::string& bad : {std::string("--mu 0.5 --mu-raw 500"), std::string("--epsilon 0.1 --epsilon-raw 3"),
+                                   std::string("--mu-raw 1e9"), std::string("--alpha 1.5"), std::string("--epsilon-raw -4")}) {
+        r = run_cli(fmt::format("view {} --phi {} {} --headless --script {}", f.image, phi, bad, script("h.json", "[]")));
+        EXPECT_NE(r.rc, 0) << bad;
+        EXPECT_EQ(lines(r.err), 1u) << bad << ": " << r.err;
+    }
+}
+
+// A missing, truncated or mismatching workspace: one line on stderr, and the viewer still runs.
+TEST(ViewCommand, ABadWorkspaceIsOneLineAndTheViewerStillOpens) {
+    const Fixture& f = fixture();
+    const std::string w = (f.dir / "bad_base.json").string();
+    const CliResult made = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
+                                               script("n.json", R"([{"segment": 3}, {"save_workspace": ")" + w + R"("}])")));
+    ASSERT_EQ(made.rc, 0) << made.err;
+    PhantomOptions o;
+    o.size = 40;
+    const std::string other = (f.dir / "other.nii.gz").string();
+    write_image(make_phantom(o).image, other);
+    std::ifstream in(w);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string cut = (f.dir / "cut.json").string();
+    std::ofstream(cut) << text.substr(0, text.size() / 3);
+    fs::copy_file(viewer::workspace_state_path(w), viewer::workspace_state_path(cut), fs::copy_options::overwrite_existing);
+    const std::string empty = script("i.json", "[]");
+    const struct {
+        std::string args, says;
+    } cases[] = {{f.image + " --workspace " + (f.dir / "missing.json").string(), "no such file"},
+                 {f.image + " --workspace " + cut, "invalid or truncated JSON"},
+                 {other + " --workspace " + w, "was saved for another image"}};
+    for (const auto& c : cases) {
+        const CliResult r = run_cli("view " + c.args + " --headless --script " + empty);
+        EXPECT_EQ(r.rc, 0) << c.args << ": " << r.err;
+        EXPECT_EQ(lines(r.err), 1u) << r.err;
+        EXPECT_NE(r.err.find(c.says), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("the viewer opens without it"), std::string::npos) << r.err;
+    }
+}
+
+// A seed outside the ROI: refused on the command line (one line) and in a script (the entry named).
+TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
+    const Fixture& f = fixture();
+    Grid<std::uint8_t> roi(f.ph.image.lattice());
+    const Vec3i d = roi.dims();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x / 2; ++x) roi({x, y, z}) = 1;
+    const std::string roi_path = (f.dir / "half.nii.gz").string();
+    write_label_image(roi, roi_path);
+    CliResult r = run_cli(fmt::format("view {} --roi {} --seed 40,24,24 --headless --script {}", f.image, roi_path, script("j.json", "[]")));
+    EXPECT_NE(r.rc, 0);
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find("seed --seed 40,24,24: the seed at (40, 24, 24) lies outside the region of interest"), std::string::npos) << r.err;
+    r = run_cli(fmt::format("view {} --roi {} --headless --script {}", f.image, roi_path,
+                            script("k.json", R"([{"seed": [10, 24, 24]}, {"seed": [40, 24, 24]}])")));
+    EXPECT_NE(r.rc, 0);
+    EXPECT_NE(r.err.find("entry 2 (\"seed\")"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("outside the region of interest"), std::string::npos) << r.err;
+}
+
+// Scripts save and load seed files: what load_seeds read, save_seeds writes back; a file with a
+// seed outside the ROI loads the others and fails the entry naming the refused seed.
+TEST(ViewCommand, ScriptsSaveAndLoadSeedFiles) {
+    const Fixture& f = fixture();
+    const std::string out = (f.dir / "seeds_out.txt").string();
+    CliResult r = run_cli(fmt::format("view {} --headless --script {}", f.image,
+                                      script("l.json", R"([{"load_seeds": ")" + f.seeds + R"("}, {"save_seeds": ")" + out + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    std::ifstream in(out);
+    std::vector<std::string> saved;
+    for (std::string line; std::getline(in, line);)
+        if (!line.empty() && line[0] != '#') saved.push_back(line);
+    ASSERT_EQ(saved.size(), f.ph.seeds.size());
+    for (std::size_t i = 0; i < saved.size(); ++i)
+        EXPECT_EQ(saved[i], fmt::format("{},{},{}:2", f.ph.seeds[i].x, f.ph.seeds[i].y, f.ph.seeds[i].z));
+    Grid<std::uint8_t> roi(f.ph.image.lattice());
+    const Vec3i s0 = f.ph.seeds[0];
+    const Vec3i d = roi.dims();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x <= s0.x + 2; ++x) roi({x, y, z}) = 1;  // the first seed inside, 5 voxels along x outside
+    const std::string roi_path = (f.dir / "slab.nii.gz").string();
+    write_label_image(roi, roi_path);
+    const std::string two = (f.dir / "two_seeds.txt").string();
+    std::ofstream(two) << fmt::format("{},{},{}\n{},{},{}:3\n", s0.x, s0.y, s0.z, s0.x + 5, s0.y, s0.z);
+    r = run_cli(fmt::format("view {} --roi {} --headless --script {}", f.image, roi_path, script("m.json", R"([{"load_seeds": ")" + two + R"("}])")));
+    EXPECT_NE(r.rc, 0);
+    EXPECT_NE(r.err.find("loaded 1 of 2 seed(s)"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(fmt::format("refused {},{},{}:3", s0.x + 5, s0.y, s0.z)), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("outside the region of interest"), std::string::npos) << r.err;
+}
+
+// --- real windows -----------------------------------------------------------------------------
+
+bool have(const char* tool) { return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0; }
+
+// Runs a driver under Xvfb in `dir`; its output on failure.
+std::string run_driver(const fs::path& dir, const std::string& driver, const std::string& args, int& rc) {
+    const std::string cmd = "cd " + dir.string() + " && timeout 120 xvfb-run -a -s '-screen 0 1280x720x24' bash " + std::string(LIVESET_SOURCE_DIR) +
+                            "/tests/render/" + driver + " " + LIVESET_CLI_PATH + " " + args + " > driver.out 2>&1";
+    const int status = std::system(cmd.c_str());
+    rc = WIFEXITED(status) ? WEXITSTATUS(status) : 128;
+    std::ifstream in(dir / "driver.out");
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::vector<nlohmann::json> events(const fs::path& log) {
+    std::vector<nlohmann::json> out;
+    std::ifstream in(log);
+    for (std::string line; std::getline(in, line);) out.push_back(nlohmann::json::parse(line));
+    return out;
+}
+
+nlohmann::json last_of(const std::vector<nlohmann::json>& ev, const std::string& type) {
+    for (auto it = ev.rbegin(); it != ev.rend(); ++it)
+        if ((*it)["type"] == type) return *it;
+    return {};
+}
+
+// Saved from the panel, reopened with --workspace, continued: φ after 5 + 3 steps in two windows
+// is bit for bit φ after 8 steps in one headless run, and the camera is where it was left.
+TEST(WindowWorkspace, SavedReopenedAndContinuedBitForBitUnderXvfb) {
+    if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
+        GTEST_SKIP() << "xvfb-run, xauth and xdotool are needed (scripts/setup.sh installs them)";
+    const Fixture& f = fixture();
+    const fs::path dir = f.dir / "window_ws";
+    fs::create_directories(dir);
+    int rc = 0;
+    std::string out = run_driver(dir, "window_workspace.sh", f.image + " " + f.seeds + " " + (dir / "one.jsonl").string() + " 1", rc);
+    ASSERT_EQ(rc, 0) << out;
+    const auto first = events(dir / "one.jsonl");
+    out = run_driver(dir, "window_workspace.sh", f.image + " " + f.seeds + " " + (dir / "two.jsonl").string() + " 2", rc);
+    ASSERT_EQ(rc, 0) << out;
+    const auto second = events(dir / "two.jsonl");
+
+    const std::string ref = (f.dir / "ref8.json").string();
+    const CliResult r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
+                                            script("ref8_script.json", R"([{"segment": 8}, {"save_workspace": ")" + ref + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const viewer::Workspace continued = viewer::read_workspace(dir / "workspace.json"), reference = viewer::read_workspace(ref);
+    EXPECT_EQ(continued.marks.iterations, 8);
+    EXPECT_TRUE(same_bits(continued.phi, reference.phi));
+    // The camera the first window left is the one the second opened with (and left untouched).
+    const auto exit1 = last_of(first, "exit"), exit2 = last_of(second, "exit");
+    ASSERT_FALSE(exit1.is_null());
+    ASSERT_FALSE(exit2.is_null());
+    EXPECT_NE(exit1["camera"]["yaw"].get<double>(), -30.0);  // turned
+    EXPECT_EQ(exit1["camera"], exit2["camera"]);
+    EXPECT_EQ(exit2["iterations"], 8);
+    EXPECT_EQ(exit1["reason"], "ctrl+q");  // saved: no question asked
+    // The status's FPS and frame time agree: FPS x mean frame time <= 1 s.
+    for (const auto& e : {exit1, exit2}) {
+        EXPECT_GT(e["frame_ms"].get<double>(), 0.0);
+        EXPECT_LE(e["fps"].get<double>() * e["frame_ms"].get<double>(), 1000.0 + 1e-6) << e.dump();
+    }
+    EXPECT_TRUE(last_of(first, "quit_prompt").is_null());
+}
+
+// A seed click outside the ROI is refused, one inside placed; µ typed in raw units applies; Ctrl+Q asks (the prompt names the
+// recovery file), Cancel keeps the window, Quit quits with status 0 and the work in the file.
+TEST(WindowWorkspace, SeedOutsideTheRoiRefusedAndQuitAsksFirstUnderXvfb) {
+    if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
+        GTEST_SKIP() << "xvfb-run, xauth and xdotool are needed (scripts/setup.sh installs them)";
+    const Fixture& f = fixture();
+    const fs::path dir = f.dir / "window_prompts";
+    fs::create_directories(dir);
+    Grid<std::uint8_t> roi(f.ph.image.lattice());
+    const Vec3i d = roi.dims(), c{d.x / 2, d.y / 2, d.z / 2};
+    for (int z = c.z - 4; z <= c.z + 4; ++z)
+        for (int y = c.y - 4; y <= c.y + 4; ++y)
+            for (int x = c.x - 4; x <= c.x + 4; ++x) roi({x, y, z}) = 1;  // a 9^3 cube at the centre
+    const std::string roi_path = (dir / "cube.nii.gz").string();
+    write_label_image(roi, roi_path);
+    const IntensityScale scale = robust_scale(f.ph.image, &roi);  // the session's: inside the ROI
+    const int mu = static_cast<int>(std::lround(scale.low + 0.4 * (scale.high - scale.low)));
+    int rc = 0;
+    const std::string out =
+        run_driver(dir, "window_prompts.sh", f.image + " " + roi_path + " " + (dir / "events.jsonl").string() + " " + std::to_string(mu), rc);
+    ASSERT_EQ(rc, 0) << out;
+    const auto ev = events(dir / "events.jsonl");
+    const auto error = last_of(ev, "error");
+    ASSERT_FALSE(error.is_null()) << out;
+    EXPECT_NE(error["message"].get<std::string>().find("outside the region of interest"), std::string::npos) << error.dump();
+    const auto seed = last_of(ev, "seed");
+    ASSERT_FALSE(seed.is_null());
+    EXPECT_EQ(seed["seeds"], 1);
+    const Vec3d s{seed["index"][0].get<double>(), seed["index"][1].get<double>(), seed["index"][2].get<double>()};
+    EXPECT_NE(roi({static_cast<int>(s.x), static_cast<int>(s.y), static_cast<int>(s.z)}), 0);
+    // µ typed in raw units: the normalised value is it mapped through the image's scale.
+    const auto params = last_of(ev, "params");
+    ASSERT_FALSE(params.is_null()) << out;
+    EXPECT_NEAR(params["mu_raw"].get<double>(), mu, 1e-9);
+    EXPECT_FALSE(params["auto_window"].get<bool>());
+    EXPECT_NEAR(params["mu"].get<double>(), (mu - scale.low) / (scale.high - scale.low), 1e-12);
+    std::size_t prompts = 0, cancels = 0;
+    std::string file;
+    for (const auto& e : ev)
+        if (e["type"] == "quit_prompt") {
+            if (e.contains("buttons")) ++prompts, file = e["file"].get<std::string>();
+            if (e.value("answer", "") == "cancel") ++cancels;
+        }
+    EXPECT_EQ(prompts, 2u);
+    EXPECT_EQ(cancels, 1u);
+    ASSERT_FALSE(file.empty());
+    EXPECT_TRUE(fs::exists(file)) << "the unsaved seed waits in the recovery file the prompt named";
+    EXPECT_EQ(last_of(ev, "exit")["seeds"], 1);
+}
+
+}  // namespace
+}  // namespace liveset
