@@ -1,0 +1,44 @@
+// A coarse level of detail of a fragment-meshed surface, for drawing while the user interacts:
+// marching cubes of φ sampled at every second lattice point per axis (about a quarter of the
+// triangles), in fragments covering the same blocks as the fine mesher's, kept up to date
+// incrementally from the fine fragments the fine mesher rebuilt (U).
+//
+// Coarse point c is fine point 2c; the coarse lattice has twice the spacing, the same origin and
+// direction, so a coarse vertex v lies at fine index 2v. Standard library + oneTBB only.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/mesh/fragment_mesher.hpp"
+
+namespace liveset {
+
+class LodMesher {
+public:
+    // `fine` the full-resolution lattice; the coarse fragments hold max(1, fine_fragment_size / 2)
+    // cells per edge. Throws std::invalid_argument on fine_fragment_size < 1 or an empty lattice.
+    LodMesher(const Lattice& fine, int fine_fragment_size);
+
+    const Lattice& lattice() const { return coarse_phi_.lattice(); }  // coarse lattice
+    const FragmentMesher& mesher() const { return mesher_; }
+    const Grid<float>& phi() const { return coarse_phi_; }  // φ at the even fine points
+
+    // Samples all of `phi` and re-meshes every coarse fragment.
+    void rebuild(const Grid<float>& phi);
+    // After the fine mesher rebuilt fragments `fine_ids` (every changed φ point is a corner of a
+    // cell of one of them): re-samples their point boxes and re-meshes the affected coarse
+    // fragments, whose ids it returns (sorted). `phi` has the fine lattice's dimensions.
+    std::vector<FragmentId> update(const Grid<float>& phi, const FragmentMesher& fine, std::span<const FragmentId> fine_ids);
+
+private:
+    Grid<float> coarse_phi_;
+    FragmentMesher mesher_;
+    bool built_ = false;
+};
+
+// The coarse lattice of LodMesher: ceil(dims / 2) points, spacing x 2, same origin and direction.
+Lattice half_resolution(const Lattice& fine);
+
+}  // namespace liveset
