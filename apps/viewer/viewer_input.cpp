@@ -75,7 +75,10 @@ void Viewer::process_events() {
         }
         if (e.type == InputEvent::Type::kMove || to_imgui) ImGuiBridge::feed(e);
         if (e.type == InputEvent::Type::kKey) {
-            if (e.down && !ImGuiBridge::wants_keyboard()) handle_key(e);
+            if (e.down && !ImGuiBridge::wants_keyboard()) {
+                budget_.record_input(now_ms());  // the 3D pane draws coarse until still again
+                handle_key(e);
+            }
         } else if (!to_imgui || (e.type == InputEvent::Type::kMove && drag_.active)) {
             handle_pane_event(e);
         }
@@ -84,6 +87,7 @@ void Viewer::process_events() {
 
 void Viewer::handle_pane_event(const InputEvent& e) {
     if (!session_) return;
+    if (e.type != InputEvent::Type::kMove || drag_.active) budget_.record_input(now_ms());
     switch (e.type) {
         case InputEvent::Type::kPress: {
             const auto pane = pane_at(e.x, e.y);

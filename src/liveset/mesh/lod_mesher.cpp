@@ -15,7 +15,7 @@ Lattice half_resolution(const Lattice& fine) {
 
 LodMesher::LodMesher(const Lattice& fine, int fine_fragment_size)
     : coarse_phi_(half_resolution(fine), 1.0f),
-      mesher_(coarse_phi_.lattice(), std::max(1, fine_fragment_size / 2)) {
+      mesher_(coarse_phi_.lattice(), std::max(1, fine_fragment_size)) {
     if (fine_fragment_size < 1) throw std::invalid_argument("LodMesher: the fragment size must be at least 1");
 }
 

@@ -1,7 +1,8 @@
 // A coarse level of detail of a fragment-meshed surface, for drawing while the user interacts:
 // marching cubes of φ sampled at every second lattice point per axis (about a quarter of the
-// triangles), in fragments covering the same blocks as the fine mesher's, kept up to date
-// incrementally from the fine fragments the fine mesher rebuilt (U).
+// triangles), in fragments of S coarse cells (2 x 2 x 2 fine fragments of S cells: an eighth of
+// the draw calls, which llvmpipe pays for), kept up to date incrementally from the fine fragments
+// the fine mesher rebuilt (U).
 //
 // Coarse point c is fine point 2c; the coarse lattice has twice the spacing, the same origin and
 // direction, so a coarse vertex v lies at fine index 2v. Standard library + oneTBB only.
@@ -17,8 +18,8 @@ namespace liveset {
 
 class LodMesher {
 public:
-    // `fine` the full-resolution lattice; the coarse fragments hold max(1, fine_fragment_size / 2)
-    // cells per edge. Throws std::invalid_argument on fine_fragment_size < 1 or an empty lattice.
+    // `fine` the full-resolution lattice; the coarse fragments hold fine_fragment_size cells per
+    // edge. Throws std::invalid_argument on fine_fragment_size < 1 or an empty lattice.
     LodMesher(const Lattice& fine, int fine_fragment_size);
 
     const Lattice& lattice() const { return coarse_phi_.lattice(); }  // coarse lattice
