@@ -65,13 +65,19 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
     render::Framebuffer window(width, height);
     viewer.frame(window.id(), width, height, 1.0 / 60.0);  // the first picture (not timed)
     std::vector<double> frame_ms, step_counts;
+    double level_set = 0, mesh = 0, upload = 0, draw = 0;  // summed over the run's frames
     const auto v0 = Clock::now();
     viewer.set_segment_running(true);
     while (viewer.segment_running()) {
         const auto f0 = Clock::now();
         viewer.frame(window.id(), width, height, 1.0 / 60.0);
         frame_ms.push_back(ms_since(f0));
-        step_counts.push_back(viewer.last_frame().segment_steps);
+        const FrameStats& fs = viewer.last_frame();
+        step_counts.push_back(fs.segment_steps);
+        level_set += fs.level_set_ms;
+        mesh += fs.mesh_ms;
+        upload += fs.upload_ms;
+        draw += fs.draw_ms;
     }
     viewer.frame(window.id(), width, height, 1.0 / 60.0);  // the final picture
     const double viewer_ms = ms_since(v0);
@@ -82,7 +88,8 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
                               {"cli_iterations", cli.result.iterations}, {"viewer_iterations", iterations},
                               {"identical_phi", identical}, {"frames", frame_ms.size()},
                               {"frame_ms_median", f.median}, {"frame_ms_worst", f.worst},
-                              {"steps_per_frame_median", st.median}, {"triangles", s->mesher().triangle_count()}};
+                              {"steps_per_frame_median", st.median}, {"triangles", s->mesher().triangle_count()},
+                              {"level_set_ms", level_set}, {"mesh_ms", mesh}, {"upload_ms", upload}, {"draw3d_ms", draw}};
     if (o.json) {
         fmt::print("{}\n", j.dump());
     } else {
@@ -91,6 +98,9 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
         fmt::print("  viewer (Run)         {:9.1f} ms  {} iterations  {} frames  frame median {:.1f} ms, worst {:.1f} ms, "
                    "steps/frame median {:.0f}\n",
                    viewer_ms, iterations, frame_ms.size(), f.median, f.worst, st.median);
+        fmt::print("  viewer time in: level set (steps) {:.1f} s, meshing {:.1f} s, upload {:.1f} s, 3D draws {:.1f} s, "
+                   "the rest (slice panes, panel, history) {:.1f} s\n",
+                   level_set / 1e3, mesh / 1e3, upload / 1e3, draw / 1e3, (viewer_ms - level_set - mesh - upload - draw) / 1e3);
         fmt::print("  viewer / CLI         {:9.3f}   φ identical bit for bit: {}\n", viewer_ms / cli_ms, identical ? "yes" : "NO");
     }
     return identical ? 0 : 1;
@@ -120,91 +130,87 @@ InputEvent mouse(InputEvent::Type type, double x, double y, int button = 0) {
     return e;
 }
 
+// The events of sample i of each interaction (the drag's press comes before its first sample).
+std::vector<InputEvent> interaction_events(int kind, int i, const Rect& r3, const Rect& ra) {
+    using T = InputEvent::Type;
+    const double cx = r3.x + r3.w / 2.0, cy = r3.y + r3.h / 2.0;
+    InputEvent wheel = mouse(T::kScroll, kind == 1 ? cx : ra.x + ra.w / 2.0, kind == 1 ? cy : ra.y + ra.h / 2.0);
+    wheel.scroll = i % 2 ? 1.0 : -1.0;
+    switch (kind) {
+        case 0:  // rotate: one move of a held left drag per frame
+            return {mouse(T::kMove, cx + 6.0 * (i + 1), cy + 2.0 * (i % 3))};
+        case 1:  // zoom: a wheel step over the 3D pane
+        case 2:  // slice scroll: a wheel step over the axial pane
+            return {wheel};
+        case 3: {  // crosshair click in the axial pane
+            const double x = ra.x + ra.w * (0.35 + 0.03 * ((i * 7) % 10)), y = ra.y + ra.h * (0.35 + 0.03 * ((i * 3) % 10));
+            return {mouse(T::kPress, x, y), mouse(T::kRelease, x, y)};
+        }
+        default: {  // a pick on the surface (from whatever the pane shows)
+            const double x = cx + r3.w * 0.05 * ((i % 5) - 2), y = cy + r3.h * 0.1 * ((i % 3) - 1);
+            return {mouse(T::kPress, x, y), mouse(T::kRelease, x, y)};
+        }
+    }
+}
+
 }  // namespace
 
 // Each interaction: its events pushed, then one frame; the latency is that frame's wall time (the
-// events are processed and everything they changed is drawn in it).
+// events are processed and everything they changed is drawn in it). After each kind, the viewer
+// settles (full quality once still), timed apart.
 int run_interaction_bench(Viewer& viewer, const BenchOptions& o, int width, int height) {
     Session* s = viewer.session();
     if (!s || !s->has_surface()) throw cli::UsageError("--bench-mode interaction needs a surface: give --phi or --mask");
     render::Framebuffer window(width, height);
-    const auto first = Clock::now();
-    viewer.frame(window.id(), width, height, 1.0 / 60.0);
-    const double full_first = ms_since(first);  // every pane, the 3D one at full quality
-    const Rect r3 = viewer.pane_rect(Pane::kView3d), ra = viewer.pane_rect(Pane::kAxial);
-    const double cx = r3.x + r3.w / 2.0, cy = r3.y + r3.h / 2.0;
-    std::vector<double> draw3d;  // of the current interaction's frames: the 3D pane's draw
-    const auto timed = [&](const std::vector<InputEvent>& events) {
-        for (const InputEvent& e : events) viewer.push_event(e);
+    const auto frame = [&] {
         const auto t0 = Clock::now();
         viewer.frame(window.id(), width, height, 1.0 / 60.0);
-        draw3d.push_back(viewer.last_frame().draw_ms);
         return ms_since(t0);
     };
-    using T = InputEvent::Type;
+    const double first = frame();  // every pane, the 3D one at full quality
+    settle(viewer, window, width, height);
+    const Rect r3 = viewer.pane_rect(Pane::kView3d), ra = viewer.pane_rect(Pane::kAxial);
+    if (!o.json)
+        fmt::print("liveset view --bench-mode interaction: {}x{} window, {} triangles (coarse level of detail: {} triangles), "
+                   "first frame (all panes, full quality) {:.1f} ms\n",
+                   width, height, s->mesher().triangle_count(), viewer.coarse_triangles(), first);
+    static constexpr const char* kNames[] = {"rotate (3D drag)", "zoom (3D wheel)", "slice scroll (wheel)",
+                                             "click (slice crosshair)", "click (3D pick)"};
     nlohmann::json results = nlohmann::json::array();
     std::vector<double> still_ms;
-    const auto report = [&](const char* name, const std::vector<double>& v) {
-        const Summary m = summarise(v), d = summarise(draw3d);
-        draw3d.clear();
-        results.push_back({{"interaction", name}, {"samples", m.n}, {"median_ms", m.median}, {"worst_ms", m.worst},
+    viewer.set_tool(Tool::kCrosshair);
+    for (int kind = 0; kind < 5; ++kind) {
+        std::vector<double> ms, draw3d;
+        if (kind == 0) {
+            viewer.push_event(mouse(InputEvent::Type::kPress, r3.x + r3.w / 2.0, r3.y + r3.h / 2.0));
+            frame();
+        }
+        for (int i = 0; i < std::max(o.frames, 1); ++i) {
+            for (const InputEvent& e : interaction_events(kind, i, r3, ra)) viewer.push_event(e);
+            ms.push_back(frame());
+            draw3d.push_back(viewer.last_frame().draw_ms);
+        }
+        if (kind == 0) {
+            viewer.push_event(mouse(InputEvent::Type::kRelease, r3.x + r3.w / 2.0, r3.y + r3.h / 2.0));
+            frame();
+        }
+        still_ms.push_back(settle(viewer, window, width, height));
+        const Summary m = summarise(ms), d = summarise(draw3d);
+        results.push_back({{"interaction", kNames[kind]}, {"samples", m.n}, {"median_ms", m.median}, {"worst_ms", m.worst},
                            {"draw3d_median_ms", d.median}});
         if (!o.json)
-            fmt::print("  {:<24} median {:7.1f} ms   worst {:7.1f} ms   (3D pane draw median {:6.1f} ms; {} samples)\n", name,
-                       m.median, m.worst, d.median, m.n);
-    };
-    if (!o.json)
-        fmt::print("liveset view --bench-mode interaction: {}x{} window, {} triangles (coarse level of detail {}), "
-                   "first frame (all panes, full quality) {:.1f} ms\n",
-                   width, height, s->mesher().triangle_count(), viewer.budget().options().lod_min_triangles <= s->mesher().triangle_count() ? "on" : "off",
-                   full_first);
-    settle(viewer, window, width, height);
-    draw3d.clear();
-    const int n = std::max(o.frames, 1);
-    std::vector<double> rotate;  // a drag: press, then one move per frame
-    viewer.push_event(mouse(T::kPress, cx, cy));
-    viewer.frame(window.id(), width, height, 1.0 / 60.0);
-    draw3d.clear();
-    for (int i = 0; i < n; ++i) rotate.push_back(timed({mouse(T::kMove, cx + 6.0 * (i + 1), cy + 2.0 * (i % 3))}));
-    viewer.push_event(mouse(T::kRelease, cx + 6.0 * n, cy));
-    viewer.frame(window.id(), width, height, 1.0 / 60.0);
-    still_ms.push_back(settle(viewer, window, width, height));
-    report("rotate (3D drag)", rotate);
-    std::vector<double> wheel3d, scroll, click_slice, click_3d;
-    for (int i = 0; i < n; ++i) {
-        InputEvent w = mouse(T::kScroll, cx, cy);
-        w.scroll = i % 2 ? 1.0 : -1.0;
-        wheel3d.push_back(timed({w}));
+            fmt::print("  {:<24} median {:7.1f} ms   worst {:7.1f} ms   (3D pane draw median {:6.1f} ms; {} samples)\n",
+                       kNames[kind], m.median, m.worst, d.median, m.n);
     }
-    still_ms.push_back(settle(viewer, window, width, height));
-    report("zoom (3D wheel)", wheel3d);
-    for (int i = 0; i < n; ++i) {
-        InputEvent w = mouse(T::kScroll, ra.x + ra.w / 2.0, ra.y + ra.h / 2.0);
-        w.scroll = i % 2 ? 1.0 : -1.0;
-        scroll.push_back(timed({w}));
-    }
-    still_ms.push_back(settle(viewer, window, width, height));
-    report("slice scroll (wheel)", scroll);
-    viewer.set_tool(Tool::kCrosshair);
-    for (int i = 0; i < n; ++i) {
-        const double x = ra.x + ra.w * (0.35 + 0.3 * ((i * 7) % 10) / 10.0), y = ra.y + ra.h * (0.35 + 0.3 * ((i * 3) % 10) / 10.0);
-        click_slice.push_back(timed({mouse(T::kPress, x, y), mouse(T::kRelease, x, y)}));
-    }
-    still_ms.push_back(settle(viewer, window, width, height));
-    report("click (slice crosshair)", click_slice);
-    for (int i = 0; i < n; ++i) {  // a pick on the surface (from whatever the pane shows)
-        const double x = cx + r3.w * 0.1 * ((i % 5) - 2) / 2.0, y = cy + r3.h * 0.1 * ((i % 3) - 1);
-        click_3d.push_back(timed({mouse(T::kPress, x, y), mouse(T::kRelease, x, y)}));
-    }
-    still_ms.push_back(settle(viewer, window, width, height));
-    report("click (3D pick)", click_3d);
     const Summary st = summarise(still_ms);
-    if (!o.json) fmt::print("  {:<22} median {:7.1f} ms   worst {:7.1f} ms   ({} samples, after {:.0f} ms without input)\n",
-                            "full-quality redraw", st.median, st.worst, st.n, viewer.budget().options().still_ms);
     if (o.json)
         fmt::print("{}\n", nlohmann::json{{"width", width}, {"height", height}, {"triangles", s->mesher().triangle_count()},
-                                          {"interactions", results}, {"full_redraw_median_ms", st.median},
+                                          {"coarse_triangles", viewer.coarse_triangles()}, {"interactions", results},
+                                          {"first_frame_ms", first}, {"full_redraw_median_ms", st.median},
                                           {"full_redraw_worst_ms", st.worst}}.dump());
+    else
+        fmt::print("  {:<24} median {:7.1f} ms   worst {:7.1f} ms   ({} samples, {:.0f} ms after the last input)\n",
+                   "full-quality redraw", st.median, st.worst, st.n, viewer.budget().options().still_ms);
     return 0;
 }
 

@@ -19,6 +19,8 @@ void FrameBudgetOptions::validate() const {
     if (!finite_positive(frame_ms)) throw std::invalid_argument("frame budget: frame_ms must be positive");
     if (!finite_positive(draw_share) || draw_share > 1.0) throw std::invalid_argument("frame budget: draw_share must be in (0, 1]");
     if (!std::isfinite(still_ms) || still_ms < 0.0) throw std::invalid_argument("frame budget: still_ms must be >= 0");
+    if (!std::isfinite(lod_above_ms) || lod_above_ms < 0.0) throw std::invalid_argument("frame budget: lod_above_ms must be >= 0");
+    if (lod_factor < 2 || lod_factor > 8) throw std::invalid_argument("frame budget: lod_factor must be 2 to 8");
 }
 
 FrameBudget::FrameBudget(const FrameBudgetOptions& options) : options_(options) { options_.validate(); }
@@ -49,8 +51,13 @@ void FrameBudget::record_redraw(double now_ms, double cost_ms) {
     redrawn_ = true;
 }
 
-bool FrameBudget::coarse(double now_ms, bool busy, std::size_t triangles) const {
-    if (triangles < options_.lod_min_triangles) return false;
+void FrameBudget::record_full_draw(double ms) {
+    full_draw_ms_ = blend(full_draw_ms_, ms, full_draw_known_);
+    full_draw_known_ = true;
+}
+
+bool FrameBudget::coarse(double now_ms, bool busy) const {
+    if (!full_draw_known_ || full_draw_ms_ <= options_.lod_above_ms) return false;
     return busy || (has_input_ && now_ms - last_input_ms_ < options_.still_ms);
 }
 

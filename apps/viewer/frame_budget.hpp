@@ -7,22 +7,24 @@
 // which: the steps are Session's, one after another, as the CLI takes them.
 // Redraws while running: the panes showing the changing surface are redrawn only once the time
 // since their last redraw is (1 / draw_share - 1) times what that redraw cost, so drawing takes at
-// most ~draw_share of the time (on a GPU that is every frame; on llvmpipe with a whole brain a few
-// times a second). Input is processed every frame regardless.
-// Level of detail: the 3D pane draws the coarse surface while the user interacts (a drag, a wheel
-// step, a click, a key) or work runs, and the full surface once nothing happened for `still_ms`.
+// most ~draw_share of the time (on a GPU that is every frame; on llvmpipe with a whole brain every
+// second or two). Input is processed every frame regardless.
+// Level of detail: when drawing the full surface costs more than `lod_above_ms` (software OpenGL
+// with a whole brain; never on a GPU), the 3D pane draws the coarse surface (φ subsampled by
+// `lod_factor`) while the user interacts (a drag, a wheel step, a click, a key) or a segmentation
+// runs, and the full surface once nothing happened for `still_ms` (the swarm's repairs are small:
+// they are shown at full quality, paced as above).
 // Times are passed in (milliseconds on any steady clock), so the decisions are testable.
 #pragma once
-
-#include <cstddef>
 
 namespace liveset::viewer {
 
 struct FrameBudgetOptions {
     double frame_ms = 30.0;     // steps + meshing + upload per frame
-    double draw_share = 0.15;   // of the running time, at most, redrawing the changing panes
+    double draw_share = 0.05;   // of the running time, at most, redrawing the changing panes
     double still_ms = 300.0;    // no input for this long: the 3D pane is drawn at full quality
-    std::size_t lod_min_triangles = 200000;  // smaller surfaces are always drawn in full
+    double lod_above_ms = 50.0; // full 3D draws cheaper than this: no level of detail
+    int lod_factor = 3;         // the coarse surface's subsampling (about 1 / factor² of the triangles)
     void validate() const;      // throws std::invalid_argument
 };
 
@@ -46,9 +48,10 @@ public:
 
     // --- level of detail --------------------------------------------------------------------
     void record_input(double now_ms) { last_input_ms_ = now_ms; has_input_ = true; }
-    // Whether the 3D pane should draw its coarse surface at `now_ms` (`busy`: work runs or a drag
-    // is held) for a surface of `triangles` triangles.
-    bool coarse(double now_ms, bool busy, std::size_t triangles) const;
+    void record_full_draw(double ms);  // what a full-quality draw of the 3D pane cost
+    // Whether the 3D pane should draw its coarse surface at `now_ms` (`busy`: a segmentation runs
+    // or a drag is held).
+    bool coarse(double now_ms, bool busy) const;
 
 private:
     FrameBudgetOptions options_;
@@ -56,6 +59,8 @@ private:
     bool step_known_ = false, upload_known_ = false;
     double last_redraw_ms_ = 0.0, redraw_cost_ms_ = 0.0;
     bool redrawn_ = false;
+    double full_draw_ms_ = 0.0;
+    bool full_draw_known_ = false;
     double last_input_ms_ = 0.0;
     bool has_input_ = false;
 };

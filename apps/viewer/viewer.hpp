@@ -104,6 +104,7 @@ public:
     const FrameStats& last_frame() const { return last_; }
     const FrameBudget& budget() const { return budget_; }
     bool view3d_coarse() const { return view3d_coarse_; }  // the 3D pane shows the coarse level of detail
+    std::size_t coarse_triangles() const { return coarse_surface_.triangle_count(); }
     double fps() const { return fps_; }
     std::uint64_t frames() const { return frames_; }
     bool quit_requested() const { return quit_; }

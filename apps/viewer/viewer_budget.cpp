@@ -31,7 +31,7 @@ void Viewer::reset_lod() {
     view3d_coarse_ = false;
     if (!session_) return;
     const auto t0 = Clock::now();
-    lod_ = std::make_unique<LodMesher>(session_->lattice(), session_->mesher().fragment_size());
+    lod_ = std::make_unique<LodMesher>(session_->lattice(), session_->mesher().fragment_size(), budget_.options().lod_factor);
     lod_->rebuild(session_->field().phi());
     current_.mesh_ms += ms_since(t0);
     coarse_surface_.upload_all(lod_->mesher());
@@ -62,21 +62,23 @@ void Viewer::upload() {
         mark_all_panes();
     }
     // Still again: the 3D pane goes back to full quality.
-    if (view3d_coarse_ && !budget_.coarse(now_ms(), busy() || drag_.active, surface_.triangle_count()))
+    if (view3d_coarse_ && !budget_.coarse(now_ms(), segment_running_ || drag_.active))
         pane_dirty_[static_cast<int>(Pane::kView3d)] = true;
 }
 
 void Viewer::render_3d(const render::Framebuffer& fb) {
     const auto t0 = Clock::now();
     render::SceneContent content = scene_content();
-    view3d_coarse_ = lod_ && !capturing_ && budget_.coarse(now_ms(), busy() || drag_.active, surface_.triangle_count());
+    view3d_coarse_ = lod_ && !capturing_ && budget_.coarse(now_ms(), segment_running_ || drag_.active);
     if (view3d_coarse_) {
         content.surface = &coarse_surface_;
-        content.surface_scale = 2.0f;  // LodMesher's index space: half the resolution
+        content.surface_scale = static_cast<float>(lod_->factor());  // LodMesher's index space
     }
     scene_renderer_->render(fb, camera_, content, scene_style);
     glFinish();  // llvmpipe draws at flush time: count the drawing in this frame
-    current_.draw_ms += ms_since(t0);
+    const double ms = ms_since(t0);
+    current_.draw_ms += ms;
+    if (!view3d_coarse_ && !capturing_) budget_.record_full_draw(ms);
 }
 
 void Viewer::render_dirty_panes() {

@@ -64,17 +64,21 @@ TEST(FrameBudget, PacesRedrawsToTheDrawShare) {
     EXPECT_TRUE(b.redraw_due(1404.0));
 }
 
-TEST(FrameBudget, CoarseWhileBusyOrRecentlyTouchedAndOnlyForLargeSurfaces) {
+TEST(FrameBudget, CoarseWhileBusyOrRecentlyTouchedAndOnlyWhenFullDrawsAreSlow) {
     FrameBudgetOptions o;
     o.still_ms = 300.0;
-    o.lod_min_triangles = 1000;
+    o.lod_above_ms = 50.0;
     FrameBudget b(o);
-    EXPECT_FALSE(b.coarse(0.0, false, 5000));
-    EXPECT_TRUE(b.coarse(0.0, true, 5000));
-    EXPECT_FALSE(b.coarse(0.0, true, 999));
-    b.record_input(100.0);
-    EXPECT_TRUE(b.coarse(399.0, false, 5000));
-    EXPECT_FALSE(b.coarse(400.0, false, 5000));
+    EXPECT_FALSE(b.coarse(0.0, true));  // no full draw measured yet
+    b.record_full_draw(20.0);           // a GPU: never coarse
+    EXPECT_FALSE(b.coarse(0.0, true));
+    FrameBudget slow(o);
+    slow.record_full_draw(400.0);  // llvmpipe and a whole brain
+    EXPECT_FALSE(slow.coarse(0.0, false));
+    EXPECT_TRUE(slow.coarse(0.0, true));
+    slow.record_input(100.0);
+    EXPECT_TRUE(slow.coarse(399.0, false));
+    EXPECT_FALSE(slow.coarse(400.0, false));
 }
 
 TEST(FrameBudget, RefusesBadOptions) {
@@ -86,6 +90,9 @@ TEST(FrameBudget, RefusesBadOptions) {
     EXPECT_THROW(FrameBudget{o}, std::invalid_argument);
     o = {};
     o.still_ms = std::nan("");
+    EXPECT_THROW(FrameBudget{o}, std::invalid_argument);
+    o = {};
+    o.lod_factor = 1;
     EXPECT_THROW(FrameBudget{o}, std::invalid_argument);
 }
 
@@ -161,7 +168,8 @@ TEST(ViewerBudget, CoarseSurfaceWhileDraggingFullSurfaceOnceReleasedSameSilhouet
     render::HeadlessContext context;
     ViewerConfig c;
     c.headless = true;
-    c.budget.lod_min_triangles = 0;  // the phantom's surface is small: force the level of detail
+    c.budget.lod_above_ms = 0.0;     // the phantom's surface draws fast: force the level of detail
+    c.budget.lod_factor = 2;
     c.budget.still_ms = 0.0;         // full quality as soon as nothing is held
     auto s = seeded_session();
     for (int i = 0; i < 30; ++i) s->segment_step();
