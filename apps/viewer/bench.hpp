@@ -7,6 +7,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 
 #include "viewer.hpp"
 
@@ -17,8 +18,11 @@ struct BenchOptions {
     std::size_t agents = 200;
     std::optional<Vec3d> target;      // default: the surface point nearest the top of the surface
     bool json = false;
+    std::string mode = "frames";      // frames | segment | interaction (bench_modes.cpp)
 };
 
 int run_bench(Viewer& viewer, const BenchOptions& options, int width, int height);
+int run_segment_bench(Viewer& viewer, const BenchOptions& options, int width, int height);
+int run_interaction_bench(Viewer& viewer, const BenchOptions& options, int width, int height);
 
 }  // namespace liveset::viewer

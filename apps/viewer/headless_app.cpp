@@ -29,7 +29,12 @@ int run_headless(std::unique_ptr<Session> session, const std::string& image_name
     Viewer viewer(std::move(session), image_name, c);
     viewer.set_window_size(options.width, options.height);
     if (options.maximised) viewer.set_maximised(options.maximised);
-    if (options.bench) return run_bench(viewer, *options.bench, options.width, options.height);
+    if (options.bench) {
+        const BenchOptions& b = *options.bench;
+        if (b.mode == "segment") return run_segment_bench(viewer, b, options.width, options.height);
+        if (b.mode == "interaction") return run_interaction_bench(viewer, b, options.width, options.height);
+        return run_bench(viewer, b, options.width, options.height);
+    }
     if (options.script) {
         ScriptPlayer player(*options.script);
         while (!player.done()) {

@@ -28,6 +28,7 @@ struct ViewArgs : ThresholdArgs {
     double seed_radius = 2.0;
     bool headless = false, bench = false, json = false;
     int bench_frames = 100;
+    std::string bench_mode = "frames";
     std::size_t bench_agents = 200;
     std::string bench_target;
     int fragment_size = 16;
@@ -190,6 +191,7 @@ int run_view(ViewArgs& a, int threads) {
         if (a.bench) {
             viewer::BenchOptions bo;
             bo.frames = a.bench_frames;
+            bo.mode = a.bench_mode;
             bo.agents = a.bench_agents;
             bo.json = a.json;
             if (!a.bench_target.empty()) {
@@ -252,6 +254,8 @@ void add_view_command(CLI::App& app, const int& threads) {
         ->check(CLI::Range(2, 512))
         ->capture_default_str();
     v->add_flag("--bench", va.bench, "headless frame-time breakdown: static, agents moving, repairing at p = 0.1 and 0.5");
+    v->add_option("--bench-mode", va.bench_mode, "frames: the paper's four scenarios; segment: the in-viewer segmentation (Run) against the CLI's; interaction: rotate, zoom, scroll and click latency")
+        ->check(CLI::IsMember({"frames", "segment", "interaction"}))->capture_default_str();
     v->add_option("--bench-frames", va.bench_frames, "measured frames per scenario")->check(CLI::Range(1, 100000))->capture_default_str();
     v->add_option("--bench-agents", va.bench_agents, "agents in the swarm scenarios")->check(CLI::Range(1, 100000))->capture_default_str();
     v->add_option("--bench-target", va.bench_target, "swarm target I,J,K (default: the top of the surface)");

@@ -33,7 +33,8 @@ Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const V
       image_name_(std::move(image_name)),
       image_path_(config.image_path),
       log_(config.log_events),
-      autosave_(std::make_unique<Autosave>(config.autosave)) {
+      autosave_(std::make_unique<Autosave>(config.autosave)),
+      budget_(config.budget) {
     const auto* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
     renderer_ = renderer ? renderer : "unknown renderer";
     if (const auto cut = renderer_.find(" ("); cut != std::string::npos) renderer_.resize(cut);
@@ -86,6 +87,7 @@ void Viewer::show_session() {
     }
     surface_.upload_all(session_->mesher());
     session_->take_dirty_fragments();
+    reset_lod();
     camera_.frame(render::surface_bounds(session_->mesher()));
     fit_3d_pending_ = true;  // once the 3D pane has its size (frame_3d)
     const Vec3i d = session_->lattice().dims();
@@ -169,7 +171,7 @@ void Viewer::set_window_size(int width, int height) {
 }
 
 bool Viewer::needs_frame() const {
-    return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active ||
+    return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active || view3d_coarse_ || stale_ ||
            (session_ && session_->revision() != seen_revision_);
 }
 
@@ -260,32 +262,6 @@ void Viewer::swarm_step() {
     ++current_.swarm_steps;
 }
 
-void Viewer::advance() {
-    if (!session_) return;
-    if (segment_running_) {
-        const auto t0 = Clock::now();
-        do segment_step();
-        while (segment_running_ && ms_since(t0) < config_.segment_budget_ms);
-    }
-    if (swarm_running_)
-        for (int i = 0; i < swarm_steps_per_frame && swarm_running_; ++i) swarm_step();
-}
-
-void Viewer::upload() {
-    if (!session_) return;
-    const std::vector<FragmentId> ids = session_->take_dirty_fragments();
-    if (!ids.empty()) {
-        const auto t0 = Clock::now();
-        const render::UploadStats st = surface_.upload(session_->mesher(), ids);
-        current_.upload_ms += ms_since(t0);
-        current_.uploaded += st.fragments;
-    }
-    if (session_->revision() != seen_revision_) {
-        seen_revision_ = session_->revision();
-        mark_all_panes();
-    }
-}
-
 render::SceneContent Viewer::scene_content() {
     render::SceneContent c;
     std::vector<glm::vec3>& agents = agent_points_;
@@ -316,20 +292,8 @@ void Viewer::render_pane(Pane pane) {
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         return;
     }
-    if (pane == Pane::kView3d) {
-        const auto t0 = Clock::now();
-        scene_renderer_->render(fb, camera_, scene_content(), scene_style);
-        glFinish();  // llvmpipe draws at flush time: count the drawing in this frame
-        current_.draw_ms += ms_since(t0);
-        return;
-    }
+    if (pane == Pane::kView3d) return render_3d(fb);
     render_slice_pane(pane, fb, r);
-}
-
-void Viewer::render_dirty_panes() {
-    for (int i = 0; i < kPaneCount; ++i)
-        if (pane_dirty_[i] || pane_buffers_[i].width() != pane_rects_[i].w || pane_buffers_[i].height() != pane_rects_[i].h)
-            render_pane(static_cast<Pane>(i));
 }
 
 void Viewer::ensure_3d_rendered() {
@@ -474,7 +438,9 @@ std::optional<render::Pick> Viewer::click_3d(double x, double y, bool as_target)
         fail("no surface under the pointer");
         return std::nullopt;
     }
-    const Vec3d index{p->index.x, p->index.y, p->index.z};
+    Vec3d index{p->index.x, p->index.y, p->index.z};
+    if (view3d_coarse_)  // the coarse surface lies within a voxel or two of the real one
+        if (const auto q = session_->nearest_surface_point(index, 3.0)) index = *q;
     log_.add("pick", {{"pixel", {x, y}}, {"index", to_json(index)}, {"world", {p->world.x, p->world.y, p->world.z}}});
     if (as_target) {
         if (!set_target(index)) return std::nullopt;

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <deque>
 #include <map>
 #include <memory>
@@ -20,6 +21,8 @@
 #include "autosave.hpp"
 #include "event_log.hpp"
 #include "slice_panes.hpp"
+#include "frame_budget.hpp"
+#include "liveset/mesh/lod_mesher.hpp"
 #include "liveset/render/framebuffer.hpp"
 #include "liveset/render/orbit_camera.hpp"
 #include "liveset/render/picking.hpp"
@@ -76,7 +79,7 @@ struct ViewerConfig {
     std::string log_events;  // JSON-lines event log (rewritten atomically at every event); empty: none
     int panel_width = 340;
     SessionOptions session;  // for images opened from the panel
-    float segment_budget_ms = 40.0f;  // level-set time per frame while segmentation runs
+    FrameBudgetOptions budget;  // steps per frame, redraw pacing and level of detail
     std::string image_path;  // the session's image as given (the key of its recovery file)
     AutosaveConfig autosave;  // recovery files (dir empty: none)
     std::string roi_path;     // the session's ROI as given (saved in workspaces)
@@ -105,6 +108,9 @@ public:
     // evolution, upload of the rebuilt fragments, dirty panes, then panes + panel composed.
     void frame(GLuint target, int width, int height, double dt_seconds);
     const FrameStats& last_frame() const { return last_; }
+    const FrameBudget& budget() const { return budget_; }
+    bool view3d_coarse() const { return view3d_coarse_; }  // the 3D pane shows the coarse level of detail
+    std::size_t coarse_triangles() const { return coarse_surface_.triangle_count(); }
     // Over the frames of the last second: frames shown per second (0 when idle: the viewer draws
     // only on change) and their mean work in ms (input to composed panes); fps() * frame_ms() <= 1000.
     double fps() const { return fps_; }
@@ -188,9 +194,8 @@ public:
     // Renders the 3D pane now if it is out of date (picking reads its depth buffer).
     void ensure_3d_rendered();
 
-    // Seed radius and swarm steps per frame used by clicks and the run buttons.
+    // Seed radius used by clicks.
     double seed_radius = 2.0;
-    int swarm_steps_per_frame = 1;
     render::SceneStyle scene_style;
 
 private:
@@ -208,10 +213,7 @@ private:
     void show_session();  // renderer state for the session's current surface
     void report_autosave();
     void account(const SessionUpdate& update);
-    void advance();
-    void upload();
     void render_pane(Pane pane);
-    void render_dirty_panes();
     void compose(GLuint target, int width, int height);
     void mark_all_panes();
     render::SliceViewport slice_viewport(Pane pane, int width, int height) const;
@@ -227,6 +229,13 @@ private:
     void draw_display_section();
     void draw_edge_letters(Pane pane, const Rect& r);
     void remember_item(const char* name, bool field);
+    // viewer_budget.cpp
+    double now_ms() const;  // since the viewer was made
+    void advance();         // the steps that fit in this frame's budget
+    void reset_lod();       // the coarse level of detail from scratch
+    void upload();          // U (fine and coarse), then the panes due a redraw
+    void render_3d(const render::Framebuffer& fb);
+    void render_dirty_panes();
     // viewer_input.cpp
     void process_events();
     bool routes_to_imgui(const InputEvent& e) const;
@@ -289,6 +298,13 @@ private:
     bool window_shot_pending_ = false;  // F12: save what the window shows after this frame
     int offer_frames_ = 0;              // frames the recovery dialog has been shown
     Drag drag_;
+    FrameBudget budget_;
+    std::chrono::steady_clock::time_point epoch_ = std::chrono::steady_clock::now();
+    std::unique_ptr<LodMesher> lod_;
+    render::SurfaceBuffers coarse_surface_;  // lod_'s fragments on the GPU
+    bool view3d_coarse_ = false;             // the 3D pane was drawn from coarse_surface_
+    bool stale_ = false;                     // the session changed; panes not yet redrawn
+    bool capturing_ = false;                 // capture_pane: the 3D pane at full quality
     int redraw_frames_ = 2;
     bool quit_ = false;
     std::string message_;

@@ -80,7 +80,10 @@ void Viewer::process_events() {
         if (e.type == InputEvent::Type::kKey) {
             // Ctrl+Q reaches the viewer also while the quit dialog holds the keyboard: twice quits.
             const bool quit_key = e.key == GLFW_KEY_Q && (e.mods & GLFW_MOD_CONTROL) && quit_prompt_;
-            if (e.down && (!ImGuiBridge::wants_keyboard() || quit_key)) handle_key(e);
+            if (e.down && (!ImGuiBridge::wants_keyboard() || quit_key)) {
+                budget_.record_input(now_ms());  // the 3D pane draws coarse until still again
+                handle_key(e);
+            }
         } else if (!to_imgui || (e.type == InputEvent::Type::kMove && drag_.active)) {
             handle_pane_event(e);
         }
@@ -89,6 +92,7 @@ void Viewer::process_events() {
 
 void Viewer::handle_pane_event(const InputEvent& e) {
     if (!session_) return;
+    if (e.type != InputEvent::Type::kMove || drag_.active) budget_.record_input(now_ms());
     switch (e.type) {
         case InputEvent::Type::kPress: {
             const auto pane = pane_at(e.x, e.y);

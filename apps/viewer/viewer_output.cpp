@@ -61,7 +61,9 @@ render::Image Viewer::capture_pane(Pane pane, int width, int height, int supersa
     const Rect saved = pane_rects_[static_cast<int>(pane)];
     pane_rects_[static_cast<int>(pane)] = {saved.x, saved.y, width * ss, height * ss};
     upload();
+    capturing_ = true;  // full quality, even during an interaction
     render_pane(pane);  // into the pane's own buffer at the capture size
+    capturing_ = false;
     const render::Image img = pane_buffers_[static_cast<int>(pane)].read_color();
     pane_rects_[static_cast<int>(pane)] = saved;
     pane_dirty_[static_cast<int>(pane)] = true;  // back to the layout size on the next frame

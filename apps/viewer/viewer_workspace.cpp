@@ -79,7 +79,6 @@ bool Viewer::save_workspace(const std::string& path, bool overwrite) {
     WorkspaceView view;
     view.camera = camera_.pose();
     view.cursor = cursor_;
-    view.swarm_steps_per_frame = swarm_steps_per_frame;
     try {
         viewer::save_workspace(path, *session_, image_path_, config_.roi_path, view);
     } catch (const std::exception& e) {
@@ -99,7 +98,6 @@ void Viewer::apply_workspace_view(const WorkspaceView& view) {
     fit_3d_pending_ = false;  // the user's own framing
     camera_changed();
     set_cursor(view.cursor);
-    swarm_steps_per_frame = std::clamp(view.swarm_steps_per_frame, 1, 20);
 }
 
 // Seeds (the CLI's --seed format) and the workspace.

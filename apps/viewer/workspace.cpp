@@ -145,7 +145,6 @@ Workspace parse_workspace(const json& j) {
     ws.view.camera = {number(c, "yaw"), number(c, "pitch"), number(c, "zoom"), glm::dvec3(pan.x, pan.y, pan.z)};
     const Vec3d cursor = vec3(v, "cursor");
     ws.view.cursor = {static_cast<int>(cursor.x), static_cast<int>(cursor.y), static_cast<int>(cursor.z)};
-    ws.view.swarm_steps_per_frame = static_cast<int>(number(v, "swarm_steps_per_frame"));
     return ws;
 }
 
@@ -187,8 +186,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
            {"target", session.target() ? vec(*session.target()) : json(nullptr)},
            {"view", {{"camera", {{"yaw", view.camera.yaw_deg}, {"pitch", view.camera.pitch_deg}, {"zoom", view.camera.zoom},
                                  {"pan", {view.camera.pan.x, view.camera.pan.y, view.camera.pan.z}}}},
-                     {"cursor", {view.cursor.x, view.cursor.y, view.cursor.z}},
-                     {"swarm_steps_per_frame", view.swarm_steps_per_frame}}}};
+                     {"cursor", {view.cursor.x, view.cursor.y, view.cursor.z}}}}};
     try {
         write_file_atomically(workspace_state_path(path), std::string_view(reinterpret_cast<const char*>(state.data()), state.size()));
         write_file_atomically(path, j.dump(2) + "\n");

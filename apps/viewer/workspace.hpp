@@ -23,7 +23,6 @@ inline constexpr int kWorkspaceVersion = 1;
 struct WorkspaceView {
     render::CameraPose camera = render::OrbitCamera::default_pose();
     Vec3i cursor{};
-    int swarm_steps_per_frame = 1;
 };
 
 struct Workspace {

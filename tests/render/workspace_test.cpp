@@ -90,7 +90,6 @@ viewer::WorkspaceView a_view() {
     viewer::WorkspaceView v;
     v.camera = {12.5, -33.25, 1.7, glm::dvec3(1.5, -2.0, 0.25)};
     v.cursor = {10, 20, 30};
-    v.swarm_steps_per_frame = 4;
     return v;
 }
 
@@ -143,7 +142,6 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     EXPECT_EQ(ws.view.camera.zoom, 1.7);
     EXPECT_EQ(ws.view.camera.pan, glm::dvec3(1.5, -2.0, 0.25));
     EXPECT_EQ(ws.view.cursor, (Vec3i{10, 20, 30}));
-    EXPECT_EQ(ws.view.swarm_steps_per_frame, 4);
 
     // Continued in a fresh session on the same image: the same state, and the same next steps.
     Session continued(phantom48().image, options());

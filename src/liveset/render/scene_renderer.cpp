@@ -158,7 +158,8 @@ void SceneRenderer::render(const Framebuffer& target, const OrbitCamera& camera,
 
     if (content.surface != nullptr && content.surface->triangle_count() > 0) {
         surface_.use();
-        const glm::mat4 model_view = view * model;
+        // A coarse level of detail's vertices are in its own index space: scale them to the lattice's.
+        const glm::mat4 model_view = view * model * glm::mat4(glm::mat3(content.surface_scale));
         surface_.set("u_model_view", model_view);
         surface_.set("u_projection", projection);
         surface_.set("u_normal_matrix", glm::mat3(glm::transpose(glm::inverse(model_view))));

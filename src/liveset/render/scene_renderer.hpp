@@ -31,6 +31,7 @@ struct SceneStyle {
 struct SceneContent {
     const Lattice* lattice = nullptr;          // index -> world of everything below
     const SurfaceBuffers* surface = nullptr;
+    float surface_scale = 1.0f;                // surface index = this x buffer position (2: LodMesher's)
     std::span<const glm::vec3> agents;         // index space
     std::optional<glm::vec3> target;           // index space
     std::optional<glm::vec3> cursor;           // index space

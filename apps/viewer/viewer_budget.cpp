@@ -1,0 +1,95 @@
+// Viewer frame budget: the steps a frame takes, the upload of what they changed (fine and coarse
+// surfaces), redraw pacing while work runs, and the 3D pane's level of detail (frame_budget.hpp).
+#include <chrono>
+
+#include "viewer.hpp"
+
+namespace liveset::viewer {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+}  // namespace
+
+double Viewer::now_ms() const { return ms_since(epoch_); }
+
+void Viewer::advance() {
+    if (!session_) return;
+    const auto t0 = Clock::now();
+    for (int n = 0; busy() && budget_.another_step(n, ms_since(t0)); ++n) {
+        const auto s0 = Clock::now();
+        if (segment_running_) segment_step();
+        else swarm_step();
+        budget_.record_step(ms_since(s0));
+    }
+}
+
+void Viewer::reset_lod() {
+    lod_.reset();
+    view3d_coarse_ = false;
+    if (!session_) return;
+    const auto t0 = Clock::now();
+    lod_ = std::make_unique<LodMesher>(session_->lattice(), session_->mesher().fragment_size(), budget_.options().lod_factor);
+    lod_->rebuild(session_->field().phi());
+    current_.mesh_ms += ms_since(t0);
+    coarse_surface_.upload_all(lod_->mesher());
+}
+
+void Viewer::upload() {
+    if (!session_) return;
+    const std::vector<FragmentId> ids = session_->take_dirty_fragments();
+    if (!ids.empty()) {
+        const auto t0 = Clock::now();
+        const render::UploadStats st = surface_.upload(session_->mesher(), ids);
+        current_.uploaded += st.fragments;
+        if (lod_) {  // the coarse level of detail follows the fine fragments
+            const std::vector<FragmentId> coarse = lod_->update(session_->field().phi(), session_->mesher(), ids);
+            if (!coarse.empty()) coarse_surface_.upload(lod_->mesher(), coarse);
+        }
+        const double ms = ms_since(t0);
+        current_.upload_ms += ms;
+        budget_.record_upload(ms);
+    }
+    if (session_->revision() != seen_revision_) {
+        seen_revision_ = session_->revision();
+        stale_ = true;
+    }
+    // While work runs, the panes showing it are redrawn at the pace the budget allows.
+    if (stale_ && (!busy() || budget_.redraw_due(now_ms()))) {
+        stale_ = false;
+        mark_all_panes();
+    }
+    // Still again: the 3D pane goes back to full quality.
+    if (view3d_coarse_ && !budget_.coarse(now_ms(), segment_running_ || drag_.active))
+        pane_dirty_[static_cast<int>(Pane::kView3d)] = true;
+}
+
+void Viewer::render_3d(const render::Framebuffer& fb) {
+    const auto t0 = Clock::now();
+    render::SceneContent content = scene_content();
+    view3d_coarse_ = lod_ && !capturing_ && budget_.coarse(now_ms(), segment_running_ || drag_.active);
+    if (view3d_coarse_) {
+        content.surface = &coarse_surface_;
+        content.surface_scale = static_cast<float>(lod_->factor());  // LodMesher's index space
+    }
+    scene_renderer_->render(fb, camera_, content, scene_style);
+    glFinish();  // llvmpipe draws at flush time: count the drawing in this frame
+    const double ms = ms_since(t0);
+    current_.draw_ms += ms;
+    if (!view3d_coarse_ && !capturing_) budget_.record_full_draw(ms);
+}
+
+void Viewer::render_dirty_panes() {
+    const auto t0 = Clock::now();
+    bool drew = false;
+    for (int i = 0; i < kPaneCount; ++i)
+        if (pane_dirty_[i] || pane_buffers_[i].width() != pane_rects_[i].w || pane_buffers_[i].height() != pane_rects_[i].h) {
+            render_pane(static_cast<Pane>(i));
+            drew = true;
+        }
+    if (drew && busy()) budget_.record_redraw(now_ms(), ms_since(t0));
+}
+
+}  // namespace liveset::viewer
