@@ -128,6 +128,7 @@ public:
 
     // --- swarm repair -----------------------------------------------------------------------
     const RepairOptions& repair_options() const { return repair_options_; }
+    const SessionOptions& options() const { return options_; }
     // New swarm settings (agents, p, radius, ...): the swarm is re-created and, when it had a
     // target, respawned there. Throws std::invalid_argument on invalid options.
     void set_repair_options(const RepairOptions& options);
