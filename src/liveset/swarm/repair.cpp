@@ -1,14 +1,10 @@
-// The repair loop: swarm move -> surface edits -> local level-set update -> incremental mesh.
+// The repair loop: swarm move -> surface edits -> topology guard (topology_guard.cpp) -> local level-set update.
 #include "liveset/swarm/repair.hpp"
 
 #include <algorithm>
 #include <chrono>
-#include <climits>
 #include <cstdint>
 #include <stdexcept>
-#include <unordered_map>
-
-#include "liveset/grid/digital_topology.hpp"
 
 namespace liveset {
 
