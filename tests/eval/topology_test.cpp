@@ -375,3 +375,24 @@ TEST(Topology, LocalEulerCharacteristicMatchesTheWholeMasks) {
 }
 
 }  // namespace
+
+namespace {
+
+// find_missed_tunnels: a pinhole through a plate (a tunnel no inner tissue lies under) is found,
+// exactly its voxels; a dent in the same plate and a matching mask are not.
+TEST(Perforations, MissedTunnelsAreThePinholesNotTheDents) {
+    Mask truth(Lattice({12, 12, 7}));
+    paint_box(truth, {1, 1, 2}, {11, 11, 5});
+    Mask mask = truth;
+    for (int z = 2; z < 5; ++z) mask({5, 6, z}) = 0;  // the pinhole: genus 1
+    mask({2, 2, 4}) = 0;                               // a dent from the top face
+    ASSERT_EQ(mask_topology(mask).genus, 1);
+    const auto found = find_missed_tunnels(mask, truth);
+    ASSERT_EQ(found.size(), 1u);
+    EXPECT_EQ(found[0].voxels, 3u);
+    EXPECT_EQ(found[0].nearest, (Vec3i{5, 6, 3}));
+    EXPECT_TRUE(find_missed_tunnels(truth, truth).empty());
+    EXPECT_THROW(find_missed_tunnels(mask, Mask(Lattice({4, 4, 4}), 0)), std::invalid_argument);
+}
+
+}  // namespace

@@ -85,6 +85,12 @@ TopologicalNumbers topological_numbers(Inside&& inside, Vec3i p, int connectivit
     return {detail::cube_components(fg, false, true), detail::cube_components(bg, true, false)};
 }
 
+// The 13 lines through a voxel, one direction of each ± pair: 3 along faces, 6 along edges, 4
+// along corners (the digital lines a one-voxel gap can lie across).
+inline constexpr int kLineDirections[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1},  {1, 1, 0},  {1, -1, 0},
+                                               {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}, {1, 1, 1},
+                                               {1, 1, -1}, {1, -1, 1}, {1, -1, -1}};
+
 // Euler characteristic χ = V − E + F − C of the union of the closed unit cubes of the foreground
 // voxels inside the box [lo, hi] (26-connected foreground: χ = components − tunnels + cavities).
 // Flipping voxels at least one voxel inside the box changes the whole set's χ exactly as it

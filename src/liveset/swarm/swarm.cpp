@@ -54,6 +54,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "liveset/grid/digital_topology.hpp"
 #include "liveset/grid/sampling.hpp"
 
 namespace liveset {
@@ -145,10 +146,6 @@ Vec3d project(const Grid<float>& phi, Vec3d x, int iterations) {
     return x;
 }
 
-// The 13 directions through a voxel (one of each ± pair): faces, edges, corners.
-constexpr int kDirections[13][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {1, -1, 0}, {1, 0, 1}, {1, 0, -1},
-                                    {0, 1, 1}, {0, 1, -1}, {1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {1, -1, -1}};
-
 }  // namespace
 
 bool between_sheet_sides(const Grid<float>& phi, const Grid<float>& image_unit, Vec3i q, double reach, double lower, double upper) {
@@ -170,7 +167,7 @@ bool between_sheet_sides(const Grid<float>& phi, const Grid<float>& image_unit, 
         return met;
     };
     bool flanked = false, joins = false;
-    for (const auto& d : kDirections) {
+    for (const auto& d : kLineDirections) {
         const Vec3i v{d[0], d[1], d[2]};
         const int a = ray(v), b = ray(v * -1);
         flanked = flanked || ((a & kSheetHit) && (b & kSheetHit));

@@ -71,10 +71,6 @@ bool encloses_small_pocket(const Lattice& lat, Inside& inside, Vec3i start, std:
     return true;
 }
 
-// The 13 directions through a voxel (one of each ± pair): faces, edges, corners.
-constexpr int kDirections[13][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 0}, {1, -1, 0}, {1, 0, 1}, {1, 0, -1},
-                                    {0, 1, 1}, {0, 1, -1}, {1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {1, -1, -1}};
-
 // The guard's state over one batch: the flips accepted so far, read through inside().
 class Guard {
 public:
@@ -148,7 +144,7 @@ bool Guard::may_fill(Vec3i q) const {
 // not be filled or the crack is longer than kMaxCrack.
 std::vector<PointIndex> Guard::gather_crack(Vec3i start) const {
     const auto between_fronts = [this](Vec3i q) {
-        for (const auto& d : kDirections) {
+        for (const auto& d : kLineDirections) {
             const Vec3i v{d[0], d[1], d[2]};
             if (inside(q + v) && inside(q - v)) return true;
         }
