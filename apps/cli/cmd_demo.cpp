@@ -90,7 +90,12 @@ nlohmann::json run_demo_repair(const DemoArgs& a, const Phantom& ph, const Segme
     so.rounds = a.rounds;
     so.round_steps = a.round_steps;
     RoundSetup setup;
-    if (a.rule == "sheet") setup = sheet_rule_setup(ph.image, o, session.field(), ro);
+    if (a.rule == "sheet") {
+        setup = sheet_rule_setup(ph.image, o, session.field(), ro);
+        // The sheet rule raises only the sheet's tissue or what lies between its sides, so the
+        // brush may span a whole hole (the intensity rule's growth spills, its brush stays at 8).
+        so.max_range = 16.0;
+    }
     SessionRepairDriver driver(session);
     const RepairScheduleResult sched = run_repair_schedule(driver, ro, so, holes_left, setup);
     nlohmann::json rounds = nlohmann::json::array();

@@ -258,6 +258,8 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--sheet-lower", ra.sheet_lower, "the sheet tissue's lowest intensity (raw; default: the tissue model's)")->check(finite_number());
     r->add_option("--sheet-upper", ra.sheet_upper, "the sheet tissue's highest intensity (raw; default: the tissue model's)")->check(finite_number());
     r->add_flag("--no-topology-guard{false}", ra.options.topology_guard, "let edits bridge pieces or open tunnels (by default they cannot)");
+    r->add_flag("--band-only{false}", ra.options.swarm.sheet_between, "sheet rule: raise only voxels in the band (by default also voxels between the sheet's two sides)");
+    r->add_flag("--no-crack-closing{false}", ra.options.close_cracks, "refuse every bridge (by default a one-voxel crack between two fronts is filled whole when that closes a tunnel)");
     r->add_option("--out-phi", ra.out_phi, "repaired phi");
     r->add_option("--out-mask", ra.out_mask, "repaired mask");
     r->add_option("--out-mesh", ra.out_mesh, "repaired surface (.ply/.obj/.stl)");

@@ -12,6 +12,7 @@
 #include "eval/mask_shapes.hpp"
 #include "liveset/eval/perforations.hpp"
 #include "liveset/eval/topology.hpp"
+#include "liveset/grid/digital_topology.hpp"
 
 using namespace liveset;
 using liveset::test::Mask;
@@ -331,3 +332,67 @@ TEST(Perforations, FindsBubblesInTheWallButNotTheCore) {
     EXPECT_EQ(found[1].nearest, one);
     EXPECT_THROW(find_cavities(mask, Mask(Lattice({4, 4, 4}), 0)), std::invalid_argument);
 }
+
+namespace {
+
+// The local Euler characteristic (grid/digital_topology.hpp) against mask_topology, a separate
+// count by component labelling (components − genus + cavities) on random masks: over the whole
+// image it equals χ, and flipping a voxel changes χ over a box one voxel around it exactly as the
+// whole mask's χ changes.
+TEST(Topology, LocalEulerCharacteristicMatchesTheWholeMasks) {
+    std::uint64_t s = 99;
+    const auto next = [&] {
+        s = s * 6364136223846793005ull + 1442695040888963407ull;
+        return s >> 33;
+    };
+    for (int trial = 0; trial < 30; ++trial) {
+        Mask m(Lattice({9, 8, 7}));
+        for (PointIndex i = 0; i < m.size(); ++i) m[i] = next() % 100 < 30 + 2 * static_cast<unsigned>(trial);
+        const auto inside = [&](Vec3i q) { return m.lattice().contains(q) && m(q) != 0; };
+        const Topology t = mask_topology(m);
+        const long chi = static_cast<long>(t.components) - t.genus + static_cast<long>(t.cavities);
+        ASSERT_EQ(euler_characteristic_26(inside, {0, 0, 0}, {8, 7, 6}), chi) << "trial " << trial;
+        const Vec3i p{static_cast<int>(next() % 9), static_cast<int>(next() % 8), static_cast<int>(next() % 7)};
+        const Vec3i lo = p - Vec3i{1, 1, 1}, hi = p + Vec3i{1, 1, 1};
+        const long local_before = euler_characteristic_26(inside, lo, hi);
+        m(p) = m(p) ? 0 : 1;
+        const Topology u = mask_topology(m);
+        const long chi_after = static_cast<long>(u.components) - u.genus + static_cast<long>(u.cavities);
+        EXPECT_EQ(euler_characteristic_26(inside, lo, hi) - local_before, chi_after - chi) << "trial " << trial;
+    }
+    // Hand counts: a voxel 1, a 3x3x1 ring (one tunnel) 0, a 3x3x3 hollow cube (one cavity) 2.
+    Mask ring(Lattice({5, 5, 3}));
+    paint_box(ring, {1, 1, 1}, {4, 4, 2});
+    const auto in_ring = [&](Vec3i q) { return ring.lattice().contains(q) && ring(q) != 0; };
+    EXPECT_EQ(euler_characteristic_26(in_ring, {0, 0, 0}, {4, 4, 2}), 1);
+    ring({2, 2, 1}) = 0;
+    EXPECT_EQ(euler_characteristic_26(in_ring, {0, 0, 0}, {4, 4, 2}), 0);
+    Mask hollow(Lattice({5, 5, 5}));
+    paint_box(hollow, {1, 1, 1}, {4, 4, 4});
+    hollow({2, 2, 2}) = 0;
+    const auto in_hollow = [&](Vec3i q) { return hollow.lattice().contains(q) && hollow(q) != 0; };
+    EXPECT_EQ(euler_characteristic_26(in_hollow, {0, 0, 0}, {4, 4, 4}), 2);
+}
+
+}  // namespace
+
+namespace {
+
+// find_missed_tunnels: a pinhole through a plate (a tunnel no inner tissue lies under) is found,
+// exactly its voxels; a dent in the same plate and a matching mask are not.
+TEST(Perforations, MissedTunnelsAreThePinholesNotTheDents) {
+    Mask truth(Lattice({12, 12, 7}));
+    paint_box(truth, {1, 1, 2}, {11, 11, 5});
+    Mask mask = truth;
+    for (int z = 2; z < 5; ++z) mask({5, 6, z}) = 0;  // the pinhole: genus 1
+    mask({2, 2, 4}) = 0;                               // a dent from the top face
+    ASSERT_EQ(mask_topology(mask).genus, 1);
+    const auto found = find_missed_tunnels(mask, truth);
+    ASSERT_EQ(found.size(), 1u);
+    EXPECT_EQ(found[0].voxels, 3u);
+    EXPECT_EQ(found[0].nearest, (Vec3i{5, 6, 3}));
+    EXPECT_TRUE(find_missed_tunnels(truth, truth).empty());
+    EXPECT_THROW(find_missed_tunnels(mask, Mask(Lattice({4, 4, 4}), 0)), std::invalid_argument);
+}
+
+}  // namespace

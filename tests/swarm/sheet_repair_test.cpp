@@ -142,3 +142,99 @@ TEST(SheetRepair, BrushSizedToTheHole) {
 
 }  // namespace
 }  // namespace liveset
+
+namespace liveset {
+namespace {
+
+// A flat sheet (GM, z in [15, 18)) over white matter (z < 15) under CSF, punched by a hole of
+// radius 3 whose voxels read as white matter (a bias): every hole voxel lies between the sheet's
+// two sides; the white matter under it and the CSF over it do not; nor does the CSF of a sulcus
+// between two banks with white matter behind each.
+TEST(SheetRepair, BetweenTheSheetsSidesIsTheHoleOnly) {
+    const Lattice lat({40, 40, 40});
+    Grid<float> image(lat, kCsf), phi(lat, 1.0f);
+    const auto in_hole = [](Vec3i p) { return std::hypot(p.x - 20.0, p.y - 20.0) <= 3.0; };
+    for (int z = 0; z < 40; ++z)
+        for (int y = 0; y < 40; ++y)
+            for (int x = 0; x < 40; ++x) {
+                const Vec3i p{x, y, z};
+                if (z < 15) image(p) = kWm;
+                else if (z < 18) {
+                    image(p) = in_hole(p) ? kWm : kGm;
+                    if (!in_hole(p)) phi(p) = -1.0f;
+                }
+            }
+    for (int z = 0; z < 40; ++z)
+        for (int y = 0; y < 40; ++y)
+            for (int x = 0; x < 40; ++x) {
+                const Vec3i p{x, y, z};
+                const bool hole = z >= 15 && z < 18 && in_hole(p);
+                if (phi(p) < 0.0f) continue;
+                // Within 8 voxels of the hole's axis (the reach), brute force over the region.
+                if (std::hypot(x - 20.0, y - 20.0) > 8.0 || z < 8 || z > 25) continue;
+                ASSERT_EQ(between_sheet_sides(phi, image, p, 8.0, kLower, kUpper), hole) << x << "," << y << "," << z;
+            }
+    // A sulcus: banks z in [10, 13) and [16, 19) with white matter behind each, CSF between.
+    Grid<float> sulcus(lat, kCsf), sphi(lat, 1.0f);
+    for (int z = 0; z < 40; ++z)
+        for (int y = 0; y < 40; ++y)
+            for (int x = 0; x < 40; ++x) {
+                const Vec3i p{x, y, z};
+                const bool bank = (z >= 10 && z < 13) || (z >= 16 && z < 19);
+                sulcus(p) = bank ? kGm : (z < 10 || z >= 19 ? kWm : kCsf);
+                if (bank) sphi(p) = -1.0f;
+            }
+    for (int z = 13; z < 16; ++z) EXPECT_FALSE(between_sheet_sides(sphi, sulcus, {20, 20, z}, 8.0, kLower, kUpper)) << z;
+}
+
+// The drilled shell with its drill reading as white matter (bias-bright hole tissue, as in the
+// phantom): the band alone cannot close it; between the sheet's sides it closes, and every voxel
+// added is one of the drill's.
+TEST(SheetRepair, ClosesABiasBrightHoleAddingOnlyTheHolesVoxels) {
+    Shell s = drilled_shell(3.0);
+    Grid<std::uint8_t> drill(s.mask.lattice(), 0);
+    for (PointIndex i = 0; i < drill.size(); ++i)
+        if (s.image[i] == kGm && !s.mask[i]) {
+            drill[i] = 1;
+            s.image[i] = kWm;
+        }
+    // The hole is open while the shell encloses no cavity (one drill makes it a cap); its size is
+    // the drill voxels still missing.
+    const HoleSiteFinder find = [&](const SparseField& f) {
+        const Grid<std::uint8_t> m = inside_mask(f.phi());
+        std::size_t missing = 0;
+        for (PointIndex i = 0; i < m.size(); ++i) missing += drill[i] && !m[i];
+        if (mask_topology(m).cavities == 1) return std::vector<HoleSite>{};
+        return std::vector<HoleSite>{{Vec3d{kCentre.x + 23, kCentre.y, kCentre.z}, missing}};
+    };
+    for (bool between : {false, true}) {
+        SparseField field(s.mask.lattice(), 2);
+        field.init_from_mask(s.mask);
+        RepairOptions ro = sheet_options();
+        ro.swarm.sheet_between = between;
+        RepairScheduleOptions so;
+        so.rounds = 5;
+        so.round_steps = 200;
+        const RepairScheduleResult r = run_repair_schedule(field, s.image, nullptr, ro, so, find);
+        const Grid<std::uint8_t> after = inside_mask(field.phi());
+        if (!between) {
+            EXPECT_GT(r.holes_left, 0u);  // nothing in the drill is in the band
+            continue;
+        }
+        EXPECT_EQ(r.holes_left, 0u);
+        EXPECT_EQ(mask_topology(after).genus, 0);
+        EXPECT_EQ(mask_topology(after).cavities, 1u);  // sealed: the core enclosed again
+        std::size_t drilled = 0, filled = 0;
+        for (PointIndex i = 0; i < after.size(); ++i) {
+            drilled += drill[i];
+            filled += drill[i] && after[i];
+            if (after[i] && !s.mask[i]) {
+                ASSERT_TRUE(drill[i]) << "added a voxel outside the hole at " << s.mask.lattice().coord(i).x;
+            }
+        }
+        EXPECT_GE(2 * filled, drilled);  // at least half the hole's tissue restored
+    }
+}
+
+}  // namespace
+}  // namespace liveset

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "liveset/eval/topology.hpp"
+#include "liveset/grid/digital_topology.hpp"
 
 namespace liveset {
 
@@ -104,6 +105,41 @@ std::vector<Perforation> find_cavities(const Grid<std::uint8_t>& mask, const Gri
             slot[k] = out.size();
             out.push_back({size[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
         }
+    locate_nearest(lat, label, slot, out);
+    return out;
+}
+
+std::vector<Perforation> find_missed_tunnels(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth) {
+    if (!(mask.dims() == truth.dims())) throw std::invalid_argument("find_missed_tunnels: mask and truth differ in size");
+    const Lattice& lat = mask.lattice();
+    Grid<std::uint8_t> missed(lat, 0);
+    for (PointIndex i = 0; i < lat.size(); ++i) missed[i] = truth[i] && !mask[i];
+    std::size_t count = 0;
+    const std::vector<std::uint32_t> label = label_components(missed, 6, &count);
+    std::vector<std::size_t> size(count + 1, 0);
+    std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
+    std::vector<Vec3i> lo(count + 1, lat.dims()), hi(count + 1, Vec3i{-1, -1, -1});
+    for (PointIndex i = 0; i < lat.size(); ++i) {
+        const std::uint32_t k = label[i];
+        if (!k) continue;
+        const Vec3i c = lat.coord(i);
+        ++size[k];
+        sum[k] += c.cast<double>();
+        lo[k] = {std::min(lo[k].x, c.x), std::min(lo[k].y, c.y), std::min(lo[k].z, c.z)};
+        hi[k] = {std::max(hi[k].x, c.x), std::max(hi[k].y, c.y), std::max(hi[k].z, c.z)};
+    }
+    std::vector<Perforation> out;
+    std::vector<std::size_t> slot(count + 1, SIZE_MAX);
+    for (std::uint32_t k = 1; k <= count; ++k) {
+        // χ over the region's box one voxel wider, without and with the region: a rise is a tunnel
+        // (or a cavity, which find_cavities reports) that filling it closes.
+        const Vec3i a = lo[k] - Vec3i{1, 1, 1}, b = hi[k] + Vec3i{1, 1, 1};
+        const auto in_mask = [&](Vec3i q) { return lat.contains(q) && mask(q) != 0; };
+        const auto in_filled = [&](Vec3i q) { return lat.contains(q) && (mask(q) != 0 || label[lat.index(q)] == k); };
+        if (euler_characteristic_26(in_filled, a, b) <= euler_characteristic_26(in_mask, a, b)) continue;
+        slot[k] = out.size();
+        out.push_back({size[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
+    }
     locate_nearest(lat, label, slot, out);
     return out;
 }

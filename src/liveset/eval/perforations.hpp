@@ -31,4 +31,10 @@ std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const
 // (ties by centroid); `nearest` is the cavity voxel nearest its centroid. Same dimensions required.
 std::vector<Perforation> find_cavities(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& inner);
 
+// Tunnels of the mask that missed truth closes without being a perforation (e.g. a one-voxel
+// pinhole through the shell, or a crack between two fronts): 6-connected regions of missed truth
+// (truth and not mask) whose filling raises the mask's Euler characteristic (counted in the
+// region's box). Largest first (ties by centroid). Same dimensions required.
+std::vector<Perforation> find_missed_tunnels(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth);
+
 }  // namespace liveset

@@ -85,4 +85,43 @@ TopologicalNumbers topological_numbers(Inside&& inside, Vec3i p, int connectivit
     return {detail::cube_components(fg, false, true), detail::cube_components(bg, true, false)};
 }
 
+// The 13 lines through a voxel, one direction of each ± pair: 3 along faces, 6 along edges, 4
+// along corners (the digital lines a one-voxel gap can lie across).
+inline constexpr int kLineDirections[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1},  {1, 1, 0},  {1, -1, 0},
+                                               {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}, {1, 1, 1},
+                                               {1, 1, -1}, {1, -1, 1}, {1, -1, -1}};
+
+// Euler characteristic χ = V − E + F − C of the union of the closed unit cubes of the foreground
+// voxels inside the box [lo, hi] (26-connected foreground: χ = components − tunnels + cavities).
+// Flipping voxels at least one voxel inside the box changes the whole set's χ exactly as it
+// changes this one's: χ is a sum of cell counts, and only the cells of the flipped cubes change.
+template <class Inside>
+long euler_characteristic_26(Inside&& inside, Vec3i lo, Vec3i hi) {
+    const auto in = [&](int x, int y, int z) {
+        return x >= lo.x && y >= lo.y && z >= lo.z && x <= hi.x && y <= hi.y && z <= hi.z && inside(Vec3i{x, y, z});
+    };
+    long v = 0, e = 0, f = 0, c = 0;
+    // Every corner point shared by voxels (x..x+1, y..y+1, z..z+1), a[dz][dy][dx], with the three
+    // edges, three faces and the cube that start there towards +x, +y, +z.
+    for (int z = lo.z - 1; z <= hi.z; ++z)
+        for (int y = lo.y - 1; y <= hi.y; ++y)
+            for (int x = lo.x - 1; x <= hi.x; ++x) {
+                bool a[2][2][2];
+                bool any = false;
+                for (int k = 0; k < 8; ++k) {
+                    a[k >> 2][(k >> 1) & 1][k & 1] = in(x + (k & 1), y + ((k >> 1) & 1), z + (k >> 2));
+                    any = any || a[k >> 2][(k >> 1) & 1][k & 1];
+                }
+                v += any;
+                e += a[0][0][1] || a[0][1][1] || a[1][0][1] || a[1][1][1];  // along x
+                e += a[0][1][0] || a[0][1][1] || a[1][1][0] || a[1][1][1];  // along y
+                e += a[1][0][0] || a[1][0][1] || a[1][1][0] || a[1][1][1];  // along z
+                f += a[0][1][1] || a[1][1][1];                              // normal z
+                f += a[1][0][1] || a[1][1][1];                              // normal y
+                f += a[1][1][0] || a[1][1][1];                              // normal x
+                c += a[1][1][1];
+            }
+    return v - e + f - c;
+}
+
 }  // namespace liveset

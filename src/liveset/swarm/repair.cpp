@@ -1,109 +1,12 @@
-// The repair loop: swarm move -> surface edits -> local level-set update -> incremental mesh.
+// The repair loop: swarm move -> surface edits -> topology guard (topology_guard.cpp) -> local level-set update.
 #include "liveset/swarm/repair.hpp"
 
 #include <algorithm>
 #include <chrono>
-#include <climits>
 #include <cstdint>
 #include <stdexcept>
-#include <unordered_map>
-
-#include "liveset/grid/digital_topology.hpp"
 
 namespace liveset {
-
-namespace {
-
-constexpr std::size_t kPocketLimit = 32768;
-
-// Visited marks for the pocket flood: one stamp per lattice point, reused across floods (a new
-// stamp per flood, so nothing is cleared). Per thread: guard_topology may run on several threads.
-struct FloodMarks {
-    std::vector<std::uint32_t> stamp;
-    std::uint32_t current = 0;
-    std::vector<Vec3i> queue;
-    void begin(std::size_t points) {
-        if (stamp.size() != points || current == UINT32_MAX) {
-            stamp.assign(points, 0);
-            current = 0;
-        }
-        ++current;
-        queue.clear();
-    }
-    bool visit(PointIndex i) {
-        if (stamp[i] == current) return false;
-        stamp[i] = current;
-        return true;
-    }
-};
-
-// Breadth-first flood of the outside (6-connected) from `start`: true when it ends within
-// kPocketLimit voxels without reaching the lattice border. (A flat stamp array instead of a hash
-// set: the flood is the guard's worst case, ~30 k voxels when the outside is large.)
-template <class Inside>
-bool encloses_small_pocket(const Lattice& lat, Inside& inside, Vec3i start) {
-    thread_local FloodMarks marks;
-    marks.begin(lat.size());
-    std::vector<Vec3i>& queue = marks.queue;
-    queue.push_back(start);
-    marks.visit(lat.index(start));
-    const Vec3i dims = lat.dims();
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-        if (queue.size() > kPocketLimit) return false;
-        const Vec3i p = queue[head];
-        if (p.x == 0 || p.y == 0 || p.z == 0 || p.x == dims.x - 1 || p.y == dims.y - 1 || p.z == dims.z - 1) return false;
-        for (int k = 0; k < 6; ++k) {
-            Vec3i q = p;
-            q[k / 2] += (k % 2) ? 1 : -1;
-            if (inside(q) || !marks.visit(lat.index(q))) continue;
-            queue.push_back(q);
-        }
-    }
-    return true;
-}
-
-}  // namespace
-
-std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits) {
-    const Lattice& lat = field.lattice();
-    const Grid<float>& phi = field.phi();
-    std::unordered_map<PointIndex, bool> flipped;  // accepted flips of this batch: point -> inside
-    const auto inside = [&](Vec3i q) {
-        if (!lat.contains(q)) return false;
-        const PointIndex i = lat.index(q);
-        if (const auto it = flipped.find(i); it != flipped.end()) return it->second;
-        return phi[i] < 0.0f;
-    };
-    std::size_t dropped = 0;
-    std::erase_if(edits, [&](const ZeroLayerEdit& e) {
-        const float before = phi[e.point];
-        const float after = before + std::clamp(e.delta, -0.5f, 0.5f);
-        const bool was_in = before < 0.0f, is_in = after < 0.0f;
-        if (was_in == is_in) return false;
-        const Vec3i c = lat.coord(e.point);
-        const TopologicalNumbers t = topological_numbers(inside, c);
-        bool ok = is_in ? t.foreground == 1 : (t.background == 1 && t.foreground <= 1);
-        // Growth that splits the local background either closes a tunnel (good) or seals a small
-        // pocket off (a spurious cavity): refuse it when some face neighbour's outside region,
-        // with the point filled, is enclosed within kPocketLimit voxels.
-        if (ok && is_in && t.background >= 2) {
-            flipped[e.point] = true;
-            for (int k = 0; k < 6 && ok; ++k) {
-                Vec3i q = c;
-                q[k / 2] += (k % 2) ? 1 : -1;
-                if (lat.contains(q) && !inside(q)) ok = !encloses_small_pocket(lat, inside, q);
-            }
-            flipped.erase(e.point);
-        }
-        if (!ok) {
-            ++dropped;
-            return true;
-        }
-        flipped[e.point] = is_in;
-        return false;
-    });
-    return dropped;
-}
 
 RepairLoop::RepairLoop(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                        const RepairOptions& options)
@@ -160,7 +63,13 @@ RepairStep RepairLoop::step() {
                 return false;
             });
         }
-        if (options_.topology_guard) out.log.guarded = guard_topology(field_, edits);
+        if (options_.topology_guard) {
+            GuardOptions go;
+            go.pocket_limit = brush_pocket_limit(swarm_.options().edit_range);
+            go.close_cracks = options_.close_cracks;
+            go.roi = roi_;
+            out.log.guarded = guard_topology(field_, edits, go);
+        }
         out.log.modified = edits.size();
         if (!edits.empty()) {
             out.changed = field_.apply_edits(edits, RepairScope::kLocal);

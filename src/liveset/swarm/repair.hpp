@@ -29,6 +29,8 @@ struct RepairOptions {
     // pieces, starts a new piece, opens a tunnel, seals a cavity by removal or splits a piece is
     // dropped (see guard_topology), so the swarm can close holes but never make new ones.
     bool topology_guard = true;
+    // Cracks between fronts filled with the tunnel they belong to (GuardOptions::close_cracks).
+    bool close_cracks = true;
 };
 
 struct RepairStepLog {
@@ -41,12 +43,35 @@ struct RepairStepLog {
     double ms = 0.0;             // wall time of move + edits + level set + mesh
 };
 
+struct GuardOptions {
+    // Growth that seals a region of the outside off is refused when that region holds at most this
+    // many voxels (a spurious cavity); a larger one is tissue the sheet already enclosed around
+    // the hole (the white matter under a perforation), and sealing it closes the hole.
+    std::size_t pocket_limit = 32768;
+    // A growth edit refused as a bridge (its inside neighbours form two pieces: two fronts that
+    // met with a one-voxel crack between them) fills the whole crack at once when that closes a
+    // tunnel and seals no pocket (see guard_topology).
+    bool close_cracks = true;
+    const Grid<std::uint8_t>* roi = nullptr;  // crack voxels (and their face neighbours) must lie in it
+};
+
+// The pocket limit for a swarm whose brush is `edit_range` voxels (0: no brush): the voxels of the
+// brush's cube, (2⌈r⌉ + 1)³, at most 32768 — a pocket the brush could have walled in is spurious,
+// a larger one was enclosed before the swarm came.
+std::size_t brush_pocket_limit(double edit_range);
+
 // Drops, in point order, every edit that would flip the inside/outside state (φ < 0) of its point
 // non-simply: growth is kept only when the point's inside neighbours form one 26-connected piece
 // (no bridge, no new piece); shrinking only when the point is simple (no tunnel opened, no cavity
 // made, nothing split) or an isolated inside voxel. Growth that closes a tunnel or fills a
-// cavity is kept. Flips already accepted count for the later points. Returns the number dropped.
-std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits);
+// cavity is kept, growth that seals a pocket of at most options.pocket_limit voxels is not.
+// Flips already accepted count for the later points. Returns the number dropped.
+// Cracks (options.close_cracks): a bridge's crack is the outside voxels 6-connected to it within 3
+// voxels that each lie between two inside voxels along one of the 13 directions through them; it is
+// filled whole (every crack point's edit becomes −0.5) when each is a zero-layer point that edit
+// flips (φ < 0.5), in the ROI, the fill raises the Euler characteristic (counted in the box around
+// the crack: it closes a tunnel) and it seals no pocket; else the edit is dropped as before.
+std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits, const GuardOptions& options = {});
 
 // One repair step's outcome: the log line plus the changed points X (for the mesher).
 struct RepairStep {

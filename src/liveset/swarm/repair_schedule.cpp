@@ -30,6 +30,7 @@ void RepairScheduleOptions::validate() const {
 std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner) {
     std::vector<Perforation> h = find_perforations(mask, truth, inner);
     if (h.empty()) h = find_cavities(mask, inner);
+    if (h.empty()) h = find_missed_tunnels(mask, truth);
     std::vector<HoleSite> sites;
     for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
     return sites;

@@ -81,7 +81,7 @@ private:
 using HoleSiteFinder = std::function<std::vector<HoleSite>(const SparseField& field)>;
 // The holes a user who sees the truth points at, largest first: the perforations of `mask` between
 // `truth` and `inner` (eval/perforations.hpp), and when none is left, its spurious cavities
-// (bubbles) in `inner`. The phantom demo's finder (and its test's).
+// (bubbles) in `inner`, then the tunnels that missed truth closes (pinholes, cracks). The phantom demo's finder (and its test's).
 std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner);
 
 // Adjusts a round's options for its target (e.g. the sheet band sampled there); may be empty.

@@ -33,9 +33,12 @@
 //   (decision kSheet, hole repair in a sheet such as the cortex: no population statistics; an
 //   acting agent expands (Δ = −A) only when both I(x + 0.75n) and I_out lie in the sheet's band
 //   [sheet_lower, sheet_upper): the voxel it grows into looks like the sheet's tissue, neither the
-//   enclosed tissue above the band (white matter) nor the outside below it (CSF). It never
+//   enclosed tissue above the band (white matter) nor the outside below it (CSF) — or when the
+//   voxel at x + 0.75n lies between the sheet's two sides (between_sheet_sides, within the brush
+//   or sheet_reach, whichever is larger; sheet_between): a hole's tissue whose intensity bias or partial volume moved out of the band. It never
 //   contracts: a repair closes holes, the segmentation's own faces stay where they are; and its
-//   footprint skips the outside points whose own voxel lies outside the band)
+//   footprint skips the outside points whose own voxel lies outside the band and not between the
+//   sheet's sides)
 //   Δ is spread over the zero-layer points p with |p − x| ≤ edit_radius, weighted by the
 //   unit-peak Gaussian exp(−|p − x|²/(2σ_g²)), σ_g = edit_radius/2, so A is the change under the
 //   agent whatever the zero-layer sampling density. Contributions to a point are summed in agent
@@ -51,6 +54,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "liveset/grid/digital_topology.hpp"
 #include "liveset/grid/sampling.hpp"
 
 namespace liveset {
@@ -142,6 +146,39 @@ Vec3d project(const Grid<float>& phi, Vec3d x, int iterations) {
     return x;
 }
 
+}  // namespace
+
+bool between_sheet_sides(const Grid<float>& phi, const Grid<float>& image_unit, Vec3i q, double reach, double lower, double upper) {
+    const Lattice& lat = phi.lattice();
+    if (!lat.contains(q) || phi(q) < 0.0f || !(reach > 0)) return false;
+    // What a ray from q along v meets within reach, up to the sheet: kSheetHit when it meets the sheet,
+    // kInner / kOuter when it passes enclosed tissue / the outside (or leaves the lattice) first.
+    constexpr int kSheetHit = 1, kInner = 2, kOuter = 4;
+    const auto ray = [&](Vec3i v) {
+        const double step = norm(v.cast<double>());
+        int met = 0;
+        for (int k = 1; k * step <= reach; ++k) {
+            const Vec3i p = q + v * k;
+            if (!lat.contains(p)) return met | kOuter;
+            if (phi(p) < 0.0f) return met | kSheetHit;
+            const float x = image_unit(p);
+            met |= x >= upper ? kInner : (x < lower ? kOuter : 0);
+        }
+        return met;
+    };
+    bool flanked = false, joins = false;
+    for (const auto& d : kLineDirections) {
+        const Vec3i v{d[0], d[1], d[2]};
+        const int a = ray(v), b = ray(v * -1);
+        flanked = flanked || ((a & kSheetHit) && (b & kSheetHit));
+        joins = joins || ((a & kInner) && (b & kOuter)) || ((a & kOuter) && (b & kInner));
+        if (flanked && joins) return true;
+    }
+    return false;
+}
+
+namespace {
+
 bool finite_positive(double v) { return std::isfinite(v) && v > 0; }
 
 void require(bool ok, const char* message) {
@@ -170,6 +207,7 @@ void validate(const SwarmOptions& o) {
     require(finite_positive(o.stats_smoothing) && o.stats_smoothing <= 1, "swarm: stats_smoothing must be in (0, 1]");
     require(std::isfinite(o.sample_depth) && o.sample_depth >= 0 && o.sample_depth <= 8, "swarm: sample_depth must be in [0, 8]");
     require(std::isfinite(o.edit_range) && o.edit_range >= 0, "swarm: edit_range must be finite and >= 0");
+    require(std::isfinite(o.sheet_reach) && o.sheet_reach >= 0 && o.sheet_reach <= 32, "swarm: sheet_reach must be in [0, 32] voxels");
     require(o.decision != EditDecision::kSheet ||
                 (std::isfinite(o.sheet_lower) && std::isfinite(o.sheet_upper) && o.sheet_lower < o.sheet_upper),
             "swarm: the sheet decision needs a finite band sheet_lower < sheet_upper");
@@ -345,6 +383,14 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
     const int reach = static_cast<int>(std::ceil(support));
 
     const bool sheet = options_.decision == EditDecision::kSheet;
+    const double between_reach =
+        options_.sheet_between && options_.edit_range > 0 ? std::max(options_.edit_range, options_.sheet_reach) : 0.0;
+    const auto between_voxel = [&](Vec3i q) {
+        return between_reach > 0 && between_sheet_sides(phi, image_unit, q, between_reach, options_.sheet_lower, options_.sheet_upper);
+    };
+    const auto between = [&](Vec3d p) {
+        return between_voxel({static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)), static_cast<int>(std::lround(p.z))});
+    };
     std::vector<std::vector<ZeroLayerEdit>> per_agent(n_agents);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_agents), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -364,7 +410,7 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
             } else if (options_.decision == EditDecision::kSheet) {
                 const double near = trilinear(image_unit, x + n * 0.75);
                 const auto in_band = [&](double v) { return v >= options_.sheet_lower && v < options_.sheet_upper; };
-                if (in_band(near) && in_band(outside)) amount = -options_.edit_amount;
+                if ((in_band(near) && in_band(outside)) || between(x + n * 0.75)) amount = -options_.edit_amount;
             } else if (std::abs(outside - mu) <= options_.expand_sigmas * sigma)
                 amount = -options_.edit_amount;
             else if (std::abs(inside - mu) > options_.contract_sigmas * sigma)
@@ -381,8 +427,9 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
                         if (!lat.contains(q)) continue;
                         const PointIndex idx = lat.index(q);
                         if (field.status()[idx] != 0) continue;
-                        if (sheet && phi[idx] >= 0.0f && !(image_unit[idx] >= options_.sheet_lower && image_unit[idx] < options_.sheet_upper))
-                            continue;  // kSheet: never raise the surface over a voxel that is not the sheet's tissue
+                        if (sheet && phi[idx] >= 0.0f && !(image_unit[idx] >= options_.sheet_lower && image_unit[idx] < options_.sheet_upper) &&
+                            !between_voxel(q))
+                            continue;  // kSheet: never raise the surface over a voxel that is neither the sheet's tissue nor between its sides
                         const Vec3d d = q.cast<double>() - x;
                         const double d2 = dot(d, d);
                         if (d2 > support * support) continue;

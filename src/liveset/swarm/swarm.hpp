@@ -52,7 +52,22 @@ struct SwarmOptions {
     // units), between the tissue the sheet encloses (above) and the outside (below); sampled
     // around the hole by local_sheet_band (repair_schedule.hpp). Must satisfy lower < upper.
     double sheet_lower = 0.0, sheet_upper = 0.0;
+    // Decision kSheet: a voxel outside the band may still be raised when it lies between the sheet's
+    // two sides (between_sheet_sides, within max(edit_range, sheet_reach) voxels; off without an edit range) — the
+    // hole's own tissue whose intensity a bias or partial volume moved out of the band.
+    bool sheet_between = true;
+    // ... looking at least this far (voxels; 0: the brush alone).
+    double sheet_reach = 0.0;
 };
+
+// Whether outside voxel `q` lies between the sheet's two sides, within `reach` voxels along rays
+// in the 13 directions through it (±d): the sheet (φ < 0) lies on both sides of it along some
+// direction (it is in the plane of the sheet, inside a hole's rim), and along some direction one
+// ray passes the tissue the sheet encloses (intensity ≥ upper) and the other the outside (< lower,
+// or the lattice's edge) before either meets the sheet (it is in a gap joining the two tissues the
+// sheet separates). White matter under an intact sheet, or the CSF of a sulcus between two banks,
+// fails the second test.
+bool between_sheet_sides(const Grid<float>& phi, const Grid<float>& image_unit, Vec3i q, double reach, double lower, double upper);
 
 // Throws std::invalid_argument (one-line message) on an invalid option.
 void validate(const SwarmOptions& options);

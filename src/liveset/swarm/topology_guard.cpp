@@ -1,0 +1,226 @@
+// The repair's topology guard: swarm edits may close tunnels and fill cavities but never make any;
+// a bridge across a one-voxel crack between two fronts is filled with its whole crack when that
+// closes the tunnel the crack belongs to.
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "liveset/grid/digital_topology.hpp"
+#include "liveset/swarm/repair.hpp"
+
+namespace liveset {
+
+namespace {
+
+constexpr std::size_t kMaxPocketLimit = 32768;
+constexpr int kCrackReach = 3;         // voxels from the refused bridge (Chebyshev)
+constexpr std::size_t kMaxCrack = 64;  // a longer crack waits until the fronts zip it shorter
+constexpr float kCrackEdit = -0.5f;    // the edit each crack point gets
+constexpr float kFlippable = 0.5f;     // ... which flips it when φ is below this
+
+// Visited marks for the pocket flood: one stamp per lattice point, reused across floods (a new
+// stamp per flood, so nothing is cleared). Per thread: guard_topology may run on several threads.
+struct FloodMarks {
+    std::vector<std::uint32_t> stamp;
+    std::uint32_t current = 0;
+    std::vector<Vec3i> queue;
+    void begin(std::size_t points) {
+        if (stamp.size() != points || current == UINT32_MAX) {
+            stamp.assign(points, 0);
+            current = 0;
+        }
+        ++current;
+        queue.clear();
+    }
+    bool visit(PointIndex i) {
+        if (stamp[i] == current) return false;
+        stamp[i] = current;
+        return true;
+    }
+};
+
+Vec3i face_neighbour(Vec3i c, int k) {
+    c[k / 2] += (k % 2) ? 1 : -1;
+    return c;
+}
+
+// Breadth-first flood of the outside (6-connected) from `start`: true when it ends within `limit`
+// voxels without reaching the lattice border. (A flat stamp array instead of a hash set: the flood
+// is the guard's worst case, ~30 k voxels when the outside is large.)
+template <class Inside>
+bool encloses_small_pocket(const Lattice& lat, Inside& inside, Vec3i start, std::size_t limit) {
+    thread_local FloodMarks marks;
+    marks.begin(lat.size());
+    std::vector<Vec3i>& queue = marks.queue;
+    queue.push_back(start);
+    marks.visit(lat.index(start));
+    const Vec3i dims = lat.dims();
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+        if (queue.size() > limit) return false;
+        const Vec3i p = queue[head];
+        if (p.x == 0 || p.y == 0 || p.z == 0 || p.x == dims.x - 1 || p.y == dims.y - 1 || p.z == dims.z - 1) return false;
+        for (int k = 0; k < 6; ++k) {
+            const Vec3i q = face_neighbour(p, k);
+            if (inside(q) || !marks.visit(lat.index(q))) continue;
+            queue.push_back(q);
+        }
+    }
+    return true;
+}
+
+// The guard's state over one batch: the flips accepted so far, read through inside().
+class Guard {
+public:
+    Guard(const SparseField& field, const GuardOptions& o) : field_(field), lat_(field.lattice()), o_(o) {}
+    bool inside(Vec3i q) const {
+        if (!lat_.contains(q)) return false;
+        const PointIndex i = lat_.index(q);
+        if (const auto it = flipped_.find(i); it != flipped_.end()) return it->second;
+        return field_.phi()[i] < 0.0f;
+    }
+    bool keep(const ZeroLayerEdit& e);  // false: drop the edit
+    const std::vector<PointIndex>& crack_points() const { return cracks_; }
+
+private:
+    bool seals_pocket_around(Vec3i c);
+    std::vector<PointIndex> gather_crack(Vec3i start) const;
+    bool fill_crack(Vec3i start);
+    bool may_fill(Vec3i q) const;
+
+    const SparseField& field_;
+    const Lattice& lat_;
+    GuardOptions o_;
+    std::unordered_map<PointIndex, bool> flipped_;  // accepted flips of this batch: point -> inside
+    std::unordered_set<PointIndex> tried_;          // crack points already tried in this batch
+    std::vector<PointIndex> cracks_;                // crack points filled (their edits become kCrackEdit)
+};
+
+// Whether some face neighbour's outside region of c (c counted inside) is a pocket of at most
+// pocket_limit voxels.
+bool Guard::seals_pocket_around(Vec3i c) {
+    const auto in = [this](Vec3i q) { return inside(q); };
+    for (int k = 0; k < 6; ++k) {
+        const Vec3i q = face_neighbour(c, k);
+        if (lat_.contains(q) && !inside(q) && encloses_small_pocket(lat_, in, q, o_.pocket_limit)) return true;
+    }
+    return false;
+}
+
+bool Guard::keep(const ZeroLayerEdit& e) {
+    const float before = field_.phi()[e.point];
+    const float after = before + std::clamp(e.delta, -0.5f, 0.5f);
+    const bool was_in = before < 0.0f, is_in = after < 0.0f;
+    if (was_in == is_in) return true;
+    const Vec3i c = lat_.coord(e.point);
+    const TopologicalNumbers t = topological_numbers([this](Vec3i q) { return inside(q); }, c);
+    bool ok = is_in ? t.foreground == 1 : (t.background == 1 && t.foreground <= 1);
+    // Growth that splits the local background either closes a tunnel (good) or seals a small
+    // pocket off (a spurious cavity): refuse the latter.
+    if (ok && is_in && t.background >= 2) {
+        flipped_[e.point] = true;
+        ok = !seals_pocket_around(c);
+        flipped_.erase(e.point);
+    }
+    if (!ok && is_in && t.foreground >= 2 && o_.close_cracks) return fill_crack(c);
+    if (ok) flipped_[e.point] = is_in;
+    return ok;
+}
+
+bool Guard::may_fill(Vec3i q) const {
+    const PointIndex i = lat_.index(q);
+    if (field_.status()[i] != 0 || !(field_.phi()[i] < kFlippable) || tried_.count(i)) return false;
+    if (!o_.roi) return true;
+    for (int k = 0; k < 7; ++k) {
+        const Vec3i r = k ? face_neighbour(q, k - 1) : q;
+        if (!lat_.contains(r) || (*o_.roi)(r) == 0) return false;
+    }
+    return true;
+}
+
+// The crack of a refused bridge at `start` (see guard_topology); empty when some crack voxel may
+// not be filled or the crack is longer than kMaxCrack.
+std::vector<PointIndex> Guard::gather_crack(Vec3i start) const {
+    const auto between_fronts = [this](Vec3i q) {
+        for (const auto& d : kLineDirections) {
+            const Vec3i v{d[0], d[1], d[2]};
+            if (inside(q + v) && inside(q - v)) return true;
+        }
+        return false;
+    };
+    std::vector<Vec3i> queue{start};
+    std::vector<PointIndex> crack{lat_.index(start)};
+    if (!may_fill(start)) return {};
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+        for (int k = 0; k < 6; ++k) {
+            const Vec3i q = face_neighbour(queue[head], k);
+            const Vec3i d = q - start;
+            if (std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}) > kCrackReach || !lat_.contains(q) || inside(q)) continue;
+            const PointIndex i = lat_.index(q);
+            if (std::find(crack.begin(), crack.end(), i) != crack.end() || !between_fronts(q)) continue;
+            if (!may_fill(q) || crack.size() >= kMaxCrack) return {};
+            crack.push_back(i);
+            queue.push_back(q);
+        }
+    }
+    return crack;
+}
+
+// Fills the crack of the bridge at `start` when that closes a tunnel: the Euler characteristic
+// (components − tunnels + cavities) rises, no component can appear, and no pocket is sealed, so a
+// tunnel closed. Returns whether it did.
+bool Guard::fill_crack(Vec3i start) {
+    const std::vector<PointIndex> crack = gather_crack(start);
+    for (PointIndex i : crack) tried_.insert(i);
+    if (crack.empty()) return false;
+    Vec3i lo = start, hi = start;
+    for (PointIndex i : crack) {
+        const Vec3i q = lat_.coord(i);
+        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y), std::min(lo.z, q.z)};
+        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y), std::max(hi.z, q.z)};
+    }
+    lo = lo - Vec3i{1, 1, 1};
+    hi = hi + Vec3i{1, 1, 1};
+    const auto in = [this](Vec3i q) { return inside(q); };
+    const long chi_before = euler_characteristic_26(in, lo, hi);
+    for (PointIndex i : crack) flipped_[i] = true;
+    bool ok = euler_characteristic_26(in, lo, hi) > chi_before;
+    for (std::size_t k = 0; k < crack.size() && ok; ++k) ok = !seals_pocket_around(lat_.coord(crack[k]));
+    if (!ok) {
+        for (PointIndex i : crack) flipped_.erase(i);
+        return false;
+    }
+    cracks_.insert(cracks_.end(), crack.begin(), crack.end());
+    return true;
+}
+
+}  // namespace
+
+std::size_t brush_pocket_limit(double edit_range) {
+    if (!(edit_range > 0) || !std::isfinite(edit_range)) return kMaxPocketLimit;
+    const double side = 2.0 * std::ceil(edit_range) + 1.0;
+    return static_cast<std::size_t>(std::min(side * side * side, static_cast<double>(kMaxPocketLimit)));
+}
+
+std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits, const GuardOptions& options) {
+    Guard guard(field, options);
+    std::size_t dropped = 0;
+    std::erase_if(edits, [&](const ZeroLayerEdit& e) {
+        if (guard.keep(e)) return false;
+        ++dropped;
+        return true;
+    });
+    const std::vector<PointIndex>& crack = guard.crack_points();
+    if (crack.empty()) return dropped;
+    // Every crack point's edit becomes kCrackEdit (added where the swarm proposed none), in point order.
+    std::unordered_set<PointIndex> filled(crack.begin(), crack.end());
+    for (ZeroLayerEdit& e : edits)
+        if (filled.erase(e.point)) e.delta = kCrackEdit;
+    for (PointIndex i : filled) edits.push_back({i, kCrackEdit});
+    std::sort(edits.begin(), edits.end(), [](const ZeroLayerEdit& a, const ZeroLayerEdit& b) { return a.point < b.point; });
+    return dropped;
+}
+
+}  // namespace liveset
