@@ -58,6 +58,7 @@ SegmentRequest segment_request(const SegmentArgs& a, const Lattice& lattice, con
                                const std::optional<Grid<std::uint8_t>>& init, const Grid<std::uint8_t>* fit) {
     SegmentRequest req;
     fill_segment_request(req, a, lattice);
+    req.loop.step = step_options(a);
     if (roi) req.roi = &roi->mask;
     if (init) req.initial_mask = &*init;
     req.model_region = fit;

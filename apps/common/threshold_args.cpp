@@ -12,7 +12,12 @@ void add_threshold_options(CLI::App& cmd, ThresholdArgs& a) {
     cmd.add_option("--epsilon-raw", a.epsilon_raw, "half window in the image's own units")->check(finite_number());
     cmd.add_option("--n", a.n, "steepness of the threshold term")->check(finite_number())->capture_default_str();
     cmd.add_option("--alpha", a.alpha, "curvature weight in [0,1)")->check(finite_number())->capture_default_str();
+    cmd.add_option("--step", a.step, "level-set step: sleeping (converged stretches of front sleep until something near them changes) or exact (the whole band every step)")
+        ->check(CLI::IsMember({"sleeping", "exact"}))
+        ->capture_default_str();
 }
+
+StepOptions step_options(const ThresholdArgs& a) { return a.step == "exact" ? StepOptions{} : sleeping_step(); }
 
 void check_threshold_args(const ThresholdArgs& a) {
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");

@@ -1,13 +1,15 @@
 // The threshold-speed options `liveset segment` and `liveset view` share (--mu, --epsilon, --mu-raw,
-// --epsilon-raw, --n, --alpha): one registration with the same help and checks, one rule for the
+// --epsilon-raw, --n, --alpha, --step): one registration with the same help and checks, one rule for the
 // pairs, and the mapping of raw values to the normalised units the speed uses.
 #pragma once
 
 #include <CLI/CLI.hpp>
 
 #include <optional>
+#include <string>
 
 #include "liveset/segment/intensity.hpp"
+#include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
 
 namespace liveset::cli {
@@ -15,9 +17,10 @@ namespace liveset::cli {
 struct ThresholdArgs {
     std::optional<double> mu, epsilon, mu_raw, epsilon_raw;  // the window, normalised or raw units
     double n = 4.0, alpha = 0.1;
+    std::string step = "sleeping";  // --step: sleeping (segmentation.hpp, sleeping_step) or exact
 };
 
-// Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n and --alpha on `cmd`.
+// Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha and --step on `cmd`.
 void add_threshold_options(CLI::App& cmd, ThresholdArgs& a);
 // UsageError "give --mu or --mu-raw, not both" (and the same for ε).
 void check_threshold_args(const ThresholdArgs& a);
@@ -25,5 +28,7 @@ void check_threshold_args(const ThresholdArgs& a);
 // them); nullopt where not given.
 std::optional<double> unit_mu(const ThresholdArgs& a, const IntensityScale& scale);
 std::optional<double> unit_epsilon(const ThresholdArgs& a, const IntensityScale& scale);
+// The level-set step --step names: sleeping_step() (the default) or the exact full-band step.
+StepOptions step_options(const ThresholdArgs& a);
 
 }  // namespace liveset::cli

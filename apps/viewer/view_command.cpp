@@ -61,6 +61,7 @@ std::unique_ptr<Session> load_session(const ViewArgs& a) {
     so.fragment_size = a.fragment_size;
     so.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
     so.repair = demo_repair_options();
+    so.segmentation.step = step_options(a);  // as `liveset segment` (same bits)
     try {
         return std::make_unique<Session>(std::move(image), so, std::move(roi));
     } catch (const std::invalid_argument& e) {
@@ -170,6 +171,7 @@ int run_view(ViewArgs& a, int threads) {
     config.log_events = a.log_events;
     config.session.fragment_size = a.fragment_size;
     config.session.repair = demo_repair_options();
+    config.session.segmentation.step = step_options(a);
     config.image_path = a.image;
     config.roi_path = a.roi;
     config.params_note = note;

@@ -109,6 +109,39 @@ std::string read_text(const fs::path& path) {
     return text.str();
 }
 
+// The sleeping step's memory: the wake stamps run-length encoded ([stamp, count] pairs in block
+// order; neighbouring blocks mostly share a stamp).
+json activity_json(const ActivitySnapshot& a) {
+    json runs = json::array();
+    for (std::size_t i = 0; i < a.stamps.size();) {
+        std::size_t n = 1;
+        while (i + n < a.stamps.size() && a.stamps[i + n] == a.stamps[i]) ++n;
+        runs.push_back({a.stamps[i], n});
+        i += n;
+    }
+    return {{"clock", a.clock}, {"all_woken_at", a.all_woken_at}, {"speed_current", a.speed_current},
+            {"blocks", {a.blocks.x, a.blocks.y, a.blocks.z}}, {"runs", runs}};
+}
+
+ActivitySnapshot activity_from(const json& j) {
+    ActivitySnapshot a;
+    a.clock = field(j, "clock").get<std::int64_t>();
+    a.all_woken_at = field(j, "all_woken_at").get<std::int64_t>();
+    a.speed_current = field(j, "speed_current").get<bool>();
+    const auto b = numbers(j, "blocks", 3);
+    a.blocks = {static_cast<int>(b[0]), static_cast<int>(b[1]), static_cast<int>(b[2])};
+    if (a.blocks.x < 0 || a.blocks.y < 0 || a.blocks.z < 0 || a.blocks.x > 65536 || a.blocks.y > 65536 || a.blocks.z > 65536)
+        throw std::runtime_error("activity blocks out of range");
+    const std::size_t total = static_cast<std::size_t>(a.blocks.x) * static_cast<std::size_t>(a.blocks.y) * static_cast<std::size_t>(a.blocks.z);
+    for (const json& r : field(j, "runs")) {
+        const auto n = r.at(1).get<std::uint64_t>();
+        if (n == 0 || n > total - a.stamps.size()) throw std::runtime_error("activity runs do not cover its blocks");
+        a.stamps.insert(a.stamps.end(), n, r.at(0).get<std::int64_t>());
+    }
+    if (a.stamps.size() != total) throw std::runtime_error("activity runs do not cover its blocks");
+    return a;
+}
+
 Workspace parse_workspace(const json& j) {
     if (!j.is_object() || !j.contains("liveset_workspace")) throw std::runtime_error("not a liveset workspace (no 'liveset_workspace' version)");
     const int version = static_cast<int>(number(j, "liveset_workspace"));
@@ -145,6 +178,7 @@ Workspace parse_workspace(const json& j) {
     ws.view.camera = {number(c, "yaw"), number(c, "pitch"), number(c, "zoom"), glm::dvec3(pan.x, pan.y, pan.z)};
     const Vec3d cursor = vec3(v, "cursor");
     ws.view.cursor = {static_cast<int>(cursor.x), static_cast<int>(cursor.y), static_cast<int>(cursor.z)};
+    ws.activity = activity_from(field(j, "activity"));
     return ws;
 }
 
@@ -182,6 +216,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
                        {"window_from_seeds", m.window_from_seeds},
                        {"mu_raw", session.scale().to_raw(m.params.mu)}, {"epsilon_raw", session.scale().raw_length(m.params.epsilon)}}},
            {"iterations", m.iterations},
+           {"activity", activity_json(session.activity_snapshot())},
            {"swarm", swarm_json(session.repair_options())},
            {"target", session.target() ? vec(*session.target()) : json(nullptr)},
            {"view", {{"camera", {{"yaw", view.camera.yaw_deg}, {"pitch", view.camera.pitch_deg}, {"zoom", view.camera.zoom},
@@ -248,6 +283,7 @@ void apply_workspace(Session& session, const Workspace& ws) {
         throw std::invalid_argument("the workspace's level set is not a consistent sparse field");
     session.set_repair_options(ws.repair);
     if (ws.target) session.set_target(*ws.target);
+    session.restore_activity(ws.activity);  // last: loading woke the points it wrote
 }
 
 }  // namespace liveset::viewer

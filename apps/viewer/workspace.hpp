@@ -1,6 +1,7 @@
 // The viewer's workspace: everything needed to continue where the user left off, in one versioned
 // JSON file W (image and ROI paths, the image's geometry and a checksum of its voxels, seeds, µ, ε,
-// n, α, the iteration count, swarm settings and target, camera, cursor) plus φ and the sparse
+// n, α, the iteration count, the sleeping step's wake stamps, swarm settings and target, camera,
+// cursor) plus φ and the sparse
 // field's layers bit for bit in W.state next to it (the recovery file's checksummed binary format,
 // liveset/session/recovery.hpp). Both are written atomically, the state first; W records the
 // state's checksum, so a W paired with another state is refused. Every read is checked and refused
@@ -35,6 +36,7 @@ struct Workspace {
     WorkspaceView view;
     Grid<float> phi;                 // bit for bit as saved
     Grid<std::int8_t> status;
+    ActivitySnapshot activity;       // the sleeping step's memory (bit-exact continuation)
 };
 
 // FNV-1a of the image's voxel values (float bits, in index order).

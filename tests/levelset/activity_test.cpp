@@ -158,3 +158,55 @@ TEST(Activity, SleepAfterIsValidated) {
     o.sleep_after = 1'000'000;
     EXPECT_NO_THROW(validate(o));
 }
+
+namespace {
+
+// φ and statuses of `from` written into `to` (as a session loads a saved field).
+void load_bits(SparseField& to, const SparseField& from) {
+    std::vector<PointState> states;
+    for (std::size_t i = 0; i < from.phi().size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if (std::bit_cast<std::uint32_t>(from.phi()[p]) != std::bit_cast<std::uint32_t>(to.phi()[p]) || from.status()[p] != to.status()[p])
+            states.push_back({p, from.phi()[p], from.status()[p]});
+    }
+    to.restore(states);
+}
+
+}  // namespace
+
+// A field saved mid-run (φ, statuses and the activity snapshot) and loaded into another field with a
+// new speed object of the same parameters continues bit for bit as the uninterrupted run; without the
+// snapshot (everything awake again) it does not.
+TEST(Activity, ASavedSnapshotContinuesBitForBit) {
+    constexpr int kAfter = 6;
+    SparseField run = seed_field();
+    const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0, 0.05f, 22);  // the front stops at x < 22: it sleeps there
+    for (int s = 0; s < 40; ++s) run.step(speed, sleeping(kAfter));
+    const ActivitySnapshot snap = run.activity_snapshot(speed.serial());
+    EXPECT_TRUE(snap.speed_current);
+    EXPECT_EQ(snap.clock, 40);
+
+    SparseField loaded = seed_field(), forgetful = seed_field();
+    load_bits(loaded, run);
+    load_bits(forgetful, run);
+    loaded.restore_activity(snap);
+    const BlobSpeed reloaded = speed;  // a copy: another serial, as after reopening
+    ASSERT_NE(reloaded.serial(), speed.serial());
+    bool forgetful_differs = false;
+    for (int s = 0; s < 40; ++s) {
+        run.step(speed, sleeping(kAfter));
+        loaded.step(reloaded, sleeping(kAfter));
+        forgetful.step(reloaded, sleeping(kAfter));
+        ASSERT_TRUE(same_state(run, loaded)) << "step " << s + 41;
+        forgetful_differs = forgetful_differs || !same_state(run, forgetful);
+    }
+    EXPECT_TRUE(check_invariants(loaded).ok());
+    EXPECT_TRUE(forgetful_differs) << "the test cannot tell a restored activity from a fresh one";
+
+    // Not the speed the stamps were taken under: the next step wakes everything, as it would have.
+    const ActivitySnapshot stale = run.activity_snapshot(0);
+    EXPECT_FALSE(stale.speed_current);
+    // Another lattice is refused.
+    SparseField other(Lattice({30, 40, 40}), 2);
+    EXPECT_THROW(other.restore_activity(snap), std::invalid_argument);
+}

@@ -75,22 +75,23 @@ TEST(ViewCommand, HelpListsTheWindowAndWorkspaceOptions) {
         EXPECT_NE(r.out.find(option), std::string::npos) << option;
 }
 
-// Segment 20 steps and save a workspace; reopen it and take 10 more: φ is bit for bit what 30
-// steps in one run give (the level set, the parameters and the iteration count continue).
+// Segment 45 steps and save a workspace; reopen it and take 25 more: φ is bit for bit what 70
+// steps in one run give (the level set, the parameters, the iteration count and the sleeping step's
+// wake stamps continue: stretches of front are asleep by step 45 of the default sleeping step).
 TEST(ViewCommand, AWorkspaceContinuesBitForBit) {
     const Fixture& f = fixture();
     const std::string w = (f.dir / "cont.json").string(), p2 = (f.dir / "cont_phi.nii.gz").string(), p3 = (f.dir / "one_phi.nii.gz").string();
     CliResult r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
-                                      script("a.json", R"([{"segment": 20}, {"save_workspace": ")" + w + R"("}])")));
+                                      script("a.json", R"([{"segment": 45}, {"save_workspace": ")" + w + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
-    r = run_cli(fmt::format("view --workspace {} --headless --script {}", w, script("b.json", R"([{"segment": 10}, {"save_phi": ")" + p2 + R"("}])")));
+    r = run_cli(fmt::format("view --workspace {} --headless --script {}", w, script("b.json", R"([{"segment": 25}, {"save_phi": ")" + p2 + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_NE(r.err.find("from the workspace " + w), std::string::npos) << r.err;
     r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
-                            script("c.json", R"([{"segment": 30}, {"save_phi": ")" + p3 + R"("}])")));
+                            script("c.json", R"([{"segment": 70}, {"save_phi": ")" + p3 + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_TRUE(same_bits(read_image(p2), read_image(p3)));
-    EXPECT_EQ(viewer::read_workspace(w).marks.iterations, 20);
+    EXPECT_EQ(viewer::read_workspace(w).marks.iterations, 45);
 }
 
 // A φ loaded alone: µ, ε from the tissue model's window of the class most of its inside falls in,

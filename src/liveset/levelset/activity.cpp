@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 namespace liveset {
 
@@ -16,6 +17,32 @@ void FrontActivity::reset() {
     blocks_x_ = blocks_y_ = blocks_z_ = 0;
     all_woken_at_ = 0;
     speed_serial_ = 0;
+    adopt_next_speed_ = false;
+}
+
+ActivitySnapshot FrontActivity::snapshot(std::uint64_t speed_serial) const {
+    ActivitySnapshot s;
+    if (stamp_.empty()) return s;
+    s.all_woken_at = all_woken_at_;
+    s.speed_current = adopt_next_speed_ || (speed_serial != 0 && speed_serial == speed_serial_);
+    s.blocks = {static_cast<int>(blocks_x_), static_cast<int>(blocks_y_), static_cast<int>(blocks_z_)};
+    s.stamps = stamp_;
+    return s;
+}
+
+void FrontActivity::restore(const ActivitySnapshot& s, const Lattice& lattice) {
+    reset();
+    if (s.blocks == Vec3i{0, 0, 0}) return;
+    const Vec3i d = lattice.dims();
+    const Vec3i want{(d.x + 1) / 2, (d.y + 1) / 2, (d.z + 1) / 2};
+    if (!(s.blocks == want) || s.stamps.size() != static_cast<std::size_t>(want.x) * want.y * want.z)
+        throw std::invalid_argument("activity snapshot of another lattice");
+    blocks_x_ = static_cast<std::size_t>(want.x);
+    blocks_y_ = static_cast<std::size_t>(want.y);
+    blocks_z_ = static_cast<std::size_t>(want.z);
+    stamp_ = s.stamps;
+    all_woken_at_ = s.all_woken_at;
+    adopt_next_speed_ = s.speed_current;
 }
 
 void FrontActivity::begin_step(const Lattice& lattice, std::uint64_t speed_serial, std::int64_t now) {
@@ -28,6 +55,10 @@ void FrontActivity::begin_step(const Lattice& lattice, std::uint64_t speed_seria
         speed_serial_ = speed_serial;
         all_woken_at_ = now - 1;  // this step is the first of the window
         return;
+    }
+    if (adopt_next_speed_) {  // restored: this speed is the one the stamps were taken under
+        adopt_next_speed_ = false;
+        speed_serial_ = speed_serial;
     }
     if (speed_serial != speed_serial_) {
         speed_serial_ = speed_serial;

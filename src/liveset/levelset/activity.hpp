@@ -15,6 +15,16 @@
 
 namespace liveset {
 
+// What a FrontActivity remembers, saved with a field (a workspace) so that a continued run sleeps
+// and wakes exactly as the uninterrupted one would.
+struct ActivitySnapshot {
+    std::int64_t clock = 0;         // the field's global step count (the stamps' clock)
+    std::int64_t all_woken_at = 0;
+    bool speed_current = false;     // the stamps were taken under the speed the next step uses
+    Vec3i blocks{};                 // 0 x 0 x 0: the rule never ran (nothing to restore)
+    std::vector<std::int64_t> stamps;
+};
+
 class FrontActivity {
 public:
     // Forgets everything (nothing allocated; the next begin_step wakes everything).
@@ -33,7 +43,15 @@ public:
         return now - last <= sleep_after;
     }
 
+    // `speed_serial`: the serial of the speed the next step will use (0: none built yet).
+    ActivitySnapshot snapshot(std::uint64_t speed_serial) const;
+    // Takes a snapshot of the same lattice back; with speed_current, the next step's speed counts as
+    // the one the stamps were taken under (whatever its serial). Throws std::invalid_argument when
+    // the blocks do not fit the lattice.
+    void restore(const ActivitySnapshot& snapshot, const Lattice& lattice);
+
 private:
+    bool adopt_next_speed_ = false;
     std::size_t blocks_x_ = 0, blocks_y_ = 0, blocks_z_ = 0;
     std::vector<std::int64_t> stamp_;  // per block: the last step that woke it
     std::int64_t all_woken_at_ = 0;

@@ -504,4 +504,15 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
     return changed;
 }
 
+ActivitySnapshot SparseField::activity_snapshot(std::uint64_t next_speed_serial) const {
+    ActivitySnapshot s = activity_.snapshot(next_speed_serial);
+    s.clock = steps_;
+    return s;
+}
+
+void SparseField::restore_activity(const ActivitySnapshot& snapshot) {
+    activity_.restore(snapshot, lattice());
+    steps_ = snapshot.clock;
+}
+
 }  // namespace liveset

@@ -111,6 +111,13 @@ public:
     std::size_t band_size() const;
     bool in_band(PointIndex i) const { return status_[i] >= -layers_ && status_[i] <= layers_; }
 
+    // The sleeping rule's memory (the step clock and the wake stamps; activity.hpp), to save with
+    // φ and the statuses so that a continued run takes exactly the steps the uninterrupted one
+    // would. `next_speed_serial`: the serial of the speed the next step will use (0: not built).
+    ActivitySnapshot activity_snapshot(std::uint64_t next_speed_serial) const;
+    // After φ and the statuses were restored. Throws std::invalid_argument for another lattice.
+    void restore_activity(const ActivitySnapshot& snapshot);
+
     // --- updates ----------------------------------------------------------------------------
     // One global step of ∂φ/∂t = |∇φ| F with a CFL time step (|Δφ| ≤ cfl and the parabolic bound
     // dt ≤ 1/(6·curvature weight)), multithreaded over the zero layer. Both modes give the same φ,

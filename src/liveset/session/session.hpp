@@ -129,6 +129,10 @@ public:
     // --- swarm repair -----------------------------------------------------------------------
     const RepairOptions& repair_options() const { return repair_options_; }
     const SessionOptions& options() const { return options_; }
+    // The sleeping step's memory, saved with φ and the statuses (a workspace) so that a continued
+    // session steps bit for bit as the uninterrupted one; restore it after load_recovered().
+    ActivitySnapshot activity_snapshot() const { return field_.activity_snapshot(speed_ ? speed_->serial() : 0); }
+    void restore_activity(const ActivitySnapshot& snapshot) { field_.restore_activity(snapshot); }
     // New swarm settings (agents, p, radius, ...): the swarm is re-created and, when it had a
     // target, respawned there. Throws std::invalid_argument on invalid options.
     void set_repair_options(const RepairOptions& options);
