@@ -59,7 +59,9 @@ json swarm_json(const RepairOptions& r) {
             {"expand_sigmas", s.expand_sigmas}, {"contract_sigmas", s.contract_sigmas}, {"min_sigma", s.min_sigma},
             {"stats_smoothing", s.stats_smoothing}, {"sample_depth", s.sample_depth}, {"edit_range", s.edit_range},
             {"decision", static_cast<int>(s.decision)}, {"sheet_lower", s.sheet_lower}, {"sheet_upper", s.sheet_upper},
-            {"spawn_radius", r.spawn_radius}, {"respawn_distance", r.respawn_distance}, {"topology_guard", r.topology_guard}};
+            {"sheet_between", s.sheet_between}, {"sheet_reach", s.sheet_reach},
+            {"spawn_radius", r.spawn_radius}, {"respawn_distance", r.respawn_distance}, {"topology_guard", r.topology_guard},
+            {"close_cracks", r.close_cracks}};
 }
 
 RepairOptions swarm_from(const json& j, RepairOptions r) {
@@ -86,9 +88,12 @@ RepairOptions swarm_from(const json& j, RepairOptions r) {
     s.decision = static_cast<EditDecision>(decision);
     s.sheet_lower = number(j, "sheet_lower");
     s.sheet_upper = number(j, "sheet_upper");
+    s.sheet_between = field(j, "sheet_between").get<bool>();
+    s.sheet_reach = number(j, "sheet_reach");
     r.spawn_radius = number(j, "spawn_radius");
     r.respawn_distance = number(j, "respawn_distance");
     r.topology_guard = field(j, "topology_guard").get<bool>();
+    r.close_cracks = field(j, "close_cracks").get<bool>();
     return r;
 }
 

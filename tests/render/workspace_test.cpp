@@ -79,6 +79,9 @@ std::unique_ptr<Session> worked_session() {
     r.swarm.agents = 77;
     r.swarm.act_probability = 0.3;
     r.swarm.edit_range = 6.5;
+    r.swarm.sheet_between = false;  // the issue-18 settings, off their defaults
+    r.swarm.sheet_reach = 5.0;
+    r.close_cracks = false;
     s->set_repair_options(r);
     const Vec3d t = s->lattice().coord(s->field().zero_layer().front()).cast<double>();
     s->set_target(t);
@@ -134,6 +137,9 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     EXPECT_EQ(ws.repair.swarm.agents, 77u);
     EXPECT_EQ(ws.repair.swarm.act_probability, 0.3);
     EXPECT_EQ(ws.repair.swarm.edit_range, 6.5);
+    EXPECT_FALSE(ws.repair.swarm.sheet_between);
+    EXPECT_EQ(ws.repair.swarm.sheet_reach, 5.0);
+    EXPECT_FALSE(ws.repair.close_cracks);
     EXPECT_EQ(ws.repair.swarm.decision, original->repair_options().swarm.decision);
     ASSERT_TRUE(ws.target.has_value());
     EXPECT_EQ(*ws.target, *original->target());
