@@ -255,6 +255,7 @@ private:
     void draw_save_section();
     void draw_view_section();
     bool panel_button(const char* label, const char* name);
+    static void help_marker(const char* text);  // a grey "(?)" with `text` as its tooltip
     void draw_pane_labels();
     void draw_recovery_offer();
     // viewer_workspace.cpp

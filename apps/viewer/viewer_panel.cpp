@@ -13,15 +13,11 @@
 
 namespace liveset::viewer {
 
-namespace {
-
-void help_marker(const char* text) {
+void Viewer::help_marker(const char* text) {
     ImGui::SameLine();
     ImGui::TextDisabled("(?)");
     if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
 }
-
-}  // namespace
 
 bool Viewer::panel_button(const char* label, const char* name) {
     const bool pressed = ImGui::Button(label);

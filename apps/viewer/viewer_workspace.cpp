@@ -17,16 +17,6 @@ namespace liveset::viewer {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-void help_marker_text(const char* text) {
-    ImGui::SameLine();
-    ImGui::TextDisabled("(?)");
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s", text);
-}
-
-}  // namespace
-
 bool Viewer::save_seeds(const std::string& path) {
     if (!session_) return fail("open an image first");
     try {
@@ -110,7 +100,7 @@ void Viewer::draw_files_section() {
     ImGui::InputText("##workspace", &workspace_path_);
     ImGui::SameLine();
     if (panel_button("Save workspace", "save_workspace")) save_workspace(workspace_path_);
-    help_marker_text("Ctrl+S saves the workspace; `liveset view --workspace FILE` continues it. Seeds: one I,J,K:R per line, "
+    help_marker("Ctrl+S saves the workspace; `liveset view --workspace FILE` continues it. Seeds: one I,J,K:R per line, "
                      "as `liveset segment --seed` (0-based voxels)");
 }
 

@@ -34,6 +34,14 @@ void locate_nearest(const Lattice& lat, const std::vector<std::uint32_t>& label,
     });
 }
 
+// The 6-connected components of the truth the mask missed (labels 1..count, 0 elsewhere).
+std::vector<std::uint32_t> label_missed(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, std::size_t& count) {
+    Grid<std::uint8_t> missed(mask.lattice(), 0);
+    for (PointIndex i = 0; i < missed.size(); ++i) missed[i] = truth[i] && !mask[i];
+    count = 0;
+    return label_components(missed, 6, &count);
+}
+
 }  // namespace
 
 std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth,
@@ -41,10 +49,8 @@ std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const
     if (!(mask.dims() == truth.dims()) || !(mask.dims() == inner.dims()))
         throw std::invalid_argument("find_perforations: mask, truth and inner differ in size");
     const Lattice& lat = mask.lattice();
-    Grid<std::uint8_t> missed(lat, 0);
-    for (PointIndex i = 0; i < lat.size(); ++i) missed[i] = truth[i] && !mask[i];
     std::size_t count = 0;
-    const std::vector<std::uint32_t> label = label_components(missed, 6, &count);
+    const std::vector<std::uint32_t> label = label_missed(mask, truth, count);
     std::vector<std::size_t> size(count + 1, 0);
     std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
     std::vector<std::uint8_t> touches_inner(count + 1, 0), touches_outer(count + 1, 0);
@@ -112,10 +118,8 @@ std::vector<Perforation> find_cavities(const Grid<std::uint8_t>& mask, const Gri
 std::vector<Perforation> find_missed_tunnels(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth) {
     if (!(mask.dims() == truth.dims())) throw std::invalid_argument("find_missed_tunnels: mask and truth differ in size");
     const Lattice& lat = mask.lattice();
-    Grid<std::uint8_t> missed(lat, 0);
-    for (PointIndex i = 0; i < lat.size(); ++i) missed[i] = truth[i] && !mask[i];
     std::size_t count = 0;
-    const std::vector<std::uint32_t> label = label_components(missed, 6, &count);
+    const std::vector<std::uint32_t> label = label_missed(mask, truth, count);
     std::vector<std::size_t> size(count + 1, 0);
     std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
     std::vector<Vec3i> lo(count + 1, lat.dims()), hi(count + 1, Vec3i{-1, -1, -1});
