@@ -25,6 +25,7 @@ namespace liveset::cli {
 namespace {
 
 constexpr double kLowThreshold = 0.8;   // ε of the demo's segmentation: 80 % of the model window's
+constexpr double kLowThresholdMinSigmas = 2.4;  // ... but at least 2.4 σ of the GM class (cmd_demo_brain.cpp)
 constexpr std::size_t kMinHole = 50;    // the finder's smallest target, voxels
 constexpr std::size_t kMaxTargets = 10;  // the largest holes the user clicks, one round each
 constexpr int kRoundSteps = 1000;        // swarm steps per target
@@ -128,9 +129,10 @@ nlohmann::json repair_brain_holes(const BrainRepairInput& in, Session& session, 
             {"steps", steps}, {"points_modified", modified}, {"voxels_added", added},
             {"ms_per_step", steps ? ms / static_cast<double>(steps) : 0.0}, {"round_steps", kRoundSteps},
             {"finder", {{"band", {in.band_lower, in.band_upper}}, {"min_voxels", kMinHole}, {"before", count_large(found)}, {"after", found_after}}},
-            {"low_threshold", kLowThreshold}};
+            {"low_threshold", kLowThreshold}, {"low_threshold_min_sigmas", kLowThresholdMinSigmas}};
 }
 
 double brain_repair_epsilon_scale() { return kLowThreshold; }
+double brain_repair_min_sigmas() { return kLowThresholdMinSigmas; }
 
 }  // namespace liveset::cli

@@ -34,5 +34,7 @@ struct BrainRepairInput {
 nlohmann::json repair_brain_holes(const BrainRepairInput& in, Session& session, bool quiet);
 // The demo's sub-optimally low threshold: ε = this × the tissue model window's half width.
 double brain_repair_epsilon_scale();
+// ... but not below this many σ of the grey-matter class (98.4 % of its Gaussian inside the window).
+double brain_repair_min_sigmas();
 
 }  // namespace liveset::cli

@@ -28,6 +28,9 @@ struct BiasCorrectionOptions {
     double wiener_noise = 0.01;  // Wiener deconvolution noise of N4's histogram sharpening
     double fwhm = 0.15;          // FWHM of the Gaussian bias-field blur of the log-intensity histogram
     int histogram_bins = 200;
+    // Each sample N4 fits is the median of the fit voxels in its 3×3×3 neighbourhood, not the bare
+    // voxel: robust to noise (a noisy scan without bias otherwise gets a strong false field).
+    bool denoise = true;
 
     // Throws std::invalid_argument (one line) on a non-finite or out-of-range value.
     void validate() const;
