@@ -373,6 +373,34 @@ void parse_display_entry(const json& e, ScriptAction& a, const EntryError& err, 
     a.display = v;
 }
 
+// {"find_holes": {...}} / {"select_hole": rank}: the hole finder and a candidate of its list.
+void parse_holes_entry(const json& e, ScriptAction& a, const EntryError& err, const Lattice&) {
+    const json& v = e[a.name];
+    only_keys(e, {a.name}, err);
+    if (a.name == "select_hole") {
+        a.kind = ScriptAction::Kind::kSelectHole;
+        a.count = whole(v, err, "the rank", 1, 1'000'000'000);
+        return;
+    }
+    a.kind = ScriptAction::Kind::kFindHoles;
+    if (!v.is_object()) err.fail("expected an object such as {\"min_voxels\": 10}");
+    only_keys(v, {"min_voxels", "min_sheet_share", "sheet_band"}, err);
+    HoleScanOptions& o = a.hole_scan;
+    if (v.contains("min_voxels")) o.min_voxels = static_cast<std::size_t>(whole(v["min_voxels"], err, "min_voxels", 1, 2'000'000'000));
+    if (v.contains("min_sheet_share")) o.min_sheet_share = number(v["min_sheet_share"], err, "min_sheet_share");
+    if (v.contains("sheet_band")) {
+        const json& b = v["sheet_band"];
+        if (!b.is_array() || b.size() != 2) err.fail("sheet_band must be [low, high] (raw intensities)");
+        o.sheet_lower = number(b[0], err, "sheet_band");
+        o.sheet_upper = number(b[1], err, "sheet_band");
+    }
+    try {
+        o.validate();
+    } catch (const std::invalid_argument& ex) {
+        err.fail(ex.what());
+    }
+}
+
 using EntryParser = void (*)(const json&, ScriptAction&, const EntryError&, const Lattice&);
 
 // Every action a script entry can name, with its parser.
@@ -403,6 +431,8 @@ const std::map<std::string, EntryParser>& entry_parsers() {
         {"clear_target", parse_clear_target_entry},
         {"perforations", parse_perforations_entry},
         {"display", parse_display_entry},
+        {"find_holes", parse_holes_entry},
+        {"select_hole", parse_holes_entry},
     };
     return parsers;
 }

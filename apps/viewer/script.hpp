@@ -27,6 +27,12 @@
 //        prints the tunnels through the segmented shell where the truth is intact (largest first,
 //        find_perforations) and, with "target": r, aims the swarm at the r-th largest - what a
 //        user sees and clicks; as the demo does
+//   {"find_holes": {"min_voxels": 10, "min_sheet_share": 0.1, "sheet_band": [low, high]}}  (or {})
+//        the truth-free hole finder on the current segmentation (as the panel's Find holes; the
+//        band from the tissue model unless given): prints {"entry": k, "holes": {count, ms, band,
+//        sites [{rank, voxels, target (0-based, as --target), voxel1 (1-based)}], verdicts on the
+//        sites the swarm repaired since the previous find [{target, before, after, closed}]}}
+//   {"select_hole": rank}   the rank-th candidate (1-based): cursor there, the swarm's target
 #pragma once
 
 #include <optional>
@@ -45,7 +51,7 @@ struct ScriptAction {
     enum class Kind {
         kSeed, kRemoveSeed, kParams, kSegment, kClick, kTarget, kTargetSurfaceNear, kSwarm, kCamera, kCursor, kLayout,
         kTool, kUndo, kRedo, kSaveMask, kSavePhi, kSaveMesh, kScreenshot, kEval, kPerforations, kClearTarget, kDisplay,
-        kSaveWorkspace, kSaveSeeds, kLoadSeeds
+        kSaveWorkspace, kSaveSeeds, kLoadSeeds, kFindHoles, kSelectHole
     };
     Kind kind = Kind::kSeed;
     std::size_t entry = 0;  // 1-based position in the script
@@ -74,6 +80,7 @@ struct ScriptAction {
     std::optional<int> rank;       // perforations: target the rank-th largest
     bool overlays = true;          // screenshot: bounding box and crosshair
     nlohmann::json display;        // display: the validated object
+    HoleScanOptions hole_scan;     // find_holes
 };
 
 struct Script {

@@ -185,6 +185,16 @@ void ScriptPlayer::advance(Viewer& viewer) {
         case K::kPerforations: report_perforations(viewer, a); break;
         case K::kEval: report_eval(viewer, a); break;
         case K::kDisplay: check(viewer, a, apply_display(viewer, a)); break;
+        case K::kFindHoles: {  // runs on the finder's thread: wait for it a little at a time
+            if (steps_done_++ == 0) check(viewer, a, viewer.find_holes(a.hole_scan));
+            viewer.poll_holes(true);
+            if (viewer.holes_busy()) return;
+            if (!viewer.hole_tool().error().empty()) fail(a, viewer.hole_tool().error());
+            fmt::print("{}\n", nlohmann::json{{"entry", a.entry}, {"holes", hole_report(viewer.hole_tool())}}.dump());
+            std::fflush(stdout);
+            break;
+        }
+        case K::kSelectHole: check(viewer, a, viewer.select_hole(static_cast<std::size_t>(a.count))); break;
     }
     finish_entry(viewer);
 }

@@ -98,6 +98,7 @@ void Viewer::show_session() {
     ui_auto_window_ = session_->window_from_seeds();
     ui_repair_ = session_->repair_options();
     seen_revision_ = session_->revision();
+    holes_.reset();
     mark_all_panes();
 }
 
@@ -171,7 +172,7 @@ void Viewer::set_window_size(int width, int height) {
 }
 
 bool Viewer::needs_frame() const {
-    return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active || view3d_coarse_ || stale_ ||
+    return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active || view3d_coarse_ || stale_ || holes_busy() ||
            (session_ && session_->revision() != seen_revision_);
 }
 
@@ -190,6 +191,7 @@ void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     log_.set_frame(frames_);
     process_events();  // current_ already holds what scripts or the bench did since the last frame
     advance();
+    poll_holes(true);
     autosave_->tick();
     report_autosave();
     upload();
@@ -258,6 +260,7 @@ void Viewer::swarm_step() {
         fail("set a target first: click the surface with the target tool");
         return;
     }
+    holes_.aimed_at(*session_->target());  // the next hole scan judges this site
     account(session_->swarm_step());
     ++current_.swarm_steps;
 }
@@ -276,6 +279,7 @@ render::SceneContent Viewer::scene_content() {
         c.target = glm::vec3(static_cast<float>(t.x), static_cast<float>(t.y), static_cast<float>(t.z));
     }
     c.cursor = glm::vec3(static_cast<float>(cursor_.x), static_cast<float>(cursor_.y), static_cast<float>(cursor_.z));
+    add_hole_markers(c);
     return c;
 }
 

@@ -22,6 +22,7 @@
 #include "event_log.hpp"
 #include "slice_panes.hpp"
 #include "frame_budget.hpp"
+#include "hole_tool.hpp"
 #include "liveset/mesh/lod_mesher.hpp"
 #include "liveset/render/framebuffer.hpp"
 #include "liveset/render/orbit_camera.hpp"
@@ -191,6 +192,18 @@ public:
     // Moves the cursor to the voxel given as 1-based voxel numbers or millimetres (LPS, RAS).
     bool set_cursor_from(Vec3d value, render::CursorUnits units);
 
+    // --- hole finder (viewer_holes.cpp; issue 18) --------------------------------------------
+    // Starts the truth-free finder on the current segmentation (on a worker thread).
+    bool find_holes(const HoleScanOptions& options);
+    bool holes_busy() const { return holes_.running(); }
+    // Takes a finished scan (waiting a little with `wait`): the list, the markers, the verdicts.
+    void poll_holes(bool wait);
+    const HoleTool& hole_tool() const { return holes_; }
+    // Candidate `rank` (1-based, largest first): the cursor moves to its site and the swarm is
+    // aimed there (as a clicked target). step_hole: the next / previous one (keys N, P).
+    bool select_hole(std::size_t rank);
+    void step_hole(int delta);
+
     // Renders the 3D pane now if it is out of date (picking reads its depth buffer).
     void ensure_3d_rendered();
 
@@ -258,6 +271,11 @@ private:
     static void help_marker(const char* text);  // a grey "(?)" with `text` as its tooltip
     void draw_pane_labels();
     void draw_recovery_offer();
+    // viewer_holes.cpp
+    void draw_holes_section();
+    void draw_hole_list();
+    std::vector<render::SliceMarker> hole_markers(const render::SliceGeometry& g, int slice) const;
+    void add_hole_markers(render::SceneContent& c);
     // viewer_workspace.cpp
     void draw_files_section();  // seeds and workspace: save / load
     void draw_quit_prompt();
@@ -331,6 +349,10 @@ private:
     bool ui_auto_window_ = true;
     RepairOptions ui_repair_;
     SliceDisplay slices_;
+    HoleTool holes_;                       // the hole finder's scan, list and selection
+    HoleScanOptions ui_holes_;             // the panel's finder settings
+    std::vector<glm::vec3> hole_points_;   // the 3D pane's markers, refreshed per draw
+    bool hole_rows_logged_ = false;        // the list's rows were logged for a driving test
 };
 
 }  // namespace liveset::viewer

@@ -239,6 +239,9 @@ void Viewer::handle_key(const InputEvent& e) {
         const Tool t = e.key == GLFW_KEY_1 ? Tool::kCrosshair : (e.key == GLFW_KEY_2 ? Tool::kSeed : Tool::kTarget);
         set_tool(t);
         key_log(tool_name(t));
+    } else if (e.key == GLFW_KEY_N || e.key == GLFW_KEY_P) {
+        key_log(e.key == GLFW_KEY_N ? "next hole" : "previous hole");
+        step_hole(e.key == GLFW_KEY_N ? 1 : -1);
     } else if (e.key == GLFW_KEY_PAGE_UP || e.key == GLFW_KEY_UP) {
         slice_step(1);
     } else if (e.key == GLFW_KEY_PAGE_DOWN || e.key == GLFW_KEY_DOWN) {

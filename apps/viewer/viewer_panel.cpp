@@ -39,6 +39,7 @@ void Viewer::draw_panel() {
     if (ImGui::CollapsingHeader("View", ImGuiTreeNodeFlags_DefaultOpen)) draw_view_section();
     if (session_ && ImGui::CollapsingHeader("Segmentation", ImGuiTreeNodeFlags_DefaultOpen)) draw_segmentation_section();
     if (session_ && ImGui::CollapsingHeader("Repair (agent swarm)", ImGuiTreeNodeFlags_DefaultOpen)) draw_repair_section();
+    if (session_ && ImGui::CollapsingHeader("Holes (no ground truth)", ImGuiTreeNodeFlags_DefaultOpen)) draw_holes_section();
     if (session_ && ImGui::CollapsingHeader("Slice display", ImGuiTreeNodeFlags_DefaultOpen)) draw_display_section();
     if (ImGui::CollapsingHeader("Status", ImGuiTreeNodeFlags_DefaultOpen)) draw_status_section();
     if (session_ && ImGui::CollapsingHeader("History (Ctrl+Z, Ctrl+Y)")) draw_history_section();

@@ -62,6 +62,7 @@ void Viewer::render_slice_pane(Pane pane, render::Framebuffer& fb, const Rect& r
         if (d <= s.radius) overlay.seeds.push_back({g.to_uv(s.center), std::sqrt(s.radius * s.radius - d * d) * texel_mm});
     }
     if (const auto& t = session_->target(); t && std::abs((*t)[g.normal_axis] - slice) <= 2.0) overlay.target = g.to_uv(*t);
+    overlay.markers = hole_markers(g, slice);
     slice_renderers_[i]->render(fb, vp, overlay, render::SliceStyle{});
 }
 

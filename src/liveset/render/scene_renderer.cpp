@@ -128,6 +128,18 @@ void SceneRenderer::draw_sprites(std::span<const glm::vec3> points, float radius
     glBindVertexArray(0);
 }
 
+void SceneRenderer::draw_see_through(std::span<const glm::vec3> points, float radius_mm, const glm::vec3& colour, const glm::mat4& model,
+                                     const glm::mat4& view, const glm::mat4& projection, int height) {
+    if (points.empty()) return;
+    draw_sprites(points, radius_mm, colour, 1.0f, model, view, projection, height);
+    glDisable(GL_DEPTH_TEST);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
+    draw_sprites(points, radius_mm, colour, 0.45f, model, view, projection, height);
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+}
+
 void SceneRenderer::draw_lines(std::span<const glm::vec3> world_points, const glm::vec4& colour, const glm::mat4& view_projection) {
     if (world_points.empty()) return;
     lines_.use();
@@ -192,16 +204,14 @@ void SceneRenderer::render(const Framebuffer& target, const OrbitCamera& camera,
         draw_lines(box, glm::vec4(0.45f, 0.47f, 0.52f, 1.0f), view_projection);
     }
 
+    draw_see_through(content.markers, style.marker_radius_mm, style.markers, model, view, projection, target.height());
+    if (content.selected_marker) {
+        const glm::vec3 m = *content.selected_marker;
+        draw_see_through({&m, 1}, style.marker_radius_mm * 1.4f, style.selected_marker, model, view, projection, target.height());
+    }
     if (content.target) {
         const glm::vec3 t = *content.target;
-        draw_sprites({&t, 1}, style.target_radius_mm, style.target, 1.0f, model, view, projection, target.height());
-        // Seen through the surface as well (translucent, on top).
-        glDisable(GL_DEPTH_TEST);
-        glEnable(GL_BLEND);
-        glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA);
-        draw_sprites({&t, 1}, style.target_radius_mm, style.target, 0.45f, model, view, projection, target.height());
-        glDisable(GL_BLEND);
-        glEnable(GL_DEPTH_TEST);
+        draw_see_through({&t, 1}, style.target_radius_mm, style.target, model, view, projection, target.height());
     }
 
     if (style.cursor && content.cursor) {

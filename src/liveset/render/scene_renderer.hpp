@@ -1,7 +1,8 @@
 // The 3D view: the surface from the per-fragment buffers with Phong lighting from the ∇φ vertex
 // normals (outside and inside faces in different colours, so holes show), the agents as small
 // shaded spheres (point sprites), the user's target as a marker that stays visible through the
-// surface, the crosshair cursor as three axis lines and the volume's bounding box.
+// surface, markers (hole candidates; the selected one highlighted) drawn the same way, the
+// crosshair cursor as three axis lines and the volume's bounding box.
 #pragma once
 
 #include <glm/glm.hpp>
@@ -24,6 +25,9 @@ struct SceneStyle {
     glm::vec3 target{1.00f, 0.85f, 0.10f};
     float agent_radius_mm = 0.6f;
     float target_radius_mm = 2.5f;
+    glm::vec3 markers{1.0f, 0.5f, 0.0f};
+    glm::vec3 selected_marker{1.0f, 0.25f, 1.0f};
+    float marker_radius_mm = 2.0f;
     bool bounding_box = true;
     bool cursor = true;
 };
@@ -35,6 +39,8 @@ struct SceneContent {
     std::span<const glm::vec3> agents;         // index space
     std::optional<glm::vec3> target;           // index space
     std::optional<glm::vec3> cursor;           // index space
+    std::span<const glm::vec3> markers;        // index space
+    std::optional<glm::vec3> selected_marker;  // index space
 };
 
 class SceneRenderer {
@@ -50,6 +56,9 @@ public:
 private:
     void draw_sprites(std::span<const glm::vec3> points, float radius_mm, const glm::vec3& colour, float alpha,
                       const glm::mat4& model, const glm::mat4& view, const glm::mat4& projection, int height);
+    // Points seen through the surface as well: opaque where visible, translucent on top.
+    void draw_see_through(std::span<const glm::vec3> points, float radius_mm, const glm::vec3& colour, const glm::mat4& model,
+                          const glm::mat4& view, const glm::mat4& projection, int height);
     void draw_lines(std::span<const glm::vec3> world_points, const glm::vec4& colour, const glm::mat4& view_projection);
 
     ShaderProgram surface_, sprites_, lines_;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "liveset/render/marker_glyphs.hpp"
+
 namespace liveset::render {
 
 namespace {
@@ -169,7 +171,30 @@ void SliceRenderer::render(const Framebuffer& target, const SliceViewport& vp, c
         const std::vector<glm::vec2> cross{{c.x - 7, c.y}, {c.x + 7, c.y}, {c.x, c.y - 7}, {c.x, c.y + 7}};
         draw_lines(cross, style.target, projection);
     }
+    draw_markers(vp, overlay.markers, style, projection);
     glDisable(GL_BLEND);
+}
+
+// Rings with their numbers (bold: drawn twice, a pixel apart); the selected one last, on top.
+void SliceRenderer::draw_markers(const SliceViewport& vp, std::span<const SliceMarker> markers, const SliceStyle& style,
+                                 const glm::mat4& projection) {
+    for (int pass = 0; pass < 2; ++pass)
+        for (const SliceMarker& m : markers) {
+            if (m.selected != (pass == 1)) continue;
+            const glm::vec2 c(vp.to_pixel(m.centre_uv));
+            glm::vec4 colour = m.selected ? style.marker_selected : style.marker;
+            if (!m.on_slice) colour.a *= 0.55f;
+            std::vector<glm::vec2> px = ring_lines(c, kMarkerRadiusPx, 24, !m.on_slice);
+            if (m.selected) {
+                const std::vector<glm::vec2> outer = ring_lines(c, kMarkerRadiusPx + 3.0f, 24, !m.on_slice);
+                px.insert(px.end(), outer.begin(), outer.end());
+            }
+            const float h = 9.0f;
+            const std::vector<glm::vec2> digits = number_lines(m.label, c + glm::vec2(kMarkerRadiusPx + 2.0f, -kMarkerRadiusPx - h + 2.0f), h);
+            for (const glm::vec2& d : digits) px.push_back(d);
+            for (const glm::vec2& d : digits) px.push_back(d + glm::vec2(1.0f, 0.0f));
+            draw_lines(px, colour, projection);
+        }
 }
 
 }  // namespace liveset::render
