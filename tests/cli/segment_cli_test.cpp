@@ -391,7 +391,8 @@ TEST(SegmentCli, RepairRunsTheSwarmAndLogsEveryStep) {
         // average at least 85 %.
         EXPECT_GE(s["agents_on_surface"].get<int>(), 55) << line;
         on_surface_sum += s["agents_on_surface"].get<int>();
-        for (const char* key : {"points_modified", "fragments_rebuilt", "ms"}) EXPECT_TRUE(s.contains(key)) << key;
+        for (const char* key : {"points_modified", "fragments_rebuilt", "ms", "cpu_ms"}) EXPECT_TRUE(s.contains(key)) << key;
+        EXPECT_GE(s["cpu_ms"].get<double>(), 0.0) << line;
         ++n;
     }
     EXPECT_EQ(n, 120);

@@ -200,5 +200,36 @@ TEST(Repair, ACrackBetweenTwoFrontsClosesWithItsTunnel) {
     EXPECT_TRUE(edits.empty());
 }
 
+// The pocket limit against a counted cavity: a hollow cube (inside 11³ = 1 331 voxels) whose wall
+// has a one-voxel hole. Filling the hole seals the cavity off: refused exactly when the cavity
+// holds at most pocket_limit voxels (the flood from the hole's outer side reaches the border,
+// the one from its inner side counts the cavity). Run twice per limit: a batch leaves nothing
+// behind for the next one on the same thread.
+TEST(Repair, PocketLimitMatchesTheCountedCavity) {
+    const Lattice lat({24, 24, 24});
+    Grid<std::uint8_t> shell(lat, 0);
+    std::size_t cavity = 0;
+    for (int z = 5; z < 18; ++z)
+        for (int y = 5; y < 18; ++y)
+            for (int x = 5; x < 18; ++x) {
+                const bool wall = x == 5 || y == 5 || z == 5 || x == 17 || y == 17 || z == 17;
+                shell({x, y, z}) = wall && !(x == 5 && y == 11 && z == 11);
+                cavity += !wall;
+            }
+    ASSERT_EQ(cavity, 1331u);
+    const SparseField f = field_from_mask(shell);
+    const PointIndex hole = lat.index({5, 11, 11});
+    ASSERT_EQ(f.status()[hole], 0);
+    ASSERT_LT(f.phi()[hole] - 0.5f, 0.0f);
+    for (const std::size_t limit : {cavity - 1, cavity, cavity + 1, std::size_t{32768}}) {
+        for (int run = 0; run < 2; ++run) {
+            std::vector<ZeroLayerEdit> edits{{hole, -0.5f}};
+            GuardOptions o;
+            o.pocket_limit = limit;
+            EXPECT_EQ(guard_topology(f, edits, o), limit >= cavity ? 1u : 0u) << "limit " << limit;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace liveset

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <ctime>
 #include <stdexcept>
 
 namespace liveset {
@@ -99,9 +100,11 @@ std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& ima
     for (int step = 0; step < options.steps; ++step) {
         if (interrupt && interrupt->load(std::memory_order_relaxed)) break;
         const auto t0 = std::chrono::steady_clock::now();
+        const std::clock_t c0 = std::clock();
         while (next < order.size() && order[next].step <= step) loop.set_target(order[next++].position);
         RepairStepLog rec = loop.step().log;
         rec.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        rec.cpu_ms = 1000.0 * static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
         log.push_back(rec);
     }
     return log;

@@ -48,24 +48,31 @@ Vec3i face_neighbour(Vec3i c, int k) {
 }
 
 // Breadth-first flood of the outside (6-connected) from `start`: true when it ends within `limit`
-// voxels without reaching the lattice border. (A flat stamp array instead of a hash set: the flood
-// is the guard's worst case, ~30 k voxels when the outside is large.)
-template <class Inside>
-bool encloses_small_pocket(const Lattice& lat, Inside& inside, Vec3i start, std::size_t limit) {
-    thread_local FloodMarks marks;
-    marks.begin(lat.size());
+// voxels without reaching the lattice border (order-independent: the start's whole component is
+// small and away from the border). The marks are those of the caller's batch of floods: a start
+// an earlier flood of the batch reached lies in that flood's component, which was not small, so
+// it is false at once. Works on point indices: a point off the border has all six neighbours in
+// the lattice, so `outside_at` (index -> outside) needs no bounds test. (A flat stamp array
+// instead of a hash set: the flood is the guard's worst case, ~30 k voxels when the outside is large.)
+template <class OutsideAt>
+bool encloses_small_pocket(const Lattice& lat, FloodMarks& marks, const OutsideAt& outside_at, Vec3i start, std::size_t limit) {
+    const PointIndex s = lat.index(start);
+    if (!marks.visit(s)) return false;
     std::vector<Vec3i>& queue = marks.queue;
+    queue.clear();
     queue.push_back(start);
-    marks.visit(lat.index(start));
     const Vec3i dims = lat.dims();
+    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    const PointIndex step[6] = {PointIndex(0) - 1, 1, PointIndex(0) - sy, sy, PointIndex(0) - sz, sz};
     for (std::size_t head = 0; head < queue.size(); ++head) {
         if (queue.size() > limit) return false;
         const Vec3i p = queue[head];
         if (p.x == 0 || p.y == 0 || p.z == 0 || p.x == dims.x - 1 || p.y == dims.y - 1 || p.z == dims.z - 1) return false;
+        const PointIndex i = lat.index(p);
         for (int k = 0; k < 6; ++k) {
-            const Vec3i q = face_neighbour(p, k);
-            if (inside(q) || !marks.visit(lat.index(q))) continue;
-            queue.push_back(q);
+            const PointIndex j = i + step[k];  // unsigned wrap: i - 1 etc. (p is off the border)
+            if (!outside_at(j) || !marks.visit(j)) continue;
+            queue.push_back(face_neighbour(p, k));
         }
     }
     return true;
@@ -74,13 +81,20 @@ bool encloses_small_pocket(const Lattice& lat, Inside& inside, Vec3i start, std:
 // The guard's state over one batch: the flips accepted so far, read through inside().
 class Guard {
 public:
-    Guard(const SparseField& field, const GuardOptions& o) : field_(field), lat_(field.lattice()), o_(o) {}
-    bool inside(Vec3i q) const {
-        if (!lat_.contains(q)) return false;
-        const PointIndex i = lat_.index(q);
-        if (const auto it = flipped_.find(i); it != flipped_.end()) return it->second;
+    Guard(const SparseField& field, const GuardOptions& o) : field_(field), lat_(field.lattice()), o_(o) {
+        if (flip_filter_.size() != lat_.size()) flip_filter_.assign(lat_.size(), 0);
+    }
+    ~Guard() {
+        for (const PointIndex i : filtered_) flip_filter_[i] = 0;  // clear what this batch set
+    }
+    Guard(const Guard&) = delete;
+    Guard& operator=(const Guard&) = delete;
+    bool inside_at(PointIndex i) const {
+        if (flip_filter_[i] != 0)
+            if (const auto it = flipped_.find(i); it != flipped_.end()) return it->second;
         return field_.phi()[i] < 0.0f;
     }
+    bool inside(Vec3i q) const { return lat_.contains(q) && inside_at(lat_.index(q)); }
     bool keep(const ZeroLayerEdit& e);  // false: drop the edit
     const std::vector<PointIndex>& crack_points() const { return cracks_; }
 
@@ -93,18 +107,31 @@ private:
     const SparseField& field_;
     const Lattice& lat_;
     GuardOptions o_;
+    void flip(PointIndex i, bool in) {
+        flipped_[i] = in;
+        if (!flip_filter_[i]) filtered_.push_back(i);
+        flip_filter_[i] = 1;  // stays set until the batch ends: inside_at() then asks flipped_
+    }
     std::unordered_map<PointIndex, bool> flipped_;  // accepted flips of this batch: point -> inside
+    // A byte per lattice point, set where flipped_ may hold the point (per thread, reused across
+    // batches): most points the pocket flood asks about were never flipped, so no hash look-up.
+    static thread_local std::vector<std::uint8_t> flip_filter_;
+    std::vector<PointIndex> filtered_;  // the points this batch set in flip_filter_
     std::unordered_set<PointIndex> tried_;          // crack points already tried in this batch
     std::vector<PointIndex> cracks_;                // crack points filled (their edits become kCrackEdit)
 };
 
+thread_local std::vector<std::uint8_t> Guard::flip_filter_;
+
 // Whether some face neighbour's outside region of c (c counted inside) is a pocket of at most
-// pocket_limit voxels.
+// pocket_limit voxels. One batch of floods: a neighbour in a component already flooded is skipped.
 bool Guard::seals_pocket_around(Vec3i c) {
-    const auto in = [this](Vec3i q) { return inside(q); };
+    thread_local FloodMarks marks;
+    marks.begin(lat_.size());
+    const auto outside_at = [this](PointIndex i) { return !inside_at(i); };
     for (int k = 0; k < 6; ++k) {
         const Vec3i q = face_neighbour(c, k);
-        if (lat_.contains(q) && !inside(q) && encloses_small_pocket(lat_, in, q, o_.pocket_limit)) return true;
+        if (lat_.contains(q) && !inside(q) && encloses_small_pocket(lat_, marks, outside_at, q, o_.pocket_limit)) return true;
     }
     return false;
 }
@@ -120,12 +147,12 @@ bool Guard::keep(const ZeroLayerEdit& e) {
     // Growth that splits the local background either closes a tunnel (good) or seals a small
     // pocket off (a spurious cavity): refuse the latter.
     if (ok && is_in && t.background >= 2) {
-        flipped_[e.point] = true;
+        flip(e.point, true);
         ok = !seals_pocket_around(c);
         flipped_.erase(e.point);
     }
     if (!ok && is_in && t.foreground >= 2 && o_.close_cracks) return fill_crack(c);
-    if (ok) flipped_[e.point] = is_in;
+    if (ok) flip(e.point, is_in);
     return ok;
 }
 
@@ -185,7 +212,7 @@ bool Guard::fill_crack(Vec3i start) {
     hi = hi + Vec3i{1, 1, 1};
     const auto in = [this](Vec3i q) { return inside(q); };
     const long chi_before = euler_characteristic_26(in, lo, hi);
-    for (PointIndex i : crack) flipped_[i] = true;
+    for (PointIndex i : crack) flip(i, true);
     bool ok = euler_characteristic_26(in, lo, hi) > chi_before;
     for (std::size_t k = 0; k < crack.size() && ok; ++k) ok = !seals_pocket_around(lat_.coord(crack[k]));
     if (!ok) {
