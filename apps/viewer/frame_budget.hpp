@@ -25,6 +25,11 @@ struct FrameBudgetOptions {
     double still_ms = 300.0;    // no input for this long: the 3D pane is drawn at full quality
     double lod_above_ms = 50.0; // full 3D draws cheaper than this: no level of detail
     int lod_factor = 3;         // the coarse surface's subsampling (about 1 / factor² of the triangles)
+    // Running steps on a worker thread (SessionRunner): the render thread takes the changes (meshes,
+    // uploads, redraws as paced above) at most every `handover_ms` while nothing else asks for a
+    // frame. Off: the steps that fit in frame_ms are taken in each frame on the render thread.
+    bool background = true;
+    double handover_ms = 150.0;
     void validate() const;      // throws std::invalid_argument
 };
 
