@@ -16,8 +16,17 @@
 #include "liveset/render/headless_context.hpp"
 #include "viewer.hpp"
 
+#ifdef __SANITIZE_THREAD__
+#include <tbb/global_control.h>
+#endif
+
 namespace liveset::viewer {
 namespace {
+
+#ifdef __SANITIZE_THREAD__
+// Under ThreadSanitizer (build-tsan, not CI): no oneTBB worker threads (an uninstrumented scheduler).
+const tbb::global_control one_tbb_thread(tbb::global_control::max_allowed_parallelism, 1);
+#endif
 
 const Phantom& phantom() {
     static const Phantom ph = [] {

@@ -18,8 +18,18 @@
 #include "liveset/session/repair_presets.hpp"
 #include "liveset/session/session_runner.hpp"
 
+#ifdef __SANITIZE_THREAD__
+#include <tbb/global_control.h>
+#endif
+
 namespace liveset {
 namespace {
+
+#ifdef __SANITIZE_THREAD__
+// Under ThreadSanitizer (build-tsan, not CI): no oneTBB worker threads, whose uninstrumented
+// scheduler TSan cannot see; the runner's own threads and locks stay as they are.
+const tbb::global_control one_tbb_thread(tbb::global_control::max_allowed_parallelism, 1);
+#endif
 
 const Phantom& phantom48() {
     static const Phantom ph = [] {
