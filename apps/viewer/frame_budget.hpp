@@ -1,6 +1,8 @@
 // The viewer's frame budget: how many segmentation or swarm steps a frame takes, how often the
 // panes are redrawn while they run, and when the 3D pane may show its coarse level of detail.
 //
+// Background (the default): the steps run on a worker thread (viewer_background.cpp) and a frame
+// comes on input or every `handover_ms`; the step counts below apply with `background` off.
 // Steps: as many per frame as fit in `frame_ms` together with the upload of what they changed,
 // judged from running averages of the measured step and upload costs (at least one step per
 // frame, so work always advances). The budget decides only how many steps a frame takes, never
