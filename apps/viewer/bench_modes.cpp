@@ -70,6 +70,10 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
     const auto v0 = Clock::now();
     viewer.set_segment_running(true);
     while (viewer.segment_running()) {
+        if (!viewer.needs_frame()) {  // a background run: the render thread waits for its next hand-over
+            viewer.wait_for_frame(1000.0);
+            continue;
+        }
         const auto f0 = Clock::now();
         viewer.frame(window.id(), width, height, 1.0 / 60.0);
         frame_ms.push_back(ms_since(f0));

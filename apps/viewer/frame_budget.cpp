@@ -21,6 +21,7 @@ void FrameBudgetOptions::validate() const {
     if (!std::isfinite(still_ms) || still_ms < 0.0) throw std::invalid_argument("frame budget: still_ms must be >= 0");
     if (!std::isfinite(lod_above_ms) || lod_above_ms < 0.0) throw std::invalid_argument("frame budget: lod_above_ms must be >= 0");
     if (lod_factor < 2 || lod_factor > 8) throw std::invalid_argument("frame budget: lod_factor must be 2 to 8");
+    if (!finite_positive(handover_ms)) throw std::invalid_argument("frame budget: handover_ms must be positive");
 }
 
 FrameBudget::FrameBudget(const FrameBudgetOptions& options) : options_(options) { options_.validate(); }

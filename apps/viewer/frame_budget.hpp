@@ -1,6 +1,8 @@
 // The viewer's frame budget: how many segmentation or swarm steps a frame takes, how often the
 // panes are redrawn while they run, and when the 3D pane may show its coarse level of detail.
 //
+// Background (the default): the steps run on a worker thread (viewer_background.cpp) and a frame
+// comes on input or every `handover_ms`; the step counts below apply with `background` off.
 // Steps: as many per frame as fit in `frame_ms` together with the upload of what they changed,
 // judged from running averages of the measured step and upload costs (at least one step per
 // frame, so work always advances). The budget decides only how many steps a frame takes, never
@@ -25,6 +27,11 @@ struct FrameBudgetOptions {
     double still_ms = 300.0;    // no input for this long: the 3D pane is drawn at full quality
     double lod_above_ms = 50.0; // full 3D draws cheaper than this: no level of detail
     int lod_factor = 3;         // the coarse surface's subsampling (about 1 / factor² of the triangles)
+    // Running steps on a worker thread (SessionRunner): the render thread takes the changes (meshes,
+    // uploads, redraws as paced above) at most every `handover_ms` while nothing else asks for a
+    // frame. Off: the steps that fit in frame_ms are taken in each frame on the render thread.
+    bool background = true;
+    double handover_ms = 150.0;
     void validate() const;      // throws std::invalid_argument
 };
 

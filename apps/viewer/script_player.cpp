@@ -130,6 +130,7 @@ bool apply_display(Viewer& viewer, const ScriptAction& a) {
 void ScriptPlayer::advance(Viewer& viewer) {
     if (done()) return;
     const ScriptAction& a = script_.actions[next_];
+    viewer.halt_run();  // a script entry uses the session: no background run meanwhile
     Session* s = viewer.session();
     if (!s) fail(a, "no image is open");
     using K = ScriptAction::Kind;

@@ -51,6 +51,7 @@ Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const V
 }
 
 Viewer::~Viewer() {
+    halt_run();
     autosave_->at_exit();
     report_autosave();
 }
@@ -104,6 +105,7 @@ void Viewer::show_session() {
 
 void Viewer::request_quit(const std::string& reason) {
     if (quit_) return;
+    halt_run();
     quit_ = true;
     autosave_->at_exit();
     report_autosave();
@@ -172,6 +174,8 @@ void Viewer::set_window_size(int width, int height) {
 }
 
 bool Viewer::needs_frame() const {
+    if (background_active())  // no session reads
+        return !events_.empty() || redraw_frames_ > 0 || drag_.active || handover_due() || holes_busy();
     return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active || view3d_coarse_ || stale_ || holes_busy() ||
            (session_ && session_->revision() != seen_revision_);
 }
@@ -186,6 +190,7 @@ void Viewer::push_event(const InputEvent& event) {
 
 void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     const auto t0 = Clock::now();
+    begin_handover();  // a background run's worker waits between steps until end_handover()
     set_window_size(width, height);
     fit_3d_if_pending();
     log_.set_frame(frames_);
@@ -229,6 +234,7 @@ void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     (void)dt_seconds;
     ++frames_;
     if (redraw_frames_ > 0) --redraw_frames_;
+    end_handover();
 }
 
 void Viewer::account(const SessionUpdate& u) {
@@ -240,8 +246,13 @@ void Viewer::account(const SessionUpdate& u) {
 
 void Viewer::segment_step() {
     if (!session_) return;
+    halt_run();
     account(session_->segment_step());
     ++current_.segment_steps;
+    check_segment_end();
+}
+
+void Viewer::check_segment_end() {
     const SegmentStatus& st = session_->segment_status();
     if (st.converged || st.vanished) {
         const bool was_running = segment_running_;
@@ -255,6 +266,7 @@ void Viewer::segment_step() {
 
 void Viewer::swarm_step() {
     if (!session_) return;
+    halt_run();
     if (!session_->target()) {
         swarm_running_ = false;
         fail("set a target first: click the surface with the target tool");
@@ -345,6 +357,7 @@ bool Viewer::open_image(const std::string& path) {
     try {
         Grid<float> image = read_image(path);
         auto session = std::make_unique<Session>(std::move(image), config_.session);
+        halt_run();
         autosave_->at_exit();  // the previous image's unsaved work
         report_autosave();
         session_ = std::move(session);
@@ -362,6 +375,7 @@ bool Viewer::open_image(const std::string& path) {
 
 bool Viewer::add_seed(Vec3d index, double radius) {
     if (!session_) return fail("open an image first");
+    halt_run();
     try {
         account(session_->add_seed({index, radius}));
     } catch (const std::invalid_argument& e) {
@@ -375,6 +389,7 @@ bool Viewer::add_seed(Vec3d index, double radius) {
 
 bool Viewer::remove_seed_at(Vec3d index) {
     if (!session_) return fail("open an image first");
+    halt_run();
     const auto k = session_->seed_at(index, 1.0);
     if (!k) return fail("no seed there");
     account(session_->remove_seed(*k));
@@ -386,6 +401,7 @@ bool Viewer::remove_seed_at(Vec3d index) {
 
 void Viewer::set_segment_running(bool on) {
     if (!session_ || on == segment_running_) return;
+    halt_run();
     if (on && !session_->has_surface()) {
         fail("place a seed first (seed tool: click in a slice)");
         return;
@@ -400,6 +416,7 @@ void Viewer::set_segment_running(bool on) {
 
 void Viewer::set_swarm_running(bool on) {
     if (!session_ || on == swarm_running_) return;
+    halt_run();
     if (on && !session_->target()) {
         fail("set a target first: click the surface with the target tool");
         return;
@@ -414,6 +431,7 @@ void Viewer::set_swarm_running(bool on) {
 
 bool Viewer::set_target(Vec3d index) {
     if (!session_) return fail("open an image first");
+    halt_run();
     try {
         session_->set_target(index);
     } catch (const std::invalid_argument& e) {
@@ -428,6 +446,7 @@ bool Viewer::set_target(Vec3d index) {
 
 void Viewer::clear_target() {
     if (!session_) return;
+    halt_run();
     swarm_running_ = false;
     session_->clear_target();
     log_.add("clear_target");
@@ -435,6 +454,7 @@ void Viewer::clear_target() {
 
 std::optional<render::Pick> Viewer::click_3d(double x, double y, bool as_target) {
     if (!session_) return std::nullopt;
+    halt_run();
     ensure_3d_rendered();
     const auto p = render::pick(pane_buffers_[static_cast<int>(Pane::kView3d)], static_cast<int>(std::floor(x)),
                                 static_cast<int>(std::floor(y)), camera_, session_->lattice());
@@ -456,6 +476,7 @@ std::optional<render::Pick> Viewer::click_3d(double x, double y, bool as_target)
 
 void Viewer::undo(int times) {
     if (!session_) return;
+    halt_run();
     segment_running_ = swarm_running_ = false;
     for (int i = 0; i < times && session_->can_undo(); ++i) {
         const std::string label = session_->next_undo_label();
@@ -470,6 +491,7 @@ void Viewer::undo(int times) {
 
 void Viewer::redo(int times) {
     if (!session_) return;
+    halt_run();
     segment_running_ = swarm_running_ = false;
     for (int i = 0; i < times && session_->can_redo(); ++i) {
         const std::string label = session_->next_redo_label();
@@ -484,6 +506,7 @@ void Viewer::redo(int times) {
 
 bool Viewer::apply_params(const ThresholdParams& params, bool window_from_seeds) {
     if (!session_) return fail("open an image first");
+    halt_run();
     try {
         session_->set_params(params, window_from_seeds);
     } catch (const std::invalid_argument& e) {
@@ -497,6 +520,7 @@ bool Viewer::apply_params(const ThresholdParams& params, bool window_from_seeds)
 
 bool Viewer::apply_repair_options(const RepairOptions& options) {
     if (!session_) return fail("open an image first");
+    halt_run();
     try {
         session_->set_repair_options(options);
     } catch (const std::invalid_argument& e) {

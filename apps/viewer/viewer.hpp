@@ -31,6 +31,7 @@
 #include "liveset/render/slice_renderer.hpp"
 #include "liveset/render/surface_buffers.hpp"
 #include "liveset/session/session.hpp"
+#include "liveset/session/session_runner.hpp"
 #include "workspace.hpp"
 
 namespace liveset::viewer {
@@ -123,6 +124,20 @@ public:
     // else asks first (the dialog names the recovery file that keeps the work).
     void ask_quit(const std::string& reason);
     bool unsaved() const { return session_ && session_->revision() != saved_revision_; }
+
+    // --- background run (viewer_background.cpp) --------------------------------------------
+    // Running segmentation or swarm steps go to a worker thread (SessionRunner) unless the budget's
+    // `background` is off; frames then hold its hand-over, and only frames touch the session.
+    bool background_active() const { return runner_ && runner_->active(); }
+    // Stops and joins the worker so the caller may use the session; segment_running() /
+    // swarm_running() stay as they are (the next frame starts a worker again). Every action that
+    // changes or reads the session outside a frame calls it first.
+    void halt_run();
+    // For loops without a window: sleeps until a frame is due (the next hand-over or the end of
+    // the run), at most `max_ms`; returns at once without a background run.
+    void wait_for_frame(double max_ms);
+    // How long a window loop may sleep waiting for input (seconds).
+    double idle_wait_s() const;
 
     // --- state ----------------------------------------------------------------------------
     Session* session() { return session_.get(); }
@@ -247,6 +262,7 @@ private:
     void advance();         // the steps that fit in this frame's budget
     void reset_lod();       // the coarse level of detail from scratch
     void upload();          // U (fine and coarse), then the panes due a redraw
+    void upload_fine();     // the session's dirty fragments (meshed now if deferred), and the coarse ones they change
     void render_3d(const render::Framebuffer& fb);
     void render_dirty_panes();
     // viewer_input.cpp
@@ -276,6 +292,14 @@ private:
     void draw_hole_list();
     std::vector<render::SliceMarker> hole_markers(const render::SliceGeometry& g, int slice) const;
     void add_hole_markers(render::SceneContent& c);
+    // viewer_background.cpp
+    void run_in_background();  // advance(): starts, polls and ends the worker
+    void absorb_run(const RunState& state);  // the worker's steps into this frame's statistics
+    bool handover_due() const;  // time for the render thread to take the run's changes
+    void handover();            // upload() during a background run: the changes, when a redraw is due
+    void begin_handover();      // frame(): hold the hand-over for the frame
+    void end_handover();
+    void check_segment_end();   // converged or vanished: the run stops (message, action closed)
     // viewer_workspace.cpp
     void draw_files_section();  // seeds and workspace: save / load
     void draw_quit_prompt();
@@ -286,6 +310,9 @@ private:
 
     ViewerConfig config_;
     std::unique_ptr<Session> session_;
+    std::unique_ptr<SessionRunner> runner_;  // a background run of session_ (after it: destroyed first)
+    RunState run_seen_;                      // the worker's steps already accounted
+    double last_handover_ms_ = -1e9;         // now_ms() of the last hand-over of a background run
     std::string image_name_;
     std::string image_path_;
     EventLog log_;

@@ -17,6 +17,7 @@ double Viewer::now_ms() const { return ms_since(epoch_); }
 
 void Viewer::advance() {
     if (!session_) return;
+    if (budget_.options().background) return run_in_background();
     const auto t0 = Clock::now();
     for (int n = 0; busy() && budget_.another_step(n, ms_since(t0)); ++n) {
         const auto s0 = Clock::now();
@@ -37,21 +38,27 @@ void Viewer::reset_lod() {
     coarse_surface_.upload_all(lod_->mesher());
 }
 
+void Viewer::upload_fine() {
+    const auto m0 = Clock::now();
+    if (session_->flush_mesh() > 0.0) current_.mesh_ms += ms_since(m0);  // X a background run left unmeshed
+    const std::vector<FragmentId> ids = session_->take_dirty_fragments();
+    if (ids.empty()) return;
+    const auto t0 = Clock::now();
+    const render::UploadStats st = surface_.upload(session_->mesher(), ids);
+    current_.uploaded += st.fragments;
+    if (lod_) {  // the coarse level of detail follows the fine fragments
+        const std::vector<FragmentId> coarse = lod_->update(session_->field().phi(), session_->mesher(), ids);
+        if (!coarse.empty()) coarse_surface_.upload(lod_->mesher(), coarse);
+    }
+    const double ms = ms_since(t0);
+    current_.upload_ms += ms;
+    budget_.record_upload(ms);
+}
+
 void Viewer::upload() {
     if (!session_) return;
-    const std::vector<FragmentId> ids = session_->take_dirty_fragments();
-    if (!ids.empty()) {
-        const auto t0 = Clock::now();
-        const render::UploadStats st = surface_.upload(session_->mesher(), ids);
-        current_.uploaded += st.fragments;
-        if (lod_) {  // the coarse level of detail follows the fine fragments
-            const std::vector<FragmentId> coarse = lod_->update(session_->field().phi(), session_->mesher(), ids);
-            if (!coarse.empty()) coarse_surface_.upload(lod_->mesher(), coarse);
-        }
-        const double ms = ms_since(t0);
-        current_.upload_ms += ms;
-        budget_.record_upload(ms);
-    }
+    if (background_active()) return handover();  // the worker's changes, at the hand-over pace
+    upload_fine();
     if (session_->revision() != seen_revision_) {
         seen_revision_ = session_->revision();
         stale_ = true;
@@ -74,8 +81,10 @@ void Viewer::render_3d(const render::Framebuffer& fb) {
         content.surface = &coarse_surface_;
         content.surface_scale = static_cast<float>(lod_->factor());  // LodMesher's index space
     }
+    if (runner_) runner_->release();  // the draw reads only GPU buffers and copies: the worker may step meanwhile
     scene_renderer_->render(fb, camera_, content, scene_style);
     glFinish();  // llvmpipe draws at flush time: count the drawing in this frame
+    if (runner_) runner_->acquire();
     const double ms = ms_since(t0);
     current_.draw_ms += ms;
     if (!view3d_coarse_ && !capturing_) budget_.record_full_draw(ms);

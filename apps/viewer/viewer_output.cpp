@@ -11,6 +11,7 @@
 namespace liveset::viewer {
 
 bool Viewer::save_mask(const std::string& path) {
+    halt_run();
     if (!session_) return fail("open an image first");
     try {
         cli::check_output_path(path, cli::OutputKind::kImage, "mask");
@@ -27,6 +28,7 @@ bool Viewer::save_mask(const std::string& path) {
 }
 
 bool Viewer::save_phi(const std::string& path) {
+    halt_run();
     if (!session_) return fail("open an image first");
     try {
         cli::check_output_path(path, cli::OutputKind::kImage, "phi");
@@ -43,6 +45,7 @@ bool Viewer::save_phi(const std::string& path) {
 }
 
 bool Viewer::save_mesh(const std::string& path) {
+    halt_run();
     if (!session_) return fail("open an image first");
     try {
         cli::check_output_path(path, cli::OutputKind::kMesh, "mesh");
@@ -57,6 +60,7 @@ bool Viewer::save_mesh(const std::string& path) {
 }
 
 render::Image Viewer::capture_pane(Pane pane, int width, int height, int supersample) {
+    halt_run();
     const int ss = std::clamp(supersample, 1, 4);
     const Rect saved = pane_rects_[static_cast<int>(pane)];
     pane_rects_[static_cast<int>(pane)] = {saved.x, saved.y, width * ss, height * ss};
@@ -71,12 +75,14 @@ render::Image Viewer::capture_pane(Pane pane, int width, int height, int supersa
 }
 
 render::Image Viewer::capture_window(int width, int height) {
+    halt_run();
     render::Framebuffer fb(width, height);
     for (int k = 0; k < 2; ++k) frame(fb.id(), width, height, 1.0 / 60.0);  // ImGui lays out in one frame, settles in two
     return fb.read_color();
 }
 
 bool Viewer::save_screenshot(const std::string& path, std::optional<Pane> pane, int width, int height, int supersample) {
+    halt_run();
     try {
         render::Image img;
         if (pane) {

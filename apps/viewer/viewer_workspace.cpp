@@ -18,6 +18,7 @@ namespace liveset::viewer {
 namespace fs = std::filesystem;
 
 bool Viewer::save_seeds(const std::string& path) {
+    halt_run();
     if (!session_) return fail("open an image first");
     try {
         cli::write_seed_file(path, session_->seeds());
@@ -31,6 +32,7 @@ bool Viewer::save_seeds(const std::string& path) {
 }
 
 bool Viewer::load_seeds(const std::string& path) {
+    halt_run();
     if (!session_) return fail("open an image first");
     std::vector<SeedBall> seeds;
     try {
@@ -56,6 +58,7 @@ bool Viewer::load_seeds(const std::string& path) {
 }
 
 bool Viewer::save_workspace(const std::string& path, bool overwrite) {
+    halt_run();
     if (!session_) return fail("open an image first");
     std::error_code ec;
     const bool ours = std::find(own_files_.begin(), own_files_.end(), path) != own_files_.end();
@@ -105,6 +108,7 @@ void Viewer::draw_files_section() {
 }
 
 void Viewer::ask_quit(const std::string& reason) {
+    halt_run();
     if (quit_prompt_) {  // asked already: a second Ctrl+Q (or close) means it
         log_.add("quit_prompt", {{"answer", "quit"}, {"reason", reason}});
         request_quit(*quit_prompt_);
@@ -187,6 +191,7 @@ void Viewer::draw_overwrite_prompt() {
 }
 
 void Viewer::frame_3d() {
+    halt_run();
     if (!session_) return;
     const Rect r = pane_rects_[static_cast<int>(Pane::kView3d)];
     const double aspect = r.w > 0 && r.h > 0 ? static_cast<double>(r.w) / r.h : 1.0;

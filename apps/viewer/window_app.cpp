@@ -126,10 +126,10 @@ int run_window(std::unique_ptr<Session> session, const std::string& image_name, 
     auto last = std::chrono::steady_clock::now();
     while (!viewer.quit_requested()) {
         const bool playing = player && !player->done();
-        if (viewer.busy() || playing || viewer.needs_frame())
+        if (playing || viewer.needs_frame())
             glfwPollEvents();
-        else
-            glfwWaitEventsTimeout(0.5);  // sleep until input: nothing changes on its own
+        else  // sleep until input (or a background run's next hand-over): nothing else changes
+            glfwWaitEventsTimeout(viewer.idle_wait_s());
         if (glfwWindowShouldClose(window)) {  // the close button: asks first when work is unsaved
             glfwSetWindowShouldClose(window, GLFW_FALSE);
             viewer.ask_quit("window closed");

@@ -77,6 +77,34 @@ TEST(LodMesher, IncrementalUpdatesFromTheFineFragmentsEqualTheSubsampledSurfaceB
     }
 }
 
+// refresh(φ) needs no fine mesher (a background run defers it) and reports the coarse fragments a
+// fragment-driven update would: the same surface as built from scratch after each step.
+TEST(LodMesher, RefreshWithoutTheFineMesherEqualsTheFragmentDrivenUpdate) {
+    const Vec3i dims{41, 37, 35};
+    Grid<float> phi = testing::sphere_field(dims, {18.0, 17.0, 16.0}, 9.0);
+    FragmentMesher fine(phi.lattice(), 6);
+    fine.full_rebuild(phi);
+    LodMesher by_fragments(phi.lattice(), 6, 3), by_refresh(phi.lattice(), 6, 3);
+    by_fragments.rebuild(phi);
+    EXPECT_EQ(by_refresh.refresh(phi).size(), by_refresh.mesher().fragment_count());  // first call: everything
+    expect_matches_brute_force(by_refresh, phi);
+    EXPECT_TRUE(by_refresh.refresh(phi).empty());  // nothing changed
+    for (int step = 1; step <= 3; ++step) {
+        const Grid<float> next = testing::sphere_field(dims, {18.0 + step, 17.0, 16.0}, 9.0 + 2.0 * step);
+        std::vector<PointIndex> changed;
+        for (PointIndex i = 0; i < phi.values().size(); ++i)
+            if (phi.values()[i] != next.values()[i]) {
+                phi.values()[i] = next.values()[i];
+                changed.push_back(i);
+            }
+        const std::vector<FragmentId> a = by_fragments.update(phi, fine, fine.update(phi, changed));
+        const std::vector<FragmentId> b = by_refresh.refresh(phi);
+        EXPECT_EQ(a, b) << "step " << step;
+        expect_matches_brute_force(by_refresh, phi);
+    }
+    EXPECT_THROW(by_refresh.refresh(Grid<float>{Lattice({24, 20, 20})}), std::invalid_argument);
+}
+
 TEST(LodMesher, CoarseVerticesMappedToFineIndexSpaceLieOnTheSphere) {
     const Grid<float> phi = testing::sphere_field({48, 48, 48}, {23.5, 24.0, 23.0}, 15.0);
     LodMesher lod(phi.lattice(), 16);

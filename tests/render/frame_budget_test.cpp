@@ -127,6 +127,7 @@ int run_in_viewer(double frame_ms) {
     ViewerConfig c;
     c.headless = true;
     c.budget.frame_ms = frame_ms;
+    c.budget.background = false;  // steps in frames (background_run_test.cpp: on a worker)
     Viewer v(seeded_session(), "phantom", c);
     auto reference = seeded_session();
     render::Framebuffer window(640, 480);

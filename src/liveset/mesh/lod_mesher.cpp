@@ -41,16 +41,18 @@ void LodMesher::rebuild(const Grid<float>& phi) {
     built_ = true;
 }
 
+std::vector<FragmentId> LodMesher::rebuild_all(const Grid<float>& phi) {
+    rebuild(phi);
+    std::vector<FragmentId> all(mesher_.fragment_count());
+    for (FragmentId f = 0; f < all.size(); ++f) all[f] = f;
+    return all;
+}
+
 std::vector<FragmentId> LodMesher::update(const Grid<float>& phi, const FragmentMesher& fine, std::span<const FragmentId> fine_ids) {
     const int k = factor_;
     if (coarsened(phi.lattice(), k).dims() != coarse_phi_.lattice().dims())
         throw std::invalid_argument("LodMesher: φ has other dimensions");
-    if (!built_) {
-        rebuild(phi);
-        std::vector<FragmentId> all(mesher_.fragment_count());
-        for (FragmentId f = 0; f < all.size(); ++f) all[f] = f;
-        return all;
-    }
+    if (!built_) return rebuild_all(phi);
     const Vec3i fd = phi.lattice().dims();
     std::vector<PointIndex> changed;
     for (FragmentId id : fine_ids) {
@@ -71,6 +73,26 @@ std::vector<FragmentId> LodMesher::update(const Grid<float>& phi, const Fragment
                     changed.push_back(coarse_phi_.lattice().index({x, y, z}));
                 }
     }
+    if (changed.empty()) return {};
+    return mesher_.update(coarse_phi_, changed);
+}
+
+std::vector<FragmentId> LodMesher::refresh(const Grid<float>& phi) {
+    const Vec3i d = coarse_phi_.lattice().dims();
+    const int k = factor_;
+    if (coarsened(phi.lattice(), k).dims() != d) throw std::invalid_argument("LodMesher: φ has other dimensions");
+    if (!built_) return rebuild_all(phi);
+    std::vector<PointIndex> changed;
+    PointIndex c = 0;
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x, ++c) {
+                const float value = phi({k * x, k * y, k * z});
+                float& mine = coarse_phi_[c];
+                if (value == mine) continue;
+                mine = value;
+                changed.push_back(c);
+            }
     if (changed.empty()) return {};
     return mesher_.update(coarse_phi_, changed);
 }

@@ -34,8 +34,14 @@ public:
     // cell of one of them): re-samples their point boxes and re-meshes the affected coarse
     // fragments, whose ids it returns (sorted). `phi` has the fine lattice's dimensions.
     std::vector<FragmentId> update(const Grid<float>& phi, const FragmentMesher& fine, std::span<const FragmentId> fine_ids);
+    // The same without the fine mesher (its meshing deferred, e.g. during a background run):
+    // re-samples every coarse point (1 / k³ of φ) and re-meshes the coarse fragments whose samples
+    // changed, whose ids it returns (sorted).
+    std::vector<FragmentId> refresh(const Grid<float>& phi);
 
 private:
+    std::vector<FragmentId> rebuild_all(const Grid<float>& phi);  // rebuild(); every id
+
     int factor_ = 2;
     Grid<float> coarse_phi_;
     FragmentMesher mesher_;

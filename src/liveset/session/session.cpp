@@ -97,6 +97,8 @@ bool Session::load_recovered(const Grid<float>& phi, const Grid<std::int8_t>& st
 }
 
 void Session::reset_after_load() {
+    for (PointIndex p : pending_) pending_flags_[p] = 0;  // the full rebuild covers them
+    pending_.clear();
     mesher_.full_rebuild(field_.phi(), field_.zero_layer());
     for (FragmentId f = 0; f < mesher_.fragment_count(); ++f)
         if (!dirty_flags_[f]) {
@@ -412,20 +414,50 @@ SessionUpdate Session::edit(const char* label, Action action, const std::functio
 SessionUpdate Session::finish_update(ChangedPoints changed, double level_set_ms) {
     SessionUpdate u;
     u.level_set_ms = level_set_ms;
-    const auto t0 = Clock::now();
-    u.fragments = mesher_.update(field_.phi(), changed.points);
-    u.mesh_ms = ms_since(t0);
-    for (FragmentId f : u.fragments)
-        if (!dirty_flags_[f]) {
-            dirty_flags_[f] = 1;
-            dirty_.push_back(f);
-        }
+    if (defer_mesh_) {
+        for (PointIndex p : changed.points)
+            if (!pending_flags_[p]) {
+                pending_flags_[p] = 1;
+                pending_.push_back(p);
+            }
+    } else {
+        const auto t0 = Clock::now();
+        u.fragments = mesher_.update(field_.phi(), changed.points);
+        u.mesh_ms = ms_since(t0);
+        queue_dirty(u.fragments);
+    }
     u.changed = std::move(changed);
     ++revision_;
     return u;
 }
 
+void Session::queue_dirty(const std::vector<FragmentId>& fragments) {
+    for (FragmentId f : fragments)
+        if (!dirty_flags_[f]) {
+            dirty_flags_[f] = 1;
+            dirty_.push_back(f);
+        }
+}
+
+void Session::set_deferred_meshing(bool on) {
+    if (on == defer_mesh_) return;
+    if (!on) flush_mesh();
+    defer_mesh_ = on;
+    if (on) pending_flags_.assign(lattice().size(), 0);
+    else pending_flags_ = {};
+}
+
+double Session::flush_mesh() {
+    if (pending_.empty()) return 0.0;
+    const auto t0 = Clock::now();
+    queue_dirty(mesher_.update(field_.phi(), pending_));
+    for (PointIndex p : pending_) pending_flags_[p] = 0;
+    pending_.clear();
+    return ms_since(t0);
+}
+
 std::vector<FragmentId> Session::take_dirty_fragments() {
+    flush_mesh();
     std::vector<FragmentId> out;
     out.swap(dirty_);
     for (FragmentId f : out) dirty_flags_[f] = 0;

@@ -11,7 +11,12 @@
 // (Loading a mask, φ or a recovery file replaces the state instead: it re-meshes everything and
 // starts a new history.)
 //
-// Standard library + oneTBB only (no GL, no ITK). Not thread-safe: one thread drives a session.
+// With deferred meshing (set_deferred_meshing, what a background run uses: session_runner.hpp), an
+// edit still records X in the history at once but only accumulates it for the mesher; flush_mesh()
+// (or take_dirty_fragments()) meshes the union later, at the renderer's pace. φ is the same either way.
+//
+// Standard library + oneTBB only (no GL, no ITK). Not thread-safe: one thread drives a session at a
+// time (SessionRunner hands it between a worker and the renderer under a mutex).
 #pragma once
 
 #include <cstdint>
@@ -179,8 +184,17 @@ public:
     const SessionMarks& marks() const { return marks_; }
 
     // --- renderer feed ----------------------------------------------------------------------
-    // Fragments rebuilt since the last call (sorted, unique): the buffers to re-upload.
+    // Fragments rebuilt since the last call (sorted, unique): the buffers to re-upload. Meshes the
+    // accumulated X first (flush_mesh).
     std::vector<FragmentId> take_dirty_fragments();
+    // Deferred meshing: while on, edits accumulate X (deduplicated) instead of meshing it (their
+    // SessionUpdate lists no fragments); turning it off meshes what is pending. mesher() is up to
+    // date only after flush_mesh().
+    void set_deferred_meshing(bool on);
+    bool deferred_meshing() const { return defer_mesh_; }
+    // Meshes the accumulated X and queues the rebuilt fragments; returns the meshing's ms (0: none).
+    double flush_mesh();
+    std::size_t pending_mesh_points() const { return pending_.size(); }
     // Counts every change of φ, the seeds, the target or the agents (for redraw decisions).
     std::uint64_t revision() const { return revision_; }
 
@@ -206,6 +220,7 @@ private:
     SessionUpdate edit(const char* label, Action action, const std::function<Change()>& change);
     void begin_action(const char* label);  // continues an open action of the same label
     SessionUpdate finish_update(ChangedPoints changed, double level_set_ms);
+    void queue_dirty(const std::vector<FragmentId>& fragments);
     void adopt_marks(const SessionMarks& marks);
     void reset_after_load();
     void refresh_window();
@@ -229,6 +244,9 @@ private:
     EditHistory history_;
     std::vector<std::uint8_t> dirty_flags_;
     std::vector<FragmentId> dirty_;
+    bool defer_mesh_ = false;
+    std::vector<PointIndex> pending_;           // X accumulated while meshing is deferred
+    std::vector<std::uint8_t> pending_flags_;   // lattice-sized while deferring: in pending_
     std::uint64_t revision_ = 0;
 };
 

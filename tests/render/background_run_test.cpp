@@ -1,0 +1,135 @@
+// The viewer's background run (SessionRunner on a worker thread, frames taking its changes): a
+// segmentation run equals the session's foreground steps (and so `liveset segment`) bit for bit at
+// any hand-over pace; pause, a seed and undo during a run stop the worker first and leave a
+// consistent session (pause: the same φ as the same number of foreground steps; undo: the state
+// before the run); the 3D buffers end equal to the session's mesh. The session is read only
+// between frames once the run stopped (the hand-over rule). No timing is asserted.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <chrono>
+#include <thread>
+
+#include "liveset/levelset/invariants.hpp"
+#include "liveset/phantom/phantom.hpp"
+#include "liveset/render/framebuffer.hpp"
+#include "liveset/render/headless_context.hpp"
+#include "viewer.hpp"
+
+#ifdef __SANITIZE_THREAD__
+#include <tbb/global_control.h>
+#endif
+
+namespace liveset::viewer {
+namespace {
+
+#ifdef __SANITIZE_THREAD__
+// Under ThreadSanitizer (build-tsan, not CI): no oneTBB worker threads (an uninstrumented scheduler).
+const tbb::global_control one_tbb_thread(tbb::global_control::max_allowed_parallelism, 1);
+#endif
+
+const Phantom& phantom() {
+    static const Phantom ph = [] {
+        PhantomOptions o;
+        o.size = 48;
+        return make_phantom(o);
+    }();
+    return ph;
+}
+
+SessionOptions sleeping() {
+    SessionOptions o;
+    o.segmentation.step = sleeping_step();
+    return o;
+}
+
+std::unique_ptr<Session> seeded_session() {
+    auto s = std::make_unique<Session>(phantom().image, sleeping());
+    for (const Vec3i& c : phantom().seeds) s->add_seed({c.cast<double>(), 2.0});
+    s->end_action();
+    return s;
+}
+
+std::vector<std::uint32_t> bits(const Session& s) {
+    std::vector<std::uint32_t> out;
+    for (float v : s.field().phi().values()) out.push_back(std::bit_cast<std::uint32_t>(v));
+    for (std::int8_t v : s.field().status().values()) out.push_back(static_cast<std::uint32_t>(v));
+    return out;
+}
+
+ViewerConfig config(double handover_ms) {
+    ViewerConfig c;
+    c.headless = true;
+    c.budget.handover_ms = handover_ms;
+    return c;
+}
+
+// Frames as a window loop would give them (waiting for the hand-over between), `limit` at most.
+void frames_while_running(Viewer& v, const render::Framebuffer& fb, int limit) {
+    for (int n = 0; n < limit && v.segment_running();) {
+        if (!v.needs_frame()) {
+            v.wait_for_frame(1000.0);
+            continue;
+        }
+        v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+        ++n;
+    }
+}
+
+TEST(BackgroundRun, ASegmentationRunEqualsTheForegroundStepsAtAnyPace) {
+    render::HeadlessContext context;
+    auto reference = seeded_session();
+    while (!reference->segment_status().converged && reference->segment_status().iterations < 5000) reference->segment_step();
+    for (const double pace : {1.0, 40.0}) {
+        Viewer v(seeded_session(), "phantom", config(pace));
+        render::Framebuffer fb(640, 480);
+        v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+        v.set_segment_running(true);
+        frames_while_running(v, fb, 100000);
+        v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+        ASSERT_FALSE(v.segment_running());
+        EXPECT_FALSE(v.background_active());
+        const Session& s = *v.session();
+        EXPECT_TRUE(s.segment_status().converged) << "pace " << pace;
+        EXPECT_EQ(s.segment_status().iterations, reference->segment_status().iterations) << "pace " << pace;
+        EXPECT_TRUE(bits(s) == bits(*reference)) << "pace " << pace;
+        EXPECT_EQ(s.pending_mesh_points(), 0u);
+        EXPECT_EQ(v.last_frame().triangles, s.mesher().triangle_count());  // the buffers hold the final mesh
+        EXPECT_EQ(s.next_undo_label(), "segment");  // the run is one action
+    }
+}
+
+TEST(BackgroundRun, PauseSeedAndUndoDuringARunStopTheWorkerFirst) {
+    render::HeadlessContext context;
+    Viewer v(seeded_session(), "phantom", config(5.0));
+    render::Framebuffer fb(640, 480);
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+    const std::vector<std::uint32_t> before = bits(*v.session());
+    v.set_segment_running(true);
+    frames_while_running(v, fb, 3);
+    v.set_segment_running(false);  // pause: the worker is joined, the session is ours
+    ASSERT_FALSE(v.background_active());
+    const int k = v.session()->segment_status().iterations;
+    auto reference = seeded_session();
+    for (int i = 0; i < k; ++i) reference->segment_step();
+    EXPECT_TRUE(bits(*v.session()) == bits(*reference)) << k << " steps";
+    v.undo();  // the run, one action
+    EXPECT_TRUE(bits(*v.session()) == before);
+
+    v.set_segment_running(true);  // again, a seed placed while it runs
+    frames_while_running(v, fb, 2);
+    const Vec3d extra = phantom().seeds.front().cast<double>() + Vec3d{1.0, 1.0, 0.0};
+    EXPECT_TRUE(v.add_seed(extra, 1.5)) << v.message();
+    EXPECT_TRUE(v.segment_running());  // the run goes on after the seed, as in the foreground
+    frames_while_running(v, fb, 4);
+    v.undo();  // pauses, then undoes the steps after the seed
+    EXPECT_FALSE(v.segment_running());
+    EXPECT_FALSE(v.background_active());
+    EXPECT_TRUE(check_invariants(v.session()->field()).ok()) << check_invariants(v.session()->field()).summary();
+    EXPECT_EQ(v.session()->next_undo_label(), "seed");
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+    EXPECT_EQ(v.last_frame().triangles, v.session()->mesher().triangle_count());
+}
+
+}  // namespace
+}  // namespace liveset::viewer
