@@ -81,8 +81,10 @@ nlohmann::json run_demo_repair(const DemoArgs& a, const Phantom& ph, const Segme
     RepairOptions ro = demo_repair_options();
     ro.swarm.seed = a.seed;
     // The holes a user would point at: perforations first, then spurious cavities (bubbles).
+    // The sheet rule is aimed at each hole's widest opening, the intensity rule at its centroid.
+    const HoleAim aim = a.rule == "sheet" ? HoleAim::kOpening : HoleAim::kCentroid;
     const HoleSiteFinder holes_left = [&](const SparseField& field) {
-        return truth_hole_sites(inside_mask(field.phi()), ph.truth, white);
+        return truth_hole_sites(inside_mask(field.phi()), ph.truth, white, aim);
     };
     const std::vector<HoleSite> first = holes_left(session.field());
     first_hole = first.empty() ? std::nullopt : std::optional<Vec3d>(first.front().position);

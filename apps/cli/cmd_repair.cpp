@@ -147,6 +147,10 @@ void check_repair_args(RepairArgs& a) {
     if (a.sheet_lower.has_value() != a.sheet_upper.has_value()) throw UsageError("give both --sheet-lower and --sheet-upper, or neither");
     if (a.sheet_lower && !(*a.sheet_lower < *a.sheet_upper)) throw UsageError("--sheet-lower must be below --sheet-upper");
     if (a.targets.empty() && a.targets_mm.empty()) throw UsageError("give at least one --target I,J,K[@STEP] (or --target-mm)");
+    if (!a.options.swarm.sheet_between && a.options.swarm.decision != EditDecision::kSheet)
+        throw UsageError("--band-only is a setting of the sheet rule: give it with --decision sheet");
+    if (!a.options.close_cracks && !a.options.topology_guard)
+        throw UsageError("--no-crack-closing is a setting of the topology guard: it cannot go with --no-topology-guard");
     if (a.options.swarm.decision == EditDecision::kSheet) {  // checked with the band below
         a.options.swarm.sheet_lower = 0.0;
         a.options.swarm.sheet_upper = 1.0;

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <unordered_map>
+#include <unordered_set>
 
 namespace liveset {
 
@@ -27,12 +29,97 @@ void RepairScheduleOptions::validate() const {
     hole_brush_range(0, shell_thickness, max_range);  // throws on a bad brush sizing
 }
 
-std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner) {
-    std::vector<Perforation> h = find_perforations(mask, truth, inner);
-    if (h.empty()) h = find_cavities(mask, inner);
-    if (h.empty()) h = find_missed_tunnels(mask, truth);
+namespace {
+
+// The voxel of the hole region holding `start` (6-connected voxels with hole(q)) farthest from the
+// mask, counted in face steps through the region from its voxels that touch the mask (ties: the
+// one nearest `centroid`): the middle of the hole's widest opening. A large hole's centroid can lie
+// where the rim has already grown shut while the opening that is left lies at its edge.
+template <class InHole>
+Vec3d deepest_voxel(const Grid<std::uint8_t>& mask, const InHole& hole, Vec3i start, Vec3d centroid) {
+    const Lattice& lat = mask.lattice();
+    std::unordered_set<PointIndex> region{lat.index(start)};
+    std::vector<Vec3i> cells{start};
+    for (std::size_t h = 0; h < cells.size(); ++h)
+        for (int k = 0; k < 6; ++k) {
+            Vec3i q = cells[h];
+            q[k / 2] += (k % 2) ? 1 : -1;
+            if (lat.contains(q) && hole(q) && region.insert(lat.index(q)).second) cells.push_back(q);
+        }
+    std::unordered_map<PointIndex, int> depth;  // breadth-first from the voxels touching the mask
+    std::vector<Vec3i> queue;
+    for (const Vec3i& c : cells)
+        for (int k = 0; k < 6; ++k) {
+            Vec3i q = c;
+            q[k / 2] += (k % 2) ? 1 : -1;
+            if (lat.contains(q) && mask(q)) {
+                depth.emplace(lat.index(c), 1);
+                queue.push_back(c);
+                break;
+            }
+        }
+    Vec3d best = start.cast<double>();
+    int best_depth = -1;
+    double best_d2 = 0;
+    for (std::size_t h = 0; h < queue.size(); ++h) {
+        const Vec3i c = queue[h];
+        const int d = depth[lat.index(c)];
+        const Vec3d off = c.cast<double>() - centroid;
+        if (d > best_depth || (d == best_depth && dot(off, off) < best_d2)) {
+            best = c.cast<double>(), best_depth = d, best_d2 = dot(off, off);
+        }
+        for (int k = 0; k < 6; ++k) {
+            Vec3i q = c;
+            q[k / 2] += (k % 2) ? 1 : -1;
+            if (lat.contains(q) && region.count(lat.index(q)) && depth.emplace(lat.index(q), d + 1).second) queue.push_back(q);
+        }
+    }
+    return best;
+}
+
+constexpr double kSameHole = 2.0;    // voxels: a hole's site this close to a round's target is that hole
+constexpr double kMinShrink = 0.95;  // a round that leaves its hole with more than this share of its voxels stalled
+
+// The hole to aim at: the largest (the finder's first) among those aimed at by the fewest stalled
+// rounds — as a user whose click changed nothing clicks the next hole, and comes back later.
+HoleSite next_target(const std::vector<HoleSite>& holes, const std::vector<Vec3d>& stalled) {
+    const auto stalls = [&](const HoleSite& h) {
+        return std::count_if(stalled.begin(), stalled.end(), [&](const Vec3d& s) { return norm(s - h.position) <= kSameHole; });
+    };
+    const HoleSite* best = &holes.front();
+    long fewest = stalls(*best);
+    for (const HoleSite& h : holes) {
+        const long n = stalls(h);
+        if (n < fewest) best = &h, fewest = n;
+    }
+    return *best;
+}
+
+// Whether the round aimed at `target` shrank its hole: no hole of at least kMinShrink of its size is
+// left at its site.
+bool shrank(const HoleSite& target, const std::vector<HoleSite>& holes) {
+    return std::none_of(holes.begin(), holes.end(), [&](const HoleSite& h) {
+        return norm(h.position - target.position) <= kSameHole && static_cast<double>(h.voxels) > kMinShrink * static_cast<double>(target.voxels);
+    });
+}
+
+}  // namespace
+
+std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner,
+                                       HoleAim aim) {
+    if (!(mask.dims() == truth.dims()) || !(mask.dims() == inner.dims()))
+        throw std::invalid_argument("truth hole sites: mask, truth and inner differ in size");
+    const auto missed = [&](Vec3i q) { return truth(q) && !mask(q); };
+    const auto cavity = [&](Vec3i q) { return !mask(q); };
+    const auto site = [&](const Perforation& p, const auto& in_hole) {
+        return HoleSite{aim == HoleAim::kOpening ? deepest_voxel(mask, in_hole, p.nearest, p.centroid) : p.centroid, p.voxels};
+    };
     std::vector<HoleSite> sites;
-    for (const Perforation& p : h) sites.push_back({p.centroid, p.voxels});
+    for (const Perforation& p : find_perforations(mask, truth, inner)) sites.push_back(site(p, missed));
+    if (sites.empty())
+        for (const Perforation& p : find_cavities(mask, inner)) sites.push_back(site(p, cavity));
+    if (sites.empty())
+        for (const Perforation& p : find_missed_tunnels(mask, truth)) sites.push_back(site(p, missed));
     return sites;
 }
 
@@ -53,6 +140,7 @@ RepairScheduleResult run_repair_schedule(RepairDriver& driver, const RepairOptio
     if (!find) throw std::invalid_argument("repair schedule: no hole finder");
     const auto interrupted = [&] { return interrupt && interrupt->load(std::memory_order_relaxed); };
     RepairScheduleResult out;
+    std::vector<Vec3d> stalled;  // targets of rounds after which their hole had not shrunk
     std::vector<HoleSite> holes = find(driver.field());
     for (int r = 0; r < schedule.rounds && !holes.empty(); ++r) {
         if (interrupted()) {
@@ -60,7 +148,7 @@ RepairScheduleResult run_repair_schedule(RepairDriver& driver, const RepairOptio
             break;
         }
         RepairRoundLog round;
-        round.target = holes.front();
+        round.target = next_target(holes, stalled);
         round.holes = holes.size();
         RepairOptions ro = base;
         ro.steps = schedule.round_steps;
@@ -79,6 +167,7 @@ RepairScheduleResult run_repair_schedule(RepairDriver& driver, const RepairOptio
         }
         out.rounds.push_back(round);
         holes = find(driver.field());
+        if (!shrank(round.target, holes)) stalled.push_back(round.target.position);
     }
     out.holes_left = holes.size();
     return out;
