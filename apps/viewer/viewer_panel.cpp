@@ -163,7 +163,10 @@ void Viewer::draw_repair_section() {
         done |= ImGui::IsItemDeactivatedAfterEdit();
         if (ImGui::SliderFloat("expand sigmas", &expand, 0.1f, 5.0f, "%.2f")) ui_repair_.swarm.expand_sigmas = expand;
         done |= ImGui::IsItemDeactivatedAfterEdit();
-        ImGui::Text("steps/frame: as fit in %.0f ms", budget_.options().frame_ms);
+        if (budget_.options().background)
+            ImGui::Text("steps: on a worker thread; the view follows every %.0f ms", budget_.options().handover_ms);
+        else
+            ImGui::Text("steps/frame: as fit in %.0f ms", budget_.options().frame_ms);
         ImGui::TreePop();
     }
     if (done) apply_repair_options(ui_repair_);
