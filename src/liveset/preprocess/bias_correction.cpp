@@ -104,8 +104,10 @@ ShrinkPlan plan_shrink(const Lattice& lattice, double shrink_mm) {
     return plan;
 }
 
-template <class T, class Image>
-typename Image::Pointer shrunk_image(const Grid<T>& full, const ShrinkPlan& plan, Vec3d spacing_mm) {
+// The shrunk grid filled with value(p) at each sample's full-resolution voxel p = j·f (the
+// padding samples past the image's end stay 0).
+template <class Image, class Value>
+typename Image::Pointer shrunk_image(const Vec3i& n, const ShrinkPlan& plan, Vec3d spacing_mm, const Value& value) {
     auto out = Image::New();
     typename Image::SizeType size;
     for (int a = 0; a < 3; ++a) size[a] = static_cast<itk::SizeValueType>(plan.dims[a]);
@@ -115,45 +117,32 @@ typename Image::Pointer shrunk_image(const Grid<T>& full, const ShrinkPlan& plan
     out->SetSpacing(spacing);  // origin 0, identity direction: N4 fits in this parametric space anyway
     out->Allocate(true);
     auto* dst = out->GetBufferPointer();
-    const Vec3i n = full.dims();
     std::size_t k = 0;
     for (int z = 0; z < plan.dims.z; ++z)
         for (int y = 0; y < plan.dims.y; ++y)
             for (int x = 0; x < plan.dims.x; ++x, ++k) {
                 const Vec3i p{x * plan.factors.x, y * plan.factors.y, z * plan.factors.z};
-                if (p.x < n.x && p.y < n.y && p.z < n.z) dst[k] = full(p);
+                if (p.x < n.x && p.y < n.y && p.z < n.z) dst[k] = value(p);
             }
     return out;
 }
 
-// The shrunk image with each fit sample replaced by the median of the fit voxels in its 3×3×3
-// neighbourhood (BiasCorrectionOptions::denoise). N4 sharpens the histogram of the samples, and a
-// plain subsample keeps all of the scan's noise in it: on BrainWeb + noise σ 9 (no bias at all) N4
-// fitted a field of 0.63..1.32 and the tissue model merged GM with WM. The median divides Gaussian
-// noise by about 4 and keeps tissue edges (a block mean blurred them: Dice −0.02 on the clean scan).
-FloatImage::Pointer shrunk_median(const Grid<float>& full, const Grid<std::uint8_t>& fit, const ShrinkPlan& plan, Vec3d spacing_mm) {
-    auto out = shrunk_image<float, FloatImage>(full, plan, spacing_mm);
-    float* dst = out->GetBufferPointer();
-    const Vec3i n = full.dims();
-    std::size_t k = 0;
-    for (int z = 0; z < plan.dims.z; ++z)
-        for (int y = 0; y < plan.dims.y; ++y)
-            for (int x = 0; x < plan.dims.x; ++x, ++k) {
-                const Vec3i c{x * plan.factors.x, y * plan.factors.y, z * plan.factors.z};
-                if (c.x >= n.x || c.y >= n.y || c.z >= n.z || fit(c) == 0) continue;
-                std::array<float, 27> v{};
-                int count = 0;
-                for (int dz = -1; dz <= 1; ++dz)
-                    for (int dy = -1; dy <= 1; ++dy)
-                        for (int dx = -1; dx <= 1; ++dx) {
-                            const Vec3i q = c + Vec3i{dx, dy, dz};
-                            if (q.x < 0 || q.y < 0 || q.z < 0 || q.x >= n.x || q.y >= n.y || q.z >= n.z || fit(q) == 0) continue;
-                            v[static_cast<std::size_t>(count++)] = full(q);
-                        }
-                std::nth_element(v.begin(), v.begin() + count / 2, v.begin() + count);
-                dst[k] = v[static_cast<std::size_t>(count / 2)];
+// The median of the fit voxels in the 3×3×3 neighbourhood of a fit voxel c
+// (BiasCorrectionOptions::denoise). N4 sharpens the histogram of its samples, and a plain subsample
+// keeps all of the scan's noise in it: on BrainWeb + noise σ 9 (no bias at all) N4 fitted a field of
+// 0.63..1.32 and the tissue model merged GM with WM. The median divides Gaussian noise by about 4
+// and keeps tissue edges (a block mean blurred them: Dice −0.02 on the clean scan).
+float fit_median(const Grid<float>& full, const Grid<std::uint8_t>& fit, Vec3i c) {
+    std::array<float, 27> v{};
+    int count = 0;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const Vec3i q = c + Vec3i{dx, dy, dz};
+                if (full.lattice().contains(q) && fit(q) != 0) v[static_cast<std::size_t>(count++)] = full(q);
             }
-    return out;
+    std::nth_element(v.begin(), v.begin() + count / 2, v.begin() + count);
+    return v[static_cast<std::size_t>(count / 2)];
 }
 
 // Process-wide ITK default thread count pinned to 1 for the guard's lifetime: every filter N4
@@ -326,8 +315,10 @@ Grid<float> correct_bias(const Grid<float>& image, const Grid<std::uint8_t>* mas
     report.shrunk_dims = plan.dims;
     const Vec3d s = image.lattice().spacing();
     const Vec3d shrunk_spacing{s.x * plan.factors.x, s.y * plan.factors.y, s.z * plan.factors.z};
-    const auto small = options.denoise ? shrunk_median(image, fit, plan, shrunk_spacing) : shrunk_image<float, FloatImage>(image, plan, shrunk_spacing);
-    const auto small_mask = shrunk_image<std::uint8_t, MaskImage>(fit, plan, shrunk_spacing);
+    const auto small = shrunk_image<FloatImage>(image.dims(), plan, shrunk_spacing, [&](Vec3i p) {
+        return options.denoise && fit(p) != 0 ? fit_median(image, fit, p) : image(p);
+    });
+    const auto small_mask = shrunk_image<MaskImage>(image.dims(), plan, shrunk_spacing, [&](Vec3i p) { return fit(p); });
     const unsigned char* m = small_mask->GetBufferPointer();
     if (std::none_of(m, m + small_mask->GetBufferedRegion().GetNumberOfPixels(), [](unsigned char v) { return v != 0; }))
         fail("the mask leaves no voxel on the shrunk grid (" + dims_text(plan.dims) + "); lower shrink_mm");
