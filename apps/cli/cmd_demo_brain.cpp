@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "cli_support.hpp"
 #include "demo_brain.hpp"
+#include "finder_repair.hpp"
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/fragment_mesher.hpp"
@@ -29,17 +30,20 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+constexpr double kLowThreshold = 0.8;           // ε of the --repair segmentation: 80 % of the model window's
+constexpr double kLowThresholdMinSigmas = 2.4;  // ... but at least 2.4 σ of the GM class (low_threshold)
+
 // The seeds a user would click in clearly grey voxels all over the cortex (voxel indices).
 const std::vector<Vec3i> kBrainSeeds = {{35, 83, 113}, {35, 125, 38}, {44, 164, 92},  {71, 74, 53},
                                         {122, 149, 47}, {140, 86, 74}, {38, 71, 26}, {83, 23, 71}};
 
 // The demo's sub-optimally low threshold (--repair): the tissue model's window for the seeds' class,
-// narrowed to brain_repair_epsilon_scale() of its half width around the same centre — but never
-// below brain_repair_min_sigmas() of the class's fitted σ (noise included), nor wider than the
+// narrowed to kLowThreshold of its half width around the same centre — but never
+// below kLowThresholdMinSigmas of the class's fitted σ (noise included), nor wider than the
 // window: on a noisy scan the plain narrowing leaves so much of the grey matter outside that the
 // front stalls at the seeds (BrainWeb + noise σ 9: Dice 0.18) instead of leaving holes. Also fills
 // the grey matter's band and class mean for the finder and the sheet rule.
-void low_threshold(const Grid<float>& t1, const Grid<std::uint8_t>& roi, SegmentRequest& req, BrainRepairInput& band) {
+void low_threshold(const Grid<float>& t1, const Grid<std::uint8_t>& roi, SegmentRequest& req, FoundHolesInput& band) {
     std::vector<std::string> warnings;
     const Grid<std::uint8_t> region = model_region(t1, nullptr, &roi, 3);
     const std::optional<TissueModel> model = fit_window_model(t1, region, TissueModelOptions{}, warnings);
@@ -53,7 +57,7 @@ void low_threshold(const Grid<float>& t1, const Grid<std::uint8_t>& roi, Segment
     const ModelWindow w = model_window(*model, seed_values);
     req.mu_raw = w.mu();
     const double sigma = model->classes[static_cast<std::size_t>(w.seed_class)].sigma;
-    req.epsilon_raw = std::max(brain_repair_epsilon_scale() * w.epsilon(), std::min(w.epsilon(), brain_repair_min_sigmas() * sigma));
+    req.epsilon_raw = std::max(kLowThreshold * w.epsilon(), std::min(w.epsilon(), kLowThresholdMinSigmas * sigma));
     band.band_lower = w.lower;
     band.band_upper = w.upper;
     band.sheet_mean = model->classes[static_cast<std::size_t>(w.seed_class)].mean;
@@ -135,7 +139,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     for (const Vec3i& s : kBrainSeeds) req.seeds.push_back({{double(s.x), double(s.y), double(s.z)}, 2.0});
     req.roi = &roi;
     req.loop.step = sleeping_step();  // as `liveset segment`
-    BrainRepairInput rin{t1, roi, {}, 0, 0, 0};
+    FoundHolesInput rin{t1, &roi, {}};
     if (a.repair) low_threshold(t1, roi, req, rin);
     const SegmentRun run = segment_with_progress(t1, req, a.quiet || a.json);
     if (run.interrupted) {
@@ -161,9 +165,11 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     const Grid<float> phi_before = o.field->phi();
     if (a.repair) {
         if (!a.quiet && !a.json) fmt::print("  segmented with a low threshold (epsilon {:.1f} raw, the model's {:.1f} x {}, at least {} sigma); repairing...\n", req.epsilon_raw.value_or(0.0),
-                       rin.band_upper / 2 - rin.band_lower / 2, brain_repair_epsilon_scale(), brain_repair_min_sigmas());
+                       rin.band_upper / 2 - rin.band_lower / 2, kLowThreshold, kLowThresholdMinSigmas);
         rin.scale = o.scale;
-        repair = repair_brain_holes(rin, session, true);
+        repair = repair_found_holes(rin, session, true);
+        repair["low_threshold"] = kLowThreshold;
+        repair["low_threshold_min_sigmas"] = kLowThresholdMinSigmas;
         after = evaluation_report(inside_mask(session.field().phi(), &roi), truth);
     }
 

@@ -9,13 +9,16 @@
 
 #include <cmath>
 #include <ctime>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "cli_support.hpp"
+#include "finder_repair.hpp"
 #include "image_commands.hpp"
+#include "liveset/session/hole_scan.hpp"
 #include "liveset/session/session.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
@@ -35,6 +38,10 @@ struct RepairArgs {
     std::string out_phi, out_mask, out_mesh, log;
     std::string decision = "intensity";
     std::optional<double> sheet_lower, sheet_upper;  // the sheet's band (raw); from the tissue model when absent
+    std::size_t find_holes = 0;  // --find-holes N: the finder's N largest holes are the targets, one round each
+    int round_steps = 1000;      // --round-steps (with --find-holes)
+    std::size_t min_hole = 50;   // --min-hole (with --find-holes)
+    bool p_given = false, decision_given = false, steps_given = false;
     bool json = false, quiet = false;
 };
 
@@ -59,23 +66,33 @@ RepairTarget parse_target(const std::string& text, const Lattice& lattice, bool 
     return {b.center, step};
 }
 
-constexpr double kVerdictRadius = 6.0;  // the finder's verdict counts hole voxels this close to a target
+constexpr double kVerdictRadius = kHoleVerdictRadius;  // the finder's verdict counts hole voxels this close to a target
 
-// The sheet's band for the finder's verdicts and --decision sheet: given, or the tissue model's
-// window for the class most of the segmentation's voxels are in (nullopt when it cannot be told).
-std::optional<HoleFinderOptions> sheet_band(const RepairArgs& a, const Grid<float>& image, const Grid<std::uint8_t>& mask,
-                                            const Grid<std::uint8_t>* roi) {
-    HoleFinderOptions o;
+// The sheet tissue's band (raw) and its class mean, for the finder and the sheet rule.
+struct SheetBand {
+    HoleFinderOptions finder;
+    double mean = 0;
+};
+
+// The sheet's band for the finder's verdicts and --decision sheet: given (its mean the band's
+// middle), or the tissue model's window and class mean for the class most of the segmentation's
+// voxels are in (nullopt when it cannot be told).
+std::optional<SheetBand> sheet_band(const RepairArgs& a, const Grid<float>& image, const Grid<std::uint8_t>& mask,
+                                    const Grid<std::uint8_t>* roi) {
+    SheetBand o;
     if (a.sheet_lower) {
-        o.sheet_lower = *a.sheet_lower;
-        o.sheet_upper = *a.sheet_upper;
+        o.finder.sheet_lower = *a.sheet_lower;
+        o.finder.sheet_upper = *a.sheet_upper;
+        o.mean = 0.5 * (*a.sheet_lower + *a.sheet_upper);
         return o;
     }
     std::vector<std::string> warnings;
-    const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, warnings);
+    TissueModel model;
+    const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, warnings, &model);
     if (!w) return std::nullopt;
-    o.sheet_lower = w->lower;
-    o.sheet_upper = w->upper;
+    o.finder.sheet_lower = w->lower;
+    o.finder.sheet_upper = w->upper;
+    o.mean = model.classes[static_cast<std::size_t>(w->seed_class)].mean;
     return o;
 }
 
@@ -141,12 +158,21 @@ void check_repair_args(RepairArgs& a) {
     if (!a.out_mask.empty()) check_output_path(a.out_mask, OutputKind::kImage, "--out-mask");
     if (!a.out_mesh.empty()) check_output_path(a.out_mesh, OutputKind::kMesh, "--out-mesh");
     if (!a.log.empty()) check_output_path(a.log, OutputKind::kText, "--log");
+    if (a.sheet_lower.has_value() != a.sheet_upper.has_value()) throw UsageError("give both --sheet-lower and --sheet-upper, or neither");
+    if (a.sheet_lower && !(*a.sheet_lower < *a.sheet_upper)) throw UsageError("--sheet-lower must be below --sheet-upper");
+    if (a.find_holes > 0) {
+        if (!a.targets.empty() || !a.targets_mm.empty()) throw UsageError("give --target/--target-mm or --find-holes, not both");
+        if (a.decision_given && a.decision != "sheet") throw UsageError("--find-holes repairs with the sheet rule: leave out --decision or give --decision sheet");
+        if (a.steps_given) throw UsageError("--find-holes runs --round-steps steps per hole: give --round-steps instead of --steps");
+        if (a.round_steps < 1) throw UsageError("--round-steps must be at least 1");
+        a.decision = "sheet";
+        if (!a.p_given) a.options.swarm.act_probability = FoundHolesInput::default_options().swarm.act_probability;
+    } else if (a.targets.empty() && a.targets_mm.empty()) {
+        throw UsageError("give at least one --target I,J,K[@STEP] (or --target-mm), or --find-holes N");
+    }
     a.options.swarm.decision = a.decision == "random" ? EditDecision::kRandom
                                : a.decision == "sheet" ? EditDecision::kSheet
                                                         : EditDecision::kIntensity;
-    if (a.sheet_lower.has_value() != a.sheet_upper.has_value()) throw UsageError("give both --sheet-lower and --sheet-upper, or neither");
-    if (a.sheet_lower && !(*a.sheet_lower < *a.sheet_upper)) throw UsageError("--sheet-lower must be below --sheet-upper");
-    if (a.targets.empty() && a.targets_mm.empty()) throw UsageError("give at least one --target I,J,K[@STEP] (or --target-mm)");
     if (!a.options.swarm.sheet_between && a.options.swarm.decision != EditDecision::kSheet)
         throw UsageError("--band-only is a setting of the sheet rule: give it with --decision sheet");
     if (!a.options.close_cracks && !a.options.topology_guard)
@@ -162,56 +188,9 @@ void check_repair_args(RepairArgs& a) {
     }
 }
 
-int run_repair_command(RepairArgs a, int threads) {
-    const auto guard = limit_threads(threads);
-    const InterruptGuard interrupt;
-    check_repair_args(a);
-
-    const Grid<float> image = read_image(a.image);
-    std::optional<Grid<std::uint8_t>> roi;
-    if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
-    std::vector<RepairTarget> targets;
-    for (const std::string& t : a.targets) targets.push_back(parse_target(t, image.lattice(), false));
-    for (const std::string& t : a.targets_mm) targets.push_back(parse_target(t, image.lattice(), true));
-    // The repair edits through a Session (the viewer's edit path: local update, history, mesher of
-    // 8³-cell fragments); the session's scale is robust_scale(image, roi), as before.
-    SessionOptions so;
-    so.fragment_size = 8;
-    Session session(image, so, roi);
-    load_level_set(session, a.input);
-    const SparseField& field = session.field();
-    check_targets(targets, field, roi ? &*roi : nullptr, a.options);
-    const IntensityScale scale = session.scale();
-    const Grid<std::uint8_t> mask_before = inside_mask(field.phi(), roi ? &*roi : nullptr);
-    const std::optional<HoleFinderOptions> band = sheet_band(a, image, mask_before, roi ? &*roi : nullptr);
-    if (a.options.swarm.decision == EditDecision::kSheet) {
-        if (!band) throw UsageError("--decision sheet: the tissue model cannot tell the sheet's tissue; give --sheet-lower and --sheet-upper");
-        a.options.swarm.sheet_lower = scale.to_unit(band->sheet_lower);
-        a.options.swarm.sheet_upper = scale.to_unit(band->sheet_upper);
-    }
-
-    session.set_repair_options(a.options);
-    const std::vector<RepairStepLog> log = run_targets(session, targets, a.options.steps, interrupt.flag());
-    if (interrupt.interrupted()) {
-        if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} steps; nothing written\n", log.size());
-        return 130;
-    }
-    const Grid<std::uint8_t> mask = inside_mask(field.phi(), roi ? &*roi : nullptr);
-    nlohmann::json verdicts = nlohmann::json::array();
-    std::size_t closed = 0;
-    if (band) {  // the finder's verdict per target (no ground truth)
-        const Grid<std::uint8_t> hb = hole_voxels(mask_before, image, roi ? &*roi : nullptr, *band);
-        const Grid<std::uint8_t> ha = hole_voxels(mask, image, roi ? &*roi : nullptr, *band);
-        for (const RepairTarget& t : targets) {
-            const HoleVerdict v = hole_verdict(t.position, kVerdictRadius, hb, ha, mask_before, mask);
-            closed += v.closed && v.before > 0;
-            verdicts.push_back(verdict_json(Vec3i{static_cast<int>(std::lround(t.position.x)), static_cast<int>(std::lround(t.position.y)),
-                                                  static_cast<int>(std::lround(t.position.z))}, 0, v));
-        }
-    }
-    if (!a.out_phi.empty()) write_image(field.phi(), a.out_phi);
-    if (!a.out_mask.empty()) write_label_image(mask, a.out_mask);
-    if (!a.out_mesh.empty()) write_mesh(a.out_mesh, marching_cubes_band(field.phi(), field.zero_layer()).view(), image.lattice());
+// The step log (--log), the summary (text or --json) of a --target run.
+void print_step_summary(const RepairArgs& a, const std::vector<RepairStepLog>& log, const nlohmann::json& verdicts,
+                        const std::optional<SheetBand>& band) {
     std::size_t modified = 0, fragments = 0;
     double ms = 0;
     std::string lines;
@@ -227,7 +206,7 @@ int run_repair_command(RepairArgs a, int threads) {
                      {"fragments_rebuilt", fragments}, {"ms_per_step", log.empty() ? 0.0 : ms / static_cast<double>(log.size())},
                      {"agents_on_surface_end", log.empty() ? 0 : log.back().on_surface}, {"targets", verdicts},
                      {"verdict_radius", kVerdictRadius}};
-    if (band) j["sheet_band"] = {band->sheet_lower, band->sheet_upper};
+    if (band) j["sheet_band"] = {band->finder.sheet_lower, band->finder.sheet_upper};
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
@@ -235,7 +214,111 @@ int run_repair_command(RepairArgs a, int threads) {
                    a.options.swarm.agents, modified, fragments, j["ms_per_step"].get<double>());
         print_verdicts(verdicts, band.has_value());
     }
+}
+
+// The outputs every path writes: --out-phi, --out-mask, --out-mesh.
+void write_outputs(const RepairArgs& a, const SparseField& field, const Grid<std::uint8_t>& mask, const Lattice& lattice) {
+    if (!a.out_phi.empty()) write_image(field.phi(), a.out_phi);
+    if (!a.out_mask.empty()) write_label_image(mask, a.out_mask);
+    if (!a.out_mesh.empty()) write_mesh(a.out_mesh, marching_cubes_band(field.phi(), field.zero_layer()).view(), lattice);
+}
+
+// What a repair run works on: the image, the ROI, the session holding the level set, the sheet band.
+struct RepairInputs {
+    Grid<float> image;
+    std::optional<Grid<std::uint8_t>> roi;
+    std::unique_ptr<Session> session;
+    std::optional<SheetBand> band;
+    Grid<std::uint8_t> mask_before;
+    const Grid<std::uint8_t>* roi_ptr() const { return roi ? &*roi : nullptr; }
+};
+
+RepairInputs load_inputs(const RepairArgs& a) {
+    RepairInputs in{read_image(a.image), std::nullopt, nullptr, std::nullopt, {}};
+    if (!a.roi.empty()) in.roi = load_mask_like(a.roi, in.image.lattice(), "--roi");
+    // The repair edits through a Session (the viewer's edit path: local update, history, mesher of
+    // 8³-cell fragments); the session's scale is robust_scale(image, roi), as before.
+    SessionOptions so;
+    so.fragment_size = 8;
+    in.session = std::make_unique<Session>(in.image, so, in.roi);
+    load_level_set(*in.session, a.input);
+    in.mask_before = inside_mask(in.session->field().phi(), in.roi_ptr());
+    in.band = sheet_band(a, in.image, in.mask_before, in.roi_ptr());
+    return in;
+}
+
+// --find-holes N: the demo's truth-free repair (finder_repair.hpp) on the user's own segmentation.
+int run_found_holes(const RepairArgs& a, RepairInputs& in, const InterruptGuard& interrupt) {
+    if (!in.band) throw UsageError("--find-holes: the tissue model cannot tell the sheet's tissue; give --sheet-lower and --sheet-upper");
+    FoundHolesInput f{in.image, in.roi_ptr(), in.session->scale()};
+    f.band_lower = in.band->finder.sheet_lower;
+    f.band_upper = in.band->finder.sheet_upper;
+    f.sheet_mean = in.band->mean;
+    f.max_targets = a.find_holes;
+    f.min_voxels = a.min_hole;
+    f.round_steps = a.round_steps;
+    f.options = a.options;
+    const nlohmann::json j = repair_found_holes(f, *in.session, true, &interrupt.flag());
+    if (interrupt.interrupted()) {
+        if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} steps; nothing written\n", j["steps"].get<std::size_t>());
+        return 130;
+    }
+    const SparseField& field = in.session->field();
+    write_outputs(a, field, inside_mask(field.phi(), in.roi_ptr()), in.image.lattice());
+    if (a.json) {
+        fmt::print("{}\n", j.dump());
+    } else if (!a.quiet) {
+        fmt::print("liveset repair --find-holes: {} targets from the finder (>= {} voxels; {} such holes before, {} after), {} agents x {} steps each, "
+                   "sheet rule: {} of {} closed by the finder's verdict, {} voxels added, {:.3f} ms/step\n",
+                   j["targets"].size(), a.min_hole, j["finder"]["before"].get<std::size_t>(), j["finder"]["after"].get<std::size_t>(),
+                   a.options.swarm.agents, a.round_steps, j["closed"].get<std::size_t>(), j["targets"].size(),
+                   j["voxels_added"].get<std::size_t>(), j["ms_per_step"].get<double>());
+        print_verdicts(j["verdicts"], true);
+    }
     return 0;
+}
+
+// --target / --target-mm: the swarm aimed where the user points, target k from its step on.
+int run_given_targets(RepairArgs a, RepairInputs& in, const InterruptGuard& interrupt) {
+    std::vector<RepairTarget> targets;
+    for (const std::string& t : a.targets) targets.push_back(parse_target(t, in.image.lattice(), false));
+    for (const std::string& t : a.targets_mm) targets.push_back(parse_target(t, in.image.lattice(), true));
+    Session& session = *in.session;
+    const SparseField& field = session.field();
+    check_targets(targets, field, in.roi_ptr(), a.options);
+    if (a.options.swarm.decision == EditDecision::kSheet) {
+        if (!in.band) throw UsageError("--decision sheet: the tissue model cannot tell the sheet's tissue; give --sheet-lower and --sheet-upper");
+        a.options.swarm.sheet_lower = session.scale().to_unit(in.band->finder.sheet_lower);
+        a.options.swarm.sheet_upper = session.scale().to_unit(in.band->finder.sheet_upper);
+    }
+    session.set_repair_options(a.options);
+    const std::vector<RepairStepLog> log = run_targets(session, targets, a.options.steps, interrupt.flag());
+    if (interrupt.interrupted()) {
+        if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} steps; nothing written\n", log.size());
+        return 130;
+    }
+    const Grid<std::uint8_t> mask = inside_mask(field.phi(), in.roi_ptr());
+    nlohmann::json verdicts = nlohmann::json::array();
+    if (in.band) {  // the finder's verdict per target (no ground truth)
+        const Grid<std::uint8_t> hb = hole_voxels(in.mask_before, in.image, in.roi_ptr(), in.band->finder);
+        const Grid<std::uint8_t> ha = hole_voxels(mask, in.image, in.roi_ptr(), in.band->finder);
+        for (const RepairTarget& t : targets) {
+            const HoleVerdict v = hole_verdict(t.position, kVerdictRadius, hb, ha, in.mask_before, mask);
+            verdicts.push_back(verdict_json(Vec3i{static_cast<int>(std::lround(t.position.x)), static_cast<int>(std::lround(t.position.y)),
+                                                  static_cast<int>(std::lround(t.position.z))}, 0, v));
+        }
+    }
+    write_outputs(a, field, mask, in.image.lattice());
+    print_step_summary(a, log, verdicts, in.band);
+    return 0;
+}
+
+int run_repair_command(RepairArgs a, int threads) {
+    const auto guard = limit_threads(threads);
+    const InterruptGuard interrupt;
+    check_repair_args(a);
+    RepairInputs in = load_inputs(a);
+    return a.find_holes > 0 ? run_found_holes(a, in, interrupt) : run_given_targets(a, in, interrupt);
 }
 
 }  // namespace
@@ -244,9 +327,13 @@ void add_repair_command(CLI::App& app, const int& threads) {
     static RepairArgs ra;
     auto* r = app.add_subcommand("repair", "agent-swarm repair of a segmentation around target points (paper section 4)");
     r->add_option("input", ra.input, "phi (<0 inside) or 0/1 mask to repair")->required();
-    r->add_option("--image", ra.image, "the image the segmentation came from")->required();
+    r->add_option("--image", ra.image, "the image the segmentation came from (the --out-corrected image when it was segmented with --bias-correct)")->required();
     r->add_option("--target", ra.targets, "target voxel I,J,K[@STEP] (from step STEP on; default 0); repeatable");
     r->add_option("--target-mm", ra.targets_mm, "target X,Y,Z[@STEP] in physical LPS mm; repeatable");
+    r->add_option("--find-holes", ra.find_holes, "no targets needed: the truth-free hole finder's N largest holes (as `liveset holes` lists them, >= --min-hole voxels, 12 voxels apart) are repaired one round each with the sheet rule, the brush sized to the hole and the band sampled around it, as `liveset demo --brain --repair` does (p 0.3 unless --p is given)")
+        ->check(CLI::Range(std::size_t{1}, std::size_t{1000}));
+    r->add_option("--round-steps", ra.round_steps, "with --find-holes: swarm steps per hole")->check(CLI::Range(1, 10'000'000))->capture_default_str();
+    r->add_option("--min-hole", ra.min_hole, "with --find-holes: the smallest hole repaired, voxels")->check(CLI::Range(std::size_t{1}, std::size_t{1} << 40))->capture_default_str();
     r->add_option("--roi", ra.roi, "region-of-interest mask the surface may not grow out of");
     r->add_option("--agents", ra.options.swarm.agents, "number of agents")->check(CLI::Range(1, 1'000'000))->capture_default_str();
     r->add_option("--steps", ra.options.steps, "swarm steps")->check(CLI::Range(0, 10'000'000))->capture_default_str();
@@ -273,7 +360,12 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--log", ra.log, "one JSON line per step: step, agents_on_surface, points_modified, changed, fragments_rebuilt, ms, cpu_ms (processor time)");
     r->add_flag("--json", ra.json, "print the summary as one JSON object");
     r->add_flag("--quiet,-q", ra.quiet, "print nothing");
-    r->callback([&threads] {
+    r->callback([&threads, r] {
+        ra.p_given = r->count("--p") > 0;
+        ra.decision_given = r->count("--decision") > 0;
+        ra.steps_given = r->count("--steps") > 0;
+        if (ra.find_holes == 0 && (r->count("--round-steps") > 0 || r->count("--min-hole") > 0))
+            throw UsageError("--round-steps and --min-hole are settings of --find-holes");
         const int rc = run_repair_command(ra, threads);
         if (rc != 0) std::exit(rc);
     });

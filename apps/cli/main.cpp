@@ -35,7 +35,10 @@ int main(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+        // One line, as every other bad input (CLI11's own would add a second, "Run with --help").
+        fmt::print(stderr, "liveset: error: {} (see --help)\n", e.what());
+        return e.get_exit_code();
     } catch (const liveset::cli::UsageError& e) {
         fmt::print(stderr, "liveset: error: {}\n", e.what());
         return 1;

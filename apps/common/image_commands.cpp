@@ -12,13 +12,19 @@
 namespace liveset::cli {
 
 Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& reference, const std::string& option) {
-    Grid<std::uint8_t> m = read_label_image(path);
+    // Read as real values: a MINC byte mask whose real range is 0..1 holds 1/255 inside, a resampled
+    // mask fractions; non-zero is inside, whatever the type (README, "ROI").
+    const Grid<float> raw = read_image(path);
     try {
-        require_same_geometry(m.lattice(), reference, option);
+        require_same_geometry(raw.lattice(), reference, option);
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{} {} does not overlay the image: {}", option, path, e.what()));
     }
-    for (std::uint8_t& v : m.values()) v = v != 0;
+    Grid<std::uint8_t> m(raw.lattice(), 0);
+    for (PointIndex i = 0; i < raw.size(); ++i) {
+        if (!std::isfinite(raw[i])) throw UsageError(fmt::format("{} {} is not a mask: it holds NaN or infinite values", option, path));
+        m[i] = raw[i] != 0.0f;
+    }
     return m;
 }
 

@@ -102,3 +102,45 @@ TEST(RoiAutoCli, BadInputIsOneLineAndWritesNothing) {
         EXPECT_FALSE(fs::exists(roi));
     }
 }
+
+// A ROI file is a mask by its real values, non-zero inside (README): a MINC byte mask with real
+// range 0..1 holds 1/255 inside, a resampled one fractions. The same region given as 0/1 labels, as
+// 0/(1/255) reals and as 0/0.37 reals segments the same voxels; a NaN in it is one line, nothing written.
+TEST(RoiAutoCli, AMaskIsItsNonZeroRealValues) {
+    const Grid<float> image = read_image(head_image().string());
+    Grid<std::uint8_t> labels(image.lattice(), 0);
+    Grid<float> scaled(image.lattice(), 0.0f), fraction(image.lattice(), 0.0f);
+    for (int z = 0; z < 64; ++z)
+        for (int y = 0; y < 64; ++y)
+            for (int x = 0; x < 64; ++x)
+                if (1.5 * norm(Vec3d{x - 31.5, y - 31.5, z - 31.5}) < 24) labels({x, y, z}) = 1, scaled({x, y, z}) = 1.0f / 255, fraction({x, y, z}) = 0.37f;
+    write_label_image(labels, (work_dir() / "roi_labels.nii.gz").string());
+    write_image(scaled, (work_dir() / "roi_scaled.nii.gz").string());
+    write_image(fraction, (work_dir() / "roi_fraction.nii.gz").string());
+    std::vector<Grid<std::uint8_t>> segs;
+    for (const char* name : {"roi_labels", "roi_scaled", "roi_fraction"}) {
+        const fs::path seg = work_dir() / (std::string(name) + "_seg.nii.gz");
+        const auto r = run_cli("--threads 1 segment " + head_image().string() + " --roi " + (work_dir() / (std::string(name) + ".nii.gz")).string() +
+                               " --seed 32,32,32:3 --mu-raw 112 --epsilon-raw 40 --iterations 200 --quiet --out-mask " + seg.string());
+        ASSERT_EQ(r.rc, 0) << name << ": " << r.err;
+        segs.push_back(read_label_image(seg.string()));
+    }
+    std::size_t inside = 0, outside_roi = 0;
+    for (PointIndex i = 0; i < labels.size(); ++i) inside += segs[0][i] != 0, outside_roi += segs[0][i] && !labels[i];
+    EXPECT_GT(inside, 1000u);
+    EXPECT_EQ(outside_roi, 0u);
+    for (int k : {1, 2}) {
+        std::size_t differ = 0;
+        for (PointIndex i = 0; i < labels.size(); ++i) differ += segs[k][i] != segs[0][i];
+        EXPECT_EQ(differ, 0u) << k;
+    }
+
+    scaled[0] = std::nanf("");
+    write_image(scaled, (work_dir() / "roi_nan.nii.gz").string());
+    const fs::path out = work_dir() / "nan_seg.nii.gz";
+    const auto r = run_cli("segment " + head_image().string() + " --roi " + (work_dir() / "roi_nan.nii.gz").string() +
+                           " --seed 32,32,32:3 --iterations 5 --quiet --out-mask " + out.string());
+    EXPECT_NE(r.rc, 0);
+    EXPECT_EQ(lines(r.err), 1) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+}

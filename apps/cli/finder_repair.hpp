@@ -1,0 +1,38 @@
+// Truth-free hole repair as a user without ground truth does it: the hole finder picks the targets,
+// one sheet-rule round per target (brush sized to the hole, the sheet's band sampled around it),
+// the finder's verdict per target. Shared by `liveset demo --brain --repair` and `liveset repair --find-holes`.
+#pragma once
+
+#include <atomic>
+#include <cstddef>
+#include <nlohmann/json.hpp>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/segment/intensity.hpp"
+#include "liveset/session/session.hpp"
+#include "liveset/swarm/repair.hpp"
+
+namespace liveset::cli {
+
+struct FoundHolesInput {
+    const Grid<float>& image;            // the image the segmentation came from (raw units)
+    const Grid<std::uint8_t>* roi;       // region of interest (outside counts as the outside tissue); may be null
+    IntensityScale scale;                // the session's normalisation of `image`
+    double band_lower = 0, band_upper = 0;  // the sheet tissue's band (raw; the tissue model's window)
+    double sheet_mean = 0;               // the sheet tissue's class mean (raw)
+    std::size_t max_targets = 10;        // the largest holes clicked, one round each
+    std::size_t min_voxels = 50;         // the finder's smallest target
+    int round_steps = 1000;              // swarm steps per target
+    RepairOptions options = default_options();  // swarm settings (the decision is the sheet rule)
+
+    // The paper's 200 agents, p = 0.3, edit radius 2.
+    static RepairOptions default_options();
+};
+
+// Finder -> targets -> one round per target through `session` (which holds the segmentation) ->
+// verdicts. Returns {targets, verdicts, closed, agents, p, steps, points_modified, voxels_added,
+// ms_per_step, round_steps, finder: {band, min_voxels, before, after}}. Throws UsageError on a bad
+// input (band not ordered, no targets wanted). Stops early when *interrupt is set (the caller checks it).
+nlohmann::json repair_found_holes(const FoundHolesInput& in, Session& session, bool quiet, const std::atomic<bool>* interrupt = nullptr);
+
+}  // namespace liveset::cli
