@@ -29,7 +29,9 @@ void expect_closed_with_dice_up(int size, int seed, bool genus = true) {
     const auto &before = j["before"], &after = j["after"];
     EXPECT_GT(before["holes"].get<long>(), 0) << size << "/" << seed << ": the segmentation leaves holes to repair";
     EXPECT_EQ(after["holes"].get<long>(), 0) << size << "/" << seed;
-    if (genus) EXPECT_EQ(after["genus"].get<long>(), 0) << size << "/" << seed;
+    if (genus) {
+        EXPECT_EQ(after["genus"].get<long>(), 0) << size << "/" << seed;
+    }
     EXPECT_GT(after["dice"].get<double>(), before["dice"].get<double>()) << size << "/" << seed;
 }
 
