@@ -1,8 +1,8 @@
 #!/bin/sh
 # The phantom repair sweep (issue 18 item 5): liveset demo at sizes 64, 96, 128 x phantom seeds 1-3
 # with one repair rule; one line per case: size seed dice_before dice_after holes_before holes_after genus_after.
-# Usage: scripts/phantom_sweep.sh [intensity|sheet] [BUILD=build]
-rule=${1:-sheet}; build=${2:-build}; tmp=$(mktemp -d)
+# Usage: scripts/phantom_sweep.sh [sheet-fallback|intensity|sheet] [BUILD=build]
+rule=${1:-sheet-fallback}; build=${2:-build}; tmp=$(mktemp -d)
 for size in 64 96 128; do
   for seed in 1 2 3; do
     "$build/liveset" --threads 1 demo --size "$size" --seed "$seed" --repair-rule "$rule" --out "$tmp/d" --json --no-view |

@@ -4,6 +4,7 @@
 // timings) and every output written to a folder.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -37,7 +38,9 @@ struct DemoArgs {
     std::uint64_t seed = 1;
     int rounds = 20;        // repair rounds (one target each)
     int round_steps = 100;  // swarm steps per round
-    std::string rule = "intensity";  // repair rule: intensity (population statistics) or sheet
+    // Repair rule: sheet-fallback (the default: the sheet rule, a stalled hole's round the intensity
+    // rule), sheet, or intensity (population statistics).
+    std::string rule = "sheet-fallback";
     bool json = false, quiet = false, no_view = false;
     bool brain = false;  // the real-brain demo instead (demo_brain.hpp)
     bool repair = false;  // with --brain: the paper's Figure 5 (low threshold, finder, swarm repair)
@@ -50,7 +53,12 @@ double ms_since(std::chrono::steady_clock::time_point t0) {
 
 // --repair-rule sheet: the sheet rule (EditDecision::kSheet) with the grey matter's band from the
 // tissue model of the phantom, shifted to the sheet's intensity around each target.
-RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, const SparseField& repaired, RepairOptions& ro) {
+// With `fallback` (--repair-rule sheet-fallback) a round aimed at a hole whose earlier round stalled
+// (HoleSite::stalled_rounds: the sheet rule changed nothing there, e.g. a bias-bright tunnel whose
+// voxels lie above the band) uses the intensity rule of demo_repair_options() instead, its brush
+// at most that rule's 8 voxels: only where the sheet rule already failed, one small brush at a time.
+RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, const SparseField& repaired, RepairOptions& ro,
+                            bool fallback) {
     std::vector<std::string> warnings;
     TissueModel model;
     const std::optional<ModelWindow> w = sheet_window(image, o.mask, nullptr, TissueModelOptions{}, warnings, &model);
@@ -67,6 +75,12 @@ RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, c
         const auto [l, u] = local_sheet_band(*unit, field->phi(), t.position, 10.0, lo, hi, mean);
         r.swarm.sheet_lower = l;
         r.swarm.sheet_upper = u;
+        if (fallback && t.stalled_rounds > 0) {
+            const RepairOptions d = demo_repair_options();
+            r.swarm.decision = d.swarm.decision;
+            r.swarm.edit_radius = d.swarm.edit_radius;
+            r.swarm.edit_range = std::min(r.swarm.edit_range, d.swarm.edit_range);
+        }
     };
 }
 
@@ -82,7 +96,8 @@ nlohmann::json run_demo_repair(const DemoArgs& a, const Phantom& ph, const Segme
     ro.swarm.seed = a.seed;
     // The holes a user would point at: perforations first, then spurious cavities (bubbles).
     // The sheet rule is aimed at each hole's widest opening, the intensity rule at its centroid.
-    const HoleAim aim = a.rule == "sheet" ? HoleAim::kOpening : HoleAim::kCentroid;
+    const bool sheet = a.rule != "intensity";
+    const HoleAim aim = sheet ? HoleAim::kOpening : HoleAim::kCentroid;
     const HoleSiteFinder holes_left = [&](const SparseField& field) {
         return truth_hole_sites(inside_mask(field.phi()), ph.truth, white, aim);
     };
@@ -92,8 +107,8 @@ nlohmann::json run_demo_repair(const DemoArgs& a, const Phantom& ph, const Segme
     so.rounds = a.rounds;
     so.round_steps = a.round_steps;
     RoundSetup setup;
-    if (a.rule == "sheet") {
-        setup = sheet_rule_setup(ph.image, o, session.field(), ro);
+    if (sheet) {
+        setup = sheet_rule_setup(ph.image, o, session.field(), ro, a.rule == "sheet-fallback");
         // The sheet rule raises only the sheet's tissue or what lies between its sides, so the
         // brush may span a whole hole (the intensity rule's growth spills, its brush stays at 8).
         so.max_range = 16.0;
@@ -161,6 +176,8 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     // statistics window, which its repair presets were made for. (The tissue model's window, the
     // default of `liveset segment`, gives Dice 0.9752 here, but the repair rounds then leave one
     // tunnel: holes 2 -> 1; docs/BENCHMARKS.md. `liveset demo --brain` shows the model window.)
+    // --repair-rule sheet alone segments with the model's window (docs/BENCHMARKS.md, session 10);
+    // its tunnels at 96^3 include handles of bias-bright voxels that no growth can close.
     req.window.estimate = a.rule == "sheet" ? WindowSource::kModel : WindowSource::kSeeds;
     const bool quiet_progress = a.quiet || a.json;
     const SegmentRun run = segment_with_progress(ph.image, req, quiet_progress);
@@ -249,7 +266,7 @@ void add_demo_command(CLI::App& app, const int& threads, DemoWindow window) {
     demo->add_option("--seed", da.seed, "phantom noise seed")->capture_default_str();
     demo->add_option("--rounds", da.rounds, "repair rounds (one target, the largest hole left, each)")->check(CLI::Range(0, 1000))->capture_default_str();
     demo->add_option("--round-steps", da.round_steps, "swarm steps per repair round")->check(CLI::Range(1, 100000))->capture_default_str();
-    demo->add_option("--repair-rule", da.rule, "intensity: the population-statistics rule with the seeds' window (the presets); sheet: the sheet rule with the tissue model's window")->check(CLI::IsMember({"intensity", "sheet"}))->capture_default_str();
+    demo->add_option("--repair-rule", da.rule, "sheet-fallback: the sheet rule, a hole whose round stalled gets the intensity rule (seeds' window); intensity: the population-statistics rule with the seeds' window (the presets); sheet: the sheet rule with the tissue model's window")->check(CLI::IsMember({"sheet-fallback", "intensity", "sheet"}))->capture_default_str();
     demo->add_flag("--json", da.json, "print the report as one JSON object on stdout");
     demo->add_flag("--quiet,-q", da.quiet, "print nothing");
     demo->add_flag("--no-view", da.no_view, "do not open the viewer even when a display is available (--json implies it)");

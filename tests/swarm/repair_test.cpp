@@ -231,5 +231,86 @@ TEST(Repair, PocketLimitMatchesTheCountedCavity) {
     }
 }
 
+// A plate three voxels thick with a one-voxel slit at x = 15 from y = y0 to y1 - 1 (every z of the
+// plate): the slit's voxels, the plate's, and the Euler characteristic of the plate with and
+// without the slit filled, counted by brute force (mask_topology over the whole lattice).
+struct SlitPlate {
+    Grid<std::uint8_t> plate, slit;
+    long euler_open = 0, euler_filled = 0;
+    SlitPlate(const Lattice& lat, int y0, int y1) : plate(lat, 0), slit(lat, 0) {
+        for (int z = 10; z < 13; ++z)
+            for (int y = 5; y < 35; ++y)
+                for (int x = 5; x < 25; ++x) (x == 15 && y >= y0 && y < y1 ? slit : plate)({x, y, z}) = 1;
+        Grid<std::uint8_t> filled = plate;
+        for (PointIndex i = 0; i < filled.size(); ++i) filled[i] = plate[i] || slit[i];
+        euler_open = mask_topology(plate).euler_solid;
+        euler_filled = mask_topology(filled).euler_solid;
+    }
+};
+
+// A slit 24 voxels long (72 voxels, far beyond the 3 voxels the crack used to be gathered within):
+// one growth edit in its middle fills it whole, exactly its voxels, and the tunnel closes (the
+// brute-force χ rises by one). A sulcus-like slit — the same slit opened at the plate's edge, a
+// notch and no tunnel: filling it changes no χ — is never zipped: the edit is dropped, nothing added.
+TEST(Repair, ALongSlitClosesWholeButASulcusIsNotZipped) {
+    const Lattice lat({30, 40, 30});
+    const SlitPlate tunnel(lat, 8, 32);
+    ASSERT_EQ(tunnel.euler_filled, tunnel.euler_open + 1);
+    SparseField f = field_from_mask(tunnel.plate);
+    std::vector<ZeroLayerEdit> edits{{lat.index({15, 20, 11}), -0.4f}};
+    EXPECT_EQ(guard_topology(f, edits), 0u);
+    std::size_t slit_voxels = 0;
+    for (PointIndex i = 0; i < tunnel.slit.size(); ++i) slit_voxels += tunnel.slit[i];
+    ASSERT_EQ(slit_voxels, 72u);
+    ASSERT_EQ(edits.size(), slit_voxels);
+    for (const ZeroLayerEdit& e : edits) EXPECT_TRUE(tunnel.slit[e.point]);
+    f.apply_edits(edits);
+    const Grid<std::uint8_t> after = inside_mask(f.phi());
+    for (PointIndex i = 0; i < after.size(); ++i) ASSERT_EQ(after[i], tunnel.plate[i] || tunnel.slit[i]);
+    EXPECT_EQ(mask_topology(after).euler_solid, tunnel.euler_filled);
+
+    const SlitPlate sulcus(lat, 5, 29);  // open at y = 5, the plate's edge
+    ASSERT_EQ(sulcus.euler_filled, sulcus.euler_open);
+    SparseField g = field_from_mask(sulcus.plate);
+    for (const int y : {8, 17, 27}) {
+        edits = {{lat.index({15, y, 11}), -0.4f}};
+        EXPECT_EQ(guard_topology(g, edits), 1u) << "y " << y;
+        EXPECT_TRUE(edits.empty()) << "y " << y;
+    }
+}
+
+// A slit whose voxels the fronts have not come close to yet (φ 0.8: off the zero layer, no edit can
+// flip them) but one: the refused bridge there deepens the inside voxels beside the slit (no sign
+// changes, the brute-force χ stays), which brings the slit onto the zero layer; the same edit
+// repeated then fills the slit whole and the tunnel closes. No step changes the topology otherwise.
+TEST(Repair, ASlitOffTheZeroLayerIsPreparedThenFilled) {
+    const Lattice lat({30, 40, 30});
+    const SlitPlate tunnel(lat, 10, 30);
+    const Vec3i start{15, 20, 11};
+    SparseField f(lat, 2);
+    f.init_from_sdf([&](Vec3d p) {
+        const Vec3i q = p.cast<int>();
+        if (tunnel.plate(q)) return -0.3;
+        return tunnel.slit(q) && !(q == start) ? 0.8 : 0.3;
+    });
+    ASSERT_NE(f.status()[lat.index({15, 21, 11})], 0);
+    bool filled = false;
+    for (int step = 0; step < 6 && !filled; ++step) {
+        std::vector<ZeroLayerEdit> edits{{lat.index(start), -0.4f}};
+        guard_topology(f, edits);
+        f.apply_edits(edits);
+        const Grid<std::uint8_t> now = inside_mask(f.phi());
+        const long euler = mask_topology(now).euler_solid;
+        filled = euler == tunnel.euler_filled;
+        if (!filled) {
+            ASSERT_EQ(euler, tunnel.euler_open) << "step " << step;
+            for (PointIndex i = 0; i < now.size(); ++i) ASSERT_EQ(now[i], tunnel.plate[i]) << "step " << step;
+        } else {
+            for (PointIndex i = 0; i < now.size(); ++i) ASSERT_EQ(now[i], tunnel.plate[i] || tunnel.slit[i]) << "step " << step;
+        }
+    }
+    EXPECT_TRUE(filled);
+}
+
 }  // namespace
 }  // namespace liveset

@@ -236,5 +236,44 @@ TEST(SheetRepair, ClosesABiasBrightHoleAddingOnlyTheHolesVoxels) {
     }
 }
 
+// HoleSite::stalled_rounds, as the round's setup sees it: the band-only rule cannot raise the
+// bias-bright drill, so every round stalls at the one hole and round r is told r earlier rounds
+// stalled there (counted here from the finder's answers before and after each round).
+TEST(SheetRepair, EachRoundIsToldHowOftenItsHoleStalled) {
+    Shell s = drilled_shell(3.0);
+    Grid<std::uint8_t> drill(s.mask.lattice(), 0);
+    for (PointIndex i = 0; i < drill.size(); ++i)
+        if (s.image[i] == kGm && !s.mask[i]) {
+            drill[i] = 1;
+            s.image[i] = kWm;
+        }
+    std::vector<std::size_t> sizes;  // the hole's size at each call of the finder
+    const HoleSiteFinder find = [&](const SparseField& f) {
+        const Grid<std::uint8_t> m = inside_mask(f.phi());
+        std::size_t missing = 0;
+        for (PointIndex i = 0; i < m.size(); ++i) missing += drill[i] && !m[i];
+        sizes.push_back(missing);
+        return std::vector<HoleSite>{{Vec3d{kCentre.x + 23, kCentre.y, kCentre.z}, missing}};
+    };
+    std::vector<int> told;
+    const RoundSetup setup = [&](RepairOptions&, const HoleSite& t) { told.push_back(t.stalled_rounds); };
+    SparseField field(s.mask.lattice(), 2);
+    field.init_from_mask(s.mask);
+    RepairOptions ro = sheet_options();
+    ro.swarm.sheet_between = false;
+    RepairScheduleOptions so;
+    so.rounds = 4;
+    so.round_steps = 30;
+    run_repair_schedule(field, s.image, nullptr, ro, so, find, setup);
+    ASSERT_EQ(told.size(), 4u);
+    ASSERT_EQ(sizes.size(), 5u);
+    int stalled = 0;
+    for (std::size_t r = 0; r < told.size(); ++r) {
+        EXPECT_EQ(told[r], stalled) << "round " << r;
+        stalled += static_cast<double>(sizes[r + 1]) > 0.95 * static_cast<double>(sizes[r]);
+    }
+    EXPECT_EQ(stalled, 4);  // nothing in the drill is in the band
+}
+
 }  // namespace
 }  // namespace liveset

@@ -69,11 +69,14 @@ std::size_t brush_pocket_limit(double edit_range);
 // made, nothing split) or an isolated inside voxel. Growth that closes a tunnel or fills a
 // cavity is kept, growth that seals a pocket of at most options.pocket_limit voxels is not.
 // Flips already accepted count for the later points. Returns the number dropped.
-// Cracks (options.close_cracks): a bridge's crack is the outside voxels 6-connected to it within 3
-// voxels that each lie between two inside voxels along one of the 13 directions through them; it is
-// filled whole (every crack point's edit becomes −0.5) when each is a zero-layer point that edit
-// flips (φ < 0.5), in the ROI, the fill raises the Euler characteristic (counted in the box around
-// the crack: it closes a tunnel) and it seals no pocket; else the edit is dropped as before.
+// Cracks (options.close_cracks): a bridge's crack is the outside voxels 6-connected to it that each
+// lie between two inside voxels along one of the 13 directions through them, gathered along the
+// whole slit (at most 512 voxels, all in the ROI); it is filled whole (every crack point's edit
+// becomes −0.5) when the fill raises the Euler characteristic (counted in the box around the crack:
+// it closes a tunnel), seals no pocket and each crack voxel is a zero-layer point that edit flips
+// (φ < 0.5). When only the last fails, the inside zero-layer face neighbours of the voxels that
+// cannot flip get −0.5 instead (no sign changes: the slit comes onto the zero layer for a later
+// batch). Else the edit is dropped as before.
 std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits, const GuardOptions& options = {});
 
 // One repair step's outcome: the log line plus the changed points X (for the mesher).

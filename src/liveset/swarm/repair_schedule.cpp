@@ -92,7 +92,9 @@ HoleSite next_target(const std::vector<HoleSite>& holes, const std::vector<Vec3d
         const long n = stalls(h);
         if (n < fewest) best = &h, fewest = n;
     }
-    return *best;
+    HoleSite out = *best;
+    out.stalled_rounds = static_cast<int>(fewest);
+    return out;
 }
 
 // Whether the round aimed at `target` shrank its hole: no hole of at least kMinShrink of its size is

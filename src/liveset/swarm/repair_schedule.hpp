@@ -24,6 +24,7 @@ double hole_brush_range(std::size_t hole_voxels, double shell_thickness = 3.0, d
 struct HoleSite {
     Vec3d position;          // index space: where the round aims the swarm
     std::size_t voxels = 0;  // the hole's size (sizes the brush)
+    int stalled_rounds = 0;  // set by run_repair_schedule: earlier rounds at this site that stalled
 };
 
 struct RepairScheduleOptions {

@@ -5,6 +5,7 @@
 #include <climits>
 #include <cmath>
 #include <cstdint>
+#include <span>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -16,8 +17,10 @@ namespace liveset {
 namespace {
 
 constexpr std::size_t kMaxPocketLimit = 32768;
-constexpr int kCrackReach = 3;         // voxels from the refused bridge (Chebyshev)
-constexpr std::size_t kMaxCrack = 64;  // a longer crack waits until the fronts zip it shorter
+// A crack is gathered whole, up to this many voxels (a one-voxel slit where two fronts met can be
+// tens of voxels long and, across a sheet a few voxels thick, a few hundred); a larger region of
+// outside voxels between inside ones is no crack but a sulcus's worth, and is left alone.
+constexpr std::size_t kMaxCrack = 512;
 constexpr float kCrackEdit = -0.5f;    // the edit each crack point gets
 constexpr float kFlippable = 0.5f;     // ... which flips it when φ is below this
 
@@ -97,12 +100,16 @@ public:
     bool inside(Vec3i q) const { return lat_.contains(q) && inside_at(lat_.index(q)); }
     bool keep(const ZeroLayerEdit& e);  // false: drop the edit
     const std::vector<PointIndex>& crack_points() const { return cracks_; }
+    const std::vector<PointIndex>& deepened_points() const { return deepen_; }
 
 private:
-    bool seals_pocket_around(Vec3i c);
+    bool seals_pocket_around(std::span<const Vec3i> cs);
+    bool seals_pocket_around(const std::vector<PointIndex>& points);
     std::vector<PointIndex> gather_crack(Vec3i start) const;
     bool fill_crack(Vec3i start);
-    bool may_fill(Vec3i q) const;
+    void prepare_crack(const std::vector<PointIndex>& crack);
+    bool in_roi(Vec3i q) const;
+    bool flippable(PointIndex i) const;
 
     const SparseField& field_;
     const Lattice& lat_;
@@ -119,21 +126,31 @@ private:
     std::vector<PointIndex> filtered_;  // the points this batch set in flip_filter_
     std::unordered_set<PointIndex> tried_;          // crack points already tried in this batch
     std::vector<PointIndex> cracks_;                // crack points filled (their edits become kCrackEdit)
+    std::vector<PointIndex> deepen_;                // inside points deepened to prepare a crack (edits kCrackEdit)
+    std::unordered_set<PointIndex> deepened_;       // ... as a set: no flip there is accepted in this batch
 };
 
 thread_local std::vector<std::uint8_t> Guard::flip_filter_;
 
-// Whether some face neighbour's outside region of c (c counted inside) is a pocket of at most
-// pocket_limit voxels. One batch of floods: a neighbour in a component already flooded is skipped.
-bool Guard::seals_pocket_around(Vec3i c) {
+// Whether some face neighbour's outside region of a voxel of `cs` (counted inside) is a pocket of at
+// most pocket_limit voxels. One batch of floods: a neighbour in a component already flooded is skipped.
+bool Guard::seals_pocket_around(std::span<const Vec3i> cs) {
     thread_local FloodMarks marks;
     marks.begin(lat_.size());
     const auto outside_at = [this](PointIndex i) { return !inside_at(i); };
-    for (int k = 0; k < 6; ++k) {
-        const Vec3i q = face_neighbour(c, k);
-        if (lat_.contains(q) && !inside(q) && encloses_small_pocket(lat_, marks, outside_at, q, o_.pocket_limit)) return true;
-    }
+    for (const Vec3i c : cs)
+        for (int k = 0; k < 6; ++k) {
+            const Vec3i q = face_neighbour(c, k);
+            if (lat_.contains(q) && !inside(q) && encloses_small_pocket(lat_, marks, outside_at, q, o_.pocket_limit)) return true;
+        }
     return false;
+}
+
+bool Guard::seals_pocket_around(const std::vector<PointIndex>& points) {
+    std::vector<Vec3i> cs;
+    cs.reserve(points.size());
+    for (PointIndex i : points) cs.push_back(lat_.coord(i));
+    return seals_pocket_around(std::span<const Vec3i>(cs));
 }
 
 bool Guard::keep(const ZeroLayerEdit& e) {
@@ -141,6 +158,7 @@ bool Guard::keep(const ZeroLayerEdit& e) {
     const float after = before + std::clamp(e.delta, -0.5f, 0.5f);
     const bool was_in = before < 0.0f, is_in = after < 0.0f;
     if (was_in == is_in) return true;
+    if (deepened_.count(e.point)) return false;  // deepened to prepare a crack: stays inside
     const Vec3i c = lat_.coord(e.point);
     const TopologicalNumbers t = topological_numbers([this](Vec3i q) { return inside(q); }, c);
     bool ok = is_in ? t.foreground == 1 : (t.background == 1 && t.foreground <= 1);
@@ -148,7 +166,7 @@ bool Guard::keep(const ZeroLayerEdit& e) {
     // pocket off (a spurious cavity): refuse the latter.
     if (ok && is_in && t.background >= 2) {
         flip(e.point, true);
-        ok = !seals_pocket_around(c);
+        ok = !seals_pocket_around(std::span<const Vec3i>(&c, 1));
         flipped_.erase(e.point);
     }
     if (!ok && is_in && t.foreground >= 2 && o_.close_cracks) return fill_crack(c);
@@ -156,9 +174,7 @@ bool Guard::keep(const ZeroLayerEdit& e) {
     return ok;
 }
 
-bool Guard::may_fill(Vec3i q) const {
-    const PointIndex i = lat_.index(q);
-    if (field_.status()[i] != 0 || !(field_.phi()[i] < kFlippable) || tried_.count(i)) return false;
+bool Guard::in_roi(Vec3i q) const {
     if (!o_.roi) return true;
     for (int k = 0; k < 7; ++k) {
         const Vec3i r = k ? face_neighbour(q, k - 1) : q;
@@ -167,8 +183,13 @@ bool Guard::may_fill(Vec3i q) const {
     return true;
 }
 
-// The crack of a refused bridge at `start` (see guard_topology); empty when some crack voxel may
-// not be filled or the crack is longer than kMaxCrack.
+// A crack voxel's edit flips it this step: a zero-layer point with φ below kFlippable.
+bool Guard::flippable(PointIndex i) const { return field_.status()[i] == 0 && field_.phi()[i] < kFlippable; }
+
+// The crack of a refused bridge at `start` (see guard_topology): the outside voxels 6-connected to
+// it that each lie between two inside voxels along one of the 13 lines through them — the whole
+// one-voxel slit where two fronts met, however long. Empty when it holds more than kMaxCrack
+// voxels, a voxel outside the ROI or one already tried in this batch.
 std::vector<PointIndex> Guard::gather_crack(Vec3i start) const {
     const auto between_fronts = [this](Vec3i q) {
         for (const auto& d : kLineDirections) {
@@ -177,17 +198,18 @@ std::vector<PointIndex> Guard::gather_crack(Vec3i start) const {
         }
         return false;
     };
+    const PointIndex s = lat_.index(start);
+    if (tried_.count(s) || !in_roi(start)) return {};
     std::vector<Vec3i> queue{start};
-    std::vector<PointIndex> crack{lat_.index(start)};
-    if (!may_fill(start)) return {};
+    std::vector<PointIndex> crack{s};
+    std::unordered_set<PointIndex> seen{s};
     for (std::size_t head = 0; head < queue.size(); ++head) {
         for (int k = 0; k < 6; ++k) {
             const Vec3i q = face_neighbour(queue[head], k);
-            const Vec3i d = q - start;
-            if (std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}) > kCrackReach || !lat_.contains(q) || inside(q)) continue;
+            if (!lat_.contains(q) || inside(q)) continue;
             const PointIndex i = lat_.index(q);
-            if (std::find(crack.begin(), crack.end(), i) != crack.end() || !between_fronts(q)) continue;
-            if (!may_fill(q) || crack.size() >= kMaxCrack) return {};
+            if (!seen.insert(i).second || !between_fronts(q)) continue;
+            if (tried_.count(i) || !in_roi(q) || crack.size() >= kMaxCrack) return {};
             crack.push_back(i);
             queue.push_back(q);
         }
@@ -196,8 +218,12 @@ std::vector<PointIndex> Guard::gather_crack(Vec3i start) const {
 }
 
 // Fills the crack of the bridge at `start` when that closes a tunnel: the Euler characteristic
-// (components − tunnels + cavities) rises, no component can appear, and no pocket is sealed, so a
-// tunnel closed. Returns whether it did.
+// (components − tunnels + cavities) counted in the crack's box rises with the whole crack filled,
+// no component can appear, and no pocket is sealed, so a tunnel closed. A crack some of whose
+// voxels this step's edit cannot flip yet (off the zero layer, or φ ≥ kFlippable: the fronts have
+// not come close enough) is prepared instead: the inside zero-layer face neighbours of those voxels
+// are deepened (their edits become kCrackEdit; no sign changes), which brings the crack onto the
+// zero layer for a later step. Returns whether the crack is filled this step.
 bool Guard::fill_crack(Vec3i start) {
     const std::vector<PointIndex> crack = gather_crack(start);
     for (PointIndex i : crack) tried_.insert(i);
@@ -212,15 +238,42 @@ bool Guard::fill_crack(Vec3i start) {
     hi = hi + Vec3i{1, 1, 1};
     const auto in = [this](Vec3i q) { return inside(q); };
     const long chi_before = euler_characteristic_26(in, lo, hi);
-    for (PointIndex i : crack) flip(i, true);
-    bool ok = euler_characteristic_26(in, lo, hi) > chi_before;
-    for (std::size_t k = 0; k < crack.size() && ok; ++k) ok = !seals_pocket_around(lat_.coord(crack[k]));
-    if (!ok) {
-        for (PointIndex i : crack) flipped_.erase(i);
+    // The crack voxels' states before (a voxel flipped out earlier in this batch keeps that flip
+    // when the fill is refused).
+    std::vector<std::pair<PointIndex, int>> saved;  // -1: no flip recorded, else the flip's state
+    saved.reserve(crack.size());
+    for (PointIndex i : crack) {
+        const auto it = flipped_.find(i);
+        saved.emplace_back(i, it == flipped_.end() ? -1 : int(it->second));
+        flip(i, true);
+    }
+    const bool ok = euler_characteristic_26(in, lo, hi) > chi_before && !seals_pocket_around(crack);
+    const bool ready = std::all_of(crack.begin(), crack.end(), [this](PointIndex i) { return flippable(i); });
+    if (!ok || !ready) {
+        for (const auto& [i, state] : saved) {
+            if (state < 0) flipped_.erase(i);
+            else flipped_[i] = state != 0;
+        }
+        if (ok) prepare_crack(crack);
         return false;
     }
     cracks_.insert(cracks_.end(), crack.begin(), crack.end());
     return true;
+}
+
+// Deepens the inside zero-layer face neighbours of the crack voxels that cannot flip yet.
+void Guard::prepare_crack(const std::vector<PointIndex>& crack) {
+    for (PointIndex i : crack) {
+        if (flippable(i)) continue;
+        const Vec3i c = lat_.coord(i);
+        for (int k = 0; k < 6; ++k) {
+            const Vec3i q = face_neighbour(c, k);
+            if (!lat_.contains(q)) continue;
+            const PointIndex j = lat_.index(q);
+            if (field_.status()[j] == 0 && field_.phi()[j] < 0.0f && inside_at(j) && in_roi(q) && deepened_.insert(j).second)
+                deepen_.push_back(j);
+        }
+    }
 }
 
 }  // namespace
@@ -240,9 +293,11 @@ std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>&
         return true;
     });
     const std::vector<PointIndex>& crack = guard.crack_points();
-    if (crack.empty()) return dropped;
-    // Every crack point's edit becomes kCrackEdit (added where the swarm proposed none), in point order.
+    if (crack.empty() && guard.deepened_points().empty()) return dropped;
+    // Every crack point's edit, and every deepened point's, becomes kCrackEdit (added where the swarm
+    // proposed none), in point order.
     std::unordered_set<PointIndex> filled(crack.begin(), crack.end());
+    filled.insert(guard.deepened_points().begin(), guard.deepened_points().end());
     for (ZeroLayerEdit& e : edits)
         if (filled.erase(e.point)) e.delta = kCrackEdit;
     for (PointIndex i : filled) edits.push_back({i, kCrackEdit});
