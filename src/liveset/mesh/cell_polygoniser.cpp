@@ -188,7 +188,7 @@ void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& o
     for (int j = 0; j < n; ++j) out.indices[base + static_cast<std::size_t>(j)] = v[tri[static_cast<std::size_t>(j)]];
 }
 
-void CellPolygoniser::emit_cell_owned(const Grid<float>& phi, Vec3i c, int cs, Mesh& out) {
+void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Mesh& out) {
     const auto& tables = mc::kTables;
     const std::size_t row = (static_cast<std::size_t>(c.y - lo_.y) * static_cast<std::size_t>(px_) +
                              static_cast<std::size_t>(c.x - lo_.x)) * 3;
@@ -208,17 +208,10 @@ void CellPolygoniser::emit_cell_owned(const Grid<float>& phi, Vec3i c, int cs, M
     for (unsigned mask = edges & owned; mask != 0; mask &= mask - 1) {
         const int e = std::countr_zero(mask);
         const mc::EdgeStart& es = mc::kEdgeStarts[static_cast<std::size_t>(e)];
-        if (out.vertices.size() >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
-        const auto id = static_cast<std::uint32_t>(out.vertices.size());
-        const Vec3i p{c.x + es.dx, c.y + es.dy, c.z + es.dz};
-        const int ax = es.axis;
-        if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (ax == 0) <= dims_.x - 2 && p.y + (ax == 1) <= dims_.y - 2 &&
-            p.z + (ax == 2) <= dims_.z - 2) {
-            const std::size_t i = static_cast<std::size_t>(p.x) + static_cast<std::size_t>(p.y) * sy_ + static_cast<std::size_t>(p.z) * sz_;
-            out.vertices.push_back(edge_vertex_interior(values_, i, p, ax, sy_, sz_));
-        } else {
-            out.vertices.push_back(make_edge_vertex(phi, p, ax));
-        }
+        if (out.vertices.size() + deferred_.size() >= 0xFFFF'FFFFu)
+            throw std::length_error("mesh has too many vertices for 32-bit indices");
+        const auto id = static_cast<std::uint32_t>(out.vertices.size() + deferred_.size());
+        deferred_.push_back({{c.x + es.dx, c.y + es.dy, c.z + es.dz}, es.axis});  // computed by finish_vertices()
         gid_[gindex(es)] = id;
         v[e] = id;
         ++computed_;
@@ -229,6 +222,25 @@ void CellPolygoniser::emit_cell_owned(const Grid<float>& phi, Vec3i c, int cs, M
     out.indices.resize(base + static_cast<std::size_t>(n));
     std::uint32_t* dst = out.indices.data() + base;
     for (int j = 0; j < n; ++j) dst[j] = v[tri[static_cast<std::size_t>(j)]];
+}
+
+void CellPolygoniser::finish_vertices(const Grid<float>& phi, Mesh& out) {
+    // One simple loop over independent vertices: the φ loads of consecutive vertices overlap.
+    const std::size_t first = out.vertices.size();
+    out.vertices.resize(first + deferred_.size());
+    Vertex* dst = out.vertices.data() + first;
+    for (std::size_t k = 0; k < deferred_.size(); ++k) {
+        const Vec3i p = deferred_[k].p;
+        const int ax = deferred_[k].axis;
+        if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (ax == 0) <= dims_.x - 2 && p.y + (ax == 1) <= dims_.y - 2 &&
+            p.z + (ax == 2) <= dims_.z - 2) {
+            const std::size_t i = static_cast<std::size_t>(p.x) + static_cast<std::size_t>(p.y) * sy_ + static_cast<std::size_t>(p.z) * sz_;
+            dst[k] = edge_vertex_interior(values_, i, p, ax, sy_, sz_);
+        } else {
+            dst[k] = make_edge_vertex(phi, p, ax);
+        }
+    }
+    deferred_.clear();
 }
 
 void CellPolygoniser::polygonise_box(const Grid<float>& phi, Vec3i lo, Vec3i hi, Mesh& out,
@@ -289,6 +301,7 @@ void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& si
         throw std::invalid_argument("row bitmaps are smaller than the box's cell rows");
     if (ny <= 0 || hi.x <= lo.x) return;
     if (gid_.size() < 2 * slice_) gid_.resize(2 * slice_, 0);
+    deferred_.clear();
     const FastDivider div_y(static_cast<std::uint32_t>(ny));
     const std::size_t wpr = signs.words_per_row;
     const auto k0 = static_cast<std::size_t>(lo.x) >> 6, k1 = static_cast<std::size_t>(hi.x - 1) >> 6;
@@ -310,13 +323,14 @@ void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& si
                 any = true;
                 for (; cross != 0; cross &= cross - 1) {
                     const int x = static_cast<int>(64 * k) + std::countr_zero(cross);
-                    emit_cell_owned(phi, {x, y, z}, cr.cell_case(x), out);
+                    emit_cell_owned({x, y, z}, cr.cell_case(x), out);
                     ++cells_;
                 }
             }
             if (any) crossing_rows[r >> 6] |= std::uint64_t{1} << (r & 63);
         }
     }
+    finish_vertices(phi, out);
 }
 
 }  // namespace liveset

@@ -115,7 +115,8 @@ private:
     // emit_cell() for polygonise_rows(), which visits every crossing cell of the box: a cell creates
     // exactly the vertices of the edges it is the first visited cell of (kOwnedEdges) and reads the
     // others from gid_, with no generation test.
-    void emit_cell_owned(const Grid<float>& phi, Vec3i c, int cs, Mesh& out);
+    void emit_cell_owned(Vec3i c, int cs, Mesh& out);
+    void finish_vertices(const Grid<float>& phi, Mesh& out);  // computes deferred_ into out.vertices
 
     // G: 2 slices * px * py * 3 entries, each (generation << 32 | vertex id). An entry is set only
     // when its generation equals its slot's current one, so a slice is cleared in O(1) by giving
@@ -123,6 +124,11 @@ private:
     std::vector<std::uint64_t> g_;
     std::array<std::uint64_t, 2> generation_{};  // current generation per slot, in the high half
     std::vector<std::uint32_t> gid_;  // polygonise_rows()' G, same layout: vertex ids only
+    struct DeferredVertex {
+        Vec3i p;
+        int axis;
+    };
+    std::vector<DeferredVertex> deferred_;  // polygonise_rows()' vertices, ids assigned, not yet computed
     std::uint32_t next_generation_ = 1;
     IndexDecoder decoder_;  // for the lattice of dims decoder_dims_
     Vec3i decoder_dims_{};
