@@ -50,10 +50,12 @@ struct CellRows {
         return cross;
     }
     static int bit(const std::uint64_t* row, int x) { return static_cast<int>((row[x >> 6] >> (x & 63)) & 1u); }
-    int cell_case(int x) const {
-        return bit(r[0], x) | bit(r[0], x + 1) << 1 | bit(r[1], x) << 2 | bit(r[1], x + 1) << 3 | bit(r[2], x) << 4 |
-               bit(r[2], x + 1) << 5 | bit(r[3], x) << 6 | bit(r[3], x + 1) << 7;
+    // Bits x and x + 1 of a row (corners x and x + 1 of the cell) as bits 0 and 1.
+    static int pair(const std::uint64_t* row, int x) {
+        if ((x & 63) != 63) return static_cast<int>((row[x >> 6] >> (x & 63)) & 3u);
+        return bit(row, x) | bit(row, x + 1) << 1;
     }
+    int cell_case(int x) const { return pair(r[0], x) | pair(r[1], x) << 2 | pair(r[2], x) << 4 | pair(r[3], x) << 6; }
 };
 
 }  // namespace liveset
