@@ -240,6 +240,24 @@ TEST(FragmentMesher, ResultsIndependentOfThreadCount) {
     expect_same_meshers(runs[0], runs[2]);
 }
 
+TEST(FragmentMesher, IncrementalUpdatesIndependentOfThreadCount) {
+    // The X pass flags fragments and queues sign-flip rows from several threads; the result must not
+    // depend on how many.
+    std::vector<FragmentMesher> runs;
+    for (int threads : {1, 2}) {
+        tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+        SparseField f(Lattice({36, 34, 32}), 2);
+        f.init_from_sdf(shapes::Sphere({17.5, 16.5, 15.5}, 4.0));
+        const testing::BlobSpeed speed({17.5, 16.5, 15.5}, 11.0);
+        FragmentMesher m(f.lattice(), 4);
+        m.full_rebuild(f.phi(), f.zero_layer());
+        for (int s = 1; s <= 60; ++s) m.update(f.phi(), f.step(speed, StepOptions{}).changed.points);
+        runs.push_back(std::move(m));
+    }
+    ASSERT_GT(runs[0].triangle_count(), 0u);
+    expect_same_meshers(runs[0], runs[1]);
+}
+
 TEST(FragmentMesher, SingleFragmentUpdateIsSurfaceProportional) {
     Grid<float> phi = sphere_field({64, 64, 64}, {31.7, 32.2, 31.4}, 20);
     FragmentMesher m(phi.lattice(), 64);
