@@ -240,6 +240,24 @@ TEST(FragmentMesher, ResultsIndependentOfThreadCount) {
     expect_same_meshers(runs[0], runs[2]);
 }
 
+TEST(FragmentMesher, IncrementalUpdatesIndependentOfThreadCount) {
+    // The X pass flags fragments and queues sign-flip rows from several threads; the result must not
+    // depend on how many.
+    std::vector<FragmentMesher> runs;
+    for (int threads : {1, 2}) {
+        tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+        SparseField f(Lattice({36, 34, 32}), 2);
+        f.init_from_sdf(shapes::Sphere({17.5, 16.5, 15.5}, 4.0));
+        const testing::BlobSpeed speed({17.5, 16.5, 15.5}, 11.0);
+        FragmentMesher m(f.lattice(), 4);
+        m.full_rebuild(f.phi(), f.zero_layer());
+        for (int s = 1; s <= 60; ++s) m.update(f.phi(), f.step(speed, StepOptions{}).changed.points);
+        runs.push_back(std::move(m));
+    }
+    ASSERT_GT(runs[0].triangle_count(), 0u);
+    expect_same_meshers(runs[0], runs[1]);
+}
+
 TEST(FragmentMesher, SingleFragmentUpdateIsSurfaceProportional) {
     Grid<float> phi = sphere_field({64, 64, 64}, {31.7, 32.2, 31.4}, 20);
     FragmentMesher m(phi.lattice(), 64);
@@ -247,13 +265,36 @@ TEST(FragmentMesher, SingleFragmentUpdateIsSurfaceProportional) {
     m.full_rebuild(phi);
     EXPECT_EQ(m.last_stats().cells_visited, 63u * 63u * 63u);
     const std::size_t crossing = marching_cubes_naive(phi).triangle_count();
+    // Brute force: the cell rows (y, z) holding a crossing cell, and the crossing cells.
+    const auto crossing_rows = [](const Grid<float>& g, std::size_t* cells) {
+        std::set<std::pair<int, int>> rows;
+        *cells = 0;
+        for (int z = 0; z < 63; ++z)
+            for (int y = 0; y < 63; ++y)
+                for (int xx = 0; xx < 63; ++xx) {
+                    const int cs = cell_case(g, {xx, y, z});
+                    if (cs == 0 || cs == 255) continue;
+                    rows.insert({y, z});
+                    ++*cells;
+                }
+        return rows;
+    };
+    std::size_t cells_before = 0, cells_after = 0;
+    std::set<std::pair<int, int>> rows = crossing_rows(phi, &cells_before);
     const Vec3i p{52, 32, 31};
-    phi(p) = -0.7f;
+    ASSERT_FALSE(is_inside(phi(p)));
+    phi(p) = -0.7f;  // flips: the 4 cell rows around p become candidates too
+    for (int z = p.z - 1; z <= p.z; ++z)
+        for (int y = p.y - 1; y <= p.y; ++y) rows.insert({y, z});
+    crossing_rows(phi, &cells_after);
     const std::vector<PointIndex> x{phi.lattice().index(p)};
     EXPECT_EQ(m.update(phi, x), (std::vector<FragmentId>{0}));
-    // Visits the crossing cells plus the 8 around the edit: far fewer than the 250k cells.
+    // Visits the old crossing rows plus those around the flipped point (a third of the 3969 rows)
+    // and polygonises exactly the crossing cells: far fewer than the 250k cells.
+    EXPECT_EQ(m.last_stats().rows_visited, rows.size());
+    EXPECT_LT(m.last_stats().rows_visited, 63u * 63u / 2);
+    EXPECT_EQ(m.last_stats().cells_visited, cells_after);
     EXPECT_LT(m.last_stats().cells_visited, crossing);
-    EXPECT_LT(m.last_stats().cells_visited, 63u * 63u * 63u / 20);
     EXPECT_EQ(canonical_triangles(m.merged()), canonical_triangles(marching_cubes_naive(phi)));
 }
 

@@ -18,6 +18,25 @@ namespace {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
+// Edges whose vertex a cell creates when cells are visited in z, y, x order and every crossing cell
+// of the box is visited: a crossing edge makes all 4 cells around it crossing, so its vertex is
+// created by the first of them in that order that lies in the box - the cell at (start - 1) on
+// each other axis b, or at start[b] when start[b] - 1 is outside the box. Indexed by bit b set when
+// the cell is at the box's low end on axis b.
+constexpr std::array<unsigned, 8> kOwnedEdges = [] {
+    std::array<unsigned, 8> t{};
+    for (unsigned low = 0; low < 8; ++low)
+        for (int e = 0; e < mc::kEdges; ++e) {
+            const mc::EdgeStart& es = mc::kEdgeStarts[static_cast<std::size_t>(e)];
+            const int d[3] = {es.dx, es.dy, es.dz};
+            bool owned = true;
+            for (int b = 0; b < 3; ++b)
+                if (b != es.axis && d[b] == 0 && (low & (1u << b)) == 0) owned = false;
+            if (owned) t[low] |= 1u << e;
+        }
+    return t;
+}();
+
 // central_gradient() with a fast path for points whose 6-neighbours are all inside the lattice:
 // the same arithmetic ((φ(p+e) - φ(p-e)) / 2), so bit-identical results, without clamping.
 inline Vec3f gradient(const Grid<float>& phi, Vec3i p) {
@@ -90,6 +109,10 @@ void CellPolygoniser::prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi) {
         decoder_dims_ = d;
     }
     lo_ = lo;
+    dims_ = d;
+    values_ = phi.values().data();
+    sy_ = phi.lattice().stride_y();
+    sz_ = phi.lattice().stride_z();
     px_ = hi.x - lo.x + 1;
     py_ = hi.y - lo.y + 1;
     slice_ = static_cast<std::size_t>(px_) * static_cast<std::size_t>(py_) * 3;
@@ -99,6 +122,8 @@ void CellPolygoniser::prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi) {
     renew_slot(1);
     layer_ = INT_MIN;
     computed_ = 0;
+    cells_ = 0;
+    rows_ = 0;
 }
 
 void CellPolygoniser::renew_slot(int slot) {
@@ -143,7 +168,15 @@ void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& o
         }
         if (out.vertices.size() >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
         const auto id = static_cast<std::uint32_t>(out.vertices.size());
-        out.vertices.push_back(make_edge_vertex(phi, {c.x + es.dx, c.y + es.dy, c.z + es.dz}, es.axis));
+        const Vec3i p{c.x + es.dx, c.y + es.dy, c.z + es.dz};
+        const int ax = es.axis;
+        if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (ax == 0) <= dims_.x - 2 && p.y + (ax == 1) <= dims_.y - 2 &&
+            p.z + (ax == 2) <= dims_.z - 2) {  // inlined here: no Vertex round trip through memory
+            const std::size_t i = static_cast<std::size_t>(p.x) + static_cast<std::size_t>(p.y) * sy_ + static_cast<std::size_t>(p.z) * sz_;
+            out.vertices.push_back(edge_vertex_interior(values_, i, p, ax, sy_, sz_));
+        } else {
+            out.vertices.push_back(make_edge_vertex(phi, p, ax));
+        }
         entry = generation_[slot] | id;
         v[e] = id;
         ++computed_;
@@ -153,6 +186,61 @@ void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& o
     const std::size_t base = out.indices.size();
     out.indices.resize(base + static_cast<std::size_t>(n));
     for (int j = 0; j < n; ++j) out.indices[base + static_cast<std::size_t>(j)] = v[tri[static_cast<std::size_t>(j)]];
+}
+
+void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Mesh& out) {
+    const auto& tables = mc::kTables;
+    const std::size_t row = (static_cast<std::size_t>(c.y - lo_.y) * static_cast<std::size_t>(px_) +
+                             static_cast<std::size_t>(c.x - lo_.x)) * 3;
+    const std::size_t row_step = static_cast<std::size_t>(px_) * 3;
+    const int slot0 = c.z & 1;
+    const auto gindex = [&](const mc::EdgeStart& es) {
+        return static_cast<std::size_t>(slot0 ^ es.dz) * slice_ + row + static_cast<std::size_t>(es.dy) * row_step +
+               static_cast<std::size_t>(es.dx) * 3 + static_cast<std::size_t>(es.axis);
+    };
+    const unsigned edges = tables.edges[static_cast<std::size_t>(cs)];
+    const unsigned owned = kOwnedEdges[static_cast<std::size_t>((c.x == lo_.x) | (c.y == lo_.y) << 1 | (c.z == lo_.z) << 2)];
+    std::uint32_t v[mc::kEdges];
+    for (unsigned mask = edges & ~owned; mask != 0; mask &= mask - 1) {  // created by an earlier cell
+        const int e = std::countr_zero(mask);
+        v[e] = gid_[gindex(mc::kEdgeStarts[static_cast<std::size_t>(e)])];
+    }
+    for (unsigned mask = edges & owned; mask != 0; mask &= mask - 1) {
+        const int e = std::countr_zero(mask);
+        const mc::EdgeStart& es = mc::kEdgeStarts[static_cast<std::size_t>(e)];
+        if (out.vertices.size() + deferred_.size() >= 0xFFFF'FFFFu)
+            throw std::length_error("mesh has too many vertices for 32-bit indices");
+        const auto id = static_cast<std::uint32_t>(out.vertices.size() + deferred_.size());
+        deferred_.push_back({{c.x + es.dx, c.y + es.dy, c.z + es.dz}, es.axis});  // computed by finish_vertices()
+        gid_[gindex(es)] = id;
+        v[e] = id;
+        ++computed_;
+    }
+    const auto& tri = tables.triangles[static_cast<std::size_t>(cs)];
+    const int n = 3 * tables.triangle_count[static_cast<std::size_t>(cs)];
+    const std::size_t base = out.indices.size();
+    out.indices.resize(base + static_cast<std::size_t>(n));
+    std::uint32_t* dst = out.indices.data() + base;
+    for (int j = 0; j < n; ++j) dst[j] = v[tri[static_cast<std::size_t>(j)]];
+}
+
+void CellPolygoniser::finish_vertices(const Grid<float>& phi, Mesh& out) {
+    // One simple loop over independent vertices: the φ loads of consecutive vertices overlap.
+    const std::size_t first = out.vertices.size();
+    out.vertices.resize(first + deferred_.size());
+    Vertex* dst = out.vertices.data() + first;
+    for (std::size_t k = 0; k < deferred_.size(); ++k) {
+        const Vec3i p = deferred_[k].p;
+        const int ax = deferred_[k].axis;
+        if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (ax == 0) <= dims_.x - 2 && p.y + (ax == 1) <= dims_.y - 2 &&
+            p.z + (ax == 2) <= dims_.z - 2) {
+            const std::size_t i = static_cast<std::size_t>(p.x) + static_cast<std::size_t>(p.y) * sy_ + static_cast<std::size_t>(p.z) * sz_;
+            dst[k] = edge_vertex_interior(values_, i, p, ax, sy_, sz_);
+        } else {
+            dst[k] = make_edge_vertex(phi, p, ax);
+        }
+    }
+    deferred_.clear();
 }
 
 void CellPolygoniser::polygonise_box(const Grid<float>& phi, Vec3i lo, Vec3i hi, Mesh& out,
@@ -167,6 +255,7 @@ void CellPolygoniser::polygonise_box(const Grid<float>& phi, Vec3i lo, Vec3i hi,
                 if (cs == 0 || cs == 255) continue;
                 enter_layer(z);
                 emit_cell(phi, c, cs, out);
+                ++cells_;
                 if (crossing_cells) crossing_cells->push_back(l.index(c));
             }
         }
@@ -195,8 +284,53 @@ void CellPolygoniser::polygonise_cells(const Grid<float>& phi, Vec3i lo, Vec3i h
         if (cs == 0 || cs == 255) continue;
         enter_layer(c.z);
         emit_cell(phi, c, cs, out);
+        ++cells_;
         if (crossing_cells) crossing_cells->push_back(key);
     }
+}
+
+void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& signs, Vec3i lo, Vec3i hi,
+                                      std::span<const std::uint64_t> rows_a, std::span<const std::uint64_t> rows_b, Mesh& out,
+                                      std::span<std::uint64_t> crossing_rows) {
+    prepare(phi, lo, hi);
+    if (!(signs.dims == phi.dims())) throw std::invalid_argument("sign bits do not match the phi grid");
+    const int ny = hi.y - lo.y;
+    const std::size_t nrows = static_cast<std::size_t>(ny) * static_cast<std::size_t>(hi.z - lo.z);
+    const std::size_t nwords = (nrows + 63) / 64;
+    if (rows_a.size() < nwords || rows_b.size() < nwords || crossing_rows.size() < nwords)
+        throw std::invalid_argument("row bitmaps are smaller than the box's cell rows");
+    if (ny <= 0 || hi.x <= lo.x) return;
+    if (gid_.size() < 2 * slice_) gid_.resize(2 * slice_, 0);
+    deferred_.clear();
+    const FastDivider div_y(static_cast<std::uint32_t>(ny));
+    const std::size_t wpr = signs.words_per_row;
+    const auto k0 = static_cast<std::size_t>(lo.x) >> 6, k1 = static_cast<std::size_t>(hi.x - 1) >> 6;
+    for (std::size_t w = 0; w < nwords; ++w) {
+        for (std::uint64_t m = rows_a[w] | rows_b[w]; m != 0; m &= m - 1) {
+            const auto r = static_cast<std::uint32_t>(64 * w + static_cast<std::size_t>(std::countr_zero(m)));
+            if (r >= nrows) break;
+            ++rows_;
+            const std::uint32_t rz = div_y.divide(r);
+            const int y = lo.y + static_cast<int>(r - rz * static_cast<std::uint32_t>(ny)), z = lo.z + static_cast<int>(rz);
+            const CellRows cr(signs, y, z);
+            bool any = false;
+            for (std::size_t k = k0; k <= k1; ++k) {
+                std::uint64_t cross = cr.crossing_unmasked(k, wpr);
+                const int from = lo.x - static_cast<int>(64 * k), to = hi.x - static_cast<int>(64 * k);  // cells [from, to) of word k
+                if (from > 0) cross &= ~std::uint64_t{0} << from;
+                if (to < 64) cross &= (std::uint64_t{1} << to) - 1;
+                if (cross == 0) continue;
+                any = true;
+                for (; cross != 0; cross &= cross - 1) {
+                    const int x = static_cast<int>(64 * k) + std::countr_zero(cross);
+                    emit_cell_owned({x, y, z}, cr.cell_case(x), out);
+                    ++cells_;
+                }
+            }
+            if (any) crossing_rows[r >> 6] |= std::uint64_t{1} << (r & 63);
+        }
+    }
+    finish_vertices(phi, out);
 }
 
 }  // namespace liveset

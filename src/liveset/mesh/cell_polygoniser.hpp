@@ -15,6 +15,7 @@
 #include "liveset/grid/grid.hpp"
 #include "liveset/grid/index_decoder.hpp"
 #include "liveset/mesh/mesh.hpp"
+#include "liveset/mesh/sign_bits.hpp"
 
 namespace liveset {
 
@@ -49,16 +50,22 @@ inline Vertex edge_vertex_interior(const float* v, std::size_t i, Vec3i p, int a
     const float s = 1.0f - t;
     const float n[3] = {s * ga[0] + t * gb[0], s * ga[1] + t * gb[1], s * ga[2] + t * gb[2]};
     const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    Vertex out{};
+    // Every field is a scalar assigned once (no store through a run-time axis index), so the caller
+    // receives the vertex in registers rather than through a stack copy it must reload.
+    float nx = 0.0f, ny = 0.0f, nz = 0.0f;
     if (std::isfinite(len) && len > 1e-20f) {
         const float inv = 1.0f / len;
-        for (int k = 0; k < 3; ++k) out.normal[k] = n[k] * inv;
+        nx = n[0] * inv;
+        ny = n[1] * inv;
+        nz = n[2] * inv;
     } else {
-        out.normal[axis] = is_inside(a) ? 1.0f : -1.0f;
+        const float d = is_inside(a) ? 1.0f : -1.0f;
+        nx = axis == 0 ? d : 0.0f;
+        ny = axis == 1 ? d : 0.0f;
+        nz = axis == 2 ? d : 0.0f;
     }
-    for (int k = 0; k < 3; ++k) out.position[k] = static_cast<float>(p[k]);
-    out.position[axis] = static_cast<float>(p[axis]) + t;
-    return out;
+    const float px = static_cast<float>(p.x), py = static_cast<float>(p.y), pz = static_cast<float>(p.z);
+    return Vertex{{axis == 0 ? px + t : px, axis == 1 ? py + t : py, axis == 2 ? pz + t : pz}, {nx, ny, nz}};
 }
 
 // Marching-cubes case index of the cell with minimum corner c (bit k set when corner k is inside).
@@ -83,28 +90,58 @@ public:
     void polygonise_cells(const Grid<float>& phi, Vec3i lo, Vec3i hi, std::span<const CellKey> cells,
                           Mesh& out, std::vector<CellKey>* crossing_cells = nullptr);
 
+    // Visits the cell rows of the box listed in the bitmap rows_a | rows_b (bit (y - lo.y) +
+    // (hi.y - lo.y) * (z - lo.z) for cell row (y, z); both spans hold ceil(rows / 64) words) and,
+    // in each, the cells whose corners differ in sign, read 64 at a time from `signs` (which must
+    // be φ's sign bits). Sets in `crossing_rows` (same layout, cleared by the caller) the rows that
+    // hold a crossing cell. Gives the same output as polygonise_box() when the listed rows include
+    // every row of the box with a crossing.
+    void polygonise_rows(const Grid<float>& phi, const SignBits& signs, Vec3i lo, Vec3i hi,
+                         std::span<const std::uint64_t> rows_a, std::span<const std::uint64_t> rows_b, Mesh& out,
+                         std::span<std::uint64_t> crossing_rows);
+
     // Lattice-edge vertices computed by the last call (each exactly once).
     std::size_t vertices_computed() const { return computed_; }
+    // Crossing cells polygonised by the last call.
+    std::size_t cells_polygonised() const { return cells_; }
+    // Cell rows examined by the last polygonise_rows() call.
+    std::size_t rows_visited() const { return rows_; }
 
 private:
     void prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi);
     void enter_layer(int z);
     void renew_slot(int slot);
     void emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& out);
+    // emit_cell() for polygonise_rows(), which visits every crossing cell of the box: a cell creates
+    // exactly the vertices of the edges it is the first visited cell of (kOwnedEdges) and reads the
+    // others from gid_, with no generation test.
+    void emit_cell_owned(Vec3i c, int cs, Mesh& out);
+    void finish_vertices(const Grid<float>& phi, Mesh& out);  // computes deferred_ into out.vertices
 
     // G: 2 slices * px * py * 3 entries, each (generation << 32 | vertex id). An entry is set only
     // when its generation equals its slot's current one, so a slice is cleared in O(1) by giving
     // its slot a new generation.
     std::vector<std::uint64_t> g_;
     std::array<std::uint64_t, 2> generation_{};  // current generation per slot, in the high half
+    std::vector<std::uint32_t> gid_;  // polygonise_rows()' G, same layout: vertex ids only
+    struct DeferredVertex {
+        Vec3i p;
+        int axis;
+    };
+    std::vector<DeferredVertex> deferred_;  // polygonise_rows()' vertices, ids assigned, not yet computed
     std::uint32_t next_generation_ = 1;
     IndexDecoder decoder_;  // for the lattice of dims decoder_dims_
     Vec3i decoder_dims_{};
     Vec3i lo_{};
+    Vec3i dims_{};                   // φ's lattice, its values and strides (set by prepare())
+    const float* values_ = nullptr;
+    std::size_t sy_ = 0, sz_ = 0;
     int px_ = 0, py_ = 0;
     std::size_t slice_ = 0;  // entries per slice
     int layer_ = INT_MIN;    // cell layer z currently being polygonised
     std::size_t computed_ = 0;
+    std::size_t cells_ = 0;
+    std::size_t rows_ = 0;
 };
 
 }  // namespace liveset

@@ -14,16 +14,16 @@
 
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
+#include "liveset/mesh/slab_marching_cubes.hpp"
 
 namespace liveset {
 
 struct FragmentMesher::Scratch {
     struct Local {
         CellPolygoniser poly;
-        std::vector<CellKey> candidates;
-        std::vector<CellKey> crossing;
+        std::vector<CellKey> crossing;     // a scan's crossing cells
+        std::vector<std::uint64_t> rows;   // the rebuilt fragment's new crossing rows
         std::vector<FragmentId> flagged;   // fragments this thread flagged in B during update()
-        std::vector<PointIndex> flipped;   // changed points whose sign flipped
     };
     tbb::enumerable_thread_specific<Local> locals;
 };
@@ -42,7 +42,9 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
     fragments_.resize(n);
     flags_.assign(n, 0);
     decode_ = IndexDecoder(lattice);
-    inside_.assign(lattice.size() / 64 + 1, 0);
+    signs_.dims = d;
+    signs_.words_per_row = (static_cast<std::size_t>(std::max(d.x, 0)) + 63) / 64;
+    signs_.words.assign(static_cast<std::size_t>(std::max(d.y, 0)) * static_cast<std::size_t>(std::max(d.z, 0)) * signs_.words_per_row, 0);
     if (n > 0) {
         for (int a = 0; a < 3; ++a) {
             auto& t = ranges_[a];
@@ -55,6 +57,17 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
                 r.wide_lo = std::max(v - 2, 0) / size_;
                 r.wide_hi = std::min(v + 1, last) / size_;
             }
+            const std::uint32_t stride = a == 0 ? 1u : a == 1 ? static_cast<std::uint32_t>(fdims_.x)
+                                                              : static_cast<std::uint32_t>(fdims_.x) * static_cast<std::uint32_t>(fdims_.y);
+            single_[a].resize(t.size());
+            for (std::size_t v = 0; v < t.size(); ++v)
+                single_[a][v] = t[v].wide_lo == t[v].wide_hi ? static_cast<std::uint32_t>(t[v].wide_lo) * stride : kSpansFragments;
+            cell_fragment_[a].resize(static_cast<std::size_t>(cells_[a]));
+            cell_offset_[a].resize(static_cast<std::size_t>(cells_[a]));
+            for (int c = 0; c < cells_[a]; ++c) {
+                cell_fragment_[a][static_cast<std::size_t>(c)] = c / size_;
+                cell_offset_[a][static_cast<std::size_t>(c)] = c % size_;
+            }
         }
     }
     for (FragmentId id = 0; id < n; ++id) {
@@ -64,6 +77,9 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
             f.origin[a] = fc[a] * size_;
             f.extent[a] = std::min(size_, cells_[a] - f.origin[a]);
         }
+        const std::size_t words = (static_cast<std::size_t>(f.extent.y) * static_cast<std::size_t>(f.extent.z) + 63) / 64;
+        f.rows.assign(words, 0);
+        f.pending.assign(words, 0);
     }
 }
 
@@ -134,52 +150,46 @@ std::vector<FragmentId> FragmentMesher::affected_fragments(std::span<const Point
 }
 
 void FragmentMesher::rebuild(const Grid<float>& phi, std::span<const FragmentId> ids, bool scan) {
-    std::atomic<std::size_t> visited{0}, computed{0};
+    std::atomic<std::size_t> visited{0}, rows{0}, computed{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
         Scratch::Local& local = scratch_->locals.local();
-        std::size_t my_visited = 0, my_computed = 0;
+        std::size_t my_visited = 0, my_rows = 0, my_computed = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             Fragment& f = fragments_[ids[i]];
             const Vec3i hi = f.origin + f.extent;
             f.mesh.clear();
-            local.crossing.clear();
+            local.rows.assign(f.rows.size(), 0);
             if (scan) {
+                local.crossing.clear();
                 local.poly.polygonise_box(phi, f.origin, hi, f.mesh, &local.crossing);
                 my_visited += static_cast<std::size_t>(f.extent.x) * static_cast<std::size_t>(f.extent.y) *
                               static_cast<std::size_t>(f.extent.z);
+                for (CellKey key : local.crossing) {
+                    const Vec3i c = decode_.coord(key);
+                    const auto bit = static_cast<std::size_t>((c.y - f.origin.y) + f.extent.y * (c.z - f.origin.z));
+                    local.rows[bit >> 6] |= std::uint64_t{1} << (bit & 63);
+                }
             } else {
-                sort_unique(f.pending);
-                local.candidates.clear();
-                std::set_union(f.crossing.begin(), f.crossing.end(), f.pending.begin(), f.pending.end(),
-                               std::back_inserter(local.candidates));
-                local.poly.polygonise_cells(phi, f.origin, hi, local.candidates, f.mesh, &local.crossing);
-                my_visited += local.candidates.size();
+                local.poly.polygonise_rows(phi, signs_, f.origin, hi, f.rows, f.pending, f.mesh, local.rows);
+                my_visited += local.poly.cells_polygonised();
+                my_rows += local.poly.rows_visited();
             }
             my_computed += local.poly.vertices_computed();
-            f.crossing.swap(local.crossing);
-            f.pending.clear();
+            f.rows.swap(local.rows);
+            std::fill(f.pending.begin(), f.pending.end(), 0);
         }
         visited += my_visited;
+        rows += my_rows;
         computed += my_computed;
     });
     stats_.fragments_rebuilt = ids.size();
     stats_.cells_visited = visited;
+    stats_.rows_visited = rows;
     stats_.vertices_computed = computed;
 }
 
 void FragmentMesher::sync_signs(const Grid<float>& phi) {
-    const std::span<const float> v = phi.values();
-    const std::size_t n = v.size();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, inside_.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t w = r.begin(); w != r.end(); ++w) {
-            std::uint64_t bits = 0;
-            const std::size_t base = w * 64;
-            const std::size_t stop = std::min(base + 64, n);
-            for (std::size_t i = base; i < stop; ++i)
-                if (is_inside(v[i])) bits |= std::uint64_t{1} << (i - base);
-            inside_[w] = bits;
-        }
-    });
+    signs_ = sign_bits(phi);
     initialised_ = true;
 }
 
@@ -196,13 +206,85 @@ void FragmentMesher::full_rebuild(const Grid<float>& phi, std::span<const PointI
     const std::vector<CellKey> cells = cells_around_points(lattice_, zero_layer);  // validates indices
     sync_signs(phi);
     for (Fragment& f : fragments_) {
-        f.crossing.clear();
-        f.pending.clear();
+        std::fill(f.rows.begin(), f.rows.end(), 0);
+        std::fill(f.pending.begin(), f.pending.end(), 0);
     }
-    for (CellKey key : cells) fragments_[fragment_of_cell(lattice_.coord(key))].pending.push_back(key);
+    for (CellKey key : cells) {
+        const Vec3i c = decode_.coord(key);
+        Fragment& f = fragments_[fragment_of_cell(c)];
+        const auto bit = static_cast<std::size_t>((c.y - f.origin.y) + f.extent.y * (c.z - f.origin.z));
+        f.pending[bit >> 6] |= std::uint64_t{1} << (bit & 63);
+    }
     std::vector<FragmentId> all(fragments_.size());
     for (FragmentId i = 0; i < all.size(); ++i) all[i] = i;
     rebuild(phi, all, false);
+}
+
+void FragmentMesher::mark_flipped(Vec3i p) {
+    // Cells with corner p: x in [p.x - 1, p.x] (one or two fragments), the same for y and z.
+    const int x0 = std::max(p.x - 1, 0), x1 = std::min(p.x, cells_.x - 1);
+    const int y0 = std::max(p.y - 1, 0), y1 = std::min(p.y, cells_.y - 1);
+    const int z0 = std::max(p.z - 1, 0), z1 = std::min(p.z, cells_.z - 1);
+    const int fx0 = cell_fragment_[0][static_cast<std::size_t>(x0)], fx1 = cell_fragment_[0][static_cast<std::size_t>(x1)];
+    for (int z = z0; z <= z1; ++z) {
+        const int fz = cell_fragment_[2][static_cast<std::size_t>(z)], oz = cell_offset_[2][static_cast<std::size_t>(z)];
+        for (int y = y0; y <= y1; ++y) {
+            const int fy = cell_fragment_[1][static_cast<std::size_t>(y)], oy = cell_offset_[1][static_cast<std::size_t>(y)];
+            for (int fx = fx0; fx <= fx1; ++fx) {
+                Fragment& f = fragments_[fragment_id({fx, fy, fz})];
+                const auto bit = static_cast<std::size_t>(oy + f.extent.y * oz);
+                const std::uint64_t mask = std::uint64_t{1} << (bit & 63);
+                if ((f.rows[bit >> 6] & mask) != 0) continue;  // a candidate anyway (rows are not written here)
+                std::atomic_ref<std::uint64_t> word(f.pending[bit >> 6]);
+                if ((word.load(std::memory_order_relaxed) & mask) == 0) word.fetch_or(mask, std::memory_order_relaxed);
+            }
+        }
+    }
+}
+
+void FragmentMesher::flag(FragmentId f, std::vector<FragmentId>& flagged) {
+    std::atomic_ref<std::uint8_t> b(flags_[f]);
+    if (b.load(std::memory_order_relaxed) == 0 && b.exchange(1, std::memory_order_relaxed) == 0) flagged.push_back(f);
+}
+
+std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed) {
+    // Pass over X (parallel): flag the affected fragments in B, and update the sign bits; a point
+    // whose sign flipped queues the rows of its cells - only those cells can start or stop
+    // crossing; every other row that may cross now is in its fragment's row bitmap already.
+    for (auto& local : scratch_->locals) local.flagged.clear();
+    const std::span<const float> values = phi.values();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, changed.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+        Scratch::Local& local = scratch_->locals.local();
+        const std::uint32_t* sx = single_[0].data();
+        const std::uint32_t* sy = single_[1].data();
+        const std::uint32_t* sz = single_[2].data();
+        FragmentId last = kSpansFragments;  // the fragment flagged for the previous point, if single
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {
+            if (k + 16 < r.end()) __builtin_prefetch(values.data() + changed[k + 16]);  // X is scattered over the lattice
+            const PointIndex x = changed[k];
+            const Vec3i p = decode_.coord(x);
+            const std::uint32_t fx = sx[p.x], fy = sy[p.y], fz = sz[p.z];
+            if (((fx | fy | fz) & kSpansFragments) == 0) {  // p and its stencil lie inside one fragment
+                const FragmentId f = fx + fy + fz;
+                if (f != last) flag(f, local.flagged);
+                last = f;
+            } else {
+                for_each_affected(p, [&](FragmentId f) { flag(f, local.flagged); });
+            }
+            const bool now = is_inside(values[x]);
+            const std::uint64_t bit = std::uint64_t{1} << (p.x & 63);
+            std::atomic_ref<std::uint64_t> word(signs_.words[signs_.word_of(p)]);
+            if (((word.load(std::memory_order_relaxed) & bit) != 0) != now) {
+                const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed)
+                                              : word.fetch_and(~bit, std::memory_order_relaxed);
+                if (((old & bit) != 0) != now) mark_flipped(p);  // exactly one thread sees the flip
+            }
+        }
+    });
+    std::vector<FragmentId> u;
+    for (auto& local : scratch_->locals) u.insert(u.end(), local.flagged.begin(), local.flagged.end());
+    std::sort(u.begin(), u.end());
+    return u;
 }
 
 std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span<const PointIndex> changed) {
@@ -220,63 +302,12 @@ std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span
         return all;
     }
 
-    // Pass over X (parallel): flag the affected fragments in B, and find the points whose sign
-    // flipped - only their cells can start or stop crossing; every other cell that may cross now
-    // is in its fragment's crossing list already.
-    for (auto& local : scratch_->locals) {
-        local.flagged.clear();
-        local.flipped.clear();
-    }
-    const std::span<const float> values = phi.values();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, changed.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-        Scratch::Local& local = scratch_->locals.local();
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            if (k + 16 < r.end()) {  // X is in band-list order, scattered over the lattice
-                const PointIndex ahead = changed[k + 16];
-                __builtin_prefetch(values.data() + ahead);
-                __builtin_prefetch(inside_.data() + (ahead >> 6));
-            }
-            const PointIndex x = changed[k];
-            for_each_affected(decode_.coord(x), [&](FragmentId f) {
-                std::atomic_ref<std::uint8_t> flag(flags_[f]);
-                if (flag.load(std::memory_order_relaxed) == 0 && flag.exchange(1, std::memory_order_relaxed) == 0)
-                    local.flagged.push_back(f);
-            });
-            const bool now = is_inside(values[x]);
-            const std::uint64_t bit = std::uint64_t{1} << (x & 63u);
-            std::atomic_ref<std::uint64_t> word(inside_[x >> 6]);
-            if (((word.load(std::memory_order_relaxed) & bit) != 0) != now) {
-                const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed)
-                                              : word.fetch_and(~bit, std::memory_order_relaxed);
-                if (((old & bit) != 0) != now) local.flipped.push_back(x);  // exactly one thread sees the flip
-            }
-        }
-    });
-    std::vector<FragmentId> u;
-    std::vector<PointIndex> flipped;
-    for (auto& local : scratch_->locals) {
-        u.insert(u.end(), local.flagged.begin(), local.flagged.end());
-        flipped.insert(flipped.end(), local.flipped.begin(), local.flipped.end());
-    }
-    std::sort(u.begin(), u.end());
-    for (PointIndex x : flipped) {
-        // Cells with x as a corner may change sign pattern: queue them in their fragments.
-        const Vec3i p = decode_.coord(x);
-        const int x0 = std::max(p.x - 1, 0), x1 = std::min(p.x, cells_.x - 1);
-        const int y0 = std::max(p.y - 1, 0), y1 = std::min(p.y, cells_.y - 1);
-        const int z0 = std::max(p.z - 1, 0), z1 = std::min(p.z, cells_.z - 1);
-        for (int z = z0; z <= z1; ++z)
-            for (int y = y0; y <= y1; ++y)
-                for (int xx = x0; xx <= x1; ++xx) {
-                    const Vec3i c{xx, y, z};
-                    fragments_[fragment_of_cell(c)].pending.push_back(lattice_.index(c));
-                }
-    }
+    const std::vector<FragmentId> u = flag_and_flip(phi, changed);
     try {
         rebuild(phi, u, false);
     } catch (...) {
         for (FragmentId f : u) flags_[f] = 0;
-        initialised_ = false;  // crossing lists may be stale: the next update starts from scratch
+        initialised_ = false;  // row bitmaps may be stale: the next update starts from scratch
         throw;
     }
     for (FragmentId f : u) flags_[f] = 0;

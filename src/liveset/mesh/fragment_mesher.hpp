@@ -9,13 +9,14 @@
 // fragments are computed in both (each fragment's V/T must be a self-contained GPU buffer); they are
 // bit-identical because make_edge_vertex() is a pure function of φ.
 //
-// Surface-proportional rebuilds: each fragment keeps the sorted list of its cells that hold a
-// crossing (corner signs differ), and the mesher keeps one sign bit per lattice point. A cell
-// starts or stops crossing only if one of its corners flips sign, so a rebuild visits (old
-// crossing cells) ∪ (cells with a corner whose sign flipped) and keeps those that still cross -
-// under a moving front, X holds the whole band but only a thin sheet of it flips sign. It never
-// scans the fragment, so a single whole-lattice fragment (the paper's x100 case)
-// costs O(surface), not O(volume). The only O(volume) pass is full_rebuild(φ) without a zero layer.
+// Surface-proportional rebuilds: the mesher keeps one sign bit per lattice point (SignBits, rows of
+// 64-bit words) and each fragment a bitmap of its cell rows (y, z) that hold a crossing cell
+// (corner signs differ). A cell starts or stops crossing only if one of its corners flips sign, so
+// a rebuild visits the rows (old crossing rows) ∪ (rows of cells with a corner whose sign flipped)
+// and, in each, finds the crossing cells 64 at a time from the sign bits - under a moving front, X
+// holds the whole band but only a thin sheet of it flips sign. It never scans the fragment's cells,
+// so a single whole-lattice fragment (the paper's x100 case) costs O(surface) cell work plus one
+// bit per cell row. The only O(volume) pass is full_rebuild(φ) without a zero layer.
 #pragma once
 
 #include <array>
@@ -28,6 +29,7 @@
 #include "liveset/grid/index_decoder.hpp"
 #include "liveset/mesh/cell_polygoniser.hpp"
 #include "liveset/mesh/mesh.hpp"
+#include "liveset/mesh/sign_bits.hpp"
 
 namespace liveset {
 
@@ -45,7 +47,8 @@ struct FragmentView {
 
 struct FragmentUpdateStats {
     std::size_t fragments_rebuilt = 0;
-    std::size_t cells_visited = 0;       // candidate cells examined
+    std::size_t cells_visited = 0;       // cells polygonised (a scan: every cell of the fragments)
+    std::size_t rows_visited = 0;        // candidate cell rows examined (0 for a scan)
     std::size_t vertices_computed = 0;   // edge vertices computed (border vertices count per fragment)
 };
 
@@ -95,9 +98,10 @@ public:
 private:
     struct Fragment {
         Vec3i origin{}, extent{};
-        Mesh mesh;                      // V and T
-        std::vector<CellKey> crossing;  // sorted keys of owned cells with a sign change
-        std::vector<CellKey> pending;   // cells whose corners changed since the last rebuild
+        Mesh mesh;  // V and T
+        // Bitmaps over the owned cell rows, bit (y - origin.y) + extent.y * (z - origin.z):
+        std::vector<std::uint64_t> rows;     // rows holding a crossing cell, as last meshed
+        std::vector<std::uint64_t> pending;  // rows with a cell corner whose sign flipped since then
     };
     struct Scratch;
 
@@ -111,6 +115,9 @@ private:
     template <class Visit>
     void for_each_affected(Vec3i p, Visit&& visit) const;
     void sync_signs(const Grid<float>& phi);
+    void mark_flipped(Vec3i p);
+    void flag(FragmentId f, std::vector<FragmentId>& flagged);  // set B[f]; record f if this call set it  // queue the rows of the cells with corner p in their fragments' pending
+    std::vector<FragmentId> flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed);
     void rebuild(const Grid<float>& phi, std::span<const FragmentId> ids, bool scan);
 
     Lattice lattice_;
@@ -121,8 +128,13 @@ private:
     std::vector<std::uint8_t> flags_;  // B
     IndexDecoder decode_;
     std::array<std::vector<AxisRange>, 3> ranges_;  // per axis, indexed by point coordinate
-    std::vector<std::uint64_t> inside_;             // sign bit per lattice point, as last meshed
-    bool initialised_ = false;                      // inside_ and crossing lists are valid
+    // Per axis and point coordinate: the one fragment coordinate of the wide range times the axis'
+    // fragment-id stride, or kSpansFragments when the wide range spans two fragments.
+    std::array<std::vector<std::uint32_t>, 3> single_;
+    static constexpr std::uint32_t kSpansFragments = 0x8000'0000u;
+    std::array<std::vector<int>, 3> cell_fragment_, cell_offset_;  // per axis: cell c -> c / S, c % S
+    SignBits signs_;              // is_inside() per lattice point, as last meshed
+    bool initialised_ = false;    // signs_ and the row bitmaps are valid
     FragmentUpdateStats stats_;
     std::unique_ptr<Scratch> scratch_;  // per-thread polygonisers
 };

@@ -42,31 +42,6 @@ inline std::uint64_t pack_signs(const float* v, int n) {
     return bits;
 }
 
-inline int bit(const std::uint64_t* row, int x) { return static_cast<int>((row[x >> 6] >> (x & 63)) & 1u); }
-
-// The four point rows around cell row (y, z): corner bit k of a cell = row k>>1 at x + (k & 1).
-struct CellRows {
-    const std::uint64_t* r[4];  // (y, z), (y + 1, z), (y, z + 1), (y + 1, z + 1)
-    CellRows(const SignBits& s, int y, int z) : r{s.row(y, z), s.row(y + 1, z), s.row(y, z + 1), s.row(y + 1, z + 1)} {}
-
-    // Bit x - 64k set when cell x of the row has corners of both signs (cells x < ncx only).
-    std::uint64_t crossing(std::size_t k, std::size_t wpr, int ncx) const {
-        const std::uint64_t o = r[0][k] | r[1][k] | r[2][k] | r[3][k];
-        const std::uint64_t a = r[0][k] & r[1][k] & r[2][k] & r[3][k];
-        const bool more = k + 1 < wpr;
-        const std::uint64_t o1 = more ? (r[0][k + 1] | r[1][k + 1] | r[2][k + 1] | r[3][k + 1]) : 0;
-        const std::uint64_t a1 = more ? (r[0][k + 1] & r[1][k + 1] & r[2][k + 1] & r[3][k + 1]) : 0;
-        std::uint64_t cross = (o | (o >> 1) | (o1 << 63)) & ~(a & ((a >> 1) | (a1 << 63)));
-        const int valid = ncx - static_cast<int>(64 * k);
-        if (valid < 64) cross &= valid <= 0 ? 0 : (std::uint64_t{1} << valid) - 1;
-        return cross;
-    }
-    int cell_case(int x) const {
-        return bit(r[0], x) | bit(r[0], x + 1) << 1 | bit(r[1], x) << 2 | bit(r[1], x + 1) << 3 | bit(r[2], x) << 4 |
-               bit(r[2], x + 1) << 5 | bit(r[3], x) << 6 | bit(r[3], x + 1) << 7;
-    }
-};
-
 // Crossing edges (bits differing between neighbours) along x in one point row of nx points.
 inline std::size_t x_edge_count(const std::uint64_t* r, std::size_t wpr, int nx) {
     std::size_t n = 0;

@@ -9,6 +9,7 @@
 
 #include "liveset/grid/grid.hpp"
 #include "liveset/mesh/mesh.hpp"
+#include "liveset/mesh/sign_bits.hpp"
 
 namespace liveset {
 
@@ -21,18 +22,6 @@ struct SlabMarchingCubesOptions {
 // Equal to marching_cubes_naive(phi) (vertices bit-identical, same indices), computed with the
 // sign bits and z-slabs in parallel. O(volume / 64) word operations plus O(surface) polygonising.
 Mesh marching_cubes_slabs(const Grid<float>& phi, const SlabMarchingCubesOptions& options = {});
-
-// is_inside() of every lattice point packed in bits: row (y, z) starts at word
-// (y + dims.y * z) * words_per_row, bit x of that row is point (x, y, z); bits past dims.x are 0.
-struct SignBits {
-    Vec3i dims{};
-    std::size_t words_per_row = 0;
-    std::vector<std::uint64_t> words;
-    const std::uint64_t* row(int y, int z) const {
-        return words.data() + (static_cast<std::size_t>(y) + static_cast<std::size_t>(dims.y) * static_cast<std::size_t>(z)) *
-                                  words_per_row;
-    }
-};
 
 // The sign pass (parallel over z, vectorised where SSE2 is available).
 SignBits sign_bits(const Grid<float>& phi);
