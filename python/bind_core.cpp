@@ -7,6 +7,7 @@
 #include "bindings.hpp"
 #include "cli_common.hpp"
 #include "cli_support.hpp"
+#include "finder_repair.hpp"
 #include "image_commands.hpp"
 #include "liveset/eval/holes.hpp"
 #include "liveset/io/image_io.hpp"
@@ -14,6 +15,7 @@
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_io.hpp"
 #include "liveset/preprocess/bias_correction.hpp"
+#include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/window.hpp"
 
 namespace liveset::py {
@@ -234,6 +236,63 @@ std::string find_holes_json(const pyb::array& mask, const pyb::array& image, con
         .dump();
 }
 
+// The arguments of `_repair_holes` (liveset.repair_holes) after the arrays.
+struct RepairHolesArgs {
+    std::optional<std::pair<double, double>> band;  // raw; the tissue model's when absent
+    std::size_t holes = 10, min_voxels = 50, agents = 200;
+    int round_steps = 1000;
+    double p = 0.3;
+    std::uint64_t seed = 1;
+};
+
+// `liveset repair --find-holes` (finder_repair.hpp) on arrays: the finder's largest holes, one
+// sheet-rule round each, through a Session on `image`. Returns (φ, report JSON).
+pyb::tuple repair_holes(const pyb::array& level, bool is_mask, const pyb::array& image, const pyb::object& roi, const Lattice& lattice,
+                        const RepairHolesArgs& a) {
+    const Grid<float> img = grid_from_array(image, lattice);
+    std::optional<Grid<std::uint8_t>> r;
+    if (!roi.is_none()) r = mask_from_array(roi.cast<pyb::array>(), lattice);
+    std::optional<Grid<float>> phi_in;
+    std::optional<Grid<std::uint8_t>> mask_in;
+    if (is_mask) mask_in = mask_from_array(level, lattice);
+    else phi_in = grid_from_array(level, lattice);
+    nlohmann::json report;
+    std::optional<Grid<float>> phi;
+    {
+        pyb::gil_scoped_release nogil;
+        SessionOptions so;
+        so.fragment_size = 8;  // as `liveset repair`
+        Session session(img, so, r);
+        if (mask_in) session.load_mask(*mask_in);
+        else session.load_phi(*phi_in);
+        const Grid<std::uint8_t>* roi_ptr = r ? &*r : nullptr;
+        cli::FoundHolesInput in{img, roi_ptr, session.scale()};
+        if (a.band) {
+            in.band_lower = a.band->first;
+            in.band_upper = a.band->second;
+            in.sheet_mean = 0.5 * (a.band->first + a.band->second);
+        } else {
+            std::vector<std::string> warnings;
+            TissueModel model;
+            const std::optional<ModelWindow> w =
+                sheet_window(img, inside_mask(session.field().phi(), roi_ptr), roi_ptr, TissueModelOptions{}, warnings, &model);
+            if (!w) throw std::invalid_argument("cannot tell the sheet's tissue from the image; give sheet_band=(lower, upper)");
+            in.band_lower = w->lower;
+            in.band_upper = w->upper;
+            in.sheet_mean = model.classes[static_cast<std::size_t>(w->seed_class)].mean;
+        }
+        in.max_targets = a.holes;
+        in.min_voxels = a.min_voxels;
+        in.round_steps = a.round_steps;
+        in.options.swarm.agents = a.agents;
+        in.options.swarm.act_probability = a.p;
+        in.options.swarm.seed = a.seed;
+        report = cli::repair_found_holes(in, session, true);
+        phi = session.field().phi();
+    }
+    return pyb::make_tuple(array_from_grid(std::move(*phi)), report.dump());
+}
+
 SegmentArgs segment_args(const pyb::kwargs& kw) {
     SegmentArgs a;
     for (const auto& [key, value] : kw) {
@@ -300,6 +359,13 @@ void register_core(pyb::module_& m) {
         if (mask.ndim() != 3) throw std::invalid_argument("the mask must be a 3D array");
         const Lattice l = lattice_from(pyb::make_tuple(mask.shape(0), mask.shape(1), mask.shape(2)), geo[0], geo[1], geo[2]);
         return find_holes_json(mask, image, roi, l, band, min_voxels, min_sheet_share);
+    });
+    m.def("_repair_holes", [](const pyb::array& level, bool is_mask, const pyb::array& image, const pyb::object& roi, const pyb::tuple& geo,
+                              const std::optional<std::pair<double, double>>& band, std::size_t holes, std::size_t min_voxels, int round_steps,
+                              std::size_t agents, double p, std::uint64_t seed) {
+        if (level.ndim() != 3) throw std::invalid_argument("phi_or_mask must be a 3D array");
+        const Lattice l = lattice_from(pyb::make_tuple(level.shape(0), level.shape(1), level.shape(2)), geo[0], geo[1], geo[2]);
+        return repair_holes(level, is_mask, image, roi, l, RepairHolesArgs{band, holes, min_voxels, agents, round_steps, p, seed});
     });
     m.def("_evaluate", [](const pyb::array& mask, const pyb::array& truth, const pyb::tuple& geo) {
         if (mask.ndim() != 3) throw std::invalid_argument("the mask must be a 3D array");

@@ -10,7 +10,7 @@ like ITK; ``Image.from_nibabel`` / ``to_nibabel`` convert nibabel's RAS affines)
     surf = liveset.mesh(seg.phi)                 # vertices/faces in LPS mm
     print(liveset.evaluate(seg.mask, truth, label=2)["dice"])
 
-Functions: read, read_header, write, segment, tissue_model, mesh, evaluate, find_holes, repair, set_threads; classes
+Functions: read, read_header, write, segment, tissue_model, mesh, evaluate, find_holes, repair, repair_holes, set_threads; classes
 Image, Session, Segmentation, Mesh; exception ImageIOError (an OSError). Other bad input raises
 ValueError with a one-line message. Long calls release the GIL and stop on Ctrl-C.
 Cohorts: ``liveset.batch`` (``python3 -m liveset.batch MANIFEST.csv --out DIR``) on Dask.
@@ -19,8 +19,8 @@ from . import _liveset
 from .api import (ImageIOError, Mesh, Segmentation, evaluate, find_holes, mesh, read, read_header, segment,
                   set_threads, tissue_model, write)
 from .image import Image
-from .session import Session, repair
+from .session import Session, repair, repair_holes
 
 __version__ = _liveset.__version__
 __all__ = ["Image", "ImageIOError", "Mesh", "Segmentation", "Session", "evaluate", "find_holes", "mesh", "read",
-           "read_header", "repair", "segment", "set_threads", "tissue_model", "write"]
+           "read_header", "repair", "repair_holes", "segment", "set_threads", "tissue_model", "write"]

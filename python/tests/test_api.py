@@ -239,3 +239,27 @@ def test_find_holes_finds_exactly_a_drilled_hole():
     assert intact["holes"] == []
     with pytest.raises(ValueError):
         liveset.find_holes(img.like(shell.astype(np.uint8)), img, sheet_band=(0.75, 0.3))
+
+
+def test_repair_holes_closes_the_finders_holes_inside_the_shell():
+    # The same shell with two shafts drilled through it (GM-bright): repair_holes (the CLI's
+    # --find-holes) aims at the finder's sites, fills the shafts and adds nothing outside the shell.
+    n, c = 48, 23.5
+    ijk = np.stack(np.meshgrid(*[np.arange(n)] * 3, indexing="ij"), -1).astype(float)
+    r = np.linalg.norm(ijk - c, axis=-1)
+    image = np.where(r < 12, 130.0, np.where(r < 16, 100.0, 50.0)).astype(np.float32)
+    shell = (r >= 12) & (r < 16)
+    shafts = shell & (((np.hypot(ijk[..., 0] - c, ijk[..., 1] - c) <= 2.5) & (ijk[..., 2] > c)) |
+                      ((np.hypot(ijk[..., 1] - c, ijk[..., 2] - c) <= 2.0) & (ijk[..., 0] < c)))
+    img = liveset.Image(image, SPACING, ORIGIN, DIRECTION)
+    seg = img.like((shell & ~shafts).astype(np.uint8))
+    found = liveset.find_holes(seg, img, sheet_band=(75, 115), min_voxels=10)
+    phi, report = liveset.repair_holes(seg, img, 2, sheet_band=(75, 115), min_voxels=10, round_steps=400)
+    assert [t for t in report["targets"]] == [h["target"] for h in found["holes"][:2]]
+    assert report["closed"] == 2 and report["finder"]["after"] == 0
+    after = phi.array < 0
+    assert phi.same_geometry(img)
+    assert after[shafts].mean() >= 0.9
+    assert not (after & ~shell & ~(seg.array != 0)).any()
+    with pytest.raises(ValueError):
+        liveset.repair_holes(seg, img, 0)

@@ -1,6 +1,6 @@
 // Truth-free hole repair as a user without ground truth does it: the hole finder picks the targets,
 // one sheet-rule round per target (brush sized to the hole, the sheet's band sampled around it),
-// the finder's verdict per target. Shared by `liveset demo --brain --repair` and `liveset repair --find-holes`.
+// the finder's verdict per target. Shared by `liveset demo --brain --repair`, `liveset repair --find-holes` and Python's `repair_holes`.
 #pragma once
 
 #include <atomic>
