@@ -268,18 +268,11 @@ pyb::tuple repair_holes(const pyb::array& level, bool is_mask, const pyb::array&
         const Grid<std::uint8_t>* roi_ptr = r ? &*r : nullptr;
         cli::FoundHolesInput in{img, roi_ptr, session.scale()};
         if (a.band) {
-            in.band_lower = a.band->first;
-            in.band_upper = a.band->second;
-            in.sheet_mean = 0.5 * (a.band->first + a.band->second);
+            in.band = {a.band->first, a.band->second, 0.5 * (a.band->first + a.band->second)};
         } else {
-            std::vector<std::string> warnings;
-            TissueModel model;
-            const std::optional<ModelWindow> w =
-                sheet_window(img, inside_mask(session.field().phi(), roi_ptr), roi_ptr, TissueModelOptions{}, warnings, &model);
-            if (!w) throw std::invalid_argument("cannot tell the sheet's tissue from the image; give sheet_band=(lower, upper)");
-            in.band_lower = w->lower;
-            in.band_upper = w->upper;
-            in.sheet_mean = model.classes[static_cast<std::size_t>(w->seed_class)].mean;
+            const std::optional<cli::SheetBand> b = cli::model_sheet_band(img, inside_mask(session.field().phi(), roi_ptr), roi_ptr);
+            if (!b) throw std::invalid_argument("cannot tell the sheet's tissue from the image; give sheet_band=(lower, upper)");
+            in.band = *b;
         }
         in.max_targets = a.holes;
         in.min_voxels = a.min_voxels;

@@ -58,9 +58,7 @@ void low_threshold(const Grid<float>& t1, const Grid<std::uint8_t>& roi, Segment
     req.mu_raw = w.mu();
     const double sigma = model->classes[static_cast<std::size_t>(w.seed_class)].sigma;
     req.epsilon_raw = std::max(kLowThreshold * w.epsilon(), std::min(w.epsilon(), kLowThresholdMinSigmas * sigma));
-    band.band_lower = w.lower;
-    band.band_upper = w.upper;
-    band.sheet_mean = model->classes[static_cast<std::size_t>(w.seed_class)].mean;
+    band.band = {w.lower, w.upper, model->classes[static_cast<std::size_t>(w.seed_class)].mean};
 }
 
 // The sample's three files present and the output folder writable (one line each otherwise).
@@ -165,7 +163,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     const Grid<float> phi_before = o.field->phi();
     if (a.repair) {
         if (!a.quiet && !a.json) fmt::print("  segmented with a low threshold (epsilon {:.1f} raw, the model's {:.1f} x {}, at least {} sigma); repairing...\n", req.epsilon_raw.value_or(0.0),
-                       rin.band_upper / 2 - rin.band_lower / 2, kLowThreshold, kLowThresholdMinSigmas);
+                       rin.band.upper / 2 - rin.band.lower / 2, kLowThreshold, kLowThresholdMinSigmas);
         rin.scale = o.scale;
         repair = repair_found_holes(rin, session, true);
         repair["low_threshold"] = kLowThreshold;

@@ -68,32 +68,12 @@ RepairTarget parse_target(const std::string& text, const Lattice& lattice, bool 
 
 constexpr double kVerdictRadius = kHoleVerdictRadius;  // the finder's verdict counts hole voxels this close to a target
 
-// The sheet tissue's band (raw) and its class mean, for the finder and the sheet rule.
-struct SheetBand {
-    HoleFinderOptions finder;
-    double mean = 0;
-};
-
 // The sheet's band for the finder's verdicts and --decision sheet: given (its mean the band's
-// middle), or the tissue model's window and class mean for the class most of the segmentation's
-// voxels are in (nullopt when it cannot be told).
+// middle), or the tissue model's (model_sheet_band; nullopt when it cannot be told).
 std::optional<SheetBand> sheet_band(const RepairArgs& a, const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                     const Grid<std::uint8_t>* roi) {
-    SheetBand o;
-    if (a.sheet_lower) {
-        o.finder.sheet_lower = *a.sheet_lower;
-        o.finder.sheet_upper = *a.sheet_upper;
-        o.mean = 0.5 * (*a.sheet_lower + *a.sheet_upper);
-        return o;
-    }
-    std::vector<std::string> warnings;
-    TissueModel model;
-    const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, warnings, &model);
-    if (!w) return std::nullopt;
-    o.finder.sheet_lower = w->lower;
-    o.finder.sheet_upper = w->upper;
-    o.mean = model.classes[static_cast<std::size_t>(w->seed_class)].mean;
-    return o;
+    if (a.sheet_lower) return SheetBand{*a.sheet_lower, *a.sheet_upper, 0.5 * (*a.sheet_lower + *a.sheet_upper)};
+    return model_sheet_band(image, mask, roi);
 }
 
 // Bad targets, before anything runs or is written: outside the ROI, or with no surface within the
@@ -206,7 +186,7 @@ void print_step_summary(const RepairArgs& a, const std::vector<RepairStepLog>& l
                      {"fragments_rebuilt", fragments}, {"ms_per_step", log.empty() ? 0.0 : ms / static_cast<double>(log.size())},
                      {"agents_on_surface_end", log.empty() ? 0 : log.back().on_surface}, {"targets", verdicts},
                      {"verdict_radius", kVerdictRadius}};
-    if (band) j["sheet_band"] = {band->finder.sheet_lower, band->finder.sheet_upper};
+    if (band) j["sheet_band"] = {band->lower, band->upper};
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
@@ -251,9 +231,7 @@ RepairInputs load_inputs(const RepairArgs& a) {
 int run_found_holes(const RepairArgs& a, RepairInputs& in, const InterruptGuard& interrupt) {
     if (!in.band) throw UsageError("--find-holes: the tissue model cannot tell the sheet's tissue; give --sheet-lower and --sheet-upper");
     FoundHolesInput f{in.image, in.roi_ptr(), in.session->scale()};
-    f.band_lower = in.band->finder.sheet_lower;
-    f.band_upper = in.band->finder.sheet_upper;
-    f.sheet_mean = in.band->mean;
+    f.band = *in.band;
     f.max_targets = a.find_holes;
     f.min_voxels = a.min_hole;
     f.round_steps = a.round_steps;
@@ -288,8 +266,8 @@ int run_given_targets(RepairArgs a, RepairInputs& in, const InterruptGuard& inte
     check_targets(targets, field, in.roi_ptr(), a.options);
     if (a.options.swarm.decision == EditDecision::kSheet) {
         if (!in.band) throw UsageError("--decision sheet: the tissue model cannot tell the sheet's tissue; give --sheet-lower and --sheet-upper");
-        a.options.swarm.sheet_lower = session.scale().to_unit(in.band->finder.sheet_lower);
-        a.options.swarm.sheet_upper = session.scale().to_unit(in.band->finder.sheet_upper);
+        a.options.swarm.sheet_lower = session.scale().to_unit(in.band->lower);
+        a.options.swarm.sheet_upper = session.scale().to_unit(in.band->upper);
     }
     session.set_repair_options(a.options);
     const std::vector<RepairStepLog> log = run_targets(session, targets, a.options.steps, interrupt.flag());
@@ -300,8 +278,8 @@ int run_given_targets(RepairArgs a, RepairInputs& in, const InterruptGuard& inte
     const Grid<std::uint8_t> mask = inside_mask(field.phi(), in.roi_ptr());
     nlohmann::json verdicts = nlohmann::json::array();
     if (in.band) {  // the finder's verdict per target (no ground truth)
-        const Grid<std::uint8_t> hb = hole_voxels(in.mask_before, in.image, in.roi_ptr(), in.band->finder);
-        const Grid<std::uint8_t> ha = hole_voxels(mask, in.image, in.roi_ptr(), in.band->finder);
+        const Grid<std::uint8_t> hb = hole_voxels(in.mask_before, in.image, in.roi_ptr(), in.band->finder());
+        const Grid<std::uint8_t> ha = hole_voxels(mask, in.image, in.roi_ptr(), in.band->finder());
         for (const RepairTarget& t : targets) {
             const HoleVerdict v = hole_verdict(t.position, kVerdictRadius, hb, ha, in.mask_before, mask);
             verdicts.push_back(verdict_json(Vec3i{static_cast<int>(std::lround(t.position.x)), static_cast<int>(std::lround(t.position.y)),

@@ -56,6 +56,21 @@ Verdicts verdicts(const std::vector<HoleSite>& targets, const Grid<std::uint8_t>
 
 }  // namespace
 
+HoleFinderOptions SheetBand::finder() const {
+    HoleFinderOptions o;
+    o.sheet_lower = lower;
+    o.sheet_upper = upper;
+    return o;
+}
+
+std::optional<SheetBand> model_sheet_band(const Grid<float>& image, const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* roi) {
+    std::vector<std::string> warnings;
+    TissueModel model;
+    const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, warnings, &model);
+    if (!w) return std::nullopt;
+    return SheetBand{w->lower, w->upper, model.classes[static_cast<std::size_t>(w->seed_class)].mean};
+}
+
 RepairOptions FoundHolesInput::default_options() {
     RepairOptions ro;  // 200 agents as in the paper
     ro.swarm.agents = 200;
@@ -72,8 +87,8 @@ RepairScheduleResult run_rounds(const FoundHolesInput& in, Session& session, con
                                 const std::atomic<bool>* interrupt) {
     const SparseField& field = session.field();
     const Grid<float>& unit = session.unit_image();  // the session's normalisation (in.scale)
-    const double lo = in.scale.to_unit(in.band_lower), hi = in.scale.to_unit(in.band_upper);
-    const double mean = in.scale.to_unit(in.sheet_mean);
+    const double lo = in.scale.to_unit(in.band.lower), hi = in.scale.to_unit(in.band.upper);
+    const double mean = in.scale.to_unit(in.band.mean);
     RepairOptions ro = in.options;
     ro.swarm.decision = EditDecision::kSheet;
     ro.swarm.sheet_lower = lo;
@@ -99,12 +114,10 @@ RepairScheduleResult run_rounds(const FoundHolesInput& in, Session& session, con
 }  // namespace
 
 nlohmann::json repair_found_holes(const FoundHolesInput& in, Session& session, bool quiet, const std::atomic<bool>* interrupt) {
-    if (!(in.band_lower < in.band_upper)) throw UsageError("the sheet tissue's band is empty (its lower end is not below its upper)");
+    if (!(in.band.lower < in.band.upper)) throw UsageError("the sheet tissue's band is empty (its lower end is not below its upper)");
     if (in.max_targets == 0 || in.round_steps < 1) throw UsageError("--find-holes wants at least one target and one step per round");
     const SparseField& field = session.field();
-    HoleFinderOptions fo;
-    fo.sheet_lower = in.band_lower;
-    fo.sheet_upper = in.band_upper;
+    const HoleFinderOptions fo = in.band.finder();
     const Grid<std::uint8_t> mask_before = inside_mask(field.phi(), in.roi);
     const Grid<std::uint8_t> holes_before = hole_voxels(mask_before, in.image, in.roi, fo);
     const std::vector<HoleCandidate> found = find_holes(mask_before, in.image, in.roi, fo);
@@ -135,7 +148,7 @@ nlohmann::json repair_found_holes(const FoundHolesInput& in, Session& session, b
     return {{"targets", list}, {"verdicts", v.targets}, {"closed", v.closed}, {"agents", in.options.swarm.agents},
             {"p", in.options.swarm.act_probability}, {"steps", steps}, {"points_modified", modified}, {"voxels_added", added},
             {"ms_per_step", ms_per_step}, {"round_steps", in.round_steps}, {"verdict_radius", kHoleVerdictRadius},
-            {"finder", {{"band", {in.band_lower, in.band_upper}}, {"min_voxels", in.min_voxels}, {"before", count_large(found)}, {"after", found_after}}}};
+            {"finder", {{"band", {in.band.lower, in.band.upper}}, {"min_voxels", in.min_voxels}, {"before", count_large(found)}, {"after", found_after}}}};
 }
 
 }  // namespace liveset::cli

@@ -6,7 +6,9 @@
 #include <atomic>
 #include <cstddef>
 #include <nlohmann/json.hpp>
+#include <optional>
 
+#include "liveset/eval/holes.hpp"
 #include "liveset/grid/grid.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/session/session.hpp"
@@ -14,12 +16,21 @@
 
 namespace liveset::cli {
 
+// The sheet tissue's band and class mean, raw intensities.
+struct SheetBand {
+    double lower = 0, upper = 0, mean = 0;
+    HoleFinderOptions finder() const;  // the finder's options with this band
+};
+
+// The tissue model's window and class mean for the class most of `mask`'s voxels are in
+// (sheet_window); nullopt when the model cannot tell the sheet's tissue.
+std::optional<SheetBand> model_sheet_band(const Grid<float>& image, const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* roi);
+
 struct FoundHolesInput {
     const Grid<float>& image;            // the image the segmentation came from (raw units)
     const Grid<std::uint8_t>* roi;       // region of interest (outside counts as the outside tissue); may be null
     IntensityScale scale;                // the session's normalisation of `image`
-    double band_lower = 0, band_upper = 0;  // the sheet tissue's band (raw; the tissue model's window)
-    double sheet_mean = 0;               // the sheet tissue's class mean (raw)
+    SheetBand band{};                    // the sheet tissue's (the tissue model's window and class mean)
     std::size_t max_targets = 10;        // the largest holes clicked, one round each
     std::size_t min_voxels = 50;         // the finder's smallest target
     int round_steps = 1000;              // swarm steps per target

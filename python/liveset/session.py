@@ -8,6 +8,7 @@ from typing import Optional, Sequence
 import numpy as np
 
 from . import _liveset
+from .api import _mask_arg
 from .image import Image, as_image
 
 
@@ -163,12 +164,8 @@ def repair_holes(phi_or_mask, image, holes: int = 10, *, roi=None, sheet_band=No
         raise ValueError("phi_or_mask and the image do not share a geometry (shape, spacing, origin or direction)")
     a = np.asarray(src.array)
     is_mask = bool(np.all((a == 0) | (a == 1)))
-    r = None
-    if roi is not None:
-        ri = as_image(roi, "roi")
-        if not ri.same_geometry(img):
-            raise ValueError("the roi and the image do not share a geometry (shape, spacing, origin or direction)")
-        r = np.asarray(ri.array) != 0
+    r = _mask_arg(roi, img, "roi")
+    r = None if r is None else r != 0
     if int(holes) < 1 or int(round_steps) < 1 or int(min_voxels) < 1 or int(agents) < 1:
         raise ValueError("holes, round_steps, min_voxels and agents must be at least 1")
     band = None if sheet_band is None else (float(sheet_band[0]), float(sheet_band[1]))

@@ -146,6 +146,30 @@ void CellPolygoniser::enter_layer(int z) {
     layer_ = z;
 }
 
+// Inlined into both emitters (no Vertex round trip through memory on the interior path).
+[[gnu::always_inline]] inline Vertex CellPolygoniser::edge_vertex(const Grid<float>& phi, Vec3i p, int ax) const {
+    if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (ax == 0) <= dims_.x - 2 && p.y + (ax == 1) <= dims_.y - 2 &&
+        p.z + (ax == 2) <= dims_.z - 2) {
+        const std::size_t i = static_cast<std::size_t>(p.x) + static_cast<std::size_t>(p.y) * sy_ + static_cast<std::size_t>(p.z) * sz_;
+        return edge_vertex_interior(values_, i, p, ax, sy_, sz_);
+    }
+    return make_edge_vertex(phi, p, ax);
+}
+
+namespace {
+
+// The triangles of case `cs`, their corners the cell's edge vertex ids `v`, appended to out.indices.
+[[gnu::always_inline]] inline void append_triangles(int cs, const std::uint32_t* v, Mesh& out) {
+    const auto& tri = mc::kTables.triangles[static_cast<std::size_t>(cs)];
+    const int n = 3 * mc::kTables.triangle_count[static_cast<std::size_t>(cs)];
+    const std::size_t base = out.indices.size();
+    out.indices.resize(base + static_cast<std::size_t>(n));
+    std::uint32_t* dst = out.indices.data() + base;
+    for (int j = 0; j < n; ++j) dst[j] = v[tri[static_cast<std::size_t>(j)]];
+}
+
+}  // namespace
+
 void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& out) {
     const auto& tables = mc::kTables;
     // G offset of the cell's minimum corner; a corner (dx, dy, dz) adds dx*3 + dy*px*3 and picks the
@@ -168,24 +192,12 @@ void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& o
         }
         if (out.vertices.size() >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
         const auto id = static_cast<std::uint32_t>(out.vertices.size());
-        const Vec3i p{c.x + es.dx, c.y + es.dy, c.z + es.dz};
-        const int ax = es.axis;
-        if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (ax == 0) <= dims_.x - 2 && p.y + (ax == 1) <= dims_.y - 2 &&
-            p.z + (ax == 2) <= dims_.z - 2) {  // inlined here: no Vertex round trip through memory
-            const std::size_t i = static_cast<std::size_t>(p.x) + static_cast<std::size_t>(p.y) * sy_ + static_cast<std::size_t>(p.z) * sz_;
-            out.vertices.push_back(edge_vertex_interior(values_, i, p, ax, sy_, sz_));
-        } else {
-            out.vertices.push_back(make_edge_vertex(phi, p, ax));
-        }
+        out.vertices.push_back(edge_vertex(phi, {c.x + es.dx, c.y + es.dy, c.z + es.dz}, es.axis));
         entry = generation_[slot] | id;
         v[e] = id;
         ++computed_;
     }
-    const auto& tri = tables.triangles[static_cast<std::size_t>(cs)];
-    const int n = 3 * tables.triangle_count[static_cast<std::size_t>(cs)];
-    const std::size_t base = out.indices.size();
-    out.indices.resize(base + static_cast<std::size_t>(n));
-    for (int j = 0; j < n; ++j) out.indices[base + static_cast<std::size_t>(j)] = v[tri[static_cast<std::size_t>(j)]];
+    append_triangles(cs, v, out);
 }
 
 void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Mesh& out) {
@@ -216,12 +228,7 @@ void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Mesh& out) {
         v[e] = id;
         ++computed_;
     }
-    const auto& tri = tables.triangles[static_cast<std::size_t>(cs)];
-    const int n = 3 * tables.triangle_count[static_cast<std::size_t>(cs)];
-    const std::size_t base = out.indices.size();
-    out.indices.resize(base + static_cast<std::size_t>(n));
-    std::uint32_t* dst = out.indices.data() + base;
-    for (int j = 0; j < n; ++j) dst[j] = v[tri[static_cast<std::size_t>(j)]];
+    append_triangles(cs, v, out);
 }
 
 void CellPolygoniser::finish_vertices(const Grid<float>& phi, Mesh& out) {
@@ -230,15 +237,7 @@ void CellPolygoniser::finish_vertices(const Grid<float>& phi, Mesh& out) {
     out.vertices.resize(first + deferred_.size());
     Vertex* dst = out.vertices.data() + first;
     for (std::size_t k = 0; k < deferred_.size(); ++k) {
-        const Vec3i p = deferred_[k].p;
-        const int ax = deferred_[k].axis;
-        if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (ax == 0) <= dims_.x - 2 && p.y + (ax == 1) <= dims_.y - 2 &&
-            p.z + (ax == 2) <= dims_.z - 2) {
-            const std::size_t i = static_cast<std::size_t>(p.x) + static_cast<std::size_t>(p.y) * sy_ + static_cast<std::size_t>(p.z) * sz_;
-            dst[k] = edge_vertex_interior(values_, i, p, ax, sy_, sz_);
-        } else {
-            dst[k] = make_edge_vertex(phi, p, ax);
-        }
+        dst[k] = edge_vertex(phi, deferred_[k].p, deferred_[k].axis);
     }
     deferred_.clear();
 }

@@ -117,6 +117,9 @@ private:
     // others from gid_, with no generation test.
     void emit_cell_owned(Vec3i c, int cs, Mesh& out);
     void finish_vertices(const Grid<float>& phi, Mesh& out);  // computes deferred_ into out.vertices
+    // The vertex on the edge from p along +axis: edge_vertex_interior() on the cached values away
+    // from the lattice's border, make_edge_vertex() next to it.
+    Vertex edge_vertex(const Grid<float>& phi, Vec3i p, int axis) const;
 
     // G: 2 slices * px * py * 3 entries, each (generation << 32 | vertex id). An entry is set only
     // when its generation equals its slot's current one, so a slice is cleared in O(1) by giving
