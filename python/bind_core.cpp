@@ -243,6 +243,7 @@ struct RepairHolesArgs {
     int round_steps = 1000;
     double p = 0.3;
     std::uint64_t seed = 1;
+    double between_share = 0.25;  // SwarmOptions::sheet_between_share
 };
 
 // `liveset repair --find-holes` (finder_repair.hpp) on arrays: the finder's largest holes, one
@@ -280,6 +281,7 @@ pyb::tuple repair_holes(const pyb::array& level, bool is_mask, const pyb::array&
         in.options.swarm.agents = a.agents;
         in.options.swarm.act_probability = a.p;
         in.options.swarm.seed = a.seed;
+        in.options.swarm.sheet_between_share = a.between_share;
         report = cli::repair_found_holes(in, session, true);
         phi = session.field().phi();
     }
@@ -355,10 +357,10 @@ void register_core(pyb::module_& m) {
     });
     m.def("_repair_holes", [](const pyb::array& level, bool is_mask, const pyb::array& image, const pyb::object& roi, const pyb::tuple& geo,
                               const std::optional<std::pair<double, double>>& band, std::size_t holes, std::size_t min_voxels, int round_steps,
-                              std::size_t agents, double p, std::uint64_t seed) {
+                              std::size_t agents, double p, std::uint64_t seed, double between_share) {
         if (level.ndim() != 3) throw std::invalid_argument("phi_or_mask must be a 3D array");
         const Lattice l = lattice_from(pyb::make_tuple(level.shape(0), level.shape(1), level.shape(2)), geo[0], geo[1], geo[2]);
-        return repair_holes(level, is_mask, image, roi, l, RepairHolesArgs{band, holes, min_voxels, agents, round_steps, p, seed});
+        return repair_holes(level, is_mask, image, roi, l, RepairHolesArgs{band, holes, min_voxels, agents, round_steps, p, seed, between_share});
     });
     m.def("_evaluate", [](const pyb::array& mask, const pyb::array& truth, const pyb::tuple& geo) {
         if (mask.ndim() != 3) throw std::invalid_argument("the mask must be a 3D array");

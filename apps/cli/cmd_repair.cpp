@@ -41,7 +41,7 @@ struct RepairArgs {
     std::size_t find_holes = 0;  // --find-holes N: the finder's N largest holes are the targets, one round each
     int round_steps = 1000;      // --round-steps (with --find-holes)
     std::size_t min_hole = 50;   // --min-hole (with --find-holes)
-    bool p_given = false, decision_given = false, steps_given = false;
+    bool p_given = false, decision_given = false, steps_given = false, share_given = false;
     bool json = false, quiet = false;
 };
 
@@ -155,6 +155,10 @@ void check_repair_args(RepairArgs& a) {
                                                         : EditDecision::kIntensity;
     if (!a.options.swarm.sheet_between && a.options.swarm.decision != EditDecision::kSheet)
         throw UsageError("--band-only is a setting of the sheet rule: give it with --decision sheet");
+    if (a.share_given && a.options.swarm.decision != EditDecision::kSheet)
+        throw UsageError("--between-share is a setting of the sheet rule: give it with --decision sheet");
+    if (a.share_given && !a.options.swarm.sheet_between)
+        throw UsageError("--between-share sets what the between-the-sides test admits: it cannot go with --band-only");
     if (!a.options.close_cracks && !a.options.topology_guard)
         throw UsageError("--no-crack-closing is a setting of the topology guard: it cannot go with --no-topology-guard");
     if (a.options.swarm.decision == EditDecision::kSheet) {  // checked with the band below
@@ -268,6 +272,8 @@ int run_given_targets(RepairArgs a, RepairInputs& in, const InterruptGuard& inte
         if (!in.band) throw UsageError("--decision sheet: the tissue model cannot tell the sheet's tissue; give --sheet-lower and --sheet-upper");
         a.options.swarm.sheet_lower = session.scale().to_unit(in.band->lower);
         a.options.swarm.sheet_upper = session.scale().to_unit(in.band->upper);
+        a.options.swarm.sheet_mean = std::clamp(session.scale().to_unit(in.band->mean), a.options.swarm.sheet_lower,
+                                                a.options.swarm.sheet_upper);
     }
     session.set_repair_options(a.options);
     const std::vector<RepairStepLog> log = run_targets(session, targets, a.options.steps, interrupt.flag());
@@ -331,6 +337,9 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--sheet-upper", ra.sheet_upper, "the sheet tissue's highest intensity (raw; default: the tissue model's)")->check(finite_number());
     r->add_flag("--no-topology-guard{false}", ra.options.topology_guard, "let edits bridge pieces or open tunnels (by default they cannot)");
     r->add_flag("--band-only{false}", ra.options.swarm.sheet_between, "sheet rule: raise only voxels in the band (by default also voxels between the sheet's two sides)");
+    r->add_option("--between-share", ra.options.swarm.sheet_between_share, "sheet rule: the smallest share of the sheet's tissue (by its intensity, partial-volume model) a voxel admitted for lying between the sheet's sides must hold; 0.5 = the band only, 0 = up to the neighbouring tissues' means")
+        ->check(CLI::Range(0.0, 0.5))
+        ->capture_default_str();
     r->add_flag("--no-crack-closing{false}", ra.options.close_cracks, "refuse every bridge (by default a one-voxel crack between two fronts is filled whole when that closes a tunnel)");
     r->add_option("--out-phi", ra.out_phi, "repaired phi");
     r->add_option("--out-mask", ra.out_mask, "repaired mask");
@@ -342,6 +351,7 @@ void add_repair_command(CLI::App& app, const int& threads) {
         ra.p_given = r->count("--p") > 0;
         ra.decision_given = r->count("--decision") > 0;
         ra.steps_given = r->count("--steps") > 0;
+        ra.share_given = r->count("--between-share") > 0;
         if (ra.find_holes == 0 && (r->count("--round-steps") > 0 || r->count("--min-hole") > 0))
             throw UsageError("--round-steps and --min-hole are settings of --find-holes");
         const int rc = run_repair_command(ra, threads);

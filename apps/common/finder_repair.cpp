@@ -93,6 +93,7 @@ RepairScheduleResult run_rounds(const FoundHolesInput& in, Session& session, con
     ro.swarm.decision = EditDecision::kSheet;
     ro.swarm.sheet_lower = lo;
     ro.swarm.sheet_upper = hi;
+    ro.swarm.sheet_mean = mean;
     RepairScheduleOptions so;
     so.rounds = static_cast<int>(targets.size());
     so.round_steps = in.round_steps;
@@ -105,6 +106,7 @@ RepairScheduleResult run_rounds(const FoundHolesInput& in, Session& session, con
         const auto [l, u] = local_sheet_band(unit, field.phi(), t.position, 10.0, lo, hi, mean);
         r.swarm.sheet_lower = l;
         r.swarm.sheet_upper = u;
+        r.swarm.sheet_mean = std::clamp(mean + (l - lo), l, u);  // the class mean moves with the band
         ++next;
     };
     SessionRepairDriver driver(session);

@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include <bit>
+#include <cmath>
 #include <chrono>
 #include <cstring>
 #include <fstream>
@@ -60,6 +61,8 @@ json swarm_json(const RepairOptions& r) {
             {"stats_smoothing", s.stats_smoothing}, {"sample_depth", s.sample_depth}, {"edit_range", s.edit_range},
             {"decision", static_cast<int>(s.decision)}, {"sheet_lower", s.sheet_lower}, {"sheet_upper", s.sheet_upper},
             {"sheet_between", s.sheet_between}, {"sheet_reach", s.sheet_reach},
+            {"sheet_mean", std::isnan(s.sheet_mean) ? json(nullptr) : json(s.sheet_mean)},
+            {"sheet_between_share", s.sheet_between_share}, {"sheet_between_limited", s.sheet_between_limited},
             {"spawn_radius", r.spawn_radius}, {"respawn_distance", r.respawn_distance}, {"topology_guard", r.topology_guard},
             {"close_cracks", r.close_cracks}};
 }
@@ -90,6 +93,10 @@ RepairOptions swarm_from(const json& j, RepairOptions r) {
     s.sheet_upper = number(j, "sheet_upper");
     s.sheet_between = field(j, "sheet_between").get<bool>();
     s.sheet_reach = number(j, "sheet_reach");
+    // Absent from a workspace written before the between test's intensity limit: the defaults.
+    if (j.contains("sheet_mean") && !j["sheet_mean"].is_null()) s.sheet_mean = number(j, "sheet_mean");
+    if (j.contains("sheet_between_share")) s.sheet_between_share = number(j, "sheet_between_share");
+    if (j.contains("sheet_between_limited")) s.sheet_between_limited = field(j, "sheet_between_limited").get<bool>();
     r.spawn_radius = number(j, "spawn_radius");
     r.respawn_distance = number(j, "respawn_distance");
     r.topology_guard = field(j, "topology_guard").get<bool>();

@@ -148,13 +148,17 @@ def repair(phi_or_mask, image, targets: Sequence[Sequence[float]], *, steps: int
 
 
 def repair_holes(phi_or_mask, image, holes: int = 10, *, roi=None, sheet_band=None, min_voxels: int = 50,
-                 round_steps: int = 1000, agents: int = 200, p: float = 0.3, seed: int = 1):
+                 round_steps: int = 1000, agents: int = 200, p: float = 0.3, seed: int = 1,
+                 between_share: float = 0.25):
     """``liveset repair --find-holes``: no clicks — the truth-free finder's ``holes`` largest holes
     (>= ``min_voxels``, 12 voxels apart) are repaired one round each with the sheet rule (brush sized
     to the hole, the sheet's band sampled around it), as ``liveset demo --brain --repair`` does.
     ``image``: the image the segmentation came from (the bias-corrected one if it was segmented
     with bias correction); ``sheet_band=(lower, upper)`` raw, by default the tissue model's band of
-    the sheet's class. Returns ``(phi, report)``: the repaired φ (< 0 inside) and ``{"targets",
+    the sheet's class. ``between_share``: the smallest share of the sheet's tissue, by intensity
+    (partial-volume model), that a voxel out of the band must hold to be added for lying between the
+    sheet's sides (0.5: the band only; 0: up to the neighbouring tissues' means; the CLI's
+    ``--between-share``). Returns ``(phi, report)``: the repaired φ (< 0 inside) and ``{"targets",
     "verdicts", "closed", "voxels_added", "finder": {"before", "after", ...}, ...}`` as the CLI's
     ``--json``. Unlike segment, it does not stop on Ctrl-C (holes × round_steps swarm steps, about
     a second per 1 000 on a brain)."""
@@ -168,8 +172,11 @@ def repair_holes(phi_or_mask, image, holes: int = 10, *, roi=None, sheet_band=No
     r = None if r is None else r != 0
     if int(holes) < 1 or int(round_steps) < 1 or int(min_voxels) < 1 or int(agents) < 1:
         raise ValueError("holes, round_steps, min_voxels and agents must be at least 1")
+    if not 0.0 <= float(between_share) <= 0.5:
+        raise ValueError(f"between_share must be in [0, 0.5], got {between_share}")
     band = None if sheet_band is None else (float(sheet_band[0]), float(sheet_band[1]))
     level = (a != 0) if is_mask else np.asarray(a, dtype=np.float32)
     phi, report = _liveset._repair_holes(level, is_mask, np.asarray(img.array, dtype=np.float32), r, img.geometry, band,
-                                          int(holes), int(min_voxels), int(round_steps), int(agents), float(p), int(seed))
+                                          int(holes), int(min_voxels), int(round_steps), int(agents), float(p), int(seed),
+                                          float(between_share))
     return img.like(phi), json.loads(report)

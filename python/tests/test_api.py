@@ -263,3 +263,5 @@ def test_repair_holes_closes_the_finders_holes_inside_the_shell():
     assert not (after & ~shell & ~(seg.array != 0)).any()
     with pytest.raises(ValueError):
         liveset.repair_holes(seg, img, 0)
+    with pytest.raises(ValueError):
+        liveset.repair_holes(seg, img, 2, sheet_band=(75, 115), between_share=0.7)

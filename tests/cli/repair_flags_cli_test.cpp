@@ -1,5 +1,5 @@
 // `liveset repair --band-only` (the sheet rule's between-the-sides test off) compared with the
-// default run on a bias-bright hole; --band-only and --no-crack-closing in bad combinations get one
+// default run on a bias-bright hole; --band-only, --between-share and --no-crack-closing in bad combinations get one
 // line on stderr and a non-zero exit. (--no-crack-closing's behaviour is tested on the guard itself,
 // Repair.ACrackBetweenTwoFrontsClosesWithItsTunnel: on a CLI fixture the fronts zip a slit shut
 // from its ends within a few steps either way.)
@@ -33,9 +33,10 @@ std::size_t added_voxels(const std::filesystem::path& before, const std::filesys
 }
 
 // 64^3 shell: WM 130 (r <= 21), GM 100 (21 < r <= 25), CSF 50; a drill of radius 3 along +x is
-// missing from the mask and bias-bright (140: above the band 75..115, like the white matter). Only
-// the between-the-sides test can raise it; --band-only raises nothing (nothing outside the mask is
-// in the band).
+// missing from the mask and bias-bright (120: above the band 75..115, but more than a quarter the
+// sheet's tissue: below 115 + (115 - 95)/2). Only the between-the-sides test can raise it;
+// --band-only raises nothing (nothing outside the mask is in the band), nor does --between-share 0.5
+// (a between voxel must then lie in the band).
 TEST(RepairFlagsCli, BandOnlyLeavesABrightHoleThatTheBetweenTestCloses) {
     const auto dir = fresh_dir("band");
     const Lattice lat({64, 64, 64});
@@ -48,7 +49,7 @@ TEST(RepairFlagsCli, BandOnlyLeavesABrightHoleThatTheBetweenTestCloses) {
                 const bool drill = x > 32 && std::hypot(y - 32.0, z - 32.0) <= 3.0;
                 if (r <= 21) image({x, y, z}) = 130.0f;
                 else if (r <= 25) {
-                    image({x, y, z}) = drill ? 140.0f : 100.0f;
+                    image({x, y, z}) = drill ? 120.0f : 100.0f;
                     mask({x, y, z}) = !drill;
                 }
             }
@@ -65,6 +66,9 @@ TEST(RepairFlagsCli, BandOnlyLeavesABrightHoleThatTheBetweenTestCloses) {
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_EQ(added_voxels(dir / "seg.nii.gz", dir / "band.nii.gz"), 0u);
     EXPECT_EQ(nlohmann::json::parse(r.out)["targets"][0]["local_genus"]["after"].get<int>(), 1);
+    r = run_cli(base + " --between-share 0.5 --out-mask " + (dir / "half.nii.gz").string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_EQ(added_voxels(dir / "seg.nii.gz", dir / "half.nii.gz"), 0u);
     std::filesystem::remove_all(dir);
 }
 
@@ -81,7 +85,8 @@ TEST(RepairFlagsCli, BadCombinationsGetOneLineAndNonZeroExit) {
     const std::string base = "repair " + (dir / "seg.nii.gz").string() + " --image " + (dir / "t1.nii.gz").string() +
                              " --target 8,8,4 --out-mask " + (dir / "x.nii.gz").string();
     for (const char* extra : {" --band-only", " --band-only --decision intensity", " --no-crack-closing --no-topology-guard",
-}) {
+                              " --between-share 0.3", " --between-share 0.3 --decision sheet --band-only",
+                              " --between-share 0.7 --decision sheet", " --between-share nan --decision sheet"}) {
         const auto r = run_cli(base + extra);
         EXPECT_NE(r.rc, 0) << extra;
         EXPECT_EQ(testing::lines(r.err), 1) << extra << "\n" << r.err;

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <bit>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -81,6 +82,8 @@ std::unique_ptr<Session> worked_session() {
     r.swarm.edit_range = 6.5;
     r.swarm.sheet_between = false;  // the issue-18 settings, off their defaults
     r.swarm.sheet_reach = 5.0;
+    r.swarm.sheet_between_share = 0.4;
+    r.swarm.sheet_between_limited = false;
     r.close_cracks = false;
     s->set_repair_options(r);
     const Vec3d t = s->lattice().coord(s->field().zero_layer().front()).cast<double>();
@@ -139,6 +142,9 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     EXPECT_EQ(ws.repair.swarm.edit_range, 6.5);
     EXPECT_FALSE(ws.repair.swarm.sheet_between);
     EXPECT_EQ(ws.repair.swarm.sheet_reach, 5.0);
+    EXPECT_EQ(ws.repair.swarm.sheet_between_share, 0.4);
+    EXPECT_FALSE(ws.repair.swarm.sheet_between_limited);
+    EXPECT_TRUE(std::isnan(ws.repair.swarm.sheet_mean));  // the band's centre, kept as null
     EXPECT_FALSE(ws.repair.close_cracks);
     EXPECT_EQ(ws.repair.swarm.decision, original->repair_options().swarm.decision);
     ASSERT_TRUE(ws.target.has_value());

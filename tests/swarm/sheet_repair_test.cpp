@@ -187,26 +187,39 @@ TEST(SheetRepair, BetweenTheSheetsSidesIsTheHoleOnly) {
     for (int z = 13; z < 16; ++z) EXPECT_FALSE(between_sheet_sides(sphi, sulcus, {20, 20, z}, 8.0, kLower, kUpper)) << z;
 }
 
-// The drilled shell with its drill reading as white matter (bias-bright hole tissue, as in the
+// The drilled shell with its drill reading above the band (bias-bright hole tissue, as in the
 // phantom): the band alone cannot close it; between the sheet's sides it closes, and every voxel
 // added is one of the drill's.
-TEST(SheetRepair, ClosesABiasBrightHoleAddingOnlyTheHolesVoxels) {
-    Shell s = drilled_shell(3.0);
-    Grid<std::uint8_t> drill(s.mask.lattice(), 0);
-    for (PointIndex i = 0; i < drill.size(); ++i)
-        if (s.image[i] == kGm && !s.mask[i]) {
-            drill[i] = 1;
-            s.image[i] = kWm;
-        }
+// The drilled shell with the drill's tissue reading `drill_value` (a bias moved it out of the band).
+struct BrightDrill {
+    Shell shell = drilled_shell(3.0);
+    Grid<std::uint8_t> drill{shell.mask.lattice(), 0};
+    explicit BrightDrill(float drill_value) {
+        for (PointIndex i = 0; i < drill.size(); ++i)
+            if (shell.image[i] == kGm && !shell.mask[i]) {
+                drill[i] = 1;
+                shell.image[i] = drill_value;
+            }
+    }
     // The hole is open while the shell encloses no cavity (one drill makes it a cap); its size is
     // the drill voxels still missing.
-    const HoleSiteFinder find = [&](const SparseField& f) {
-        const Grid<std::uint8_t> m = inside_mask(f.phi());
-        std::size_t missing = 0;
-        for (PointIndex i = 0; i < m.size(); ++i) missing += drill[i] && !m[i];
-        if (mask_topology(m).cavities == 1) return std::vector<HoleSite>{};
-        return std::vector<HoleSite>{{Vec3d{kCentre.x + 23, kCentre.y, kCentre.z}, missing}};
-    };
+    HoleSiteFinder finder() const {
+        return [this](const SparseField& f) {
+            const Grid<std::uint8_t> m = inside_mask(f.phi());
+            std::size_t missing = 0;
+            for (PointIndex i = 0; i < m.size(); ++i) missing += drill[i] && !m[i];
+            if (mask_topology(m).cavities == 1) return std::vector<HoleSite>{};
+            return std::vector<HoleSite>{{Vec3d{kCentre.x + 23, kCentre.y, kCentre.z}, missing}};
+        };
+    }
+};
+
+TEST(SheetRepair, ClosesABiasBrightHoleAddingOnlyTheHolesVoxels) {
+    // 0.7: above the band [0.35, 0.65), still more than a quarter the sheet's tissue (below 0.725).
+    const BrightDrill b(0.7f);
+    const Shell& s = b.shell;
+    const Grid<std::uint8_t>& drill = b.drill;
+    const HoleSiteFinder find = b.finder();
     for (bool between : {false, true}) {
         SparseField field(s.mask.lattice(), 2);
         field.init_from_mask(s.mask);
@@ -234,6 +247,67 @@ TEST(SheetRepair, ClosesABiasBrightHoleAddingOnlyTheHolesVoxels) {
         }
         EXPECT_GE(2 * filled, drilled);  // at least half the hole's tissue restored
     }
+}
+
+// sheet_between_range: the band widened towards each neighbouring class mean (2·edge − mean) so that
+// a voxel holds at least the given share of the sheet's tissue by the partial-volume model.
+TEST(SheetRepair, BetweenRangeHoldsTheSheetsShare) {
+    SwarmOptions o = sheet_options().swarm;
+    const auto expect = [&](double lo, double hi) {
+        const auto [l, h] = sheet_between_range(o);
+        EXPECT_NEAR(l, lo, 1e-12);
+        EXPECT_NEAR(h, hi, 1e-12);
+    };
+    expect(0.275, 0.725);  // the default quarter, mean at the band's centre
+    o.sheet_between_share = 0.5;
+    expect(kLower, kUpper);  // half: the band itself
+    o.sheet_between_share = 0.0;
+    expect(0.2, 0.8);  // nothing: up to the neighbouring class means (kCsf, kWm)
+    o.sheet_between_share = 0.25;
+    o.sheet_mean = 0.45;  // CSF at 0.25, WM at 0.85: a quarter GM reads 0.30 and 0.75
+    expect(0.30, 0.75);
+    o.sheet_mean = 0.7;  // outside the band
+    EXPECT_THROW(validate(o), std::invalid_argument);
+    o.sheet_mean = 0.45;
+    o.sheet_between_share = 0.6;
+    EXPECT_THROW(validate(o), std::invalid_argument);
+}
+
+// A drill whose voxels read 0.76, under 15 % the sheet's tissue by the partial-volume model (kWm
+// 0.8, kGm 0.5), is not the hole's tissue by intensity: between the sides or not, the default rule
+// (at least a quarter) adds none of it; admitting up to the class means (share 0) closes it.
+TEST(SheetRepair, AVoxelMostlyTheEnclosedTissueIsNotAdded) {
+    const BrightDrill b(0.76f);
+    for (double share : {0.25, 0.0}) {
+        SparseField field(b.shell.mask.lattice(), 2);
+        field.init_from_mask(b.shell.mask);
+        RepairOptions ro = sheet_options();
+        ro.swarm.sheet_between_share = share;
+        RepairScheduleOptions so;
+        so.rounds = 3;
+        so.round_steps = 200;
+        const RepairScheduleResult r = run_repair_schedule(field, b.shell.image, nullptr, ro, so, b.finder());
+        const Grid<std::uint8_t> after = inside_mask(field.phi());
+        std::size_t added = 0;
+        for (PointIndex i = 0; i < after.size(); ++i) added += after[i] && !b.shell.mask[i];
+        if (share > 0) {
+            EXPECT_GT(r.holes_left, 0u);
+            EXPECT_EQ(added, 0u);
+        } else {
+            EXPECT_EQ(r.holes_left, 0u);
+            EXPECT_EQ(mask_topology(after).cavities, 1u);
+        }
+    }
+    // Reading as the white matter itself (the phantom's bias bumps): only without the limit.
+    const BrightDrill w(kWm);
+    SparseField field(w.shell.mask.lattice(), 2);
+    field.init_from_mask(w.shell.mask);
+    RepairOptions ro = sheet_options();
+    ro.swarm.sheet_between_limited = false;
+    RepairScheduleOptions so;
+    so.rounds = 3;
+    so.round_steps = 200;
+    EXPECT_EQ(run_repair_schedule(field, w.shell.image, nullptr, ro, so, w.finder()).holes_left, 0u);
 }
 
 // HoleSite::stalled_rounds, as the round's setup sees it: the band-only rule cannot raise the

@@ -35,10 +35,12 @@
 //   [sheet_lower, sheet_upper): the voxel it grows into looks like the sheet's tissue, neither the
 //   enclosed tissue above the band (white matter) nor the outside below it (CSF) — or when the
 //   voxel at x + 0.75n lies between the sheet's two sides (between_sheet_sides, within the brush
-//   or sheet_reach, whichever is larger; sheet_between): a hole's tissue whose intensity bias or partial volume moved out of the band. It never
+//   or sheet_reach, whichever is larger; sheet_between): a hole's tissue whose intensity bias, noise
+//   or partial volume moved out of the band. It never
 //   contracts: a repair closes holes, the segmentation's own faces stay where they are; and its
-//   footprint skips the outside points whose own voxel lies outside the band and not between the
-//   sheet's sides)
+//   footprint skips the outside points whose own voxel lies outside the band unless it lies between
+//   the sheet's sides and still holds at least sheet_between_share of the sheet's tissue by its
+//   intensity (sheet_between_range; sheet_between_limited))
 //   Δ is spread over the zero-layer points p with |p − x| ≤ edit_radius, weighted by the
 //   unit-peak Gaussian exp(−|p − x|²/(2σ_g²)), σ_g = edit_radius/2, so A is the change under the
 //   agent whatever the zero-layer sampling density. Contributions to a point are summed in agent
@@ -211,6 +213,16 @@ void validate(const SwarmOptions& o) {
     require(o.decision != EditDecision::kSheet ||
                 (std::isfinite(o.sheet_lower) && std::isfinite(o.sheet_upper) && o.sheet_lower < o.sheet_upper),
             "swarm: the sheet decision needs a finite band sheet_lower < sheet_upper");
+    require(std::isfinite(o.sheet_between_share) && o.sheet_between_share >= 0 && o.sheet_between_share <= 0.5,
+            "swarm: sheet_between_share must be in [0, 0.5]");
+    require(std::isnan(o.sheet_mean) || (o.sheet_mean >= o.sheet_lower && o.sheet_mean <= o.sheet_upper),
+            "swarm: sheet_mean must lie in the sheet's band [sheet_lower, sheet_upper]");
+}
+
+std::pair<double, double> sheet_between_range(const SwarmOptions& o) {
+    const double mean = std::isnan(o.sheet_mean) ? 0.5 * (o.sheet_lower + o.sheet_upper) : o.sheet_mean;
+    const double widen = 1.0 - 2.0 * o.sheet_between_share;
+    return {o.sheet_lower - widen * (mean - o.sheet_lower), o.sheet_upper + widen * (o.sheet_upper - mean)};
 }
 
 Swarm::Swarm(const SwarmOptions& options) : options_(options) { validate(options_); }
@@ -385,11 +397,19 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
     const bool sheet = options_.decision == EditDecision::kSheet;
     const double between_reach =
         options_.sheet_between && options_.edit_range > 0 ? std::max(options_.edit_range, options_.sheet_reach) : 0.0;
-    const auto between_voxel = [&](Vec3i q) {
-        return between_reach > 0 && between_sheet_sides(phi, image_unit, q, between_reach, options_.sheet_lower, options_.sheet_upper);
+    const std::pair<double, double> between_range = sheet_between_range(options_);
+    const double between_lo = between_range.first, between_hi = between_range.second;
+    // `limited`: the voxel must also hold sheet_between_share of the sheet's tissue (the footprint's
+    // test; an agent may decide to grow towards a gap at any intensity, but raises only such voxels).
+    const auto between_voxel = [&](Vec3i q, bool limited) {
+        if (!(between_reach > 0) || !lat.contains(q)) return false;
+        const float v = image_unit(q);
+        return (!limited || !options_.sheet_between_limited || (v >= between_lo && v < between_hi)) &&
+               between_sheet_sides(phi, image_unit, q, between_reach, options_.sheet_lower, options_.sheet_upper);
     };
     const auto between = [&](Vec3d p) {
-        return between_voxel({static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)), static_cast<int>(std::lround(p.z))});
+        return between_voxel({static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)), static_cast<int>(std::lround(p.z))},
+                             false);
     };
     std::vector<std::vector<ZeroLayerEdit>> per_agent(n_agents);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_agents), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -428,7 +448,7 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
                         const PointIndex idx = lat.index(q);
                         if (field.status()[idx] != 0) continue;
                         if (sheet && phi[idx] >= 0.0f && !(image_unit[idx] >= options_.sheet_lower && image_unit[idx] < options_.sheet_upper) &&
-                            !between_voxel(q))
+                            !between_voxel(q, true))
                             continue;  // kSheet: never raise the surface over a voxel that is neither the sheet's tissue nor between its sides
                         const Vec3d d = q.cast<double>() - x;
                         const double d2 = dot(d, d);

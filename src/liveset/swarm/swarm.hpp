@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -58,6 +59,21 @@ struct SwarmOptions {
     bool sheet_between = true;
     // ... looking at least this far (voxels; 0: the brush alone).
     double sheet_reach = 0.0;
+    // Decision kSheet: the sheet tissue's class mean (normalised units, inside the band; NaN: the
+    // band's centre), and the smallest share s of the sheet's tissue that a voxel out of the band,
+    // raised by a footprint because it lies between the sheet's sides, must hold by the
+    // partial-volume model (a border voxel reads as the share-weighted mean of two class means; the
+    // band's edges are the midpoints, so the neighbouring class means are 2·edge − mean): its
+    // intensity within [lower − (1−2s)(mean − lower), upper + (1−2s)(upper − mean))
+    // (sheet_between_range). Bias and noise move a hole's own tissue out of the band; a voxel three
+    // quarters white matter or CSF (s = 0.25) is not the hole's tissue. 0 admits up to the
+    // neighbouring class means; at most 0.5 (the band itself). An agent still decides to grow at a
+    // gap whatever the voxel's intensity; only what its footprint raises is limited.
+    double sheet_mean = std::numeric_limits<double>::quiet_NaN();
+    double sheet_between_share = 0.25;
+    // false: no intensity limit on between voxels (the phantom demo: its holes are grey matter a
+    // bias bump lifted to the white matter's intensity).
+    bool sheet_between_limited = true;
 };
 
 // Whether outside voxel `q` lies between the sheet's two sides, within `reach` voxels along rays
@@ -68,6 +84,10 @@ struct SwarmOptions {
 // sheet separates). White matter under an intact sheet, or the CSF of a sulcus between two banks,
 // fails the second test.
 bool between_sheet_sides(const Grid<float>& phi, const Grid<float>& image_unit, Vec3i q, double reach, double lower, double upper);
+
+// The intensity range [lo, hi) a voxel admitted by between_sheet_sides alone must lie in (see
+// SwarmOptions::sheet_between_share).
+std::pair<double, double> sheet_between_range(const SwarmOptions& options);
 
 // Throws std::invalid_argument (one-line message) on an invalid option.
 void validate(const SwarmOptions& options);
