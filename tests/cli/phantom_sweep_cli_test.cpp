@@ -1,8 +1,10 @@
 // The phantom repair sweep of issue 18 item 5, the cases it meets (docs/BENCHMARKS.md has the whole
 // 3 sizes x 3 seeds table): `liveset demo` with its default rule (sheet-fallback: the sheet rule
 // aimed at each hole's widest opening, a hole whose round stalled gets the intensity rule's round)
-// ends at holes 0 with Dice up at 64^3 (seeds 1-3), 96^3 and 128^3 (seeds 1-2). Not met, so not
-// here: 96^3 and 128^3 seed 3 (tunnels left; Dice still up).
+// ends at holes 0 with Dice up at 64^3 and 96^3 (seeds 1-3), with the truth's topology: no handle,
+// the truth's one cavity, and the truth finder sees nothing left. Not met, so not here: 128^3
+// seeds 1-3 (a one-voxel bubble the segmentation left, and at seeds 2-3 a handle of white-matter
+// voxels the segmentation put in, which no growth closes; Dice still up).
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -16,9 +18,7 @@ namespace {
 
 using testing::run_cli;
 
-// `genus`: whether the repaired mask must also have no handle left (128^3 seed 2 ends at holes 0,
-// the truth's Euler characteristic, with genus 2: extra pieces balance the handles).
-void expect_closed_with_dice_up(int size, int seed, bool genus = true) {
+void expect_closed_with_dice_up(int size, int seed) {
     const auto dir = std::filesystem::temp_directory_path() /
                      ("liveset_sweep_" + std::to_string(::getpid()) + "_" + std::to_string(size) + "_" + std::to_string(seed));
     const auto r = run_cli("--threads 1 demo --size " + std::to_string(size) + " --seed " + std::to_string(seed) +
@@ -29,9 +29,11 @@ void expect_closed_with_dice_up(int size, int seed, bool genus = true) {
     const auto &before = j["before"], &after = j["after"];
     EXPECT_GT(before["holes"].get<long>(), 0) << size << "/" << seed << ": the segmentation leaves holes to repair";
     EXPECT_EQ(after["holes"].get<long>(), 0) << size << "/" << seed;
-    if (genus) {
-        EXPECT_EQ(after["genus"].get<long>(), 0) << size << "/" << seed;
-    }
+    // holes 0 alone could be an open core balanced by a bubble: the truth's Betti numbers too, and
+    // the finder's verdict (no perforation of the core, no cavity, no tunnel left).
+    EXPECT_EQ(after["genus"].get<long>(), 0) << size << "/" << seed;
+    EXPECT_EQ(after["cavities"].get<long>(), after["truth"]["cavities"].get<long>()) << size << "/" << seed;
+    EXPECT_EQ(j["repair"]["holes_left"].get<long>(), 0) << size << "/" << seed;
     EXPECT_GT(after["dice"].get<double>(), before["dice"].get<double>()) << size << "/" << seed;
 }
 
@@ -39,13 +41,8 @@ TEST(PhantomSweep, DefaultRuleClosesThe64Phantoms) {
     for (int seed = 1; seed <= 3; ++seed) expect_closed_with_dice_up(64, seed);
 }
 
-TEST(PhantomSweep, DefaultRuleClosesThe96PhantomSeeds1And2) {
-    for (int seed = 1; seed <= 2; ++seed) expect_closed_with_dice_up(96, seed);
-}
-
-TEST(PhantomSweep, DefaultRuleClosesThe128PhantomSeeds1And2) {
-    expect_closed_with_dice_up(128, 1);
-    expect_closed_with_dice_up(128, 2, false);
+TEST(PhantomSweep, DefaultRuleClosesThe96Phantoms) {
+    for (int seed = 1; seed <= 3; ++seed) expect_closed_with_dice_up(96, seed);
 }
 
 }  // namespace

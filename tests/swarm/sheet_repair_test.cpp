@@ -2,11 +2,14 @@
 // truth is known analytically: the hole closes, only sheet voxels are added, nothing contracts.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 #include <stdexcept>
 
 #include "liveset/eval/holes.hpp"
+#include "liveset/eval/perforations.hpp"
 #include "liveset/eval/topology.hpp"
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/swarm/repair_schedule.hpp"
@@ -119,6 +122,72 @@ TEST(SheetRepair, LocalBandFollowsTheSheetsOwnIntensity) {
     const auto [lo2, hi2] = local_sheet_band(s.image, phi, {2, 2, 2}, 3.0, kLower, kUpper, kGm);
     EXPECT_DOUBLE_EQ(lo2, kLower);
     EXPECT_DOUBLE_EQ(hi2, kUpper);
+}
+
+// A repair that grew into the white matter can wall a pocket of it off; a missed-GM tube from the
+// outside into that pocket touches white matter and the outside like a perforation, and filling it
+// raises the Euler characteristic like one (it seals the pocket), yet it is no hole of the shell.
+// The truth finder lists the real perforation only; with it filled the mask has the truth's
+// topology (checked by brute force), the tube still open.
+TEST(SheetRepair, ATubeIntoAWalledOffPocketIsNoHole) {
+    Shell s = drilled_shell(1.5);  // the real perforation, along +x
+    Grid<std::uint8_t> truth(s.mask.lattice(), 0), inner(s.mask.lattice(), 0), tube(s.mask.lattice(), 0);
+    for (int z = 0; z < kN; ++z)
+        for (int y = 0; y < kN; ++y)
+            for (int x = 0; x < kN; ++x) {
+                const double r = norm(Vec3d{double(x), double(y), double(z)} - kCentre);
+                truth({x, y, z}) = r > kCore && r <= kOuter;
+                inner({x, y, z}) = r <= kCore;
+            }
+    // The pocket: white matter x 12..14, y, z 31..33, and (11,32,32) (r = 21, white matter) between it and
+    // the grey matter; walled in by the mask over the box x 11..15, y, z 30..34; the tube: the grey
+    // matter on the line y = z = 32 from x = 10 out to the CSF.
+    const auto in_pocket = [](Vec3i q) {
+        return (q.x >= 12 && q.x <= 14 && std::abs(q.y - 32) <= 1 && std::abs(q.z - 32) <= 1) || q == Vec3i{11, 32, 32};
+    };
+    for (int z = 30; z <= 34; ++z)
+        for (int y = 30; y <= 34; ++y)
+            for (int x = 11; x <= 15; ++x) s.mask({x, y, z}) = !in_pocket({x, y, z});
+    for (int x = 0; x < 11; ++x)
+        if (truth({x, 32, 32})) {
+            tube({x, 32, 32}) = 1;
+            s.mask({x, 32, 32}) = 0;
+        }
+    const auto with = [](Grid<std::uint8_t> m, const Grid<std::uint8_t>& add) {
+        for (PointIndex i = 0; i < m.size(); ++i) m[i] = m[i] || add[i];
+        return m;
+    };
+    Grid<std::uint8_t> drill(s.mask.lattice(), 0);
+    for (PointIndex i = 0; i < drill.size(); ++i) drill[i] = truth[i] && !s.mask[i] && !tube[i];
+    // The premise, by brute force: both look like perforations and filling either raises χ by one.
+    ASSERT_EQ(find_perforations(s.mask, truth, inner).size(), 2u);
+    const Topology t0 = mask_topology(s.mask), t_tube = mask_topology(with(s.mask, tube)), t_drill = mask_topology(with(s.mask, drill));
+    ASSERT_EQ(t_tube.euler_solid, t0.euler_solid + 1);
+    ASSERT_EQ(t_drill.euler_solid, t0.euler_solid + 1);
+    ASSERT_EQ(t_tube.genus, t0.genus);  // ... the tube's fill only seals the pocket off
+    // The walled-off pocket is counted in, nothing else.
+    const Grid<std::uint8_t> enclosed = with_walled_inner(s.mask, inner);
+    std::size_t added = 0;
+    for (PointIndex i = 0; i < enclosed.size(); ++i) {
+        if (enclosed[i] != s.mask[i]) {
+            ++added;
+            ASSERT_TRUE(in_pocket(s.mask.lattice().coord(i)));
+        }
+    }
+    EXPECT_EQ(added, 28u);
+    const std::vector<HoleSite> sites = truth_hole_sites(s.mask, truth, inner);
+    ASSERT_EQ(sites.size(), 1u);
+    EXPECT_GT(sites[0].position.x, kCentre.x + kCore);  // the drill, not the tube
+    const auto dv = drill.values();
+    EXPECT_EQ(sites[0].voxels, static_cast<std::size_t>(std::count(dv.begin(), dv.end(), std::uint8_t{1})));
+    // The drill filled: nothing left to find, and the truth's topology (the tube is a dent).
+    const Grid<std::uint8_t> repaired = with(s.mask, drill);
+    EXPECT_TRUE(truth_hole_sites(repaired, truth, inner, HoleAim::kOpening).empty());
+    const Topology tr = mask_topology(truth), rep = mask_topology(repaired);
+    EXPECT_EQ(rep.components, tr.components);
+    EXPECT_EQ(rep.cavities, tr.cavities);
+    EXPECT_EQ(rep.genus, tr.genus);
+    EXPECT_THROW(with_walled_inner(s.mask, Grid<std::uint8_t>(Lattice({4, 4, 4}), 0)), std::invalid_argument);
 }
 
 TEST(SheetRepair, BadOptionsThrow) {

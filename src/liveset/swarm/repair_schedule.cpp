@@ -3,6 +3,7 @@
 #include "liveset/swarm/repair_schedule.hpp"
 
 #include "liveset/eval/perforations.hpp"
+#include "liveset/eval/topology.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -107,21 +108,42 @@ bool shrank(const HoleSite& target, const std::vector<HoleSite>& holes) {
 
 }  // namespace
 
+Grid<std::uint8_t> with_walled_inner(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& inner) {
+    if (!(mask.dims() == inner.dims())) throw std::invalid_argument("walled inner: mask and inner differ in size");
+    Grid<std::uint8_t> open(mask.lattice(), 0);
+    for (PointIndex i = 0; i < open.size(); ++i) open[i] = inner[i] && !mask[i];
+    std::size_t count = 0;
+    const std::vector<std::uint32_t> label = label_components(open, 6, &count);
+    std::vector<std::size_t> size(count + 1, 0);
+    for (const std::uint32_t k : label) ++size[k];
+    size[0] = 0;
+    // The core: the largest piece (ties: the first in scan order, as label_components numbers them).
+    const auto core = static_cast<std::uint32_t>(std::max_element(size.begin(), size.end()) - size.begin());
+    Grid<std::uint8_t> out = mask;
+    for (PointIndex i = 0; i < out.size(); ++i)
+        if (label[i] != 0 && label[i] != core) out[i] = 1;
+    return out;
+}
+
 std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner,
                                        HoleAim aim) {
     if (!(mask.dims() == truth.dims()) || !(mask.dims() == inner.dims()))
         throw std::invalid_argument("truth hole sites: mask, truth and inner differ in size");
+    // Perforations and tunnels are read with the inner tissue the mask has walled off from the core
+    // counted in (enclosed tissue, no place a hole leads to); the missed-truth regions are the same
+    // (inner and truth do not overlap), sites and cavities are the mask's own.
+    const Grid<std::uint8_t> enclosed = with_walled_inner(mask, inner);
     const auto missed = [&](Vec3i q) { return truth(q) && !mask(q); };
     const auto cavity = [&](Vec3i q) { return !mask(q); };
     const auto site = [&](const Perforation& p, const auto& in_hole) {
         return HoleSite{aim == HoleAim::kOpening ? deepest_voxel(mask, in_hole, p.nearest, p.centroid) : p.centroid, p.voxels};
     };
     std::vector<HoleSite> sites;
-    for (const Perforation& p : find_perforations(mask, truth, inner)) sites.push_back(site(p, missed));
+    for (const Perforation& p : find_perforations(enclosed, truth, inner)) sites.push_back(site(p, missed));
     if (sites.empty())
         for (const Perforation& p : find_cavities(mask, inner)) sites.push_back(site(p, cavity));
     if (sites.empty())
-        for (const Perforation& p : find_missed_tunnels(mask, truth)) sites.push_back(site(p, missed));
+        for (const Perforation& p : find_missed_tunnels(enclosed, truth)) sites.push_back(site(p, missed));
     return sites;
 }
 

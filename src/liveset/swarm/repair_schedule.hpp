@@ -87,10 +87,19 @@ using HoleSiteFinder = std::function<std::vector<HoleSite>(const SparseField& fi
 // demo aims it at centroids and the sheet rule at openings (docs/BENCHMARKS.md).
 enum class HoleAim { kCentroid, kOpening };
 
+// `mask` with the pieces of `inner` it has walled off from the inner core counted in: every
+// 6-connected component of inner voxels outside the mask but the largest (the core). A repair that
+// grew into the inner tissue can wall a pocket of it off; a missed-truth tube from the outside into
+// such a pocket is no perforation of the shell (filling it seals the pocket, a spurious cavity,
+// and closes no tunnel). Throws std::invalid_argument when the sizes differ.
+Grid<std::uint8_t> with_walled_inner(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& inner);
+
 // The holes a user who sees the truth points at, largest first: the perforations of `mask` between
-// `truth` and `inner` (eval/perforations.hpp), and when none is left, its spurious cavities
-// (bubbles) in `inner`, then the tunnels that missed truth closes (pinholes, cracks). The phantom
-// demo's finder (and its test's). Throws std::invalid_argument when the sizes differ.
+// `truth` and the inner core (eval/perforations.hpp, on with_walled_inner(mask, inner): a missed
+// region that reaches only a walled-off pocket is none), and when none is left, its spurious
+// cavities (bubbles) in `inner`, then the tunnels that missed truth closes (pinholes, cracks;
+// counted with the walled-off pockets in, so a tube whose filling only seals a pocket is none).
+// The phantom demo's finder (and its test's). Throws std::invalid_argument when the sizes differ.
 std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner,
                                        HoleAim aim = HoleAim::kCentroid);
 
