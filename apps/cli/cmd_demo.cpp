@@ -36,7 +36,7 @@ struct DemoArgs {
     std::string out = "liveset-demo";
     int size = 128;
     std::uint64_t seed = 1;
-    int rounds = 20;        // repair rounds (one target each)
+    int rounds = 30;        // repair rounds (one target each; the schedule stops when no hole is left)
     int round_steps = 100;  // swarm steps per round
     // Repair rule: sheet-fallback (the default: the sheet rule, a stalled hole's round the intensity
     // rule), sheet, or intensity (population statistics).
