@@ -68,7 +68,6 @@ RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, c
     ro.swarm.decision = EditDecision::kSheet;
     ro.swarm.sheet_lower = lo;
     ro.swarm.sheet_upper = hi;
-    ro.swarm.sheet_mean = mean;
     // The phantom's holes are local bias bumps that lift the shell's grey matter to the white
     // matter's intensity (phantom.hpp, "Bias"): no intensity tells their tissue, so the between test
     // decides alone here. On real scans (finder_repair, repair --decision sheet) the limit holds.
@@ -80,7 +79,6 @@ RoundSetup sheet_rule_setup(const Grid<float>& image, const SegmentOutcome& o, c
         const auto [l, u] = local_sheet_band(*unit, field->phi(), t.position, 10.0, lo, hi, mean);
         r.swarm.sheet_lower = l;
         r.swarm.sheet_upper = u;
-        r.swarm.sheet_mean = std::clamp(mean + (l - lo), l, u);  // the class mean moves with the band
         if (fallback && t.stalled_rounds > 0) {
             const RepairOptions d = demo_repair_options();
             r.swarm.decision = d.swarm.decision;

@@ -219,12 +219,17 @@ def test_docs_example_runs(tmp_path):
     np.testing.assert_allclose(seg.affine, nib.load(str(tmp_path / "t1.nii.gz")).affine, atol=1e-6)
 
 
+def _centred_grid(n):
+    """The voxel indices of an n^3 grid (n, n, n, 3), their distance from its centre, and the centre."""
+    c = (n - 1) / 2
+    ijk = np.stack(np.meshgrid(*[np.arange(n)] * 3, indexing="ij"), -1).astype(float)
+    return ijk, np.linalg.norm(ijk - c, axis=-1), c
+
+
 def test_find_holes_finds_exactly_a_drilled_hole():
     # A grey-matter shell (0.5) between white matter (1.0) and CSF (0.1), segmented except for a
     # 4x4 shaft drilled through the top: the finder's one candidate is exactly the drilled voxels.
-    n, c = 40, 19.5
-    ijk = np.stack(np.meshgrid(*[np.arange(n)] * 3, indexing="ij"), -1).astype(float)
-    r = np.linalg.norm(ijk - c, axis=-1)
+    ijk, r, c = _centred_grid(40)
     image = np.where(r < 8, 1.0, np.where(r < 12, 0.5, 0.1)).astype(np.float32)
     shell = (r >= 8) & (r < 12)
     drilled = shell & (np.abs(ijk[..., 0] - c) < 2) & (np.abs(ijk[..., 1] - c) < 2) & (ijk[..., 2] > c)
@@ -244,9 +249,7 @@ def test_find_holes_finds_exactly_a_drilled_hole():
 def test_repair_holes_closes_the_finders_holes_inside_the_shell():
     # The same shell with two shafts drilled through it (GM-bright): repair_holes (the CLI's
     # --find-holes) aims at the finder's sites, fills the shafts and adds nothing outside the shell.
-    n, c = 48, 23.5
-    ijk = np.stack(np.meshgrid(*[np.arange(n)] * 3, indexing="ij"), -1).astype(float)
-    r = np.linalg.norm(ijk - c, axis=-1)
+    ijk, r, c = _centred_grid(48)
     image = np.where(r < 12, 130.0, np.where(r < 16, 100.0, 50.0)).astype(np.float32)
     shell = (r >= 12) & (r < 16)
     shafts = shell & (((np.hypot(ijk[..., 0] - c, ijk[..., 1] - c) <= 2.5) & (ijk[..., 2] > c)) |

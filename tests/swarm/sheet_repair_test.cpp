@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 #include "liveset/eval/holes.hpp"
 #include "liveset/eval/perforations.hpp"
@@ -256,9 +257,6 @@ TEST(SheetRepair, BetweenTheSheetsSidesIsTheHoleOnly) {
     for (int z = 13; z < 16; ++z) EXPECT_FALSE(between_sheet_sides(sphi, sulcus, {20, 20, z}, 8.0, kLower, kUpper)) << z;
 }
 
-// The drilled shell with its drill reading above the band (bias-bright hole tissue, as in the
-// phantom): the band alone cannot close it; between the sheet's sides it closes, and every voxel
-// added is one of the drill's.
 // The drilled shell with the drill's tissue reading `drill_value` (a bias moved it out of the band).
 struct BrightDrill {
     Shell shell = drilled_shell(3.0);
@@ -281,24 +279,31 @@ struct BrightDrill {
             return std::vector<HoleSite>{{Vec3d{kCentre.x + 23, kCentre.y, kCentre.z}, missing}};
         };
     }
+    // `rounds` rounds of 200 steps of `ro` from the drilled mask, aimed by finder(): the schedule's
+    // result and the mask after.
+    std::pair<RepairScheduleResult, Grid<std::uint8_t>> repair(const RepairOptions& ro, int rounds) const {
+        SparseField field(shell.mask.lattice(), 2);
+        field.init_from_mask(shell.mask);
+        RepairScheduleOptions so;
+        so.rounds = rounds;
+        so.round_steps = 200;
+        RepairScheduleResult r = run_repair_schedule(field, shell.image, nullptr, ro, so, finder());
+        return {std::move(r), inside_mask(field.phi())};
+    }
 };
 
+// The drilled shell with its drill reading above the band (bias-bright hole tissue, as in the
+// phantom): the band alone cannot close it; between the sheet's sides it closes, and every voxel
+// added is one of the drill's.
 TEST(SheetRepair, ClosesABiasBrightHoleAddingOnlyTheHolesVoxels) {
     // 0.7: above the band [0.35, 0.65), still more than a quarter the sheet's tissue (below 0.725).
     const BrightDrill b(0.7f);
     const Shell& s = b.shell;
     const Grid<std::uint8_t>& drill = b.drill;
-    const HoleSiteFinder find = b.finder();
     for (bool between : {false, true}) {
-        SparseField field(s.mask.lattice(), 2);
-        field.init_from_mask(s.mask);
         RepairOptions ro = sheet_options();
         ro.swarm.sheet_between = between;
-        RepairScheduleOptions so;
-        so.rounds = 5;
-        so.round_steps = 200;
-        const RepairScheduleResult r = run_repair_schedule(field, s.image, nullptr, ro, so, find);
-        const Grid<std::uint8_t> after = inside_mask(field.phi());
+        const auto [r, after] = b.repair(ro, 5);
         if (!between) {
             EXPECT_GT(r.holes_left, 0u);  // nothing in the drill is in the band
             continue;
@@ -348,15 +353,9 @@ TEST(SheetRepair, BetweenRangeHoldsTheSheetsShare) {
 TEST(SheetRepair, AVoxelMostlyTheEnclosedTissueIsNotAdded) {
     const BrightDrill b(0.76f);
     for (double share : {0.25, 0.0}) {
-        SparseField field(b.shell.mask.lattice(), 2);
-        field.init_from_mask(b.shell.mask);
         RepairOptions ro = sheet_options();
         ro.swarm.sheet_between_share = share;
-        RepairScheduleOptions so;
-        so.rounds = 3;
-        so.round_steps = 200;
-        const RepairScheduleResult r = run_repair_schedule(field, b.shell.image, nullptr, ro, so, b.finder());
-        const Grid<std::uint8_t> after = inside_mask(field.phi());
+        const auto [r, after] = b.repair(ro, 3);
         std::size_t added = 0;
         for (PointIndex i = 0; i < after.size(); ++i) added += after[i] && !b.shell.mask[i];
         if (share > 0) {
@@ -369,14 +368,9 @@ TEST(SheetRepair, AVoxelMostlyTheEnclosedTissueIsNotAdded) {
     }
     // Reading as the white matter itself (the phantom's bias bumps): only without the limit.
     const BrightDrill w(kWm);
-    SparseField field(w.shell.mask.lattice(), 2);
-    field.init_from_mask(w.shell.mask);
     RepairOptions ro = sheet_options();
     ro.swarm.sheet_between_limited = false;
-    RepairScheduleOptions so;
-    so.rounds = 3;
-    so.round_steps = 200;
-    EXPECT_EQ(run_repair_schedule(field, w.shell.image, nullptr, ro, so, w.finder()).holes_left, 0u);
+    EXPECT_EQ(w.repair(ro, 3).first.holes_left, 0u);
 }
 
 // HoleSite::stalled_rounds, as the round's setup sees it: the band-only rule cannot raise the
