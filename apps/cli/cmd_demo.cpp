@@ -124,7 +124,8 @@ nlohmann::json run_demo_repair(const DemoArgs& a, const Phantom& ph, const Segme
     double repair_ms = 0.0;
     for (const RepairRoundLog& r : sched.rounds) {
         const Vec3d t = r.target.position;
-        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", r.target.voxels}, {"holes", r.holes}, {"edit_range", r.edit_range}});
+        rounds.push_back({{"target", {t.x, t.y, t.z}}, {"hole_voxels", r.target.voxels}, {"holes", r.holes}, {"edit_range", r.edit_range},
+                          {"cut", r.target.cut}});
         steps += static_cast<std::size_t>(r.steps);
         fragments += r.fragments;
         modified += r.modified;

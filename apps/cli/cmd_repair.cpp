@@ -41,7 +41,7 @@ struct RepairArgs {
     std::size_t find_holes = 0;  // --find-holes N: the finder's N largest holes are the targets, one round each
     int round_steps = 1000;      // --round-steps (with --find-holes)
     std::size_t min_hole = 50;   // --min-hole (with --find-holes)
-    bool p_given = false, decision_given = false, steps_given = false, share_given = false;
+    bool p_given = false, decision_given = false, steps_given = false, share_given = false, range_given = false;
     bool json = false, quiet = false;
 };
 
@@ -152,7 +152,13 @@ void check_repair_args(RepairArgs& a) {
     }
     a.options.swarm.decision = a.decision == "random" ? EditDecision::kRandom
                                : a.decision == "sheet" ? EditDecision::kSheet
+                               : a.decision == "cut"   ? EditDecision::kCut
                                                         : EditDecision::kIntensity;
+    if (a.options.swarm.decision == EditDecision::kCut) {
+        if (!a.options.topology_guard)
+            throw UsageError("--decision cut removes only what cuts a handle, which the topology guard decides: it cannot go with --no-topology-guard");
+        if (!a.range_given) a.options.swarm.edit_range = 3.0;  // the brush around the handle
+    }
     if (!a.options.swarm.sheet_between && a.options.swarm.decision != EditDecision::kSheet)
         throw UsageError("--band-only is a setting of the sheet rule: give it with --decision sheet");
     if (a.share_given && a.options.swarm.decision != EditDecision::kSheet)
@@ -330,8 +336,8 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--contract-sigmas", ra.options.swarm.contract_sigmas, "contract where the inside intensity is beyond this many sigmas")->check(finite_number())->capture_default_str();
     r->add_option("--sample-depth", ra.options.swarm.sample_depth, "population samples this many voxels inside the surface (0: at the agents)")->check(finite_number())->capture_default_str();
     r->add_option("--edit-range", ra.options.swarm.edit_range, "only agents within this many voxels of the target edit (0: all)")->check(finite_number())->capture_default_str();
-    r->add_option("--decision", ra.decision, "how acting agents edit: intensity (population statistics), sheet (grow only into voxels in the sheet tissue's band: hole repair without growing into the neighbours) or random (the paper's speed test)")
-        ->check(CLI::IsMember({"intensity", "random", "sheet"}))
+    r->add_option("--decision", ra.decision, "how acting agents edit: intensity (population statistics), sheet (grow only into voxels in the sheet tissue's band: hole repair without growing into the neighbours) cut (lower the surface, keeping only the removals that cut a handle of the segmentation; brush 3 voxels unless --edit-range) or random (the paper's speed test)")
+        ->check(CLI::IsMember({"intensity", "random", "sheet", "cut"}))
         ->capture_default_str();
     r->add_option("--sheet-lower", ra.sheet_lower, "the sheet tissue's lowest intensity (raw; default: the tissue model's)")->check(finite_number());
     r->add_option("--sheet-upper", ra.sheet_upper, "the sheet tissue's highest intensity (raw; default: the tissue model's)")->check(finite_number());
@@ -352,6 +358,7 @@ void add_repair_command(CLI::App& app, const int& threads) {
         ra.decision_given = r->count("--decision") > 0;
         ra.steps_given = r->count("--steps") > 0;
         ra.share_given = r->count("--between-share") > 0;
+        ra.range_given = r->count("--edit-range") > 0;
         if (ra.find_holes == 0 && (r->count("--round-steps") > 0 || r->count("--min-hole") > 0))
             throw UsageError("--round-steps and --min-hole are settings of --find-holes");
         const int rc = run_repair_command(ra, threads);

@@ -87,7 +87,7 @@ RepairOptions swarm_from(const json& j, RepairOptions r) {
     s.sample_depth = number(j, "sample_depth");
     s.edit_range = number(j, "edit_range");
     const int decision = static_cast<int>(number(j, "decision"));
-    if (decision < 0 || decision > static_cast<int>(EditDecision::kSheet)) throw std::runtime_error("unknown swarm decision rule");
+    if (decision < 0 || decision > static_cast<int>(EditDecision::kCut)) throw std::runtime_error("unknown swarm decision rule");
     s.decision = static_cast<EditDecision>(decision);
     s.sheet_lower = number(j, "sheet_lower");
     s.sheet_upper = number(j, "sheet_upper");

@@ -2,7 +2,7 @@
 // default run on a bias-bright hole; --band-only, --between-share and --no-crack-closing in bad combinations get one
 // line on stderr and a non-zero exit. (--no-crack-closing's behaviour is tested on the guard itself,
 // Repair.ACrackBetweenTwoFrontsClosesWithItsTunnel: on a CLI fixture the fronts zip a slit shut
-// from its ends within a few steps either way.)
+// from its ends within a few steps either way.) `--decision cut` cuts a handle and nothing else.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli_run.hpp"
+#include "liveset/eval/topology.hpp"
 #include "liveset/io/image_io.hpp"
 
 namespace liveset {
@@ -72,6 +73,45 @@ TEST(RepairFlagsCli, BandOnlyLeavesABrightHoleThatTheBetweenTestCloses) {
     std::filesystem::remove_all(dir);
 }
 
+// 32^3 shell (9 < r <= 12) whose mask took in a one-voxel rod of the core's tissue along x (a
+// handle: genus 1). `--decision cut` aimed at the rod removes rod voxels only and leaves genus 0.
+TEST(RepairFlagsCli, CutRemovesOnlyTheHandle) {
+    const auto dir = fresh_dir("cut");
+    const Lattice lat({32, 32, 32});
+    Grid<float> image(lat, 50.0f);
+    Grid<std::uint8_t> mask(lat, 0), rod(lat, 0);
+    for (int z = 0; z < 32; ++z)
+        for (int y = 0; y < 32; ++y)
+            for (int x = 0; x < 32; ++x) {
+                const double r = std::sqrt((x - 16.0) * (x - 16.0) + (y - 16.0) * (y - 16.0) + (z - 16.0) * (z - 16.0));
+                rod({x, y, z}) = r <= 9 && y == 16 && z == 16;
+                if (r <= 9) image({x, y, z}) = 130.0f;
+                else if (r <= 12) image({x, y, z}) = 100.0f;
+                mask({x, y, z}) = (r > 9 && r <= 12) || rod({x, y, z});
+            }
+    ASSERT_EQ(mask_topology(mask).genus, 1);
+    write_image(image, (dir / "t1.nii.gz").string());
+    write_label_image(mask, (dir / "seg.nii.gz").string());
+    const auto r = run_cli("--threads 1 repair " + (dir / "seg.nii.gz").string() + " --image " + (dir / "t1.nii.gz").string() +
+                           " --decision cut --p 0.3 --steps 100 --target 16,16,16 --out-mask " + (dir / "cut.nii.gz").string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const Grid<std::uint8_t> after = read_label_image((dir / "cut.nii.gz").string());
+    const Topology t = mask_topology(after);
+    EXPECT_EQ(t.genus, 0);
+    EXPECT_EQ(t.components, 1u);
+    EXPECT_EQ(t.cavities, 1u);
+    std::size_t removed = 0;
+    for (PointIndex i = 0; i < after.size(); ++i) {
+        EXPECT_FALSE(after[i] && !mask[i]);
+        if (mask[i] && !after[i]) {
+            ++removed;
+            EXPECT_TRUE(rod[i]) << "removed a voxel off the handle";
+        }
+    }
+    EXPECT_GE(removed, 1u);
+    std::filesystem::remove_all(dir);
+}
+
 TEST(RepairFlagsCli, BadCombinationsGetOneLineAndNonZeroExit) {
     const auto dir = fresh_dir("bad");
     const Lattice lat({16, 16, 16});
@@ -86,7 +126,8 @@ TEST(RepairFlagsCli, BadCombinationsGetOneLineAndNonZeroExit) {
                              " --target 8,8,4 --out-mask " + (dir / "x.nii.gz").string();
     for (const char* extra : {" --band-only", " --band-only --decision intensity", " --no-crack-closing --no-topology-guard",
                               " --between-share 0.3", " --between-share 0.3 --decision sheet --band-only",
-                              " --between-share 0.7 --decision sheet", " --between-share nan --decision sheet"}) {
+                              " --between-share 0.7 --decision sheet", " --between-share nan --decision sheet",
+                              " --decision cut --no-topology-guard", " --decision cut --edit-range 0"}) {
         const auto r = run_cli(base + extra);
         EXPECT_NE(r.rc, 0) << extra;
         EXPECT_EQ(testing::lines(r.err), 1) << extra << "\n" << r.err;

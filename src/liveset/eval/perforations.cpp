@@ -148,4 +148,45 @@ std::vector<Perforation> find_missed_tunnels(const Grid<std::uint8_t>& mask, con
     return out;
 }
 
+std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& inner) {
+    if (!(mask.dims() == inner.dims())) throw std::invalid_argument("find_inner_handles: mask and inner differ in size");
+    const Lattice& lat = mask.lattice();
+    Grid<std::uint8_t> taken(lat, 0);
+    for (PointIndex i = 0; i < lat.size(); ++i) taken[i] = mask[i] && inner[i];
+    std::size_t count = 0;
+    const std::vector<std::uint32_t> label = label_components(taken, 26, &count);
+    std::vector<std::size_t> size(count + 1, 0);
+    std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
+    std::vector<Vec3i> lo(count + 1, lat.dims()), hi(count + 1, Vec3i{-1, -1, -1});
+    for (PointIndex i = 0; i < lat.size(); ++i) {
+        const std::uint32_t k = label[i];
+        if (!k) continue;
+        const Vec3i c = lat.coord(i);
+        ++size[k];
+        sum[k] += c.cast<double>();
+        lo[k] = {std::min(lo[k].x, c.x), std::min(lo[k].y, c.y), std::min(lo[k].z, c.z)};
+        hi[k] = {std::max(hi[k].x, c.x), std::max(hi[k].y, c.y), std::max(hi[k].z, c.z)};
+    }
+    std::vector<Perforation> out;
+    std::vector<std::size_t> slot(count + 1, SIZE_MAX);
+    const Topology whole = count ? mask_topology(mask) : Topology{};
+    for (std::uint32_t k = 1; k <= count; ++k) {
+        const Vec3i a = lo[k] - Vec3i{1, 1, 1}, b = hi[k] + Vec3i{1, 1, 1};
+        const auto in_mask = [&](Vec3i q) { return lat.contains(q) && mask(q) != 0; };
+        const auto in_cut = [&](Vec3i q) { return lat.contains(q) && mask(q) != 0 && label[lat.index(q)] != k; };
+        if (euler_characteristic_26(in_cut, a, b) <= euler_characteristic_26(in_mask, a, b)) continue;
+        // The rise is a handle cut only when no piece split off and no cavity opened (a rarer
+        // candidate: the whole-mask count, once per region the box test passes).
+        Grid<std::uint8_t> cut = mask;
+        for (PointIndex i = 0; i < lat.size(); ++i)
+            if (label[i] == k) cut[i] = 0;
+        const Topology t = mask_topology(cut);
+        if (t.components != whole.components || t.cavities != whole.cavities) continue;
+        slot[k] = out.size();
+        out.push_back({size[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
+    }
+    locate_nearest(lat, label, slot, out);
+    return out;
+}
+
 }  // namespace liveset

@@ -37,4 +37,11 @@ std::vector<Perforation> find_cavities(const Grid<std::uint8_t>& mask, const Gri
 // region's box). Largest first (ties by centroid). Same dimensions required.
 std::vector<Perforation> find_missed_tunnels(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth);
 
+// Handles of the mask made of `inner` tissue it took in (e.g. white matter in a grey-matter
+// segmentation, bridging a fold): 26-connected regions of mask and inner whose removal raises the
+// mask's Euler characteristic (counted in the region's box) and leaves its pieces and cavities as
+// they are (mask_topology with and without the region), so removing it cuts a handle. `voxels` is
+// the region's size. Largest first (ties by centroid). Same dimensions required.
+std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& inner);
+
 }  // namespace liveset

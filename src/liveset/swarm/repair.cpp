@@ -16,6 +16,8 @@ RepairLoop::RepairLoop(SparseField& field, const Grid<float>& image_unit, const 
     if (!(options.spawn_radius > 0)) throw std::invalid_argument("the spawn radius must be > 0");
     if (!(image_unit.dims() == field.lattice().dims())) throw std::invalid_argument("image and level set differ in size");
     if (roi && !(roi->dims() == field.lattice().dims())) throw std::invalid_argument("region of interest and level set differ in size");
+    if (options.swarm.decision == EditDecision::kCut && !options.topology_guard)
+        throw std::invalid_argument("the cut decision needs the topology guard (it keeps only the flips that cut a handle)");
 }
 
 void RepairLoop::set_target(Vec3d target) {
@@ -69,6 +71,7 @@ RepairStep RepairLoop::step() {
             go.pocket_limit = brush_pocket_limit(swarm_.options().edit_range);
             go.close_cracks = options_.close_cracks;
             go.roi = roi_;
+            go.cut_handles = swarm_.options().decision == EditDecision::kCut;
             out.log.guarded = guard_topology(field_, edits, go);
         }
         out.log.modified = edits.size();

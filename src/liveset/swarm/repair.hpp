@@ -56,6 +56,12 @@ struct GuardOptions {
     // tunnel and seals no pocket (see guard_topology).
     bool close_cracks = true;
     const Grid<std::uint8_t>* roi = nullptr;  // crack voxels (and their face neighbours) must lie in it
+    // Cutting a handle (EditDecision::kCut): a removal is kept only when it cuts a handle — the
+    // point's inside neighbours form two 26-connected pieces, its outside neighbours one, and the
+    // two pieces are joined elsewhere (no piece split off; see guard_topology) — the mirror of growth
+    // that closes a tunnel; every other removal (a simple one too: the surface elsewhere in the
+    // brush stays where it is) is dropped.
+    bool cut_handles = false;
 };
 
 // The pocket limit for a swarm whose brush is `edit_range` voxels (0: no brush): the voxels of the
@@ -77,6 +83,10 @@ std::size_t brush_pocket_limit(double edit_range);
 // (φ < 0.5). When only the last fails, the inside zero-layer face neighbours of the voxels that
 // cannot flip get −0.5 instead (no sign changes: the slit comes onto the zero layer for a later
 // batch). Else the edit is dropped as before.
+// Handle cuts (options.cut_handles): removals are kept only where they cut a handle: two inside
+// pieces around the point, one outside piece, and the pieces joined by an inside path elsewhere —
+// two 26-connected floods of the inside, one from each piece, grown by turns until they meet (kept)
+// or one runs out (a piece would split off) or they pass 2^21 voxels (dropped: not known).
 std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits, const GuardOptions& options = {});
 
 // One repair step's outcome: the log line plus the changed points X (for the mesher).

@@ -144,6 +144,8 @@ std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Gri
         for (const Perforation& p : find_cavities(mask, inner)) sites.push_back(site(p, cavity));
     if (sites.empty())
         for (const Perforation& p : find_missed_tunnels(enclosed, truth)) sites.push_back(site(p, missed));
+    if (sites.empty())
+        for (const Perforation& p : find_inner_handles(mask, inner)) sites.push_back(HoleSite{p.nearest.cast<double>(), p.voxels, 0, true});
     return sites;
 }
 
@@ -179,6 +181,7 @@ RepairScheduleResult run_repair_schedule(RepairDriver& driver, const RepairOptio
         ro.swarm.seed = base.swarm.seed + static_cast<std::uint64_t>(r);
         ro.swarm.edit_range = hole_brush_range(round.target.voxels, schedule.shell_thickness, schedule.max_range);
         if (setup) setup(ro, round.target);
+        if (round.target.cut) ro.swarm.decision = EditDecision::kCut;
         round.edit_range = ro.swarm.edit_range;
         driver.aim(ro, round.target.position);
         for (int step = 0; step < ro.steps && !interrupted(); ++step) {

@@ -25,6 +25,7 @@ struct HoleSite {
     Vec3d position;          // index space: where the round aims the swarm
     std::size_t voxels = 0;  // the hole's size (sizes the brush)
     int stalled_rounds = 0;  // set by run_repair_schedule: earlier rounds at this site that stalled
+    bool cut = false;        // a handle of tissue to cut (its round runs EditDecision::kCut), not a hole to fill
 };
 
 struct RepairScheduleOptions {
@@ -98,7 +99,9 @@ Grid<std::uint8_t> with_walled_inner(const Grid<std::uint8_t>& mask, const Grid<
 // `truth` and the inner core (eval/perforations.hpp, on with_walled_inner(mask, inner): a missed
 // region that reaches only a walled-off pocket is none), and when none is left, its spurious
 // cavities (bubbles) in `inner`, then the tunnels that missed truth closes (pinholes, cracks;
-// counted with the walled-off pockets in, so a tube whose filling only seals a pocket is none).
+// counted with the walled-off pockets in, so a tube whose filling only seals a pocket is none),
+// then the handles of `inner` tissue the mask took in (find_inner_handles; sites to cut, aimed at
+// the handle's voxel nearest its centroid).
 // The phantom demo's finder (and its test's). Throws std::invalid_argument when the sizes differ.
 std::vector<HoleSite> truth_hole_sites(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, const Grid<std::uint8_t>& inner,
                                        HoleAim aim = HoleAim::kCentroid);
@@ -109,7 +112,8 @@ using RoundSetup = std::function<void(RepairOptions& round, const HoleSite& targ
 // Round r: holes = find(field); none left -> stop; else aim a fresh swarm (seed base.seed + r) at
 // the first hole (the largest) among those with the fewest stalled rounds — a round stalled when
 // a hole of more than 95 % of its target's voxels is left within 2 voxels of its target: as a user
-// whose click changed nothing clicks the next hole and comes back later — with edit_range = hole_brush_range(its voxels) and run round_steps steps. Throws
+// whose click changed nothing clicks the next hole and comes back later — with edit_range = hole_brush_range(its voxels) and run round_steps steps.
+// `setup` adjusts the round's options; a site to cut then gets EditDecision::kCut. Throws
 // std::invalid_argument on bad options.
 RepairScheduleResult run_repair_schedule(RepairDriver& driver, const RepairOptions& base, const RepairScheduleOptions& schedule,
                                          const HoleSiteFinder& find, const RoundSetup& setup = {},

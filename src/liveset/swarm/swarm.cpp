@@ -41,6 +41,9 @@
 //   footprint skips the outside points whose own voxel lies outside the band unless it lies between
 //   the sheet's sides and still holds at least sheet_between_share of the sheet's tissue by its
 //   intensity (sheet_between_range; sheet_between_limited))
+//   (decision kCut, cutting a handle the user points at: an acting agent lowers the surface,
+//   Δ = +A, over the inside points of its footprint only; the repair loop's topology guard then
+//   keeps only the flips that cut a handle, so no voxel leaves the segmentation but those)
 //   Δ is spread over the zero-layer points p with |p − x| ≤ edit_radius, weighted by the
 //   unit-peak Gaussian exp(−|p − x|²/(2σ_g²)), σ_g = edit_radius/2, so A is the change under the
 //   agent whatever the zero-layer sampling density. Contributions to a point are summed in agent
@@ -213,6 +216,8 @@ void validate(const SwarmOptions& o) {
     require(o.decision != EditDecision::kSheet ||
                 (std::isfinite(o.sheet_lower) && std::isfinite(o.sheet_upper) && o.sheet_lower < o.sheet_upper),
             "swarm: the sheet decision needs a finite band sheet_lower < sheet_upper");
+    require(o.decision != EditDecision::kCut || o.edit_range > 0,
+            "swarm: the cut decision needs an edit range (the brush around the handle to cut)");
     require(std::isfinite(o.sheet_between_share) && o.sheet_between_share >= 0 && o.sheet_between_share <= 0.5,
             "swarm: sheet_between_share must be in [0, 0.5]");
     require(std::isnan(o.sheet_mean) || (o.sheet_mean >= o.sheet_lower && o.sheet_mean <= o.sheet_upper),
@@ -395,6 +400,7 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
     const int reach = static_cast<int>(std::ceil(support));
 
     const bool sheet = options_.decision == EditDecision::kSheet;
+    const bool cut = options_.decision == EditDecision::kCut;
     const double between_reach =
         options_.sheet_between && options_.edit_range > 0 ? std::max(options_.edit_range, options_.sheet_reach) : 0.0;
     const std::pair<double, double> between_range = sheet_between_range(options_);
@@ -427,6 +433,8 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
             double amount = 0.0;
             if (options_.decision == EditDecision::kRandom) {
                 amount = rng.uniform() < 0.5 ? -options_.edit_amount : options_.edit_amount;
+            } else if (options_.decision == EditDecision::kCut) {
+                amount = options_.edit_amount;
             } else if (options_.decision == EditDecision::kSheet) {
                 const double near = trilinear(image_unit, x + n * 0.75);
                 const auto in_band = [&](double v) { return v >= options_.sheet_lower && v < options_.sheet_upper; };
@@ -446,7 +454,7 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
                         const Vec3i q = c + Vec3i{dx, dy, dz};
                         if (!lat.contains(q)) continue;
                         const PointIndex idx = lat.index(q);
-                        if (field.status()[idx] != 0) continue;
+                        if (field.status()[idx] != 0 || (cut && !(phi[idx] < 0.0f))) continue;
                         if (sheet && phi[idx] >= 0.0f && !(image_unit[idx] >= options_.sheet_lower && image_unit[idx] < options_.sheet_upper) &&
                             !between_voxel(q, true))
                             continue;  // kSheet: never raise the surface over a voxel that is neither the sheet's tissue nor between its sides

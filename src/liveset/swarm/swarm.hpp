@@ -23,6 +23,8 @@ enum class EditDecision {
     kIntensity,  // population intensity statistics (the repair rule, see swarm.cpp)
     kRandom,     // raise or lower at random (the paper's frame-rate experiment, §4)
     kSheet,      // hole repair in a sheet: grow only into voxels of the sheet's own band (see swarm.cpp)
+    kCut,        // cut a handle: lower the surface under the agent; the topology guard keeps only the
+                 // flips that cut a handle (GuardOptions::cut_handles, set by the RepairLoop)
 };
 
 struct SwarmOptions {

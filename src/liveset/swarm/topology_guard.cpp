@@ -1,6 +1,6 @@
 // The repair's topology guard: swarm edits may close tunnels and fill cavities but never make any;
 // a bridge across a one-voxel crack between two fronts is filled with its whole crack when that
-// closes the tunnel the crack belongs to.
+// closes the tunnel the crack belongs to; in a cut, only removals that cut a handle pass.
 #include <algorithm>
 #include <climits>
 #include <cmath>
@@ -23,6 +23,8 @@ constexpr std::size_t kMaxPocketLimit = 32768;
 constexpr std::size_t kMaxCrack = 512;
 constexpr float kCrackEdit = -0.5f;    // the edit each crack point gets
 constexpr float kFlippable = 0.5f;     // ... which flips it when φ is below this
+// The two floods that tell a handle cut from a split stop (and the cut is refused) past this many voxels.
+constexpr std::size_t kMaxJoinFlood = std::size_t{1} << 21;
 
 // Visited marks for the pocket flood: one stamp per lattice point, reused across floods (a new
 // stamp per flood, so nothing is cleared). Per thread: guard_topology may run on several threads.
@@ -104,6 +106,8 @@ public:
 
 private:
     bool seals_pocket_around(std::span<const Vec3i> cs);
+    bool cuts_handle(Vec3i c, const TopologicalNumbers& t) const;
+    bool joined(Vec3i a, Vec3i b) const;
     bool seals_pocket_around(const std::vector<PointIndex>& points);
     std::vector<PointIndex> gather_crack(Vec3i start) const;
     bool fill_crack(Vec3i start);
@@ -161,6 +165,12 @@ bool Guard::keep(const ZeroLayerEdit& e) {
     if (deepened_.count(e.point)) return false;  // deepened to prepare a crack: stays inside
     const Vec3i c = lat_.coord(e.point);
     const TopologicalNumbers t = topological_numbers([this](Vec3i q) { return inside(q); }, c);
+    if (o_.cut_handles && !is_in) {
+        flip(e.point, false);
+        const bool cut = cuts_handle(c, t);
+        if (!cut) flipped_.erase(e.point);
+        return cut;
+    }
     bool ok = is_in ? t.foreground == 1 : (t.background == 1 && t.foreground <= 1);
     // Growth that splits the local background either closes a tunnel (good) or seals a small
     // pocket off (a spurious cavity): refuse the latter.
@@ -172,6 +182,68 @@ bool Guard::keep(const ZeroLayerEdit& e) {
     if (!ok && is_in && t.foreground >= 2 && o_.close_cracks) return fill_crack(c);
     if (ok) flip(e.point, is_in);
     return ok;
+}
+
+// With inside point `c` flipped out: whether that cut a handle — its inside neighbours form two
+// 26-connected pieces (t, counted before the flip), its outside neighbours one, and the pieces are
+// joined elsewhere.
+bool Guard::cuts_handle(Vec3i c, const TopologicalNumbers& t) const {
+    if (t.foreground != 2 || t.background != 1) return false;
+    // One voxel of each piece: the first inside neighbour, and the first one not 26-connected to it
+    // within the neighbourhood.
+    std::vector<Vec3i> piece, other;
+    for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dx = -1; dx <= 1; ++dx) {
+                const Vec3i q = c + Vec3i{dx, dy, dz};
+                if ((dx || dy || dz) && inside(q)) other.push_back(q);
+            }
+    if (other.empty()) return false;
+    piece.push_back(other.front());
+    other.erase(other.begin());
+    for (std::size_t head = 0; head < piece.size(); ++head)
+        std::erase_if(other, [&](Vec3i q) {
+            const Vec3i d = q - piece[head];
+            if (std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)}) > 1) return false;
+            piece.push_back(q);
+            return true;
+        });
+    return !other.empty() && joined(piece.front(), other.front());
+}
+
+// Whether inside voxels `a` and `b` are joined by a 26-connected inside path: two floods, one from
+// each, a voxel at a time from the smaller frontier; they meet -> true; one runs out (its piece is
+// finite and holds no path to the other) or both pass kMaxJoinFlood voxels -> false.
+bool Guard::joined(Vec3i a, Vec3i b) const {
+    thread_local std::vector<std::uint32_t> mark;
+    thread_local std::uint32_t base = 0;
+    if (mark.size() != lat_.size() || base >= UINT32_MAX - 2) {
+        mark.assign(lat_.size(), 0);
+        base = 0;
+    }
+    base += 2;  // side 0 marks base, side 1 base + 1
+    std::vector<Vec3i> queue[2] = {{a}, {b}};
+    std::size_t head[2] = {0, 0};
+    mark[lat_.index(a)] = base;
+    mark[lat_.index(b)] = base + 1;
+    for (std::size_t visited = 2; visited <= kMaxJoinFlood;) {
+        const int s = queue[0].size() - head[0] <= queue[1].size() - head[1] ? 0 : 1;
+        if (head[s] == queue[s].size()) return false;
+        const Vec3i p = queue[s][head[s]++];
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const Vec3i q = p + Vec3i{dx, dy, dz};
+                    if (!inside(q)) continue;
+                    std::uint32_t& m = mark[lat_.index(q)];
+                    if (m == base + static_cast<std::uint32_t>(1 - s)) return true;
+                    if (m == base + static_cast<std::uint32_t>(s)) continue;
+                    m = base + static_cast<std::uint32_t>(s);
+                    queue[s].push_back(q);
+                    ++visited;
+                }
+    }
+    return false;
 }
 
 bool Guard::in_roi(Vec3i q) const {
