@@ -12,7 +12,8 @@ namespace {
 
 std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi, double n,
                                       double alpha, int layers, int fragment_size, std::size_t history,
-                                      int agents, double p, std::uint64_t seed, bool sleeping) {
+                                      int agents, double p, std::uint64_t seed, bool sleeping, const std::string& decision,
+                                      double edit_range) {
     if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
     const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
     Grid<float> image = grid_from_array(v, l);
@@ -28,6 +29,11 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     o.repair.swarm.agents = static_cast<std::size_t>(agents);
     o.repair.swarm.act_probability = p;
     o.repair.swarm.seed = seed;
+    // The swarm's rule, as `liveset repair --decision` (the sheet rule needs a band: repair_holes).
+    if (decision == "random") o.repair.swarm.decision = EditDecision::kRandom;
+    else if (decision == "cut") o.repair.swarm.decision = EditDecision::kCut;
+    else if (decision != "intensity") throw std::invalid_argument("decision must be 'intensity', 'random' or 'cut'");
+    o.repair.swarm.edit_range = edit_range;
     if (sleeping) o.segmentation.step = sleeping_step();
     pyb::gil_scoped_release nogil;
     return std::make_unique<Session>(std::move(image), o, std::move(r));
@@ -77,7 +83,7 @@ void register_session(pyb::module_& m) {
     pyb::class_<Session>(m, "_Session")
         .def(pyb::init(&make_session), pyb::arg("image"), pyb::arg("geometry"), pyb::arg("roi"), pyb::arg("n"),
              pyb::arg("alpha"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
-             pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"))
+             pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"))
         .def("add_seed", [](Session& s, const std::vector<double>& c, double r) {
             if (!s.lattice().contains(point(c))) throw std::invalid_argument("the seed lies outside the image");
             s.add_seed({point(c), r});

@@ -335,8 +335,8 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--expand-sigmas", ra.options.swarm.expand_sigmas, "expand where the outside intensity is within this many population sigmas")->check(finite_number())->capture_default_str();
     r->add_option("--contract-sigmas", ra.options.swarm.contract_sigmas, "contract where the inside intensity is beyond this many sigmas")->check(finite_number())->capture_default_str();
     r->add_option("--sample-depth", ra.options.swarm.sample_depth, "population samples this many voxels inside the surface (0: at the agents)")->check(finite_number())->capture_default_str();
-    r->add_option("--edit-range", ra.options.swarm.edit_range, "only agents within this many voxels of the target edit (0: all)")->check(finite_number())->capture_default_str();
-    r->add_option("--decision", ra.decision, "how acting agents edit: intensity (population statistics), sheet (grow only into voxels in the sheet tissue's band: hole repair without growing into the neighbours) cut (lower the surface, keeping only the removals that cut a handle of the segmentation; brush 3 voxels unless --edit-range) or random (the paper's speed test)")
+    r->add_option("--edit-range", ra.options.swarm.edit_range, "only agents within this many voxels of the target edit (0: all; --decision cut: 3 unless given, and > 0)")->check(finite_number())->capture_default_str();
+    r->add_option("--decision", ra.decision, "how acting agents edit: intensity (population statistics), sheet (grow only into voxels in the sheet tissue's band: hole repair without growing into the neighbours), cut (lower the surface, keeping only the removals that cut a handle of the segmentation; brush 3 voxels unless --edit-range) or random (the paper's speed test)")
         ->check(CLI::IsMember({"intensity", "random", "sheet", "cut"}))
         ->capture_default_str();
     r->add_option("--sheet-lower", ra.sheet_lower, "the sheet tissue's lowest intensity (raw; default: the tissue model's)")->check(finite_number());

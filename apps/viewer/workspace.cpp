@@ -290,7 +290,7 @@ void check_workspace_image(const Workspace& ws, const fs::path& path, const Grid
 }
 
 void apply_workspace(Session& session, const Workspace& ws) {
-    validate(ws.repair.swarm);
+    validate(ws.repair);
     if (!session.load_recovered(ws.phi, ws.status, ws.marks))
         throw std::invalid_argument("the workspace's level set is not a consistent sparse field");
     session.set_repair_options(ws.repair);

@@ -26,7 +26,8 @@ class Session:
 
     def __init__(self, image, roi=None, *, n: float = 4.0, alpha: float = 0.1, layers: int = 2,
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
-                 seed: int = 1, sleeping: bool = True):
+                 seed: int = 1, sleeping: bool = True, decision: str = "intensity",
+                 edit_range: Optional[float] = None):
         img = as_image(image)
         self.image = img
         r = None
@@ -34,7 +35,8 @@ class Session:
             r = np.asarray(roi) if isinstance(roi, np.ndarray) else as_image(roi, "roi").array
         self._s = _liveset._Session(img.array, img.geometry, r, float(n), float(alpha), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),
-                                    bool(sleeping))
+                                    bool(sleeping), str(decision),
+                                    float(_edit_range(decision, edit_range)))
 
     # seeds and parameters
     def add_seed(self, ijk: Sequence[float], radius: float = 2.0) -> None:
@@ -127,14 +129,25 @@ class Session:
         return self.image.like(self._s.phi())
 
 
+def _edit_range(decision: str, edit_range: Optional[float]) -> float:
+    """The brush: as given, else 3 voxels for a cut and none (0) for the other rules."""
+    if edit_range is not None:
+        return float(edit_range)
+    return 3.0 if decision == "cut" else 0.0
+
+
 def repair(phi_or_mask, image, targets: Sequence[Sequence[float]], *, steps: int = 300, roi=None,
-           agents: int = 200, p: float = 0.1, seed: int = 1) -> Image:
+           agents: int = 200, p: float = 0.1, seed: int = 1, decision: str = "intensity",
+           edit_range: Optional[float] = None) -> Image:
     """Agent-swarm repair (paper §4) of a segmentation at the given targets (voxel indices), one
     after the other, `steps` swarm steps each; returns the repaired φ (< 0 inside). ``image`` is
-    the intensity image the swarm's decisions read. Uses Session (exact step, not the CLI's
+    the intensity image the swarm's decisions read. ``decision``: ``"intensity"`` (population
+    statistics), ``"random"`` (the paper's speed test) or ``"cut"`` (cut a handle of the
+    segmentation at the target: only removals that cut a handle are kept; brush ``edit_range``, 3
+    voxels by default), as ``liveset repair --decision``. Uses Session (exact step, not the CLI's
     ``liveset repair`` option set: no @STEP schedule, no log)."""
     img = as_image(image)
-    s = Session(img, roi=roi, agents=agents, p=p, seed=seed)
+    s = Session(img, roi=roi, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range)
     src = as_image(phi_or_mask, "phi_or_mask")
     a = np.asarray(src.array)
     if np.all((a == 0) | (a == 1)):

@@ -268,3 +268,24 @@ def test_repair_holes_closes_the_finders_holes_inside_the_shell():
         liveset.repair_holes(seg, img, 0)
     with pytest.raises(ValueError):
         liveset.repair_holes(seg, img, 2, sheet_band=(75, 115), between_share=0.7)
+
+
+def test_repair_cut_removes_a_handle_and_nothing_else():
+    # A shell whose mask took in a one-voxel rod of the core's tissue across the core (a handle):
+    # repair(decision="cut") at the rod's middle removes rod voxels only, and the rod no longer
+    # joins the shell's two sides (its voxels are not all there); elsewhere nothing moves.
+    ijk, r, c = _centred_grid(33)
+    image = np.where(r <= 9, 130.0, np.where(r <= 12, 100.0, 50.0)).astype(np.float32)
+    rod = (r <= 9) & (ijk[..., 1] == c) & (ijk[..., 2] == c)
+    mask = ((r > 9) & (r <= 12)) | rod
+    img = liveset.Image(image, SPACING, ORIGIN, DIRECTION)
+    phi = liveset.repair(img.like(mask.astype(np.uint8)), img, [(c, c, c)], steps=100, p=0.3, decision="cut")
+    after = phi.array < 0
+    removed = mask & ~after
+    assert removed.any()
+    assert not (removed & ~rod).any()
+    assert not (after & ~mask).any()
+    with pytest.raises(ValueError):
+        liveset.repair(img.like(mask.astype(np.uint8)), img, [(c, c, c)], decision="maybe")
+    with pytest.raises(ValueError):
+        liveset.repair(img.like(mask.astype(np.uint8)), img, [(c, c, c)], decision="cut", edit_range=0)

@@ -158,6 +158,10 @@ std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, cons
     std::vector<std::size_t> size(count + 1, 0);
     std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
     std::vector<Vec3i> lo(count + 1, lat.dims()), hi(count + 1, Vec3i{-1, -1, -1});
+    // Whether a region has a face neighbour outside the mask (or the lattice): one without is
+    // enclosed by the mask, and removing it opens a cavity (no handle cut; skipped before the
+    // whole-mask count).
+    std::vector<std::uint8_t> faces_out(count + 1, 0);
     for (PointIndex i = 0; i < lat.size(); ++i) {
         const std::uint32_t k = label[i];
         if (!k) continue;
@@ -166,11 +170,17 @@ std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, cons
         sum[k] += c.cast<double>();
         lo[k] = {std::min(lo[k].x, c.x), std::min(lo[k].y, c.y), std::min(lo[k].z, c.z)};
         hi[k] = {std::max(hi[k].x, c.x), std::max(hi[k].y, c.y), std::max(hi[k].z, c.z)};
+        for (int f = 0; f < 6 && !faces_out[k]; ++f) {
+            Vec3i q = c;
+            q[f / 2] += (f % 2) ? 1 : -1;
+            faces_out[k] = !lat.contains(q) || !mask(q);
+        }
     }
     std::vector<Perforation> out;
     std::vector<std::size_t> slot(count + 1, SIZE_MAX);
     const Topology whole = count ? mask_topology(mask) : Topology{};
     for (std::uint32_t k = 1; k <= count; ++k) {
+        if (!faces_out[k]) continue;
         const Vec3i a = lo[k] - Vec3i{1, 1, 1}, b = hi[k] + Vec3i{1, 1, 1};
         const auto in_mask = [&](Vec3i q) { return lat.contains(q) && mask(q) != 0; };
         const auto in_cut = [&](Vec3i q) { return lat.contains(q) && mask(q) != 0 && label[lat.index(q)] != k; };

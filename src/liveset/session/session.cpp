@@ -25,7 +25,7 @@ const SessionOptions& checked(const SessionOptions& o) {
     if (o.history < 20) throw std::invalid_argument("the undo history must keep at least 20 actions");
     o.window.validate();
     validate(o.segmentation);
-    validate(o.repair.swarm);
+    validate(o.repair);
     validate(o.params);
     return o;
 }
@@ -255,7 +255,7 @@ SessionUpdate Session::segment_step() {
 void Session::make_repair_loop() { repair_ = std::make_unique<RepairLoop>(field_, unit_, roi(), repair_options_); }
 
 void Session::set_repair_options(const RepairOptions& options) {
-    validate(options.swarm);
+    validate(options);
     repair_options_ = options;
     if (!repair_) return;
     make_repair_loop();
@@ -270,7 +270,7 @@ void Session::set_repair_options(const RepairOptions& options) {
 }
 
 void Session::aim_swarm(const RepairOptions& options, Vec3d target) {
-    validate(options.swarm);
+    validate(options);
     if (!all_finite(target) || !lattice().contains(target)) throw std::invalid_argument("the target lies outside the image");
     end_action();  // each round is its own undoable action
     repair_options_ = options;

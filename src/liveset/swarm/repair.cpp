@@ -12,10 +12,16 @@ namespace liveset {
 RepairLoop::RepairLoop(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                        const RepairOptions& options)
     : field_(field), image_unit_(image_unit), roi_(roi), options_(options), swarm_(options.swarm) {
-    if (!(options.respawn_distance >= 0)) throw std::invalid_argument("the respawn distance must be >= 0");
-    if (!(options.spawn_radius > 0)) throw std::invalid_argument("the spawn radius must be > 0");
+    validate(options);
     if (!(image_unit.dims() == field.lattice().dims())) throw std::invalid_argument("image and level set differ in size");
     if (roi && !(roi->dims() == field.lattice().dims())) throw std::invalid_argument("region of interest and level set differ in size");
+}
+
+void validate(const RepairOptions& options) {
+    validate(options.swarm);
+    if (options.steps < 0) throw std::invalid_argument("the number of repair steps must not be negative");
+    if (!(options.respawn_distance >= 0)) throw std::invalid_argument("the respawn distance must be >= 0");
+    if (!(options.spawn_radius > 0)) throw std::invalid_argument("the spawn radius must be > 0");
     if (options.swarm.decision == EditDecision::kCut && !options.topology_guard)
         throw std::invalid_argument("the cut decision needs the topology guard (it keeps only the flips that cut a handle)");
 }
@@ -87,8 +93,7 @@ RepairStep RepairLoop::step() {
 std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& image_unit, const Grid<std::uint8_t>* roi,
                                       std::span<const RepairTarget> targets, const RepairOptions& options,
                                       const std::atomic<bool>* interrupt) {
-    validate(options.swarm);
-    if (options.steps < 0) throw std::invalid_argument("the number of repair steps must not be negative");
+    validate(options);
     if (targets.empty()) throw std::invalid_argument("repair needs at least one target");
     std::vector<RepairTarget> order(targets.begin(), targets.end());
     for (const RepairTarget& t : order) {

@@ -60,7 +60,7 @@ struct GuardOptions {
     // point's inside neighbours form two 26-connected pieces, its outside neighbours one, and the
     // two pieces are joined elsewhere (no piece split off; see guard_topology) — the mirror of growth
     // that closes a tunnel; every other removal (a simple one too: the surface elsewhere in the
-    // brush stays where it is) is dropped.
+    // brush stays where it is) is dropped, and so is an edit raising φ anywhere else (see guard_topology).
     bool cut_handles = false;
 };
 
@@ -86,8 +86,16 @@ std::size_t brush_pocket_limit(double edit_range);
 // Handle cuts (options.cut_handles): removals are kept only where they cut a handle: two inside
 // pieces around the point, one outside piece, and the pieces joined by an inside path elsewhere —
 // two 26-connected floods of the inside, one from each piece, grown by turns until they meet (kept)
-// or one runs out (a piece would split off) or they pass 2^21 voxels (dropped: not known).
+// or one runs out (a piece would split off) or together they pass 2^21 voxels (dropped: not known);
+// an edit that flips nothing raising φ is kept only where the inside neighbours form two or more
+// pieces (a cut moves the surface nowhere else). A handle thick enough that no voxel of it has two
+// inside pieces around it (e.g. a 2 x 2 neck) cannot be cut: every removal there is simple.
 std::size_t guard_topology(const SparseField& field, std::vector<ZeroLayerEdit>& edits, const GuardOptions& options = {});
+
+// Throws std::invalid_argument (one-line message) on an invalid option: the swarm's (validate),
+// a negative step count, spawn radius ≤ 0, respawn distance < 0, or the cut decision without the
+// topology guard (the guard is what keeps a cut to the removals that cut a handle).
+void validate(const RepairOptions& options);
 
 // One repair step's outcome: the log line plus the changed points X (for the mesher).
 struct RepairStep {

@@ -161,10 +161,13 @@ bool Guard::keep(const ZeroLayerEdit& e) {
     const float before = field_.phi()[e.point];
     const float after = before + std::clamp(e.delta, -0.5f, 0.5f);
     const bool was_in = before < 0.0f, is_in = after < 0.0f;
-    if (was_in == is_in) return true;
-    if (deepened_.count(e.point)) return false;  // deepened to prepare a crack: stays inside
     const Vec3i c = lat_.coord(e.point);
-    const TopologicalNumbers t = topological_numbers([this](Vec3i q) { return inside(q); }, c);
+    const auto numbers = [&] { return topological_numbers([this](Vec3i q) { return inside(q); }, c); };
+    // A cut moves φ only where it may cut: at inside points whose inside neighbours form two or
+    // more pieces (elsewhere in the brush the surface stays where it is, to the sub-voxel).
+    if (was_in == is_in) return !(o_.cut_handles && was_in && e.delta > 0.0f) || numbers().foreground >= 2;
+    if (deepened_.count(e.point)) return false;  // deepened to prepare a crack: stays inside
+    const TopologicalNumbers t = numbers();
     if (o_.cut_handles && !is_in) {
         flip(e.point, false);
         const bool cut = cuts_handle(c, t);
@@ -213,16 +216,19 @@ bool Guard::cuts_handle(Vec3i c, const TopologicalNumbers& t) const {
 
 // Whether inside voxels `a` and `b` are joined by a 26-connected inside path: two floods, one from
 // each, a voxel at a time from the smaller frontier; they meet -> true; one runs out (its piece is
-// finite and holds no path to the other) or both pass kMaxJoinFlood voxels -> false.
+// finite and holds no path to the other) or the two together pass kMaxJoinFlood voxels -> false.
+// Marks and queues are per thread and reused across calls (a new pair of stamps per call).
 bool Guard::joined(Vec3i a, Vec3i b) const {
     thread_local std::vector<std::uint32_t> mark;
     thread_local std::uint32_t base = 0;
+    thread_local std::vector<Vec3i> queue[2];
     if (mark.size() != lat_.size() || base >= UINT32_MAX - 2) {
         mark.assign(lat_.size(), 0);
         base = 0;
     }
     base += 2;  // side 0 marks base, side 1 base + 1
-    std::vector<Vec3i> queue[2] = {{a}, {b}};
+    queue[0].assign(1, a);
+    queue[1].assign(1, b);
     std::size_t head[2] = {0, 0};
     mark[lat_.index(a)] = base;
     mark[lat_.index(b)] = base + 1;
