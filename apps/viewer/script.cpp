@@ -73,7 +73,7 @@ void output_path(const std::string& path, cli::OutputKind kind, const EntryError
 }
 
 const std::set<std::string> kRepairKeys = {"preset", "agents", "p", "radius", "amount", "seed", "expand_sigmas",
-                                           "contract_sigmas", "edit_range", "sample_depth"};
+                                           "contract_sigmas", "edit_range", "sample_depth", "decision"};
 
 void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
     if (!p.is_object()) err.fail("expected an object of parameters");
@@ -96,9 +96,13 @@ void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
     if (a.repair_fields.contains("seed")) whole(a.repair_fields["seed"], err, "seed", 0, 2'000'000'000);
     for (const char* k : {"p", "radius", "amount", "expand_sigmas", "contract_sigmas", "edit_range", "sample_depth"})
         if (a.repair_fields.contains(k)) number(a.repair_fields[k], err, k);
+    if (a.repair_fields.contains("decision")) {
+        const json& d = a.repair_fields["decision"];
+        if (!d.is_string() || (d != "intensity" && d != "random" && d != "cut")) err.fail("decision must be \"intensity\", \"random\" or \"cut\"");
+    }
     // Check the values now, on top of the defaults: a bad value fails before anything runs.
     try {
-        validate(apply_repair_fields(RepairOptions{}, a.repair_fields).swarm);
+        validate(apply_repair_fields(RepairOptions{}, a.repair_fields));
         ThresholdParams t;
         if (a.epsilon) t.epsilon = *a.epsilon;
         if (a.mu) t.mu = *a.mu;
@@ -473,6 +477,12 @@ RepairOptions apply_repair_fields(RepairOptions o, const nlohmann::json& f) {
     if (f.contains("contract_sigmas")) o.swarm.contract_sigmas = f["contract_sigmas"].get<double>();
     if (f.contains("edit_range")) o.swarm.edit_range = f["edit_range"].get<double>();
     if (f.contains("sample_depth")) o.swarm.sample_depth = f["sample_depth"].get<double>();
+    if (f.contains("decision")) {
+        const std::string d = f["decision"].get<std::string>();
+        o.swarm.decision = d == "cut" ? EditDecision::kCut : d == "random" ? EditDecision::kRandom : EditDecision::kIntensity;
+        // A cut needs a brush: 3 voxels unless the script gives one.
+        if (o.swarm.decision == EditDecision::kCut && !f.contains("edit_range") && !(o.swarm.edit_range > 0)) o.swarm.edit_range = 3.0;
+    }
     return o;
 }
 

@@ -140,7 +140,30 @@ void Viewer::draw_segmentation_section() {
     }
 }
 
-// The swarm: its target, agents, p, radius; start, stop, step, clear.
+namespace {
+
+// The swarm's rule (`liveset repair --decision`): fill (intensity), random, or cut a handle at the
+// target (a brush of 3 voxels when none is set). The sheet rule needs a band: `liveset repair
+// --find-holes` and the Find holes tool. Returns whether the choice changed.
+bool draw_rule_combo(RepairOptions& o) {
+    const EditDecision rules[] = {EditDecision::kIntensity, EditDecision::kRandom, EditDecision::kCut};
+    const char* names[] = {"fill (intensity)", "random", "cut a handle"};
+    int current = -1;
+    for (int i = 0; i < 3; ++i)
+        if (o.swarm.decision == rules[i]) current = i;
+    if (current < 0) {
+        ImGui::TextDisabled("rule: sheet (set by Find holes)");
+        return false;
+    }
+    if (!ImGui::Combo("rule", &current, names, 3)) return false;
+    o.swarm.decision = rules[current];
+    if (o.swarm.decision == EditDecision::kCut && !(o.swarm.edit_range > 0)) o.swarm.edit_range = 3.0;
+    return true;
+}
+
+}  // namespace
+
+// The swarm: its target, agents, p, radius, rule; start, stop, step, clear.
 void Viewer::draw_repair_section() {
     const auto& t = session_->target();
     if (t) ImGui::Text("target (%.1f, %.1f, %.1f), %zu agents", t->x, t->y, t->z, session_->agents().size());
@@ -157,6 +180,7 @@ void Viewer::draw_repair_section() {
     if (ImGui::SliderFloat("radius", &r, 0.5f, 8.0f, "%.1f vox")) ui_repair_.swarm.edit_radius = r;
     done |= ImGui::IsItemDeactivatedAfterEdit();
     help_marker("support of an agent's Gaussian edit");
+    done |= draw_rule_combo(ui_repair_);
     if (ImGui::TreeNode("more")) {
         float range = static_cast<float>(ui_repair_.swarm.edit_range), expand = static_cast<float>(ui_repair_.swarm.expand_sigmas);
         if (ImGui::SliderFloat("edit range", &range, 0.0f, 40.0f, "%.1f vox")) ui_repair_.swarm.edit_range = range;

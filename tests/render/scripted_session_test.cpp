@@ -4,7 +4,8 @@
 // from the truth as the demo does) with the demo's swarm settings, until `holes` = 0 without losing
 // more than 0.005 of Dice. Also:
 // a bad script is refused with one line naming the entry, before anything runs; a "display" entry's
-// zoom and window/level reach the slice pane's pixels (a second window re-grades the same slice).
+// zoom and window/level reach the slice pane's pixels (a second window re-grades the same slice);
+// the cut rule, chosen by a script, cuts a handle at the target.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -14,6 +15,7 @@
 
 #include "cli/cli_run.hpp"
 #include "liveset/eval/perforations.hpp"
+#include "liveset/eval/topology.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/render/png_writer.hpp"
@@ -159,6 +161,44 @@ TEST(ScriptedSession, DisplayWindowAndZoomReachTheSlicePixels) {
     EXPECT_EQ(centre((dir / "tenth.png").string()), (std::array<int, 3>{26, 26, 26}));   // 25.5
 }
 
+// A shell (9 < r <= 12 in 32^3) whose mask took in a one-voxel rod of the core's tissue across the
+// core (a handle): a script choosing the cut rule and aiming at the rod removes rod voxels only and
+// leaves genus 0 — the viewer's panel sets the same option (its "rule" combo).
+TEST(ScriptedSession, TheCutRuleCutsAHandleAtTheTarget) {
+    const fs::path dir = work_dir();
+    const Lattice lat({32, 32, 32});
+    Grid<float> image(lat, 50.0f);
+    Grid<std::uint8_t> mask(lat, 0), rod(lat, 0);
+    for (int z = 0; z < 32; ++z)
+        for (int y = 0; y < 32; ++y)
+            for (int x = 0; x < 32; ++x) {
+                const double r = norm(Vec3d{x - 16.0, y - 16.0, z - 16.0});
+                rod({x, y, z}) = r <= 9 && y == 16 && z == 16;
+                image({x, y, z}) = r <= 9 ? 130.0f : r <= 12 ? 100.0f : 50.0f;
+                mask({x, y, z}) = (r > 9 && r <= 12) || rod({x, y, z});
+            }
+    write_image(image, (dir / "rod_t1.nii.gz").string());
+    write_label_image(mask, (dir / "rod_seg.nii.gz").string());
+    const std::string out = (dir / "rod_cut.nii.gz").string();
+    write_text(dir / "cut.json", R"([{"params": {"decision": "cut", "p": 0.3}}, {"target": [16, 16, 16]}, {"swarm": 100},
+        {"save_mask": ")" + out + R"("}])");
+    const CliResult r = run_cli("view " + (dir / "rod_t1.nii.gz").string() + " --mask " + (dir / "rod_seg.nii.gz").string() +
+                                " --headless --script " + (dir / "cut.json").string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const Grid<std::uint8_t> after = read_label_image(out);
+    EXPECT_EQ(mask_topology(mask).genus, 1);
+    EXPECT_EQ(mask_topology(after).genus, 0);
+    std::size_t removed = 0;
+    for (PointIndex i = 0; i < after.size(); ++i) {
+        EXPECT_FALSE(after[i] && !mask[i]);
+        if (mask[i] && !after[i]) {
+            ++removed;
+            EXPECT_TRUE(rod[i]) << "removed a voxel off the handle";
+        }
+    }
+    EXPECT_GE(removed, 1u);
+}
+
 TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
     const fs::path dir = work_dir();
     PhantomOptions o;
@@ -189,6 +229,8 @@ TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
         {"[{\"display\": {\"roi\": \"dotted\"}}]", "roi must be off, outline or tint"},
         {"[{\"display\": {\"label_opacity\": 2}}]", "label_opacity must be in [0, 1]"},
         {"[{\"display\": {\"preview\": 1}}]", "preview must be true or false"},
+        {"[{\"params\": {\"decision\": \"maybe\"}}]", "decision must be"},
+        {"[{\"params\": {\"decision\": \"cut\", \"edit_range\": 0}}]", "entry 1 (\"params\")"},
     };
     for (const Case& c : cases) {
         write_text(dir / "bad.json", c.script);
