@@ -30,9 +30,9 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     o.repair.swarm.act_probability = p;
     o.repair.swarm.seed = seed;
     // The swarm's rule, as `liveset repair --decision` (the sheet rule needs a band: repair_holes).
-    if (decision == "random") o.repair.swarm.decision = EditDecision::kRandom;
-    else if (decision == "cut") o.repair.swarm.decision = EditDecision::kCut;
-    else if (decision != "intensity") throw std::invalid_argument("decision must be 'intensity', 'random' or 'cut'");
+    const std::optional<EditDecision> rule = edit_decision_named(decision);
+    if (!rule || *rule == EditDecision::kSheet) throw std::invalid_argument("decision must be 'intensity', 'random' or 'cut'");
+    o.repair.swarm.decision = *rule;
     o.repair.swarm.edit_range = edit_range;
     if (sleeping) o.segmentation.step = sleeping_step();
     pyb::gil_scoped_release nogil;

@@ -150,10 +150,7 @@ void check_repair_args(RepairArgs& a) {
     } else if (a.targets.empty() && a.targets_mm.empty()) {
         throw UsageError("give at least one --target I,J,K[@STEP] (or --target-mm), or --find-holes N");
     }
-    a.options.swarm.decision = a.decision == "random" ? EditDecision::kRandom
-                               : a.decision == "sheet" ? EditDecision::kSheet
-                               : a.decision == "cut"   ? EditDecision::kCut
-                                                        : EditDecision::kIntensity;
+    a.options.swarm.decision = edit_decision_named(a.decision).value();  // CLI11 checked the name
     if (a.options.swarm.decision == EditDecision::kCut) {
         if (!a.options.topology_guard)
             throw UsageError("--decision cut removes only what cuts a handle, which the topology guard decides: it cannot go with --no-topology-guard");

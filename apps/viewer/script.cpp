@@ -98,7 +98,8 @@ void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
         if (a.repair_fields.contains(k)) number(a.repair_fields[k], err, k);
     if (a.repair_fields.contains("decision")) {
         const json& d = a.repair_fields["decision"];
-        if (!d.is_string() || (d != "intensity" && d != "random" && d != "cut")) err.fail("decision must be \"intensity\", \"random\" or \"cut\"");
+        const std::optional<EditDecision> rule = d.is_string() ? edit_decision_named(d.get<std::string>()) : std::nullopt;
+        if (!rule || *rule == EditDecision::kSheet) err.fail("decision must be \"intensity\", \"random\" or \"cut\"");
     }
     // Check the values now, on top of the defaults: a bad value fails before anything runs.
     try {
@@ -478,8 +479,7 @@ RepairOptions apply_repair_fields(RepairOptions o, const nlohmann::json& f) {
     if (f.contains("edit_range")) o.swarm.edit_range = f["edit_range"].get<double>();
     if (f.contains("sample_depth")) o.swarm.sample_depth = f["sample_depth"].get<double>();
     if (f.contains("decision")) {
-        const std::string d = f["decision"].get<std::string>();
-        o.swarm.decision = d == "cut" ? EditDecision::kCut : d == "random" ? EditDecision::kRandom : EditDecision::kIntensity;
+        o.swarm.decision = edit_decision_named(f["decision"].get<std::string>()).value();  // parse_params checked it
         // A cut needs a brush: 3 voxels unless the script gives one.
         if (o.swarm.decision == EditDecision::kCut && !f.contains("edit_range") && !(o.swarm.edit_range > 0)) o.swarm.edit_range = 3.0;
     }

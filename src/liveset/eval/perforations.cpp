@@ -42,6 +42,29 @@ std::vector<std::uint32_t> label_missed(const Grid<std::uint8_t>& mask, const Gr
     return label_components(missed, 6, &count);
 }
 
+// Each labelled region's size, coordinate sum and bounding box (index k = label; 0 unused).
+struct RegionBoxes {
+    std::vector<std::size_t> size;
+    std::vector<Vec3d> sum;
+    std::vector<Vec3i> lo, hi;
+    Vec3d centroid(std::uint32_t k) const { return sum[k] / static_cast<double>(size[k]); }
+};
+
+RegionBoxes region_boxes(const Lattice& lat, const std::vector<std::uint32_t>& label, std::size_t count) {
+    RegionBoxes r{std::vector<std::size_t>(count + 1, 0), std::vector<Vec3d>(count + 1, Vec3d{0, 0, 0}),
+                  std::vector<Vec3i>(count + 1, lat.dims()), std::vector<Vec3i>(count + 1, Vec3i{-1, -1, -1})};
+    for (PointIndex i = 0; i < lat.size(); ++i) {
+        const std::uint32_t k = label[i];
+        if (!k) continue;
+        const Vec3i c = lat.coord(i);
+        ++r.size[k];
+        r.sum[k] += c.cast<double>();
+        r.lo[k] = {std::min(r.lo[k].x, c.x), std::min(r.lo[k].y, c.y), std::min(r.lo[k].z, c.z)};
+        r.hi[k] = {std::max(r.hi[k].x, c.x), std::max(r.hi[k].y, c.y), std::max(r.hi[k].z, c.z)};
+    }
+    return r;
+}
+
 }  // namespace
 
 std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth,
@@ -120,29 +143,18 @@ std::vector<Perforation> find_missed_tunnels(const Grid<std::uint8_t>& mask, con
     const Lattice& lat = mask.lattice();
     std::size_t count = 0;
     const std::vector<std::uint32_t> label = label_missed(mask, truth, count);
-    std::vector<std::size_t> size(count + 1, 0);
-    std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
-    std::vector<Vec3i> lo(count + 1, lat.dims()), hi(count + 1, Vec3i{-1, -1, -1});
-    for (PointIndex i = 0; i < lat.size(); ++i) {
-        const std::uint32_t k = label[i];
-        if (!k) continue;
-        const Vec3i c = lat.coord(i);
-        ++size[k];
-        sum[k] += c.cast<double>();
-        lo[k] = {std::min(lo[k].x, c.x), std::min(lo[k].y, c.y), std::min(lo[k].z, c.z)};
-        hi[k] = {std::max(hi[k].x, c.x), std::max(hi[k].y, c.y), std::max(hi[k].z, c.z)};
-    }
+    const RegionBoxes r = region_boxes(lat, label, count);
     std::vector<Perforation> out;
     std::vector<std::size_t> slot(count + 1, SIZE_MAX);
     for (std::uint32_t k = 1; k <= count; ++k) {
         // χ over the region's box one voxel wider, without and with the region: a rise is a tunnel
         // (or a cavity, which find_cavities reports) that filling it closes.
-        const Vec3i a = lo[k] - Vec3i{1, 1, 1}, b = hi[k] + Vec3i{1, 1, 1};
+        const Vec3i a = r.lo[k] - Vec3i{1, 1, 1}, b = r.hi[k] + Vec3i{1, 1, 1};
         const auto in_mask = [&](Vec3i q) { return lat.contains(q) && mask(q) != 0; };
         const auto in_filled = [&](Vec3i q) { return lat.contains(q) && (mask(q) != 0 || label[lat.index(q)] == k); };
         if (euler_characteristic_26(in_filled, a, b) <= euler_characteristic_26(in_mask, a, b)) continue;
         slot[k] = out.size();
-        out.push_back({size[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
+        out.push_back({r.size[k], r.centroid(k), Vec3i{0, 0, 0}});
     }
     locate_nearest(lat, label, slot, out);
     return out;
@@ -155,9 +167,7 @@ std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, cons
     for (PointIndex i = 0; i < lat.size(); ++i) taken[i] = mask[i] && inner[i];
     std::size_t count = 0;
     const std::vector<std::uint32_t> label = label_components(taken, 26, &count);
-    std::vector<std::size_t> size(count + 1, 0);
-    std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
-    std::vector<Vec3i> lo(count + 1, lat.dims()), hi(count + 1, Vec3i{-1, -1, -1});
+    const RegionBoxes r = region_boxes(lat, label, count);
     // Whether a region has a face neighbour outside the mask (or the lattice): one without is
     // enclosed by the mask, and removing it opens a cavity (no handle cut; skipped before the
     // whole-mask count).
@@ -166,10 +176,6 @@ std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, cons
         const std::uint32_t k = label[i];
         if (!k) continue;
         const Vec3i c = lat.coord(i);
-        ++size[k];
-        sum[k] += c.cast<double>();
-        lo[k] = {std::min(lo[k].x, c.x), std::min(lo[k].y, c.y), std::min(lo[k].z, c.z)};
-        hi[k] = {std::max(hi[k].x, c.x), std::max(hi[k].y, c.y), std::max(hi[k].z, c.z)};
         for (int f = 0; f < 6 && !faces_out[k]; ++f) {
             Vec3i q = c;
             q[f / 2] += (f % 2) ? 1 : -1;
@@ -181,7 +187,7 @@ std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, cons
     const Topology whole = count ? mask_topology(mask) : Topology{};
     for (std::uint32_t k = 1; k <= count; ++k) {
         if (!faces_out[k]) continue;
-        const Vec3i a = lo[k] - Vec3i{1, 1, 1}, b = hi[k] + Vec3i{1, 1, 1};
+        const Vec3i a = r.lo[k] - Vec3i{1, 1, 1}, b = r.hi[k] + Vec3i{1, 1, 1};
         const auto in_mask = [&](Vec3i q) { return lat.contains(q) && mask(q) != 0; };
         const auto in_cut = [&](Vec3i q) { return lat.contains(q) && mask(q) != 0 && label[lat.index(q)] != k; };
         if (euler_characteristic_26(in_cut, a, b) <= euler_characteristic_26(in_mask, a, b)) continue;
@@ -193,7 +199,7 @@ std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, cons
         const Topology t = mask_topology(cut);
         if (t.components != whole.components || t.cavities != whole.cavities) continue;
         slot[k] = out.size();
-        out.push_back({size[k], sum[k] / static_cast<double>(size[k]), Vec3i{0, 0, 0}});
+        out.push_back({r.size[k], r.centroid(k), Vec3i{0, 0, 0}});
     }
     locate_nearest(lat, label, slot, out);
     return out;

@@ -224,6 +224,14 @@ void validate(const SwarmOptions& o) {
             "swarm: sheet_mean must lie in the sheet's band [sheet_lower, sheet_upper]");
 }
 
+std::optional<EditDecision> edit_decision_named(std::string_view name) {
+    if (name == "intensity") return EditDecision::kIntensity;
+    if (name == "random") return EditDecision::kRandom;
+    if (name == "sheet") return EditDecision::kSheet;
+    if (name == "cut") return EditDecision::kCut;
+    return std::nullopt;
+}
+
 std::pair<double, double> sheet_between_range(const SwarmOptions& o) {
     const double mean = std::isnan(o.sheet_mean) ? 0.5 * (o.sheet_lower + o.sheet_upper) : o.sheet_mean;
     const double widen = 1.0 - 2.0 * o.sheet_between_share;

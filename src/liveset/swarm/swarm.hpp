@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <optional>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -93,6 +94,10 @@ std::pair<double, double> sheet_between_range(const SwarmOptions& options);
 
 // Throws std::invalid_argument (one-line message) on an invalid option.
 void validate(const SwarmOptions& options);
+
+// The rule named as the CLI, Python and scripts name it ("intensity", "random", "sheet", "cut");
+// nullopt for any other name.
+std::optional<EditDecision> edit_decision_named(std::string_view name);
 
 struct Agent {
     Vec3d position;  // index space
