@@ -31,7 +31,7 @@ void BM_BoxFlow(benchmark::State& state) {
         state.PauseTiming();
         SparseField f = make_box_field({});
         state.ResumeTiming();
-        last = run_curvature_flow(f, 5000, 0.5f);
+        last = run_curvature_flow(f, 5000, {.cfl = 0.5f});
         benchmark::DoNotOptimize(last.steps.size());
     }
     state.counters["steps"] = static_cast<double>(last.steps.size());

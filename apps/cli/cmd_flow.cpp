@@ -44,7 +44,7 @@ int run_flow(const FlowArgs& a, int threads, const char* title) {
         }
         return true;
     };
-    const BoxFlowReport rep = run_curvature_flow(field, a.box.max_steps, a.box.cfl, hook);
+    const BoxFlowReport rep = run_curvature_flow(field, a.box.max_steps, {.cfl = a.box.cfl}, hook);
     check(field);
     const double t_end = rep.steps.empty() ? 0.0 : rep.steps.back().time;
     volumes.emplace_back(t_end, enclosed_volume(field));

@@ -46,7 +46,7 @@ TEST(MeanCurvatureFlow, SmallBoxValidAtEveryStepAndVanishes) {
     SparseField f = make_box_field(o);
     double last_volume = enclosed_volume(f);
     int steps = 0;
-    const BoxFlowReport rep = run_curvature_flow(f, 5000, 0.5f, [&](const SparseField& fs, const StepResult&, const FlowStepRecord&) {
+    const BoxFlowReport rep = run_curvature_flow(f, 5000, {.cfl = 0.5f}, [&](const SparseField& fs, const StepResult&, const FlowStepRecord&) {
         ++steps;
         expect_valid(fs, "box step");
         const double v = enclosed_volume(fs);
@@ -62,7 +62,7 @@ TEST(MeanCurvatureFlow, PaperBoxVanishesNearTheExpectedTime) {
     // 50³ box in 100³: other implementations report t ≈ 236 (κ = k1 + k2) until it vanishes.
     SparseField f = make_box_field({});
     double last_volume = enclosed_volume(f);
-    const BoxFlowReport rep = run_curvature_flow(f, 5000, 0.5f, [&](const SparseField& fs, const StepResult&, const FlowStepRecord& r) {
+    const BoxFlowReport rep = run_curvature_flow(f, 5000, {.cfl = 0.5f}, [&](const SparseField& fs, const StepResult&, const FlowStepRecord& r) {
         if (r.step % 100 == 0) {
             expect_valid(fs, "paper box");
             const double v = enclosed_volume(fs);
@@ -73,4 +73,43 @@ TEST(MeanCurvatureFlow, PaperBoxVanishesNearTheExpectedTime) {
     });
     ASSERT_TRUE(rep.vanished);
     EXPECT_NEAR(rep.steps.back().time, 236.0, 0.05 * 236.0);
+}
+
+// The parabolic time-step bound is the explicit scheme's stability limit, not a guess: on a flat
+// front carrying a checkerboard ripple (the worst mode, scripts/parabolic_bound.py) the discrete
+// curvature rate is −8·w·(ripple), so the bound dt = 1/(4w) maps the ripple to exactly minus itself
+// (amplification −1: neutral) and any larger dt would make it grow. Over many steps it must not grow.
+TEST(MeanCurvatureFlow, ParabolicBoundIsTheCheckerboardsStabilityLimit) {
+    const double eps = 0.01;
+    const auto ripple = [](int x, int y) { return (x + y) % 2 == 0 ? 1.0 : -1.0; };
+    for (const float w : {1.0f, 2.5f}) {
+        SparseField f(Lattice({24, 24, 24}), 2);
+        f.init_from_sdf([&](Vec3d p) {
+            return p.z - 11.7 + eps * ripple(static_cast<int>(p.x), static_cast<int>(p.y));
+        });
+        const CurvatureSpeed speed(w);
+        double dt = 0.0;
+        const std::vector<ZeroLayerEdit> edits = f.compute_step(speed, {}, &dt);
+        EXPECT_DOUBLE_EQ(dt, 1.0 / (4.0 * w)) << "the CFL bound 0.5 / (8 w eps) is far larger here";
+        int interior = 0;
+        for (const ZeroLayerEdit& e : edits) {
+            const Vec3i p = f.lattice().coord(e.point);
+            ASSERT_EQ(p.z, 12);
+            if (p.x < 3 || p.y < 3 || p.x > 20 || p.y > 20) continue;  // clamped reads at the lattice edge
+            // Amplification 1 + Δ/(ε·c) = 1 + dt·S: −1 at the bound (S = −8w up to O(ε²)).
+            EXPECT_NEAR(1.0 + e.delta / (eps * ripple(p.x, p.y)), -1.0, 0.02) << "at " << p;
+            ++interior;
+        }
+        EXPECT_EQ(interior, 18 * 18);
+
+        for (int s = 0; s < 200; ++s) f.step(speed);
+        double amplitude = 0.0;
+        for (int y = 3; y <= 20; ++y)
+            for (int x = 3; x <= 20; ++x) {
+                const double d = f.phi()({x, y, 12}) - f.phi()({x + 1, y, 12});
+                amplitude = std::max(amplitude, std::abs(d) / 2.0);
+            }
+        EXPECT_LE(amplitude, eps * 1.02) << "the checkerboard grew under the bound, w = " << w;
+        expect_valid(f, "rippled plane");
+    }
 }

@@ -31,11 +31,10 @@ SparseField make_box_field(const BoxFlowOptions& o) {
     return field;
 }
 
-BoxFlowReport run_curvature_flow(SparseField& field, int max_steps, float cfl, const FlowHook& hook) {
+BoxFlowReport run_curvature_flow(SparseField& field, int max_steps, const StepOptions& options, const FlowHook& hook) {
     using clock = std::chrono::steady_clock;
+    validate(options);
     const CurvatureSpeed speed(1.0f);
-    StepOptions options;
-    options.cfl = cfl;
     BoxFlowReport report;
     double time = 0.0;
     const auto start = clock::now();

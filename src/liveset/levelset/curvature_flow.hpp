@@ -43,6 +43,7 @@ using FlowHook = std::function<bool(const SparseField&, const StepResult&, const
 SparseField make_box_field(const BoxFlowOptions& options);
 
 // Runs the flow on `field` (from make_box_field) until it vanishes, the step limit, or the hook says stop.
-BoxFlowReport run_curvature_flow(SparseField& field, int max_steps, float cfl, const FlowHook& hook = {});
+// `step` sets the CFL number and an optional time-step cap (the step mode is the caller's too).
+BoxFlowReport run_curvature_flow(SparseField& field, int max_steps, const StepOptions& step, const FlowHook& hook = {});
 
 }  // namespace liveset

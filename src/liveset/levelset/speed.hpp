@@ -30,7 +30,7 @@ public:
     // F at zero-layer point p. Must be thread-safe (called concurrently) and deterministic.
     virtual SpeedSample at(const Grid<float>& phi, Vec3i p) const = 0;
     // Upper bound of the coefficient w in the curvature part w·κ, for the parabolic time-step
-    // bound dt ≤ 1/(6w). Zero when the speed has no curvature part.
+    // bound dt ≤ 1/(4w). Zero when the speed has no curvature part.
     virtual float curvature_weight() const = 0;
 
 private:
