@@ -149,7 +149,7 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {
     region.reserve(zero.size() * 4);
     for (PointIndex i : zero) mark_pending(i, region);
     for (PointIndex i : zero) collect_ball(i, region);
-    sweep_layers(region);
+    sweep_whole_band(region);
     finish(region);
     sign_changes_.clear();
 }
@@ -380,7 +380,7 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         relayer_changes(region);
     } else {
         collect_band(region);
-        sweep_layers(region);
+        sweep_whole_band(region);
     }
     return finish(region);
 }
@@ -452,6 +452,53 @@ float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
     return detail::layer_value(phi_, status_, i, decoder_.coord(i), outside, is_inner);
 }
 
+// Whitaker's layer rule pushed outwards instead of pulled: every point of level k-1 (final by
+// then) offers φ ± 1 to its pending neighbours on its side, which keep the min (outside) or max
+// (inside). A point is in layer k iff some neighbour is in layer k-1 (the zero layer for k = 1),
+// and min/max are exact and order-free, so this gives the pull rule's bits (inner_layer_value,
+// the invariant checker) while visiting 6 neighbours of each source instead of of every pending
+// point at every level (the pull re-asked the points of outer layers and the ring at each level).
+// Needs the region to hold the whole band (collect_band, init_from_sdf): no final point outside
+// it can be a pending point's inner neighbour. A partial region (unite_in_box) uses the pull.
+void SparseField::sweep_whole_band(std::span<const RegionPoint> region) {
+    const float inf = std::numeric_limits<float>::infinity();
+    std::vector<PointIndex> from;
+    for (const RegionPoint& r : region) {
+        const std::int8_t s = status_[r.point];
+        if (s == kPendZero) from.push_back(r.point);
+        else if (s == kPendPos) phi_[r.point] = inf;  // the old value is in the region record
+        else if (s == kPendNeg) phi_[r.point] = -inf;
+    }
+    // A point takes its layer when first reached; later offers of the same level still count.
+    std::vector<PointIndex> reached;
+    for (int k = 1; k <= layers_ && !from.empty(); ++k) {
+        reached.clear();
+        const auto up = static_cast<std::int8_t>(k), down = static_cast<std::int8_t>(-k);
+        for (const PointIndex i : from) {
+            const float v = phi_[i];
+            const bool out = k == 1 || status_[i] > 0, in = k == 1 || status_[i] < 0;
+            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
+                const std::int8_t s = status_[q];
+                if (out && (s == kPendPos || s == up)) {
+                    if (s == kPendPos) {
+                        status_[q] = up;
+                        reached.push_back(q);
+                    }
+                    phi_[q] = std::min(phi_[q], v + 1.0f);
+                } else if (in && (s == kPendNeg || s == down)) {
+                    if (s == kPendNeg) {
+                        status_[q] = down;
+                        reached.push_back(q);
+                    }
+                    phi_[q] = std::max(phi_[q], v - 1.0f);
+                }
+            });
+        }
+        from.swap(reached);
+    }
+}
+
+// The pull form for any region: each pending point asks its neighbours, level by level.
 void SparseField::sweep_layers(std::span<const RegionPoint> region) {
     std::vector<PointIndex> pending;
     for (const RegionPoint& r : region)

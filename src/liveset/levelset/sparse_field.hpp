@@ -176,7 +176,8 @@ private:
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     void collect_band(std::vector<RegionPoint>& region);
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
-    void sweep_layers(std::span<const RegionPoint> region);
+    void sweep_layers(std::span<const RegionPoint> region);       // any region (pull)
+    void sweep_whole_band(std::span<const RegionPoint> region);   // the whole band (push, same bits)
     float inner_layer_value(PointIndex i, int k, bool outside) const;
     ChangedPoints finish(std::span<const RegionPoint> region);
     void sort_lists(bool zero_only = false);  // each (or the zero) layer list in ascending point order

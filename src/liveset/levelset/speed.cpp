@@ -26,7 +26,7 @@ float half_point_normal(const Grid<float>& phi, Vec3i p, int a, int dir) {
 
 // half_point_normal() for points whose whole stencil (±2 along a, ±1 across) is inside the
 // lattice: the same arithmetic in the same order, so bit-identical, without per-read clamping.
-float half_point_normal_interior(const float* v, std::size_t i, const std::size_t stride[3], int a, int dir) {
+[[gnu::always_inline]] inline float half_point_normal_interior(const float* v, std::size_t i, const std::size_t stride[3], int a, int dir) {
     const int b = (a + 1) % 3, c = (a + 2) % 3;
     const std::size_t j = dir > 0 ? i + stride[a] : i - stride[a];
     const std::size_t sb = stride[b], sc = stride[c];

@@ -37,17 +37,6 @@ constexpr std::array<unsigned, 8> kOwnedEdges = [] {
     return t;
 }();
 
-// central_gradient() with a fast path for points whose 6-neighbours are all inside the lattice:
-// the same arithmetic ((φ(p+e) - φ(p-e)) / 2), so bit-identical results, without clamping.
-inline Vec3f gradient(const Grid<float>& phi, Vec3i p) {
-    const Vec3i d = phi.dims();
-    if (p.x < 1 || p.y < 1 || p.z < 1 || p.x > d.x - 2 || p.y > d.y - 2 || p.z > d.z - 2) return central_gradient(phi, p);
-    const Lattice& l = phi.lattice();
-    const std::size_t sy = l.stride_y(), sz = l.stride_z(), i = l.index(p);
-    const float* v = phi.values().data();
-    return {(v[i + 1] - v[i - 1]) / 2.0f, (v[i + sy] - v[i - sy]) / 2.0f, (v[i + sz] - v[i - sz]) / 2.0f};
-}
-
 }  // namespace
 
 Vertex make_edge_vertex(const Grid<float>& phi, Vec3i p, int axis) {
@@ -65,8 +54,8 @@ Vertex make_edge_vertex(const Grid<float>& phi, Vec3i p, int axis) {
 
     Vec3i q = p;
     q[axis] += 1;
-    const Vec3f ga = gradient(phi, p);
-    const Vec3f gb = gradient(phi, q);
+    const Vec3f ga = central_gradient(phi, p);
+    const Vec3f gb = central_gradient(phi, q);
     const float s = 1.0f - t;
     const float n[3] = {s * ga.x + t * gb.x, s * ga.y + t * gb.y, s * ga.z + t * gb.z};
     const float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
