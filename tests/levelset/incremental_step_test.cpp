@@ -5,7 +5,9 @@
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <random>
+#include <vector>
 
 #include "levelset_test_util.hpp"
 #include "liveset/levelset/curvature_flow.hpp"
@@ -124,6 +126,37 @@ TEST(IncrementalStep, OneAndTwoThreadsGiveTheSameStateReportsAndListOrder) {
     }
 }
 
+// The same with sleeping on a front of several 4 096-point chunks (the rate pass joins per-chunk
+// arrays of awake points in chunk order): the same bits, reports and list order on 1 and 2 threads.
+TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenSleepingOnAFrontOfSeveralChunks) {
+    auto run = [](int threads, std::vector<std::vector<PointIndex>>& reports, std::size_t& largest) {
+        tbb::task_arena arena(threads);
+        SparseField f = blob_seed(72, 8.0);
+        arena.execute([&] {
+            const BlobSpeed speed({35.5, 35.5, 35.5}, 26.0);
+            StepOptions o = mode(StepMode::kIncremental);
+            o.sleep_after = 5;
+            for (int s = 0; s < 160; ++s) {
+                const StepResult r = f.step(speed, o);
+                reports.push_back(r.changed.points);
+                largest = std::max(largest, r.zero_layer);
+            }
+        });
+        return f;
+    };
+    std::vector<std::vector<PointIndex>> r1, r2;
+    std::size_t largest1 = 0, largest2 = 0;
+    const SparseField a = run(1, r1, largest1);
+    const SparseField b = run(2, r2, largest2);
+    EXPECT_GT(largest1, 2u * 4096u) << "the front should span several chunks";
+    EXPECT_TRUE(same_state(a, b));
+    EXPECT_EQ(r1, r2);
+    for (int k = -a.layers(); k <= a.layers(); ++k) {
+        const auto la = a.layer(k), lb = b.layer(k);
+        EXPECT_TRUE(std::equal(la.begin(), la.end(), lb.begin(), lb.end())) << "layer list order " << k;
+    }
+}
+
 TEST(IncrementalStep, BadOptionsThrowOneLineMessages) {
     SparseField f = blob_seed(16);
     const CurvatureSpeed speed;
@@ -137,4 +170,25 @@ TEST(IncrementalStep, BadOptionsThrowOneLineMessages) {
     bad.max_dt = -1.0f;
     EXPECT_THROW(validate(bad), std::invalid_argument);
     EXPECT_NO_THROW(validate(StepOptions{}));
+}
+
+// Every eighth full-band step starts by putting the layer lists back into lattice order (a radix
+// sort over the bytes the indices use). Step 16 here moves nothing (zero speed), so its sorted
+// lists survive it: each must be ascending and hold exactly the points of its layer (the
+// invariant checker also checks the slots).
+TEST(IncrementalStep, TheFullBandStepSortsTheLayerListsEveryEighthStep) {
+    SparseField f(Lattice({70, 66, 64}), 2);  // indices up to 295 680: three bytes
+    f.init_from_sdf(shapes::Sphere({34.2, 33.1, 31.7}, 24.0));
+    for (int s = 1; s <= 15; ++s) f.step(CurvatureSpeed(1.0f), mode(StepMode::kFullBand));
+    EXPECT_TRUE(f.step(CurvatureSpeed(0.0f), mode(StepMode::kFullBand)).changed.empty());
+    for (int k = -2; k <= 2; ++k) {
+        const auto list = f.layer(k);
+        ASSERT_GT(list.size(), 256u) << "layer " << k << " too small to take the radix path";
+        EXPECT_TRUE(std::is_sorted(list.begin(), list.end())) << "layer " << k;
+        std::vector<PointIndex> brute;
+        for (std::size_t i = 0; i < f.status().size(); ++i)
+            if (f.status()[static_cast<PointIndex>(i)] == k) brute.push_back(static_cast<PointIndex>(i));
+        EXPECT_EQ(std::vector<PointIndex>(list.begin(), list.end()), brute) << "layer " << k;
+    }
+    expect_valid(f, "after the sort");
 }

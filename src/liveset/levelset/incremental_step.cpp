@@ -19,13 +19,6 @@ namespace liveset {
 
 namespace {
 
-template <class F>
-void parallel_chunks(std::size_t n, F&& f) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
-    });
-}
-
 bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
 
 }  // namespace
@@ -94,37 +87,47 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
     const int sleep_after = options.sleep_after;
     if (sleep_after > 0) activity_.begin_step(lattice(), speed.serial(), steps_);
 
-    // Rates at the awake points (all of them when sleeping is off), exactly as zero_rates().
-    std::vector<double> rate(zero.size(), 0.0);
-    std::vector<std::uint8_t> awake(zero.size(), 1);
-    parallel_chunks(zero.size(), [&](std::size_t n) {
-        const Vec3i p = decoder_.coord(zero[n]);
-        if (sleep_after > 0 && !activity_.awake(p, steps_, sleep_after)) {
-            awake[n] = 0;
-            return;
+    // Rates at the awake points (all of them when sleeping is off), exactly as zero_rates(). A
+    // sleeping point costs only its awake test: each chunk of the zero layer keeps its awake
+    // points and their rates in its own arrays, joined in chunk order (the zero layer's order,
+    // whatever the thread count), so the passes below run over the awake points only.
+    constexpr std::size_t kChunk = 4096;
+    const std::size_t chunks = (zero.size() + kChunk - 1) / kChunk;
+    std::vector<std::vector<std::uint32_t>> chunk_at(chunks);  // positions in the zero layer
+    std::vector<std::vector<double>> chunk_rate(chunks);
+    const auto rate_chunk = [&](std::size_t c) {
+        const std::size_t end = std::min(zero.size(), (c + 1) * kChunk);
+        for (std::size_t n = c * kChunk; n < end; ++n) {
+            const Vec3i p = decoder_.coord(zero[n]);
+            if (sleep_after > 0 && !activity_.awake(p, steps_, sleep_after)) continue;
+            const SpeedSample s = speed.at(phi_, p);
+            double r = 0.0;
+            if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi_, p, s.propagation);
+            if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi_, p));
+            chunk_at[c].push_back(static_cast<std::uint32_t>(n));
+            chunk_rate[c].push_back(r);
         }
-        const SpeedSample s = speed.at(phi_, p);
-        double r = 0.0;
-        if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi_, p, s.propagation);
-        if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi_, p));
-        rate[n] = r;
-    });
-    result.dt = time_step(rate, speed, options);  // sleeping points (rate 0) do not bound it
+    };
+    if (chunks > 1) tbb::parallel_for(std::size_t{0}, chunks, rate_chunk);
+    else if (chunks == 1) rate_chunk(0);
+    std::vector<std::uint32_t> at;
+    std::vector<double> rate;
+    for (std::size_t c = 0; c < chunks; ++c) {
+        at.insert(at.end(), chunk_at[c].begin(), chunk_at[c].end());
+        rate.insert(rate.end(), chunk_rate[c].begin(), chunk_rate[c].end());
+    }
+    result.awake = at.size();
+    result.dt = time_step(rate, speed, options);  // sleeping points do not bound it
 
     // Δ exactly as the full-band step computes it; only points whose bits change become edits
     // (a Δ that rounds away, or a point already at the bound, changes nothing downstream).
-    std::vector<float> delta(zero.size());
-    parallel_chunks(zero.size(), [&](std::size_t n) {
-        if (!awake[n]) return;
-        const float d = static_cast<float>(std::clamp(result.dt * rate[n], -0.5, 0.5));
-        const float v = phi_[zero[n]];
-        delta[n] = d;
-        awake[n] = std::bit_cast<std::uint32_t>(v + d) != std::bit_cast<std::uint32_t>(v) ? 2 : 1;
-    });
     std::vector<ZeroLayerEdit> edits;
-    for (std::size_t n = 0; n < zero.size(); ++n) {
-        result.awake += awake[n] != 0;
-        if (awake[n] == 2) edits.push_back({zero[n], delta[n]});
+    edits.reserve(at.size());
+    for (std::size_t m = 0; m < at.size(); ++m) {
+        const PointIndex i = zero[at[m]];
+        const float d = static_cast<float>(std::clamp(result.dt * rate[m], -0.5, 0.5));
+        const float v = phi_[i];
+        if (std::bit_cast<std::uint32_t>(v + d) != std::bit_cast<std::uint32_t>(v)) edits.push_back({i, d});
     }
     result.changed = repair_band(edits, RepairScope::kLocal);
     last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

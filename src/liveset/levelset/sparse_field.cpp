@@ -229,11 +229,35 @@ std::vector<ZeroLayerEdit> SparseField::compute_step(const Speed& speed, const S
     return edits;
 }
 
+namespace {
+
+// Ascending order by LSD radix sort on bytes, skipping the bytes no index uses: a layer list of
+// n points sorts in a few linear passes (std::sort was 8 % of a BrainWeb segmentation).
+void sort_indices(std::vector<PointIndex>& v, std::vector<PointIndex>& scratch) {
+    if (v.size() < 256) {
+        std::sort(v.begin(), v.end());
+        return;
+    }
+    PointIndex top = 0;
+    for (const PointIndex i : v) top |= i;
+    scratch.resize(v.size());
+    for (int shift = 0; shift < 32 && (top >> shift) != 0; shift += 8) {
+        std::size_t count[257] = {};
+        for (const PointIndex i : v) ++count[((i >> shift) & 0xFFu) + 1];
+        for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
+        for (const PointIndex i : v) scratch[count[(i >> shift) & 0xFFu]++] = i;
+        v.swap(scratch);
+    }
+}
+
+}  // namespace
+
 void SparseField::sort_lists(bool zero_only) {
     zero_reordered_ = 0;
+    std::vector<PointIndex> scratch;
     for (auto& list : lists_) {
         if (zero_only && &list != &lists_[static_cast<std::size_t>(layers_)]) continue;
-        std::sort(list.begin(), list.end());
+        sort_indices(list, scratch);
         for (std::size_t k = 0; k < list.size(); ++k) slot_[list[k]] = static_cast<std::uint32_t>(k);
     }
 }
