@@ -1,0 +1,60 @@
+#!/usr/bin/python3
+"""Per-iteration time of liveset's step against ITK's threshold level set at equal front size.
+
+Bins each iteration by the front it started from (ITK: the active layer after the previous
+iteration; liveset: the zero layer after the previous iteration) and prints the median ms per
+iteration of both programs per bin and their ratio. liveset's bins use its growth phase only
+(before its zero layer first passes the largest bin), as ITK's 450 iterations never converge.
+
+Usage: scripts/itk_per_iteration.py ITK_LOG LIVESET_LOG   (both JSON lines, from --log)
+"""
+import json
+import statistics
+import sys
+
+BINS = [(1000, 3000), (3000, 10000), (10000, 30000), (30000, 60000), (60000, 100000), (100000, 150000)]
+
+
+def read(path, front_key):
+    rows = []
+    try:
+        with open(path) as f:
+            for line in f:
+                d = json.loads(line)
+                if "iteration" in d and "ms" in d:
+                    rows.append(d)
+    except (OSError, ValueError) as e:
+        sys.exit(f"itk_per_iteration: cannot read {path}: {e}")
+    out, prev = [], None
+    for d in rows:
+        if prev is not None:
+            out.append((prev, d["ms"]))
+        prev = d[front_key]
+    return out
+
+
+def main():
+    if len(sys.argv) != 3:
+        sys.exit(__doc__.strip().splitlines()[-1])
+    itk = read(sys.argv[1], "active_layer")
+    ls = read(sys.argv[2], "zero_layer")
+    top = BINS[-1][1]
+    growth = []
+    for front, ms in ls:
+        if front > top:
+            break
+        growth.append((front, ms))
+    print("| front size | ITK ms | liveset ms | ITK / liveset |")
+    print("|---|--:|--:|--:|")
+    for lo, hi in BINS:
+        a = [ms for f, ms in itk if lo <= f < hi]
+        b = [ms for f, ms in growth if lo <= f < hi]
+        if not a or not b:
+            print(f"| {lo}-{hi} | {len(a)} ITK / {len(b)} liveset iterations | | |")
+            continue
+        ma, mb = statistics.median(a), statistics.median(b)
+        print(f"| {lo}-{hi} | {ma:.2f} | {mb:.2f} | {ma / mb:.1f}x |")
+
+
+if __name__ == "__main__":
+    main()
