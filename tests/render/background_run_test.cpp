@@ -76,6 +76,24 @@ void frames_while_running(Viewer& v, const render::Framebuffer& fb, int limit) {
     }
 }
 
+// Frames until the run has taken at least `steps` steps that these frames accounted (a run
+// started by the first of them). A fixed number of frames is not enough: on a loaded machine the
+// worker may not have finished a step within a few 5 ms hand-overs, and a pause then closes an
+// empty run, so an undo takes back the action before it.
+void frames_until_steps(Viewer& v, const render::Framebuffer& fb, int steps) {
+    int seen = 0;
+    for (int n = 0; n < 100000 && seen < steps && v.segment_running();) {
+        if (!v.needs_frame()) {
+            v.wait_for_frame(1000.0);
+            continue;
+        }
+        v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+        seen += v.last_frame().segment_steps;
+        ++n;
+    }
+    ASSERT_GE(seen, steps) << "the run stopped before taking " << steps << " steps";
+}
+
 TEST(BackgroundRun, ASegmentationRunEqualsTheForegroundStepsAtAnyPace) {
     render::HeadlessContext context;
     auto reference = seeded_session();
@@ -106,7 +124,7 @@ TEST(BackgroundRun, PauseSeedAndUndoDuringARunStopTheWorkerFirst) {
     v.frame(fb.id(), 640, 480, 1.0 / 60.0);
     const std::vector<std::uint32_t> before = bits(*v.session());
     v.set_segment_running(true);
-    frames_while_running(v, fb, 3);
+    frames_until_steps(v, fb, 3);
     v.set_segment_running(false);  // pause: the worker is joined, the session is ours
     ASSERT_FALSE(v.background_active());
     const int k = v.session()->segment_status().iterations;
@@ -121,7 +139,8 @@ TEST(BackgroundRun, PauseSeedAndUndoDuringARunStopTheWorkerFirst) {
     const Vec3d extra = phantom().seeds.front().cast<double>() + Vec3d{1.0, 1.0, 0.0};
     EXPECT_TRUE(v.add_seed(extra, 1.5)) << v.message();
     EXPECT_TRUE(v.segment_running());  // the run goes on after the seed, as in the foreground
-    frames_while_running(v, fb, 4);
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);  // starts the new worker; also counts the steps before the seed
+    frames_until_steps(v, fb, 2);  // steps after the seed
     v.undo();  // pauses, then undoes the steps after the seed
     EXPECT_FALSE(v.segment_running());
     EXPECT_FALSE(v.background_active());
