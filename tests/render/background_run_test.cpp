@@ -64,25 +64,12 @@ ViewerConfig config(double handover_ms) {
     return c;
 }
 
-// Frames as a window loop would give them (waiting for the hand-over between), `limit` at most.
-void frames_while_running(Viewer& v, const render::Framebuffer& fb, int limit) {
-    for (int n = 0; n < limit && v.segment_running();) {
-        if (!v.needs_frame()) {
-            v.wait_for_frame(1000.0);
-            continue;
-        }
-        v.frame(fb.id(), 640, 480, 1.0 / 60.0);
-        ++n;
-    }
-}
-
-// Frames until the run has taken at least `steps` steps that these frames accounted (a run
-// started by the first of them). A fixed number of frames is not enough: on a loaded machine the
-// worker may not have finished a step within a few 5 ms hand-overs, and a pause then closes an
-// empty run, so an undo takes back the action before it.
-void frames_until_steps(Viewer& v, const render::Framebuffer& fb, int steps) {
+// Frames as a window loop would give them (waiting for the hand-over between), `limit` at most,
+// and with `min_steps` only until the frames have accounted that many of the run's steps (a run
+// started by the first of them). Returns the steps the frames accounted.
+int frames_while_running(Viewer& v, const render::Framebuffer& fb, int limit, int min_steps = 0) {
     int seen = 0;
-    for (int n = 0; n < 100000 && seen < steps && v.segment_running();) {
+    for (int n = 0; n < limit && v.segment_running() && (min_steps == 0 || seen < min_steps);) {
         if (!v.needs_frame()) {
             v.wait_for_frame(1000.0);
             continue;
@@ -91,7 +78,14 @@ void frames_until_steps(Viewer& v, const render::Framebuffer& fb, int steps) {
         seen += v.last_frame().segment_steps;
         ++n;
     }
-    ASSERT_GE(seen, steps) << "the run stopped before taking " << steps << " steps";
+    return seen;
+}
+
+// A fixed number of frames is not enough before a pause: on a loaded machine the worker may not
+// have finished a step within a few 5 ms hand-overs, and a pause then closes an empty run, so an
+// undo takes back the action before it.
+void frames_until_steps(Viewer& v, const render::Framebuffer& fb, int steps) {
+    ASSERT_GE(frames_while_running(v, fb, 100000, steps), steps) << "the run stopped before taking " << steps << " steps";
 }
 
 TEST(BackgroundRun, ASegmentationRunEqualsTheForegroundStepsAtAnyPace) {
