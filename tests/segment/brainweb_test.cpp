@@ -1,6 +1,7 @@
 // Real data: grey matter of the BrainWeb T1 (data/brainweb) segmented with the paper's
 // threshold speed inside the brain mask, on a cortical sub-volume so the test stays short (the
-// whole-volume figures are in docs/BENCHMARKS.md). Skips when the data is absent.
+// whole-volume figures are in docs/BENCHMARKS.md), with the step `liveset segment` takes (the
+// sleeping one) and, once, the exact reference step. Skips when the data is absent.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -62,6 +63,7 @@ double slab_dice(const Grid<float>& t1, std::optional<double> mu_raw, std::optio
     req.roi = &slab().brain;
     req.mu_raw = mu_raw;
     req.epsilon_raw = epsilon_raw;
+    req.loop.step = sleeping_step();  // the step `liveset segment` takes
     SegmentOutcome out = segment_image(t1, req);
     EXPECT_EQ(out.result.reason, StopReason::kConverged) << out.result.iterations;
     const double dice = compare_overlap(out.mask, slab().gm).dice;
@@ -86,13 +88,23 @@ TEST(BrainWeb, GreyMatterDiceInsideTheBrainMask) {
     req.epsilon_raw = 22.0;
     req.alpha = 0.1;
     req.n = 4.0;
-    const SegmentOutcome out = segment_image(t1, req);
+    const SegmentOutcome out = segment_image(t1, req);  // the exact (full-band) step, the reference
     EXPECT_EQ(out.result.reason, StopReason::kConverged) << out.result.iterations;
     const OverlapMetrics m = compare_overlap(out.mask, gm);
     RecordProperty("dice", std::to_string(m.dice));
     std::printf("BrainWeb slab: dice %.4f, volume difference %+.3f, %d iterations\n", m.dice, m.volume_difference, out.result.iterations);
     EXPECT_GE(m.dice, 0.90) << "iterations " << out.result.iterations;
     EXPECT_LT(std::abs(m.volume_difference), 0.10);
+
+    // Issue 16 on real data: the step `liveset segment` takes (converged stretches of front
+    // sleeping) keeps the exact step's Dice within 0.002 and nearly its mask.
+    req.loop.step = sleeping_step();
+    const SegmentOutcome fast = segment_image(t1, req);
+    EXPECT_EQ(fast.result.reason, StopReason::kConverged) << fast.result.iterations;
+    const double dice_fast = compare_overlap(fast.mask, gm).dice;
+    std::printf("BrainWeb slab, sleeping step: dice %.4f, %d iterations\n", dice_fast, fast.result.iterations);
+    EXPECT_NEAR(dice_fast, m.dice, 0.002);
+    EXPECT_GE(compare_overlap(fast.mask, out.mask).dice, 0.99);
 }
 
 // Seeds alone: the tissue model's window (no µ, ε given) reaches the documented hand-picked
@@ -156,6 +168,7 @@ TEST(BrainWeb, WholeBrainFromEightSeedsAlone) {
                           Vec3i{140, 86, 74}, Vec3i{38, 71, 26}, Vec3i{83, 23, 71}})
         req.seeds.push_back({{double(p.x), double(p.y), double(p.z)}, 2.0});
     req.roi = &brain;
+    req.loop.step = sleeping_step();  // as `liveset segment` runs it
     const SegmentOutcome out = segment_image(t1, req);
     const double dice = compare_overlap(out.mask, gm).dice;
     std::printf("BrainWeb whole brain, 8 seeds alone: window %.1f .. %.1f, dice %.4f, %d iterations\n",

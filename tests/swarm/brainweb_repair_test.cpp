@@ -1,5 +1,5 @@
 // Real data: the swarm repairs holes of the BrainWeb grey-matter segmentation of README.md
-// (whole volume, data/brainweb; ≈ 3 min on 2 cores). Targets are the hole-sized
+// (whole volume, data/brainweb; ≈ 1 min on 2 cores). Targets are the hole-sized
 // perforations the segmentation left (missed grey matter joining white matter to the outside), as
 // `liveset eval --inner-label 3` lists them, clicked one after another; the `holes` count must
 // fall and Dice must not fall. Skips when the data is absent.
@@ -42,6 +42,7 @@ TEST(BrainWebRepair, TargetedPerforationsLowerTheHoleCountWithoutLosingDice) {
     req.roi = &brain;
     req.mu_raw = 94.0;
     req.epsilon_raw = 22.0;
+    req.loop.step = sleeping_step();  // the step the README's `liveset segment` takes
     SegmentOutcome o = segment_image(t1, req);
     const Topology truth = mask_topology(gm);
     const Topology before = mask_topology(o.mask);
