@@ -185,8 +185,10 @@ void print_step_summary(const RepairArgs& a, const std::vector<RepairStepLog>& l
         modified += r.modified;
         fragments += r.fragments;
         ms += r.ms;
-        lines += fmt::format("{{\"step\":{},\"agents_on_surface\":{},\"points_modified\":{},\"changed\":{},\"fragments_rebuilt\":{},\"ms\":{:.4f},\"cpu_ms\":{:.4f}}}\n",
-                             r.step, r.on_surface, r.modified, r.changed, r.fragments, r.ms, r.cpu_ms);
+        lines += fmt::format("{{\"step\":{},\"agents_on_surface\":{},\"points_modified\":{},\"changed\":{},\"fragments_rebuilt\":{},\"ms\":{:.4f},"
+                             "\"cpu_ms\":{:.4f},\"guard_ms\":{:.4f},\"level_set_ms\":{:.4f},\"mesh_ms\":{:.4f}}}\n",
+                             r.step, r.on_surface, r.modified, r.changed, r.fragments, r.ms, r.cpu_ms, r.guard_ms, r.level_set_ms,
+                             r.mesh_ms);
     }
     if (!a.log.empty()) write_atomically(a.log, lines);
     nlohmann::json j{{"steps", log.size()}, {"agents", a.options.swarm.agents}, {"points_modified", modified},
@@ -347,7 +349,7 @@ void add_repair_command(CLI::App& app, const int& threads) {
     r->add_option("--out-phi", ra.out_phi, "repaired phi");
     r->add_option("--out-mask", ra.out_mask, "repaired mask");
     r->add_option("--out-mesh", ra.out_mesh, "repaired surface (.ply/.obj/.stl)");
-    r->add_option("--log", ra.log, "one JSON line per step: step, agents_on_surface, points_modified, changed, fragments_rebuilt, ms, cpu_ms (processor time)");
+    r->add_option("--log", ra.log, "one JSON line per step: step, agents_on_surface, points_modified, changed, fragments_rebuilt, ms, cpu_ms (processor time), and of ms: guard_ms, level_set_ms, mesh_ms (the rest is the agents' move and proposals)");
     r->add_flag("--json", ra.json, "print the summary as one JSON object");
     r->add_flag("--quiet,-q", ra.quiet, "print nothing");
     r->callback([&threads, r] {

@@ -383,6 +383,7 @@ TEST(SegmentCli, RepairRunsTheSwarmAndLogsEveryStep) {
     std::istringstream in(slurp(log));
     std::string line;
     int n = 0, on_surface_sum = 0;
+    double timed_parts = 0.0;
     while (std::getline(in, line)) {
         const nlohmann::json s = nlohmann::json::parse(line);
         EXPECT_EQ(s["step"], n);
@@ -391,11 +392,17 @@ TEST(SegmentCli, RepairRunsTheSwarmAndLogsEveryStep) {
         // average at least 85 %.
         EXPECT_GE(s["agents_on_surface"].get<int>(), 55) << line;
         on_surface_sum += s["agents_on_surface"].get<int>();
-        for (const char* key : {"points_modified", "fragments_rebuilt", "ms", "cpu_ms"}) EXPECT_TRUE(s.contains(key)) << key;
+        for (const char* key : {"points_modified", "fragments_rebuilt", "ms", "cpu_ms", "guard_ms", "level_set_ms", "mesh_ms"})
+            EXPECT_TRUE(s.contains(key)) << key;
         EXPECT_GE(s["cpu_ms"].get<double>(), 0.0) << line;
+        // The parts are timed inside the step: together at most its wall time (printed to 0.1 µs).
+        const double parts = s["guard_ms"].get<double>() + s["level_set_ms"].get<double>() + s["mesh_ms"].get<double>();
+        timed_parts += s["level_set_ms"].get<double>() + s["mesh_ms"].get<double>();
+        EXPECT_LE(parts, s["ms"].get<double>() + 0.001) << line;
         ++n;
     }
     EXPECT_EQ(n, 120);
+    EXPECT_GT(timed_parts, 0.0);  // points were modified, so the level set and the mesher did work
     EXPECT_GE(on_surface_sum, 85 * n);
     const auto dice = [&](const fs::path& m) {
         const Result e = run_cli("eval --json --mask " + m.string() + " --truth " + (ph.dir / "truth_gm.nii.gz").string());

@@ -319,12 +319,13 @@ SessionUpdate Session::swarm_step() {
             convergence_.reset();
         }
         Change c{std::move(step.changed)};
-        c.level_set_ms = step.log.modified > 0 ? field_.last_update_ms() : 0.0;
+        c.level_set_ms = step.log.level_set_ms;
         c.agents_ms = std::max(0.0, step.log.ms - c.level_set_ms);
         c.swarm = step.log;
         return c;
     });
     u.swarm.fragments = u.fragments.size();  // the mesher's U for this step's X
+    u.swarm.mesh_ms = u.mesh_ms;
     return u;
 }
 

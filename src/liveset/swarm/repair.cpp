@@ -78,12 +78,15 @@ RepairStep RepairLoop::step() {
             go.close_cracks = options_.close_cracks;
             go.roi = roi_;
             go.cut_handles = swarm_.options().decision == EditDecision::kCut;
+            const auto g0 = clock::now();
             out.log.guarded = guard_topology(field_, edits, go);
+            out.log.guard_ms = std::chrono::duration<double, std::milli>(clock::now() - g0).count();
         }
         out.log.modified = edits.size();
         if (!edits.empty()) {
             out.changed = field_.apply_edits(edits, RepairScope::kLocal);
             out.log.changed = out.changed.size();
+            out.log.level_set_ms = field_.last_update_ms();
         }
     }
     out.log.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();

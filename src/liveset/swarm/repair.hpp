@@ -41,6 +41,11 @@ struct RepairStepLog {
     std::size_t changed = 0;     // |X| reported by the local update
     std::size_t fragments = 0;   // fragments re-polygonised (filled by whoever meshes X: the Session)
     double ms = 0.0;             // wall time of move + edits + level set + mesh
+    // Of ms, the parts after the agents' move and edit proposals (wall time): the topology guard,
+    // the sparse field's local update, and the mesher's (filled by whoever meshes X: the Session).
+    double guard_ms = 0.0;
+    double level_set_ms = 0.0;
+    double mesh_ms = 0.0;
     // Processor time of the same (std::clock, all threads of the process): the wall time less what
     // other processes took while they held the core (on a shared machine, most of a slow step).
     double cpu_ms = 0.0;
