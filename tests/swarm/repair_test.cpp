@@ -231,6 +231,34 @@ TEST(Repair, PocketLimitMatchesTheCountedCavity) {
     }
 }
 
+// Growth that closes a tunnel inside a small cavity: a ring of four inside voxels around an outside
+// voxel c in a closed cavity (343 voxels, well under the pocket limit). Filling c splits c's
+// outside neighbours locally, but they join around the ring: no region is separated, the fill is
+// kept — as it is for the same ring in the open (a pocket is a region the edit walls off, not a
+// small region the edit shrinks).
+TEST(Repair, ClosingATunnelInsideASmallCavityIsKept) {
+    const Lattice lat({15, 15, 15});
+    for (const bool in_cavity : {true, false}) {
+        Grid<std::uint8_t> mask(lat, 0);
+        if (in_cavity)
+            for (int z = 2; z < 13; ++z)
+                for (int y = 2; y < 13; ++y)
+                    for (int x = 2; x < 13; ++x) mask({x, y, z}) = x < 4 || y < 4 || z < 4 || x > 10 || y > 10 || z > 10;
+        for (const Vec3i r : {Vec3i{7, 6, 7}, Vec3i{7, 8, 7}, Vec3i{7, 7, 6}, Vec3i{7, 7, 8}}) mask(r) = 1;
+        const SparseField f = field_from_mask(mask);
+        const PointIndex c = lat.index({7, 7, 7});
+        ASSERT_EQ(f.status()[c], 0);
+        ASSERT_LT(f.phi()[c] - 0.5f, 0.0f);
+        std::vector<ZeroLayerEdit> edits{{c, -0.5f}};
+        EXPECT_EQ(guard_topology(f, edits), 0u) << (in_cavity ? "in the cavity" : "in the open");
+        ASSERT_EQ(edits.size(), 1u);
+        // The fill closes the ring's tunnel (brute force over the whole lattice).
+        Grid<std::uint8_t> filled = mask;
+        filled(Vec3i{7, 7, 7}) = 1;
+        EXPECT_EQ(mask_topology(filled).genus + 1, mask_topology(mask).genus);
+    }
+}
+
 // A plate three voxels thick with a one-voxel slit at x = 15 from y = y0 to y1 - 1 (every z of the
 // plate): the slit's voxels, the plate's, and the Euler characteristic of the plate with and
 // without the slit filled, counted by brute force (mask_topology over the whole lattice).

@@ -52,9 +52,11 @@ struct RepairStepLog {
 };
 
 struct GuardOptions {
-    // Growth that seals a region of the outside off is refused when that region holds at most this
-    // many voxels (a spurious cavity); a larger one is tissue the sheet already enclosed around
-    // the hole (the white matter under a perforation), and sealing it closes the hole.
+    // Growth that seals a region of the outside off (walls it apart from the rest of the outside it
+    // touched) is refused when that region holds at most this many voxels (a spurious cavity); a
+    // larger one is tissue the sheet already enclosed around the hole (the white matter under a
+    // perforation), and sealing it closes the hole. Growth that only shrinks a region, whose pieces
+    // around the edit still join elsewhere, seals nothing, however small the region.
     std::size_t pocket_limit = 32768;
     // A growth edit refused as a bridge (its inside neighbours form two pieces: two fronts that
     // met with a one-voxel crack between them) fills the whole crack at once when that closes a
@@ -78,7 +80,8 @@ std::size_t brush_pocket_limit(double edit_range);
 // non-simply: growth is kept only when the point's inside neighbours form one 26-connected piece
 // (no bridge, no new piece); shrinking only when the point is simple (no tunnel opened, no cavity
 // made, nothing split) or an isolated inside voxel. Growth that closes a tunnel or fills a
-// cavity is kept, growth that seals a pocket of at most options.pocket_limit voxels is not.
+// cavity is kept, growth that seals a pocket of at most options.pocket_limit voxels off is not (its
+// outside face neighbours lie in two or more regions, one of them that small: see PocketFlood).
 // Flips already accepted count for the later points. Returns the number dropped.
 // Cracks (options.close_cracks): a bridge's crack is the outside voxels 6-connected to it that each
 // lie between two inside voxels along one of the 13 directions through them, gathered along the

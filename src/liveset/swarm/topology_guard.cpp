@@ -10,6 +10,7 @@
 #include <unordered_set>
 
 #include "liveset/grid/digital_topology.hpp"
+#include "liveset/swarm/pocket_flood.hpp"
 #include "liveset/swarm/repair.hpp"
 
 namespace liveset {
@@ -26,61 +27,9 @@ constexpr float kFlippable = 0.5f;     // ... which flips it when φ is below th
 // The two floods that tell a handle cut from a split stop (and the cut is refused) past this many voxels.
 constexpr std::size_t kMaxJoinFlood = std::size_t{1} << 21;
 
-// Visited marks for the pocket flood: one stamp per lattice point, reused across floods (a new
-// stamp per flood, so nothing is cleared). Per thread: guard_topology may run on several threads.
-struct FloodMarks {
-    std::vector<std::uint32_t> stamp;
-    std::uint32_t current = 0;
-    std::vector<Vec3i> queue;
-    void begin(std::size_t points) {
-        if (stamp.size() != points || current == UINT32_MAX) {
-            stamp.assign(points, 0);
-            current = 0;
-        }
-        ++current;
-        queue.clear();
-    }
-    bool visit(PointIndex i) {
-        if (stamp[i] == current) return false;
-        stamp[i] = current;
-        return true;
-    }
-};
-
 Vec3i face_neighbour(Vec3i c, int k) {
     c[k / 2] += (k % 2) ? 1 : -1;
     return c;
-}
-
-// Breadth-first flood of the outside (6-connected) from `start`: true when it ends within `limit`
-// voxels without reaching the lattice border (order-independent: the start's whole component is
-// small and away from the border). The marks are those of the caller's batch of floods: a start
-// an earlier flood of the batch reached lies in that flood's component, which was not small, so
-// it is false at once. Works on point indices: a point off the border has all six neighbours in
-// the lattice, so `outside_at` (index -> outside) needs no bounds test. (A flat stamp array
-// instead of a hash set: the flood is the guard's worst case, ~30 k voxels when the outside is large.)
-template <class OutsideAt>
-bool encloses_small_pocket(const Lattice& lat, FloodMarks& marks, const OutsideAt& outside_at, Vec3i start, std::size_t limit) {
-    const PointIndex s = lat.index(start);
-    if (!marks.visit(s)) return false;
-    std::vector<Vec3i>& queue = marks.queue;
-    queue.clear();
-    queue.push_back(start);
-    const Vec3i dims = lat.dims();
-    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
-    const PointIndex step[6] = {PointIndex(0) - 1, 1, PointIndex(0) - sy, sy, PointIndex(0) - sz, sz};
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-        if (queue.size() > limit) return false;
-        const Vec3i p = queue[head];
-        if (p.x == 0 || p.y == 0 || p.z == 0 || p.x == dims.x - 1 || p.y == dims.y - 1 || p.z == dims.z - 1) return false;
-        const PointIndex i = lat.index(p);
-        for (int k = 0; k < 6; ++k) {
-            const PointIndex j = i + step[k];  // unsigned wrap: i - 1 etc. (p is off the border)
-            if (!outside_at(j) || !marks.visit(j)) continue;
-            queue.push_back(face_neighbour(p, k));
-        }
-    }
-    return true;
 }
 
 // The guard's state over one batch: the flips accepted so far, read through inside().
@@ -136,18 +85,19 @@ private:
 
 thread_local std::vector<std::uint8_t> Guard::flip_filter_;
 
-// Whether some face neighbour's outside region of a voxel of `cs` (counted inside) is a pocket of at
-// most pocket_limit voxels. One batch of floods: a neighbour in a component already flooded is skipped.
+// Whether the voxels of `cs` (counted inside) separate a pocket of at most pocket_limit voxels off
+// the outside: their outside face neighbours lie in two or more regions, one of them small (see
+// PocketFlood). Per thread: guard_topology may run on several threads.
 bool Guard::seals_pocket_around(std::span<const Vec3i> cs) {
-    thread_local FloodMarks marks;
-    marks.begin(lat_.size());
-    const auto outside_at = [this](PointIndex i) { return !inside_at(i); };
+    thread_local PocketFlood flood;
+    thread_local std::vector<Vec3i> starts;
+    starts.clear();
     for (const Vec3i c : cs)
         for (int k = 0; k < 6; ++k) {
             const Vec3i q = face_neighbour(c, k);
-            if (lat_.contains(q) && !inside(q) && encloses_small_pocket(lat_, marks, outside_at, q, o_.pocket_limit)) return true;
+            if (lat_.contains(q) && !inside(q)) starts.push_back(q);
         }
-    return false;
+    return flood.seals(lat_, [this](PointIndex i) { return !inside_at(i); }, starts, o_.pocket_limit);
 }
 
 bool Guard::seals_pocket_around(const std::vector<PointIndex>& points) {
@@ -314,7 +264,15 @@ bool Guard::fill_crack(Vec3i start) {
     }
     lo = lo - Vec3i{1, 1, 1};
     hi = hi + Vec3i{1, 1, 1};
-    const auto in = [this](Vec3i q) { return inside(q); };
+    // The box's inside states, read once (the Euler characteristic reads each voxel eight times).
+    const Vec3i size = hi - lo + Vec3i{1, 1, 1};
+    thread_local std::vector<std::uint8_t> box;
+    box.assign(static_cast<std::size_t>(size.x) * size.y * size.z, 0);
+    const auto at = [&](Vec3i q) { return (static_cast<std::size_t>(q.z - lo.z) * size.y + (q.y - lo.y)) * size.x + (q.x - lo.x); };
+    for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x) box[at({x, y, z})] = inside({x, y, z});
+    const auto in = [&](Vec3i q) { return box[at(q)] != 0; };
     const long chi_before = euler_characteristic_26(in, lo, hi);
     // The crack voxels' states before (a voxel flipped out earlier in this batch keeps that flip
     // when the fill is refused).
@@ -324,6 +282,7 @@ bool Guard::fill_crack(Vec3i start) {
         const auto it = flipped_.find(i);
         saved.emplace_back(i, it == flipped_.end() ? -1 : int(it->second));
         flip(i, true);
+        box[at(lat_.coord(i))] = 1;
     }
     const bool ok = euler_characteristic_26(in, lo, hi) > chi_before && !seals_pocket_around(crack);
     const bool ready = std::all_of(crack.begin(), crack.end(), [this](PointIndex i) { return flippable(i); });
