@@ -359,6 +359,18 @@ TEST(Topology, LocalEulerCharacteristicMatchesTheWholeMasks) {
         const Topology u = mask_topology(m);
         const long chi_after = static_cast<long>(u.components) - u.genus + static_cast<long>(u.cavities);
         EXPECT_EQ(euler_characteristic_26(inside, lo, hi) - local_before, chi_after - chi) << "trial " << trial;
+        // Several voxels flipped at once (some at the border, some repeated), counted only at the
+        // corner points around them (euler_corners_of): the same change as the whole mask's.
+        std::vector<Vec3i> flips;
+        for (int k = 0; k < 1 + trial % 7; ++k)
+            flips.push_back({static_cast<int>(next() % 9), static_cast<int>(next() % 8), static_cast<int>(next() % 7)});
+        flips.push_back(flips.front());
+        const std::vector<Vec3i> corners = euler_corners_of(flips);
+        const long at_corners_before = euler_at_corners_26(inside, corners);
+        for (std::size_t k = 0; k + 1 < flips.size(); ++k) m(flips[k]) = m(flips[k]) ? 0 : 1;
+        const Topology w = mask_topology(m);
+        const long chi_flipped = static_cast<long>(w.components) - w.genus + static_cast<long>(w.cavities);
+        EXPECT_EQ(euler_at_corners_26(inside, corners) - at_corners_before, chi_flipped - chi_after) << "trial " << trial;
     }
     // Hand counts: a voxel 1, a 3x3x1 ring (one tunnel) 0, a 3x3x3 hollow cube (one cavity) 2.
     Mask ring(Lattice({5, 5, 3}));

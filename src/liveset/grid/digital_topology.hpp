@@ -4,7 +4,11 @@
 // truth and to keep swarm edits from opening tunnels or bridging surfaces. Header only.
 #pragma once
 
+#include <algorithm>
 #include <cstdlib>
+#include <span>
+#include <tuple>
+#include <vector>
 
 #include "liveset/grid/vec3.hpp"
 
@@ -91,6 +95,24 @@ inline constexpr int kLineDirections[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1}
                                                {1, 0, 1},  {1, 0, -1}, {0, 1, 1},  {0, 1, -1}, {1, 1, 1},
                                                {1, 1, -1}, {1, -1, 1}, {1, -1, -1}};
 
+// The part of χ = V − E + F − C that starts at corner point (x, y, z), the point shared by voxels
+// (x..x+1, y..y+1, z..z+1): its vertex, the three edges, three faces and the cube that start there
+// towards +x, +y, +z, each counted when some inside voxel's closed cube holds it.
+template <class In>
+long euler_corner_26(const In& in, int x, int y, int z) {
+    bool a[2][2][2];
+    bool any = false;
+    for (int k = 0; k < 8; ++k) {
+        a[k >> 2][(k >> 1) & 1][k & 1] = in(x + (k & 1), y + ((k >> 1) & 1), z + (k >> 2));
+        any = any || a[k >> 2][(k >> 1) & 1][k & 1];
+    }
+    const long e = long{a[0][0][1] || a[0][1][1] || a[1][0][1] || a[1][1][1]} +  // along x
+                   long{a[0][1][0] || a[0][1][1] || a[1][1][0] || a[1][1][1]} +  // along y
+                   long{a[1][0][0] || a[1][0][1] || a[1][1][0] || a[1][1][1]};   // along z
+    const long f = long{a[0][1][1] || a[1][1][1]} + long{a[1][0][1] || a[1][1][1]} + long{a[1][1][0] || a[1][1][1]};
+    return long{any} - e + f - long{a[1][1][1]};
+}
+
 // Euler characteristic χ = V − E + F − C of the union of the closed unit cubes of the foreground
 // voxels inside the box [lo, hi] (26-connected foreground: χ = components − tunnels + cavities).
 // Flipping voxels at least one voxel inside the box changes the whole set's χ exactly as it
@@ -100,28 +122,36 @@ long euler_characteristic_26(Inside&& inside, Vec3i lo, Vec3i hi) {
     const auto in = [&](int x, int y, int z) {
         return x >= lo.x && y >= lo.y && z >= lo.z && x <= hi.x && y <= hi.y && z <= hi.z && inside(Vec3i{x, y, z});
     };
-    long v = 0, e = 0, f = 0, c = 0;
-    // Every corner point shared by voxels (x..x+1, y..y+1, z..z+1), a[dz][dy][dx], with the three
-    // edges, three faces and the cube that start there towards +x, +y, +z.
+    long chi = 0;
     for (int z = lo.z - 1; z <= hi.z; ++z)
         for (int y = lo.y - 1; y <= hi.y; ++y)
-            for (int x = lo.x - 1; x <= hi.x; ++x) {
-                bool a[2][2][2];
-                bool any = false;
-                for (int k = 0; k < 8; ++k) {
-                    a[k >> 2][(k >> 1) & 1][k & 1] = in(x + (k & 1), y + ((k >> 1) & 1), z + (k >> 2));
-                    any = any || a[k >> 2][(k >> 1) & 1][k & 1];
-                }
-                v += any;
-                e += a[0][0][1] || a[0][1][1] || a[1][0][1] || a[1][1][1];  // along x
-                e += a[0][1][0] || a[0][1][1] || a[1][1][0] || a[1][1][1];  // along y
-                e += a[1][0][0] || a[1][0][1] || a[1][1][0] || a[1][1][1];  // along z
-                f += a[0][1][1] || a[1][1][1];                              // normal z
-                f += a[1][0][1] || a[1][1][1];                              // normal y
-                f += a[1][1][0] || a[1][1][1];                              // normal x
-                c += a[1][1][1];
-            }
-    return v - e + f - c;
+            for (int x = lo.x - 1; x <= hi.x; ++x) chi += euler_corner_26(in, x, y, z);
+    return chi;
+}
+
+// The corner points whose 2×2×2 window holds one of `voxels` (each voxel's own and the seven
+// towards −x, −y, −z), sorted and without repeats: flipping those voxels changes χ only there.
+inline std::vector<Vec3i> euler_corners_of(std::span<const Vec3i> voxels) {
+    std::vector<Vec3i> corners;
+    corners.reserve(voxels.size() * 8);
+    for (const Vec3i v : voxels)
+        for (int k = 0; k < 8; ++k) corners.push_back(v - Vec3i{k & 1, (k >> 1) & 1, k >> 2});
+    const auto key = [](Vec3i c) { return std::tuple(c.z, c.y, c.x); };
+    std::sort(corners.begin(), corners.end(), [&](Vec3i a, Vec3i b) { return key(a) < key(b); });
+    corners.erase(std::unique(corners.begin(), corners.end(), [](Vec3i a, Vec3i b) { return a.x == b.x && a.y == b.y && a.z == b.z; }),
+                  corners.end());
+    return corners;
+}
+
+// Σ of euler_corner_26 over `corners`, with `inside` (Vec3i → bool) read as is (no box): taken
+// before and after some voxels flip, over euler_corners_of(them), the difference is the change of
+// χ of the whole set — that of euler_characteristic_26 over any box one voxel around them.
+template <class Inside>
+long euler_at_corners_26(const Inside& inside, std::span<const Vec3i> corners) {
+    const auto in = [&](int x, int y, int z) { return inside(Vec3i{x, y, z}); };
+    long chi = 0;
+    for (const Vec3i c : corners) chi += euler_corner_26(in, c.x, c.y, c.z);
+    return chi;
 }
 
 }  // namespace liveset

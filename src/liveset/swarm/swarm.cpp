@@ -292,9 +292,17 @@ public:
         if (!(radius_ > 0)) return rep;
         const std::size_t n = p_[0].size();
         const Vec3d x{p_[0][i], p_[1][i], p_[2][i]};
+        thread_local std::vector<double> d2;
+        d2.resize(n);
+        const double* px = p_[0].data();
+        const double* py = p_[1].data();
+        const double* pz = p_[2].data();
+        for (std::size_t j = 0; j < n; ++j) {  // no branch: vectorised
+            const double ex = x.x - px[j], ey = x.y - py[j], ez = x.z - pz[j];
+            d2[j] = ex * ex + ey * ey + ez * ez;
+        }
         for (std::size_t j = 0; j < n; ++j) {
-            const double ex = x.x - p_[0][j], ey = x.y - p_[1][j], ez = x.z - p_[2][j];
-            if (ex * ex + ey * ey + ez * ez > r2_ || j == i) continue;
+            if (d2[j] > r2_ || j == i) continue;
             const Vec3d d = x - Vec3d{p_[0][j], p_[1][j], p_[2][j]};
             const double l = norm(d);
             if (l >= radius_) continue;

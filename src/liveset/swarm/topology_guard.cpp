@@ -57,7 +57,6 @@ private:
     bool seals_pocket_around(std::span<const Vec3i> cs);
     bool cuts_handle(Vec3i c, const TopologicalNumbers& t) const;
     bool joined(Vec3i a, Vec3i b) const;
-    bool seals_pocket_around(const std::vector<PointIndex>& points);
     std::vector<PointIndex> gather_crack(Vec3i start) const;
     bool fill_crack(Vec3i start);
     void prepare_crack(const std::vector<PointIndex>& crack);
@@ -98,13 +97,6 @@ bool Guard::seals_pocket_around(std::span<const Vec3i> cs) {
             if (lat_.contains(q) && !inside(q)) starts.push_back(q);
         }
     return flood.seals(lat_, [this](PointIndex i) { return !inside_at(i); }, starts, o_.pocket_limit);
-}
-
-bool Guard::seals_pocket_around(const std::vector<PointIndex>& points) {
-    std::vector<Vec3i> cs;
-    cs.reserve(points.size());
-    for (PointIndex i : points) cs.push_back(lat_.coord(i));
-    return seals_pocket_around(std::span<const Vec3i>(cs));
 }
 
 bool Guard::keep(const ZeroLayerEdit& e) {
@@ -256,24 +248,13 @@ bool Guard::fill_crack(Vec3i start) {
     const std::vector<PointIndex> crack = gather_crack(start);
     for (PointIndex i : crack) tried_.insert(i);
     if (crack.empty()) return false;
-    Vec3i lo = start, hi = start;
-    for (PointIndex i : crack) {
-        const Vec3i q = lat_.coord(i);
-        lo = {std::min(lo.x, q.x), std::min(lo.y, q.y), std::min(lo.z, q.z)};
-        hi = {std::max(hi.x, q.x), std::max(hi.y, q.y), std::max(hi.z, q.z)};
-    }
-    lo = lo - Vec3i{1, 1, 1};
-    hi = hi + Vec3i{1, 1, 1};
-    // The box's inside states, read once (the Euler characteristic reads each voxel eight times).
-    const Vec3i size = hi - lo + Vec3i{1, 1, 1};
-    thread_local std::vector<std::uint8_t> box;
-    box.assign(static_cast<std::size_t>(size.x) * size.y * size.z, 0);
-    const auto at = [&](Vec3i q) { return (static_cast<std::size_t>(q.z - lo.z) * size.y + (q.y - lo.y)) * size.x + (q.x - lo.x); };
-    for (int z = lo.z; z <= hi.z; ++z)
-        for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x) box[at({x, y, z})] = inside({x, y, z});
-    const auto in = [&](Vec3i q) { return box[at(q)] != 0; };
-    const long chi_before = euler_characteristic_26(in, lo, hi);
+    // χ changes only at the corner points around the crack voxels (counted there before and after).
+    std::vector<Vec3i> voxels;
+    voxels.reserve(crack.size());
+    for (PointIndex i : crack) voxels.push_back(lat_.coord(i));
+    const std::vector<Vec3i> corners = euler_corners_of(voxels);
+    const auto in = [this](Vec3i q) { return inside(q); };
+    const long chi_before = euler_at_corners_26(in, corners);
     // The crack voxels' states before (a voxel flipped out earlier in this batch keeps that flip
     // when the fill is refused).
     std::vector<std::pair<PointIndex, int>> saved;  // -1: no flip recorded, else the flip's state
@@ -282,9 +263,8 @@ bool Guard::fill_crack(Vec3i start) {
         const auto it = flipped_.find(i);
         saved.emplace_back(i, it == flipped_.end() ? -1 : int(it->second));
         flip(i, true);
-        box[at(lat_.coord(i))] = 1;
     }
-    const bool ok = euler_characteristic_26(in, lo, hi) > chi_before && !seals_pocket_around(crack);
+    const bool ok = euler_at_corners_26(in, corners) > chi_before && !seals_pocket_around(voxels);
     const bool ready = std::all_of(crack.begin(), crack.end(), [this](PointIndex i) { return flippable(i); });
     if (!ok || !ready) {
         for (const auto& [i, state] : saved) {
