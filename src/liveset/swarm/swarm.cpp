@@ -500,15 +500,14 @@ std::vector<ZeroLayerEdit> Swarm::surface_edits(const SparseField& field, const 
                 for (int dy = -reach; dy <= reach; ++dy)
                     for (int dx = -reach; dx <= reach; ++dx) {
                         const Vec3i q = c + Vec3i{dx, dy, dz};
-                        if (!lat.contains(q)) continue;
+                        const Vec3d d = q.cast<double>() - x;
+                        const double d2 = dot(d, d);
+                        if (d2 > support * support || !lat.contains(q)) continue;  // the footprint first: no memory read
                         const PointIndex idx = lat.index(q);
                         if (field.status()[idx] != 0 || (cut && !(phi[idx] < 0.0f))) continue;
                         if (sheet && phi[idx] >= 0.0f && !(image_unit[idx] >= options_.sheet_lower && image_unit[idx] < options_.sheet_upper) &&
                             !between_voxel(q, true))
                             continue;  // kSheet: never raise the surface over a voxel that is neither the sheet's tissue nor between its sides
-                        const Vec3d d = q.cast<double>() - x;
-                        const double d2 = dot(d, d);
-                        if (d2 > support * support) continue;
                         out.push_back({idx, static_cast<float>(amount * std::exp(-d2 * inv_two_var))});
                     }
         }
