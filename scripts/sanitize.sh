@@ -25,6 +25,52 @@ if ((${#missing[@]})); then
 fi
 
 jobs=$(nproc 2>/dev/null || echo 2)
+
+# Runs `FN NAME` for each NAME, at most $jobs at a time (each writes its own log); waits for all,
+# then fails when any failed.
+in_parallel() {
+  local fn=$1 failed=0 pid
+  shift
+  local pids=()
+  for name in "$@"; do
+    while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do sleep 1; done
+    "$fn" "$name" &
+    pids+=($!)
+  done
+  for pid in "${pids[@]}"; do wait "$pid" || failed=1; done
+  return "$failed"
+}
+
+# One library test program under ASan + UBSan (asan-core), its output kept in a log shown on failure.
+asan_core_one() {
+  local t=$1 start=$SECONDS log="build-asan/asan_core_$1.log"
+  # Left to the release suite: the whole-brain runs, and the whole-phantom segmentations and
+  # repair whose code paths the BrainWeb slab and the small repair cases already run sanitized
+  # (each 1-2 min under ASan; docs/RELIABILITY.md).
+  if "build-asan/tests/$t/${t}_tests" --gtest_filter="-$asan_core_skip" --gtest_brief=1 >"$log" 2>&1; then
+    echo "asan-core: ${t}_tests passed in $((SECONDS - start)) s" >&2
+  else
+    tail -60 "$log" >&2
+    echo "asan-core: ${t}_tests FAILED after $((SECONDS - start)) s (log: $log)" >&2
+    return 1
+  fi
+}
+
+# One libFuzzer target for $seconds (fuzz), "TARGET:SEEDS" (seed corpus folder under fuzz/corpus).
+fuzz_one() {
+  local target=${1%%:*} seeds=${1#*:} rc=0 runs
+  local corpus="build-fuzz/corpus/$target" log="build-fuzz/fuzz_$target.log"
+  mkdir -p "$corpus"
+  "build-fuzz/fuzz/fuzz_$target" -max_total_time="$seconds" -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
+    -artifact_prefix="build-fuzz/findings/$target-" "$corpus" "fuzz/corpus/$seeds" >"$log" 2>&1 || rc=$?
+  runs=$(grep -m1 '^stat::number_of_executed_units' "$log" | awk '{print $2}' || true)
+  echo "fuzz_$target: ${seconds} s, ${runs:-?} executions, exit $rc" >&2
+  if [ "$rc" -ne 0 ]; then
+    grep -E "ERROR|SUMMARY|Test unit written" "$log" >&2 || tail -20 "$log" >&2
+    return 1
+  fi
+}
+
 case "$mode" in
   asan-core)
     # The library's own test programs (atomic file writer, grid, level set, mesher, segmentation, swarm, evaluation,
@@ -37,14 +83,8 @@ case "$mode" in
     export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
     export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
     export LSAN_OPTIONS=suppressions=$PWD/tests/sanitizer/lsan.supp
-    for t in "${core[@]}"; do
-      start=$(date +%s)
-      # Left to the release suite: the whole-brain runs, and the whole-phantom segmentations and
-      # repair whose code paths the BrainWeb slab and the small repair cases already run sanitized
-      # (each 1-2 min under ASan; docs/RELIABILITY.md).
-      "build-asan/tests/$t/${t}_tests" --gtest_filter="-$asan_core_skip" --gtest_brief=1
-      echo "asan-core: ${t}_tests passed in $(( $(date +%s) - start )) s" >&2
-    done
+    # Two programs at a time on two cores (each mostly single-threaded).
+    in_parallel asan_core_one "${core[@]}"
     ;;
   asan)
     cmake --preset asan >/dev/null
@@ -86,22 +126,8 @@ case "$mode" in
     cmake --preset fuzz >/dev/null
     cmake --build --preset fuzz -j "$jobs"
     mkdir -p build-fuzz/findings
-    for entry in mesh_readers:mesh image_checks:image recovery_file:recovery session_script:script; do
-      target=${entry%%:*}
-      seeds=${entry#*:}
-      corpus="build-fuzz/corpus/$target"
-      mkdir -p "$corpus"
-      log="build-fuzz/fuzz_$target.log"
-      rc=0
-      "build-fuzz/fuzz/fuzz_$target" -max_total_time="$seconds" -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
-        -artifact_prefix="build-fuzz/findings/$target-" "$corpus" "fuzz/corpus/$seeds" >"$log" 2>&1 || rc=$?
-      runs=$(grep -m1 '^stat::number_of_executed_units' "$log" | awk '{print $2}')
-      echo "fuzz_$target: ${seconds} s, ${runs:-?} executions, exit $rc" >&2
-      if [ "$rc" -ne 0 ]; then
-        grep -E "ERROR|SUMMARY|Test unit written" "$log" >&2 || tail -20 "$log" >&2
-        exit 1
-      fi
-    done
+    # The targets side by side, one per core: each still fuzzes for $seconds on a core of its own.
+    in_parallel fuzz_one mesh_readers:mesh image_checks:image recovery_file:recovery session_script:script
     ;;
   *) echo "usage: scripts/sanitize.sh asan|asan-core|tsan|fuzz [SECONDS]" >&2; exit 2 ;;
 esac

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
-#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -15,8 +14,6 @@
 namespace liveset {
 
 namespace {
-
-constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
 // Edges whose vertex a cell creates when cells are visited in z, y, x order and every crossing cell
 // of the box is visited: a crossing edge makes all 4 cells around it crossing, so its vertex is

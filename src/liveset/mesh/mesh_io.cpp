@@ -399,7 +399,7 @@ Mesh read_obj(const fs::path& path) {
             std::array<float, 3> v{};
             for (float& c : v) {
                 std::string tok;
-                double d;
+                double d = 0.0;
                 if (!(ls >> tok) || !parse_double(tok, d)) bad("malformed " + tag);
                 c = static_cast<float>(d);
             }
