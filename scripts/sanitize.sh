@@ -83,7 +83,7 @@ case "$mode" in
     export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1
     export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
     export LSAN_OPTIONS=suppressions=$PWD/tests/sanitizer/lsan.supp
-    # Two programs at a time on two cores (each mostly single-threaded).
+    # $jobs (nproc) programs at a time, each mostly single-threaded; a failed one's log is printed.
     in_parallel asan_core_one "${core[@]}"
     ;;
   asan)
@@ -126,7 +126,7 @@ case "$mode" in
     cmake --preset fuzz >/dev/null
     cmake --build --preset fuzz -j "$jobs"
     mkdir -p build-fuzz/findings
-    # The targets side by side, one per core: each still fuzzes for $seconds on a core of its own.
+    # $jobs (nproc) targets at a time, one per core: each still fuzzes for $seconds on a core of its own.
     in_parallel fuzz_one mesh_readers:mesh image_checks:image recovery_file:recovery session_script:script
     ;;
   *) echo "usage: scripts/sanitize.sh asan|asan-core|tsan|fuzz [SECONDS]" >&2; exit 2 ;;

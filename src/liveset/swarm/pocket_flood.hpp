@@ -2,8 +2,10 @@
 // joined where they meet, so the common case (the pieces meet around the edit) costs a loop, not a limit.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "liveset/grid/lattice.hpp"

@@ -272,9 +272,6 @@ void Swarm::spawn(const SparseField& field, Vec3d near, double radius) {
 namespace {
 
 // The repulsion of the agents within `radius` of one, Σ_j dir(i, j) (1 − l / radius) over j in
-// increasing order (the same sum, bit for bit, as a loop over all agents): the agents are binned in
-// cubic cells of side `radius` (sorted by cell), and only the 27 cells around i are read.
-// The repulsion of the agents within `radius` of one, Σ_j dir(i, j) (1 − l / radius) over j in
 // increasing order. The positions are copied into three flat arrays and a pair is dropped on its
 // squared distance first (no square root: most pairs are far) with a margin above radius², so
 // every pair the test l < radius keeps still reaches it: the sum is bit for bit a plain loop's.
