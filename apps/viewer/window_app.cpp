@@ -33,14 +33,34 @@ void scaled_cursor(GLFWwindow* w, double& x, double& y) {
     y *= static_cast<double>(fh) / std::max(wh, 1);
 }
 
+// Where the pointer was when the event being handled happened: the last position the cursor
+// callback delivered (events come in order). glfwGetCursorPos asks the X server where the pointer
+// is now, which, while the viewer is busy and events wait in the queue, is further along a drag:
+// a press read that way started the drag late and lost its first moves (a pan fell short).
+struct Pointer {
+    double x = 0, y = 0;
+    bool known = false;  // no cursor event yet (the pointer has not moved in the window)
+};
+Pointer g_pointer;
+
+void pointer_at_event(GLFWwindow* w, double& x, double& y) {
+    if (g_pointer.known) {
+        x = g_pointer.x;
+        y = g_pointer.y;
+    } else {
+        glfwGetCursorPos(w, &x, &y);
+    }
+}
+
 void on_cursor(GLFWwindow* w, double x, double y) {
+    g_pointer = {x, y, true};
     scaled_cursor(w, x, y);
     viewer_of(w).push_event({InputEvent::Type::kMove, x, y});
 }
 
 void on_button(GLFWwindow* w, int button, int action, int mods) {
     double x = 0, y = 0;
-    glfwGetCursorPos(w, &x, &y);
+    pointer_at_event(w, x, y);
     scaled_cursor(w, x, y);
     InputEvent e{action == GLFW_PRESS ? InputEvent::Type::kPress : InputEvent::Type::kRelease, x, y};
     e.button = button;
@@ -50,7 +70,7 @@ void on_button(GLFWwindow* w, int button, int action, int mods) {
 
 void on_scroll(GLFWwindow* w, double, double dy) {
     double x = 0, y = 0;
-    glfwGetCursorPos(w, &x, &y);
+    pointer_at_event(w, x, y);
     scaled_cursor(w, x, y);
     InputEvent e{InputEvent::Type::kScroll, x, y};
     e.scroll = dy;
