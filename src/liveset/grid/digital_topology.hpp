@@ -138,8 +138,7 @@ inline std::vector<Vec3i> euler_corners_of(std::span<const Vec3i> voxels) {
         for (int k = 0; k < 8; ++k) corners.push_back(v - Vec3i{k & 1, (k >> 1) & 1, k >> 2});
     const auto key = [](Vec3i c) { return std::tuple(c.z, c.y, c.x); };
     std::sort(corners.begin(), corners.end(), [&](Vec3i a, Vec3i b) { return key(a) < key(b); });
-    corners.erase(std::unique(corners.begin(), corners.end(), [](Vec3i a, Vec3i b) { return a.x == b.x && a.y == b.y && a.z == b.z; }),
-                  corners.end());
+    corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
     return corners;
 }
 
