@@ -157,6 +157,47 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenSleepingOnAFrontOfSeveralChunks) 
     }
 }
 
+// A front growing at full speed changes the layer of about half the band every step: the
+// re-layering's write-back, the settling pass and the list moves (one task per list from 4 096
+// moves) run in parallel. Both modes give the same bits and reports, and 1 and 2 threads the same
+// state, reports and list order, with the invariants (lists, slots) checked every step.
+TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenManyPointsChangeLayer) {
+    auto run = [](int threads, std::vector<std::vector<PointIndex>>& reports, std::size_t& most_moves) {
+        tbb::task_arena arena(threads);
+        SparseField reference = blob_seed(72, 12.0);
+        SparseField fast = reference;
+        arena.execute([&] {
+            const BlobSpeed speed({35.5, 35.5, 35.5}, 30.0, 0.01f);
+            for (int s = 1; s <= 40; ++s) {
+                const SparseField before = fast;
+                const StepResult r = reference.step(speed, mode(StepMode::kFullBand));
+                const StepResult f = fast.step(speed, mode(StepMode::kIncremental));
+                ASSERT_TRUE(same_state(reference, fast)) << "step " << s;
+                ASSERT_EQ(sorted(r.changed.points), sorted(f.changed.points)) << "step " << s;
+                ASSERT_EQ(sorted(f.changed.points), brute_force_changes(before, fast)) << "step " << s;
+                std::size_t moves = 0;  // points whose layer changed, by brute force
+                for (const PointIndex i : f.changed.points) moves += before.status()[i] != fast.status()[i];
+                most_moves = std::max(most_moves, moves);
+                expect_valid(fast, "after a step");
+                reports.push_back(f.changed.points);
+                reports.push_back(r.changed.points);
+            }
+        });
+        return fast;
+    };
+    std::vector<std::vector<PointIndex>> r1, r2;
+    std::size_t moves1 = 0, moves2 = 0;
+    const SparseField a = run(1, r1, moves1);
+    const SparseField b = run(2, r2, moves2);
+    EXPECT_GT(moves1, 2u * 4096u) << "the steps should move many points between the lists";
+    EXPECT_TRUE(same_state(a, b));
+    EXPECT_EQ(r1, r2);
+    for (int k = -a.layers(); k <= a.layers(); ++k) {
+        const auto la = a.layer(k), lb = b.layer(k);
+        EXPECT_TRUE(std::equal(la.begin(), la.end(), lb.begin(), lb.end())) << "layer list order " << k;
+    }
+}
+
 TEST(IncrementalStep, BadOptionsThrowOneLineMessages) {
     SparseField f = blob_seed(16);
     const CurvatureSpeed speed;

@@ -1,13 +1,16 @@
-// Internals shared by the sparse field's update code (sparse_field.cpp, incremental_step.cpp):
-// the temporary status codes of one update, 6-neighbour iteration and the serial-below-a-size
-// parallel loop. Not part of the public API.
+// Internals shared by the sparse field's update code (sparse_field.cpp, relayer.cpp,
+// incremental_step.cpp): the temporary status codes of one update, 6-neighbour iteration, the
+// serial-below-a-size parallel loop and its ordered form (outputs joined in a fixed order). Not
+// part of the public API.
 #pragma once
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "liveset/grid/index_decoder.hpp"
 #include "liveset/grid/lattice.hpp"
@@ -45,6 +48,38 @@ void parallel_range(std::size_t n, F&& f) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) f(i);
     });
+}
+
+// Runs f(begin, end, part) over the fixed chunks [c·K, (c+1)·K) of [0, n), in parallel from
+// kParallelMin up, each chunk appending to its own Part; returns the parts in chunk order. The
+// chunks do not depend on the thread count, so outputs joined in that order are the serial loop's,
+// whatever the scheduling.
+template <class Part, class F>
+std::vector<Part> ordered_chunks(std::size_t n, F&& f) {
+    constexpr std::size_t kChunk = 4096;
+    const std::size_t chunks = (n + kChunk - 1) / kChunk;
+    std::vector<Part> parts(chunks);
+    const auto run = [&](std::size_t c) { f(c * kChunk, std::min(n, (c + 1) * kChunk), parts[c]); };
+    if (n < kParallelMin) {
+        for (std::size_t c = 0; c < chunks; ++c) run(c);
+    } else {
+        tbb::parallel_for(std::size_t{0}, chunks, run);
+    }
+    return parts;
+}
+
+// Appends the member `field` of every part to `out`, in the parts' order (moved, not copied,
+// when there is one part and `out` is empty: a small update's only chunk).
+template <class Part, class T>
+void join_parts(std::vector<Part>& parts, std::vector<T> Part::*field, std::vector<T>& out) {
+    if (parts.size() == 1 && out.empty()) {
+        out.swap(parts.front().*field);
+        return;
+    }
+    std::size_t total = out.size();
+    for (const Part& p : parts) total += (p.*field).size();
+    out.reserve(total);
+    for (const Part& p : parts) out.insert(out.end(), (p.*field).begin(), (p.*field).end());
 }
 
 }  // namespace liveset::detail

@@ -9,71 +9,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <numeric>
 
 #include "liveset/grid/sampling.hpp"
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/sparse_field.hpp"
 
 namespace liveset {
-
-namespace {
-
-bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
-
-}  // namespace
-
-// Level k re-evaluates the points still pending from level k-1 plus every neighbour, not yet final,
-// of a point that changed at level k-1 (entered or left layer ±(k-1), or took a new value there).
-// Exact: a point's layer and value depend only on its neighbours one level further in, so a point
-// none of whose neighbours changed keeps both (the state before the update is the layers' fixed
-// point); a point whose layer is below k is final by then (it depends on levels below k-1 only).
-void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
-    using detail::kPendNeg;
-    using detail::kPendPos;
-    std::vector<std::size_t> changed(region.size());  // region indices; level 0: every seed
-    std::iota(changed.begin(), changed.end(), std::size_t{0});
-    std::vector<std::size_t> pending, next, changed_next;
-    for (std::size_t r = 0; r < region.size(); ++r)
-        if (status_[region[r].point] == kPendPos || status_[region[r].point] == kPendNeg) pending.push_back(r);
-    std::vector<float> value;
-    for (int k = 1; k <= layers_; ++k) {
-        for (const std::size_t c : changed) {
-            const PointIndex p = region[c].point;
-            const bool outside = status_[p] > 0;  // the side of a change beyond L0 (kPendPos > 0)
-            detail::for_each_neighbor6(lattice(), decoder_, p, [&](PointIndex q) {
-                const std::int8_t s = status_[q];
-                if (detail::is_temp(s) || std::abs(s) < k || (k > 1 && (s > 0) != outside)) return;
-                region.push_back({q, s, phi_[q]});
-                status_[q] = s > 0 ? kPendPos : kPendNeg;
-                pending.push_back(region.size() - 1);
-            });
-        }
-        if (pending.empty()) break;
-        value.resize(pending.size());
-        detail::parallel_range(pending.size(), [&](std::size_t m) {
-            const PointIndex i = region[pending[m]].point;
-            value[m] = inner_layer_value(i, k, status_[i] == kPendPos);
-        });
-        next.clear();
-        changed_next.clear();
-        for (std::size_t m = 0; m < pending.size(); ++m) {
-            const std::size_t r = pending[m];
-            const RegionPoint& rp = region[r];
-            if (std::isinf(value[m])) {  // not on layer k: stays pending (far if no layer takes it)
-                next.push_back(r);
-                if (std::abs(rp.old_status) == k) changed_next.push_back(r);
-                continue;
-            }
-            const auto layer = static_cast<std::int8_t>(status_[rp.point] == kPendPos ? k : -k);
-            status_[rp.point] = layer;
-            phi_[rp.point] = value[m];
-            if (layer != rp.old_status || !same_bits(value[m], rp.old_phi)) changed_next.push_back(r);
-        }
-        pending.swap(next);
-        changed.swap(changed_next);
-    }
-}
 
 StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& options) {
     const auto start = std::chrono::steady_clock::now();
@@ -121,14 +62,19 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
 
     // Δ exactly as the full-band step computes it; only points whose bits change become edits
     // (a Δ that rounds away, or a point already at the bound, changes nothing downstream).
+    struct Part {
+        std::vector<ZeroLayerEdit> edits;
+    };
+    auto parts = detail::ordered_chunks<Part>(at.size(), [&](std::size_t b, std::size_t e, Part& out) {
+        for (std::size_t m = b; m < e; ++m) {
+            const PointIndex i = zero[at[m]];
+            const float d = static_cast<float>(std::clamp(result.dt * rate[m], -0.5, 0.5));
+            const float v = phi_[i];
+            if (std::bit_cast<std::uint32_t>(v + d) != std::bit_cast<std::uint32_t>(v)) out.edits.push_back({i, d});
+        }
+    });
     std::vector<ZeroLayerEdit> edits;
-    edits.reserve(at.size());
-    for (std::size_t m = 0; m < at.size(); ++m) {
-        const PointIndex i = zero[at[m]];
-        const float d = static_cast<float>(std::clamp(result.dt * rate[m], -0.5, 0.5));
-        const float v = phi_[i];
-        if (std::bit_cast<std::uint32_t>(v + d) != std::bit_cast<std::uint32_t>(v)) edits.push_back({i, d});
-    }
+    detail::join_parts(parts, &Part::edits, edits);
     result.changed = repair_band(edits, RepairScope::kLocal);
     last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;

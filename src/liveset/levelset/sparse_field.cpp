@@ -1,5 +1,5 @@
-// SparseField implementation: initialisation, the global step, local edits, and the shared
-// order-independent band repair (see sparse_field.hpp for the scheme).
+// SparseField implementation: initialisation, the global step, local edits, undo, and the shared
+// order-independent band repair up to the re-layering (relayer.cpp; scheme in sparse_field.hpp).
 #include "liveset/levelset/sparse_field.hpp"
 
 #include <tbb/blocked_range.h>
@@ -267,6 +267,7 @@ StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
     ++steps_;
     StepResult result = options.mode == StepMode::kFullBand ? step_full_band(speed, options) : step_incremental(speed, options);
     activity_.wake_near(sign_changes_, lattice(), steps_);  // a no-op until a sleeping step ran
+    result.sign_changes = sign_changes_;
     return result;
 }
 
@@ -398,7 +399,7 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     }
 
     // 4-5. Outer layers from the new zero layer: a local update re-layers outwards from the
-    //    changed points only (relayer_changes, incremental_step.cpp); a global one the whole band
+    //    changed points only (relayer_changes, relayer.cpp); a global one the whole band
     //    plus its outer ring. 6. Bookkeeping and the change report.
     if (scope == RepairScope::kLocal) {
         relayer_changes(region);
@@ -468,115 +469,6 @@ void SparseField::collect_band(std::vector<RegionPoint>& region) {
                 if (status_[q] == far) mark_pending(q, region);
             });
     }
-}
-
-float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
-    const std::int8_t inner = static_cast<std::int8_t>(outside ? k - 1 : -(k - 1));
-    const auto is_inner = [&](std::int8_t s) { return k == 1 ? (s == 0 || s == kPendZero) : s == inner; };
-    return detail::layer_value(phi_, status_, i, decoder_.coord(i), outside, is_inner);
-}
-
-// Whitaker's layer rule pushed outwards instead of pulled: every point of level k-1 (final by
-// then) offers φ ± 1 to its pending neighbours on its side, which keep the min (outside) or max
-// (inside). A point is in layer k iff some neighbour is in layer k-1 (the zero layer for k = 1),
-// and min/max are exact and order-free, so this gives the pull rule's bits (inner_layer_value,
-// the invariant checker) while visiting 6 neighbours of each source instead of of every pending
-// point at every level (the pull re-asked the points of outer layers and the ring at each level).
-// Needs the region to hold the whole band (collect_band, init_from_sdf): no final point outside
-// it can be a pending point's inner neighbour. A partial region (unite_in_box) uses the pull.
-void SparseField::sweep_whole_band(std::span<const RegionPoint> region) {
-    const float inf = std::numeric_limits<float>::infinity();
-    std::vector<PointIndex> from;
-    for (const RegionPoint& r : region) {
-        const std::int8_t s = status_[r.point];
-        if (s == kPendZero) from.push_back(r.point);
-        else if (s == kPendPos) phi_[r.point] = inf;  // the old value is in the region record
-        else if (s == kPendNeg) phi_[r.point] = -inf;
-    }
-    // A point takes its layer when first reached; later offers of the same level still count.
-    std::vector<PointIndex> reached;
-    for (int k = 1; k <= layers_ && !from.empty(); ++k) {
-        reached.clear();
-        const auto up = static_cast<std::int8_t>(k), down = static_cast<std::int8_t>(-k);
-        for (const PointIndex i : from) {
-            const float v = phi_[i];
-            const bool out = k == 1 || status_[i] > 0, in = k == 1 || status_[i] < 0;
-            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
-                const std::int8_t s = status_[q];
-                if (out && (s == kPendPos || s == up)) {
-                    if (s == kPendPos) {
-                        status_[q] = up;
-                        reached.push_back(q);
-                    }
-                    phi_[q] = std::min(phi_[q], v + 1.0f);
-                } else if (in && (s == kPendNeg || s == down)) {
-                    if (s == kPendNeg) {
-                        status_[q] = down;
-                        reached.push_back(q);
-                    }
-                    phi_[q] = std::max(phi_[q], v - 1.0f);
-                }
-            });
-        }
-        from.swap(reached);
-    }
-}
-
-// The pull form for any region: each pending point asks its neighbours, level by level.
-void SparseField::sweep_layers(std::span<const RegionPoint> region) {
-    std::vector<PointIndex> pending;
-    for (const RegionPoint& r : region)
-        if (status_[r.point] == kPendPos || status_[r.point] == kPendNeg) pending.push_back(r.point);
-
-    std::vector<float> value;
-    std::vector<PointIndex> next;
-    for (int k = 1; k <= layers_ && !pending.empty(); ++k) {
-        value.assign(pending.size(), 0.0f);
-        // Decide (reads only), then write: Jacobi within a layer, so any thread order agrees.
-        parallel_range(pending.size(), [&](std::size_t m) {
-            const PointIndex i = pending[m];
-            const bool outside = status_[i] == kPendPos;
-            value[m] = inner_layer_value(i, k, outside);
-        });
-        next.clear();
-        for (std::size_t m = 0; m < pending.size(); ++m) {
-            const PointIndex i = pending[m];
-            if (std::isinf(value[m])) {
-                next.push_back(i);
-                continue;
-            }
-            status_[i] = static_cast<std::int8_t>(status_[i] == kPendPos ? k : -k);
-            phi_[i] = value[m];
-        }
-        pending.swap(next);
-    }
-}
-
-ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
-    ChangedPoints changed;
-    const float far = static_cast<float>(layers_ + 1);
-    for (const RegionPoint& r : region) {
-        const PointIndex i = r.point;
-        std::int8_t s = status_[i];
-        if (s == kPendZero) {
-            s = 0;
-        } else if (s == kPendPos) {
-            s = far_outside();
-            phi_[i] = far;
-        } else if (s == kPendNeg) {
-            s = far_inside();
-            phi_[i] = -far;
-        }
-        status_[i] = s;
-        if (s != r.old_status) {
-            if (r.old_status >= -layers_ && r.old_status <= layers_) list_remove(i, r.old_status);
-            if (s >= -layers_ && s <= layers_) list_add(i, s);
-        }
-        if (s != r.old_status || std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(r.old_phi))
-            changed.points.push_back(i);
-        if ((phi_[i] < 0.0f) != (r.old_phi < 0.0f)) sign_changes_.push_back(i);
-    }
-    return changed;
 }
 
 ActivitySnapshot SparseField::activity_snapshot(std::uint64_t next_speed_serial) const {

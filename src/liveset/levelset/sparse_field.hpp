@@ -83,6 +83,7 @@ struct StepResult {
     std::size_t zero_layer = 0;    // zero-layer size before the step
     std::size_t awake = 0;         // zero-layer points evaluated (all of them unless sleeping)
     ChangedPoints changed;         // points whose φ or status changed
+    std::vector<PointIndex> sign_changes;  // the points of `changed` whose sign of φ changed
 };
 
 class SparseField {
@@ -172,14 +173,19 @@ private:
     ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope);
     // Re-layers level by level from the pending points in `region` (the zero layer's changes),
     // re-evaluating only what a change at the level below can reach; appends what it marks.
-    void relayer_changes(std::vector<RegionPoint>& region);  // incremental_step.cpp
+    void relayer_changes(std::vector<RegionPoint>& region);  // relayer.cpp, as the sweeps and finish
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     void collect_band(std::vector<RegionPoint>& region);
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
     void sweep_layers(std::span<const RegionPoint> region);       // any region (pull)
     void sweep_whole_band(std::span<const RegionPoint> region);   // the whole band (push, same bits)
     float inner_layer_value(PointIndex i, int k, bool outside) const;
+    struct ListMove {
+        std::size_t region_index;
+        std::int8_t layer;  // the new status
+    };
     ChangedPoints finish(std::span<const RegionPoint> region);
+    void move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves);
     void sort_lists(bool zero_only = false);  // each (or the zero) layer list in ascending point order
     void list_add(PointIndex i, int layer);
     void list_remove(PointIndex i, int layer);

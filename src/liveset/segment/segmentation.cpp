@@ -34,9 +34,9 @@ FrontConvergence::FrontConvergence(const Grid<float>& phi, const SegmentationOpt
     for (std::size_t i = 0; i < values.size(); ++i) inside_count_ += inside_[i] = values[i] < 0.0f;
 }
 
-std::size_t FrontConvergence::record_step(const Grid<float>& phi, const ChangedPoints& changed) {
+std::size_t FrontConvergence::record_step(const Grid<float>& phi, std::span<const PointIndex> candidates) {
     std::size_t flips = 0;
-    for (PointIndex x : changed.points) {
+    for (PointIndex x : candidates) {
         const std::uint8_t in = phi[x] < 0.0f;
         if (in != inside_[x]) {
             ++flips;
@@ -78,7 +78,7 @@ SegmentationResult run_segmentation(SparseField& field, const Speed& speed, cons
         pr.iteration = it;
         pr.dt = step.dt;
         pr.changed = step.changed.size();
-        pr.flips = convergence.record_step(field.phi(), step.changed);
+        pr.flips = convergence.record_step(field.phi(), step.sign_changes);  // only steps change the field here
         pr.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
         pr.zero_layer = field.zero_layer().size();
         pr.band = field.band_size();

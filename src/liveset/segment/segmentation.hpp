@@ -76,8 +76,10 @@ class FrontConvergence {
 public:
     // Validates `options` (std::invalid_argument) and counts the inside points of `phi`.
     FrontConvergence(const Grid<float>& phi, const SegmentationOptions& options);
-    // After a step that changed the points X of `phi`: the number of points that changed side.
-    std::size_t record_step(const Grid<float>& phi, const ChangedPoints& changed);
+    // After a step: the number of points that changed side. `candidates` must hold every point
+    // whose side changed since the last call (a step's X, or just its sign changes when nothing
+    // else changed the field in between); the others are checked and cost a read each.
+    std::size_t record_step(const Grid<float>& phi, std::span<const PointIndex> candidates);
     std::size_t inside() const { return inside_count_; }
     // Adds the current inside count to the window; true when the front has converged.
     bool converged(std::size_t zero_layer);

@@ -241,7 +241,7 @@ SessionUpdate Session::segment_step() {
     if (!convergence_) convergence_.emplace(field_.phi(), options_.segmentation);
     return edit("segment", Action::kContinued, [&] {
         StepResult step = field_.step(*speed_, options_.segmentation.step);
-        segment_.flips = convergence_->record_step(field_.phi(), step.changed);
+        segment_.flips = convergence_->record_step(field_.phi(), step.changed.points);
         segment_.inside = convergence_->inside();
         segment_.dt = step.dt;
         segment_.iterations = ++marks_.iterations;

@@ -1,0 +1,239 @@
+// Re-layering a repair region and settling it (see sparse_field.hpp for the scheme): the outer
+// layers from the new zero layer (the pull for any region, the push for the whole band, change
+// propagation for a local update), then the final statuses, X, the sign changes and the list moves.
+#include <tbb/parallel_for.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numeric>
+
+#include "liveset/levelset/band_detail.hpp"
+#include "liveset/levelset/layer_value.hpp"
+#include "liveset/levelset/sparse_field.hpp"
+
+namespace liveset {
+
+namespace {
+
+using detail::for_each_neighbor6;
+using detail::kPendNeg;
+using detail::kPendPos;
+using detail::kPendZero;
+using detail::parallel_range;
+
+bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
+
+}  // namespace
+
+// Level k re-evaluates the points still pending from level k-1 plus every neighbour, not yet final,
+// of a point that changed at level k-1 (entered or left layer ±(k-1), or took a new value there).
+// Exact: a point's layer and value depend only on its neighbours one level further in, so a point
+// none of whose neighbours changed keeps both (the state before the update is the layers' fixed
+// point); a point whose layer is below k is final by then (it depends on levels below k-1 only).
+void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
+    using detail::kPendNeg;
+    using detail::kPendPos;
+    std::vector<std::size_t> changed(region.size());  // region indices; level 0: every seed
+    std::iota(changed.begin(), changed.end(), std::size_t{0});
+    std::vector<std::size_t> pending;
+    for (std::size_t r = 0; r < region.size(); ++r)
+        if (status_[region[r].point] == kPendPos || status_[region[r].point] == kPendNeg) pending.push_back(r);
+    std::vector<float> value;
+    std::vector<std::uint8_t> outside;  // the pending point's side (a seed's old status is 0)
+    struct Part {
+        std::vector<std::size_t> next, changed;
+    };
+    for (int k = 1; k <= layers_; ++k) {
+        // Claim (serial: the first changed point in order claims, as the region's order needs):
+        // only the statuses are read here; a claimed point's old φ is read in the parallel pass.
+        const std::size_t first_new = region.size();
+        for (const std::size_t c : changed) {
+            const PointIndex p = region[c].point;
+            const bool outside = status_[p] > 0;  // the side of a change beyond L0 (kPendPos > 0)
+            detail::for_each_neighbor6(lattice(), decoder_, p, [&](PointIndex q) {
+                const std::int8_t s = status_[q];
+                if (detail::is_temp(s) || std::abs(s) < k || (k > 1 && (s > 0) != outside)) return;
+                region.push_back({q, s, 0.0f});
+                status_[q] = s > 0 ? kPendPos : kPendNeg;
+                pending.push_back(region.size() - 1);
+            });
+        }
+        if (pending.empty()) break;
+        // Decide (reads only; Jacobi within a level, so any thread order agrees) ...
+        value.resize(pending.size());
+        outside.resize(pending.size());
+        detail::parallel_range(pending.size(), [&](std::size_t m) {
+            RegionPoint& rp = region[pending[m]];
+            if (pending[m] >= first_new) rp.old_phi = phi_[rp.point];
+            outside[m] = status_[rp.point] == kPendPos;
+            value[m] = inner_layer_value(rp.point, k, outside[m] != 0);
+        });
+        // ... then write, each chunk its own points; the lists join in chunk order.
+        auto parts = detail::ordered_chunks<Part>(pending.size(), [&](std::size_t b, std::size_t e, Part& out) {
+            for (std::size_t m = b; m < e; ++m) {
+                const std::size_t r = pending[m];
+                const RegionPoint& rp = region[r];
+                if (std::isinf(value[m])) {  // not on layer k: stays pending (far if no layer takes it)
+                    out.next.push_back(r);
+                    if (std::abs(rp.old_status) == k) out.changed.push_back(r);
+                    continue;
+                }
+                const auto layer = static_cast<std::int8_t>(outside[m] != 0 ? k : -k);
+                status_[rp.point] = layer;
+                phi_[rp.point] = value[m];
+                if (layer != rp.old_status || !same_bits(value[m], rp.old_phi)) out.changed.push_back(r);
+            }
+        });
+        pending.clear();
+        changed.clear();
+        detail::join_parts(parts, &Part::next, pending);
+        detail::join_parts(parts, &Part::changed, changed);
+    }
+}
+
+float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
+    const std::int8_t inner = static_cast<std::int8_t>(outside ? k - 1 : -(k - 1));
+    const auto is_inner = [&](std::int8_t s) { return k == 1 ? (s == 0 || s == kPendZero) : s == inner; };
+    return detail::layer_value(phi_, status_, i, decoder_.coord(i), outside, is_inner);
+}
+
+// Whitaker's layer rule pushed outwards instead of pulled: every point of level k-1 (final by
+// then) offers φ ± 1 to its pending neighbours on its side, which keep the min (outside) or max
+// (inside). A point is in layer k iff some neighbour is in layer k-1 (the zero layer for k = 1),
+// and min/max are exact and order-free, so this gives the pull rule's bits (inner_layer_value,
+// the invariant checker) while visiting 6 neighbours of each source instead of of every pending
+// point at every level (the pull re-asked the points of outer layers and the ring at each level).
+// Needs the region to hold the whole band (collect_band, init_from_sdf): no final point outside
+// it can be a pending point's inner neighbour. A partial region (unite_in_box) uses the pull.
+void SparseField::sweep_whole_band(std::span<const RegionPoint> region) {
+    const float inf = std::numeric_limits<float>::infinity();
+    std::vector<PointIndex> from;
+    for (const RegionPoint& r : region) {
+        const std::int8_t s = status_[r.point];
+        if (s == kPendZero) from.push_back(r.point);
+        else if (s == kPendPos) phi_[r.point] = inf;  // the old value is in the region record
+        else if (s == kPendNeg) phi_[r.point] = -inf;
+    }
+    // A point takes its layer when first reached; later offers of the same level still count.
+    std::vector<PointIndex> reached;
+    for (int k = 1; k <= layers_ && !from.empty(); ++k) {
+        reached.clear();
+        const auto up = static_cast<std::int8_t>(k), down = static_cast<std::int8_t>(-k);
+        for (const PointIndex i : from) {
+            const float v = phi_[i];
+            const bool out = k == 1 || status_[i] > 0, in = k == 1 || status_[i] < 0;
+            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
+                const std::int8_t s = status_[q];
+                if (out && (s == kPendPos || s == up)) {
+                    if (s == kPendPos) {
+                        status_[q] = up;
+                        reached.push_back(q);
+                    }
+                    phi_[q] = std::min(phi_[q], v + 1.0f);
+                } else if (in && (s == kPendNeg || s == down)) {
+                    if (s == kPendNeg) {
+                        status_[q] = down;
+                        reached.push_back(q);
+                    }
+                    phi_[q] = std::max(phi_[q], v - 1.0f);
+                }
+            });
+        }
+        from.swap(reached);
+    }
+}
+
+// The pull form for any region: each pending point asks its neighbours, level by level.
+void SparseField::sweep_layers(std::span<const RegionPoint> region) {
+    std::vector<PointIndex> pending;
+    for (const RegionPoint& r : region)
+        if (status_[r.point] == kPendPos || status_[r.point] == kPendNeg) pending.push_back(r.point);
+
+    std::vector<float> value;
+    std::vector<PointIndex> next;
+    for (int k = 1; k <= layers_ && !pending.empty(); ++k) {
+        value.assign(pending.size(), 0.0f);
+        // Decide (reads only), then write: Jacobi within a layer, so any thread order agrees.
+        parallel_range(pending.size(), [&](std::size_t m) {
+            const PointIndex i = pending[m];
+            const bool outside = status_[i] == kPendPos;
+            value[m] = inner_layer_value(i, k, outside);
+        });
+        next.clear();
+        for (std::size_t m = 0; m < pending.size(); ++m) {
+            const PointIndex i = pending[m];
+            if (std::isinf(value[m])) {
+                next.push_back(i);
+                continue;
+            }
+            status_[i] = static_cast<std::int8_t>(status_[i] == kPendPos ? k : -k);
+            phi_[i] = value[m];
+        }
+        pending.swap(next);
+    }
+}
+
+// Moves the points whose layer changed between the lists: every removal, then every addition, each
+// in region order. A list's operations touch only its own points' slots, so each list is one task
+// once there are many moves; the lists come out the same on any thread count.
+void SparseField::move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves) {
+    const int lists = 2 * layers_ + 1;
+    const auto for_lists = [&](const auto& per_list) {
+        if (moves.size() < detail::kParallelMin) {
+            for (int l = 0; l < lists; ++l) per_list(l - layers_);
+        } else {
+            tbb::parallel_for(0, lists, [&](int l) { per_list(l - layers_); });
+        }
+    };
+    for_lists([&](int k) {
+        for (const ListMove& m : moves)
+            if (region[m.region_index].old_status == k) list_remove(region[m.region_index].point, k);
+    });
+    for_lists([&](int k) {
+        for (const ListMove& m : moves)
+            if (m.layer == k) list_add(region[m.region_index].point, k);
+    });
+}
+
+// Settles every region point (a pending one is far), in parallel over fixed chunks; then, in the
+// region's order, moves the points whose layer changed between the lists. The change report and
+// the sign changes come in the region's order, whatever the thread count.
+ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
+    struct Part {
+        std::vector<PointIndex> changed, signs;
+        std::vector<ListMove> moved;  // the points whose layer changed
+    };
+    const float far = static_cast<float>(layers_ + 1);
+    auto parts = detail::ordered_chunks<Part>(region.size(), [&](std::size_t b, std::size_t e, Part& out) {
+        for (std::size_t n = b; n < e; ++n) {
+            const RegionPoint& r = region[n];
+            const PointIndex i = r.point;
+            std::int8_t s = status_[i];
+            if (s == kPendZero) {
+                s = 0;
+            } else if (s == kPendPos) {
+                s = far_outside();
+                phi_[i] = far;
+            } else if (s == kPendNeg) {
+                s = far_inside();
+                phi_[i] = -far;
+            }
+            status_[i] = s;
+            if (s != r.old_status) out.moved.push_back({n, s});
+            if (s != r.old_status || std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(r.old_phi))
+                out.changed.push_back(i);
+            if ((phi_[i] < 0.0f) != (r.old_phi < 0.0f)) out.signs.push_back(i);
+        }
+    });
+    std::vector<ListMove> moved;
+    detail::join_parts(parts, &Part::moved, moved);
+    move_between_lists(region, moved);
+    ChangedPoints changed;
+    detail::join_parts(parts, &Part::changed, changed.points);
+    detail::join_parts(parts, &Part::signs, sign_changes_);
+    return changed;
+}
+
+}  // namespace liveset
