@@ -51,10 +51,10 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         const std::size_t first_new = region.size();
         for (const std::size_t c : changed) {
             const PointIndex p = region[c].point;
-            const bool outside = status_[p] > 0;  // the side of a change beyond L0 (kPendPos > 0)
+            const bool out = status_[p] > 0;  // the side of a change beyond L0 (kPendPos > 0)
             detail::for_each_neighbor6(lattice(), decoder_, p, [&](PointIndex q) {
                 const std::int8_t s = status_[q];
-                if (detail::is_temp(s) || std::abs(s) < k || (k > 1 && (s > 0) != outside)) return;
+                if (detail::is_temp(s) || std::abs(s) < k || (k > 1 && (s > 0) != out)) return;
                 region.push_back({q, s, 0.0f});
                 status_[q] = s > 0 ? kPendPos : kPendNeg;
                 pending.push_back(region.size() - 1);
@@ -197,9 +197,9 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
     });
 }
 
-// Settles every region point (a pending one is far), in parallel over fixed chunks; then, in the
-// region's order, moves the points whose layer changed between the lists. The change report and
-// the sign changes come in the region's order, whatever the thread count.
+// Settles every region point (a pending one is far), in parallel over fixed chunks; then moves the
+// points whose layer changed between the lists (move_between_lists). The change report and the
+// sign changes come in the region's order, whatever the thread count.
 ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
     struct Part {
         std::vector<PointIndex> changed, signs;
