@@ -159,8 +159,9 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenSleepingOnAFrontOfSeveralChunks) 
 
 // A front growing at full speed changes the layer of about half the band every step: the
 // re-layering's write-back, the settling pass and the list moves (one task per list from 4 096
-// moves) run in parallel. Both modes give the same bits and reports, and 1 and 2 threads the same
-// state, reports and list order, with the invariants (lists, slots) checked every step.
+// moves) run in parallel. Both modes give the same bits, reports and sign changes (equal to a
+// brute-force diff), and 1 and 2 threads the same state, reports and list order, with the
+// invariants (lists against statuses; a wrong slot would show as a wrong removal) every step.
 TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenManyPointsChangeLayer) {
     auto run = [](int threads, std::vector<std::vector<PointIndex>>& reports, std::size_t& most_moves) {
         tbb::task_arena arena(threads);
@@ -176,11 +177,18 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenManyPointsChangeLayer) {
                 ASSERT_EQ(sorted(r.changed.points), sorted(f.changed.points)) << "step " << s;
                 ASSERT_EQ(sorted(f.changed.points), brute_force_changes(before, fast)) << "step " << s;
                 std::size_t moves = 0;  // points whose layer changed, by brute force
-                for (const PointIndex i : f.changed.points) moves += before.status()[i] != fast.status()[i];
+                std::vector<PointIndex> signs;
+                for (const PointIndex i : f.changed.points) {
+                    moves += before.status()[i] != fast.status()[i];
+                    if ((before.phi()[i] < 0.0f) != (fast.phi()[i] < 0.0f)) signs.push_back(i);
+                }
                 most_moves = std::max(most_moves, moves);
+                ASSERT_EQ(sorted(f.sign_changes), sorted(signs)) << "step " << s;
+                ASSERT_EQ(sorted(r.sign_changes), sorted(signs)) << "step " << s;
                 expect_valid(fast, "after a step");
                 reports.push_back(f.changed.points);
                 reports.push_back(r.changed.points);
+                reports.push_back(f.sign_changes);
             }
         });
         return fast;
@@ -190,6 +198,7 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenManyPointsChangeLayer) {
     const SparseField a = run(1, r1, moves1);
     const SparseField b = run(2, r2, moves2);
     EXPECT_GT(moves1, 2u * 4096u) << "the steps should move many points between the lists";
+    EXPECT_EQ(moves1, moves2);
     EXPECT_TRUE(same_state(a, b));
     EXPECT_EQ(r1, r2);
     for (int k = -a.layers(); k <= a.layers(); ++k) {

@@ -3,6 +3,7 @@
 // propagation for a local update), then the final statuses, X, the sign changes and the list moves.
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -33,8 +34,6 @@ bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std
 // none of whose neighbours changed keeps both (the state before the update is the layers' fixed
 // point); a point whose layer is below k is final by then (it depends on levels below k-1 only).
 void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
-    using detail::kPendNeg;
-    using detail::kPendPos;
     std::vector<std::size_t> changed(region.size());  // region indices; level 0: every seed
     std::iota(changed.begin(), changed.end(), std::size_t{0});
     std::vector<std::size_t> pending;
@@ -52,7 +51,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         for (const std::size_t c : changed) {
             const PointIndex p = region[c].point;
             const bool out = status_[p] > 0;  // the side of a change beyond L0 (kPendPos > 0)
-            detail::for_each_neighbor6(lattice(), decoder_, p, [&](PointIndex q) {
+            for_each_neighbor6(lattice(), decoder_, p, [&](PointIndex q) {
                 const std::int8_t s = status_[q];
                 if (detail::is_temp(s) || std::abs(s) < k || (k > 1 && (s > 0) != out)) return;
                 region.push_back({q, s, 0.0f});
@@ -64,7 +63,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         // Decide (reads only; Jacobi within a level, so any thread order agrees) ...
         value.resize(pending.size());
         outside.resize(pending.size());
-        detail::parallel_range(pending.size(), [&](std::size_t m) {
+        parallel_range(pending.size(), [&](std::size_t m) {
             RegionPoint& rp = region[pending[m]];
             if (pending[m] >= first_new) rp.old_phi = phi_[rp.point];
             outside[m] = status_[rp.point] == kPendPos;

@@ -14,6 +14,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "liveset/grid/sampling.hpp"
 #include "liveset/levelset/band_detail.hpp"
@@ -267,7 +268,8 @@ StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
     ++steps_;
     StepResult result = options.mode == StepMode::kFullBand ? step_full_band(speed, options) : step_incremental(speed, options);
     activity_.wake_near(sign_changes_, lattice(), steps_);  // a no-op until a sleeping step ran
-    result.sign_changes = sign_changes_;
+    result.sign_changes = std::move(sign_changes_);  // read by nothing after wake_near
+    sign_changes_.clear();
     return result;
 }
 

@@ -77,6 +77,7 @@ ChangedPoints SparseField::unite_in_box(Vec3i lo, Vec3i hi, const std::function<
         status_[i] = std::abs(v) <= 0.5f ? kPendZero : (v < 0 ? kPendNeg : kPendPos);
     }
     sweep_layers(region);
+    sign_changes_.clear();
     ChangedPoints changed = finish(region);
     activity_.wake_near(changed.points, lattice(), steps_);
     last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

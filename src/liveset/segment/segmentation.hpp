@@ -92,7 +92,8 @@ private:
     double tolerance_;
 };
 
-// Called after every step with the progress and X; returning false interrupts the run.
+// Called after every step with the progress and X; returning false interrupts the run. The hook
+// must not change the field: the convergence test counts flips from each step's sign changes.
 using SegmentationHook = std::function<bool(const SegmentationProgress&, const ChangedPoints&)>;
 
 SegmentationResult run_segmentation(SparseField& field, const Speed& speed, const SegmentationOptions& options,
