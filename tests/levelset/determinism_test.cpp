@@ -33,8 +33,5 @@ TEST(Determinism, OneAndTwoThreadsGiveIdenticalResults) {
     const SparseField b = run(2, c2);
     EXPECT_TRUE(same_state(a, b));
     EXPECT_EQ(c1, c2);
-    for (int k = -a.layers(); k <= a.layers(); ++k) {
-        const auto la = a.layer(k), lb = b.layer(k);
-        EXPECT_TRUE(std::equal(la.begin(), la.end(), lb.begin(), lb.end())) << "layer list order " << k;
-    }
+    expect_same_list_order(a, b);
 }

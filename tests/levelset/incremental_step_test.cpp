@@ -120,10 +120,7 @@ TEST(IncrementalStep, OneAndTwoThreadsGiveTheSameStateReportsAndListOrder) {
     const SparseField b = run(2, r2);
     EXPECT_TRUE(same_state(a, b));
     EXPECT_EQ(r1, r2);
-    for (int k = -a.layers(); k <= a.layers(); ++k) {
-        const auto la = a.layer(k), lb = b.layer(k);
-        EXPECT_TRUE(std::equal(la.begin(), la.end(), lb.begin(), lb.end())) << "layer list order " << k;
-    }
+    expect_same_list_order(a, b);
 }
 
 // The same with sleeping on a front of several 4 096-point chunks (the rate pass joins per-chunk
@@ -151,10 +148,7 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenSleepingOnAFrontOfSeveralChunks) 
     EXPECT_GT(largest1, 2u * 4096u) << "the front should span several chunks";
     EXPECT_TRUE(same_state(a, b));
     EXPECT_EQ(r1, r2);
-    for (int k = -a.layers(); k <= a.layers(); ++k) {
-        const auto la = a.layer(k), lb = b.layer(k);
-        EXPECT_TRUE(std::equal(la.begin(), la.end(), lb.begin(), lb.end())) << "layer list order " << k;
-    }
+    expect_same_list_order(a, b);
 }
 
 // A front growing at full speed changes the layer of about half the band every step: the
@@ -201,10 +195,7 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenManyPointsChangeLayer) {
     EXPECT_EQ(moves1, moves2);
     EXPECT_TRUE(same_state(a, b));
     EXPECT_EQ(r1, r2);
-    for (int k = -a.layers(); k <= a.layers(); ++k) {
-        const auto la = a.layer(k), lb = b.layer(k);
-        EXPECT_TRUE(std::equal(la.begin(), la.end(), lb.begin(), lb.end())) << "layer list order " << k;
-    }
+    expect_same_list_order(a, b);
 }
 
 TEST(IncrementalStep, BadOptionsThrowOneLineMessages) {

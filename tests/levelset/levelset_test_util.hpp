@@ -101,6 +101,14 @@ inline std::vector<PointState> states_at(const SparseField& before, std::span<co
     return out;
 }
 
+// The layer lists of `a` and `b` hold the same points in the same order.
+inline void expect_same_list_order(const SparseField& a, const SparseField& b) {
+    for (int k = -a.layers(); k <= a.layers(); ++k) {
+        const auto la = a.layer(k), lb = b.layer(k);
+        EXPECT_TRUE(std::equal(la.begin(), la.end(), lb.begin(), lb.end())) << "layer list order " << k;
+    }
+}
+
 inline void expect_valid(const SparseField& f, const char* where) {
     const InvariantReport r = check_invariants(f);
     EXPECT_TRUE(r.ok()) << where << ": " << r.summary();

@@ -1,9 +1,6 @@
 // The incremental global step: the same Δφ as the full-band step, applied only where it moves a
 // zero-layer value and re-layered only around those points; with sleeping on, only at the awake
 // zero-layer points (see sparse_field.hpp and activity.hpp).
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -29,34 +26,29 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
     if (sleep_after > 0) activity_.begin_step(lattice(), speed.serial(), steps_);
 
     // Rates at the awake points (all of them when sleeping is off), exactly as zero_rates(). A
-    // sleeping point costs only its awake test: each chunk of the zero layer keeps its awake
-    // points and their rates in its own arrays, joined in chunk order (the zero layer's order,
-    // whatever the thread count), so the passes below run over the awake points only.
-    constexpr std::size_t kChunk = 4096;
-    const std::size_t chunks = (zero.size() + kChunk - 1) / kChunk;
-    std::vector<std::vector<std::uint32_t>> chunk_at(chunks);  // positions in the zero layer
-    std::vector<std::vector<double>> chunk_rate(chunks);
-    const auto rate_chunk = [&](std::size_t c) {
-        const std::size_t end = std::min(zero.size(), (c + 1) * kChunk);
-        for (std::size_t n = c * kChunk; n < end; ++n) {
+    // sleeping point costs only its awake test: each 4 096-point chunk of the zero layer keeps its
+    // awake points and their rates in its own arrays, joined in chunk order (the zero layer's
+    // order, whatever the thread count), so the passes below run over the awake points only.
+    struct Rates {
+        std::vector<std::uint32_t> at;  // positions in the zero layer
+        std::vector<double> rate;
+    };
+    auto rates = detail::ordered_chunks<Rates>(zero.size(), [&](std::size_t b, std::size_t e, Rates& out) {
+        for (std::size_t n = b; n < e; ++n) {
             const Vec3i p = decoder_.coord(zero[n]);
             if (sleep_after > 0 && !activity_.awake(p, steps_, sleep_after)) continue;
             const SpeedSample s = speed.at(phi_, p);
             double r = 0.0;
             if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi_, p, s.propagation);
             if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi_, p));
-            chunk_at[c].push_back(static_cast<std::uint32_t>(n));
-            chunk_rate[c].push_back(r);
+            out.at.push_back(static_cast<std::uint32_t>(n));
+            out.rate.push_back(r);
         }
-    };
-    if (chunks > 1) tbb::parallel_for(std::size_t{0}, chunks, rate_chunk);
-    else if (chunks == 1) rate_chunk(0);
+    });
     std::vector<std::uint32_t> at;
     std::vector<double> rate;
-    for (std::size_t c = 0; c < chunks; ++c) {
-        at.insert(at.end(), chunk_at[c].begin(), chunk_at[c].end());
-        rate.insert(rate.end(), chunk_rate[c].begin(), chunk_rate[c].end());
-    }
+    detail::join_parts(rates, &Rates::at, at);
+    detail::join_parts(rates, &Rates::rate, rate);
     result.awake = at.size();
     result.dt = time_step(rate, speed, options);  // sleeping points do not bound it
 
