@@ -59,8 +59,8 @@ int run_bench(Viewer& viewer, const BenchOptions& o, int width, int height) {
                                   {"repairing p=0.5", true, 0.5}};
     nlohmann::json results = nlohmann::json::array();
     if (!o.json)
-        fmt::print("liveset view --bench: {} frames per scenario, 3D view {}x{}, {} triangles, renderer: software unless a GPU is present\n",
-                   o.frames, width - viewer.panel_rect().w, height, s->mesher().triangle_count());
+        fmt::print("liveset view --bench: {} frames per scenario, 3D view {}x{}, {} triangles, renderer: {}\n", o.frames,
+                   width - viewer.panel_rect().w, height, s->mesher().triangle_count(), o.renderer);
     for (const Scenario& sc : scenarios) {
         if (sc.agents) {
             RepairOptions ro = demo_repair_options();
@@ -110,7 +110,8 @@ int run_bench(Viewer& viewer, const BenchOptions& o, int width, int height) {
                        1000.0 * n / std::max(t.frame, 1e-9), t.fragments / n, t.triangles / n);
     }
     if (o.json)
-        fmt::print("{}\n", nlohmann::json{{"width", width - viewer.panel_rect().w}, {"height", height}, {"target", {target.x, target.y, target.z}},
+        fmt::print("{}\n", nlohmann::json{{"width", width - viewer.panel_rect().w}, {"height", height},
+                                          {"renderer", o.renderer}, {"target", {target.x, target.y, target.z}},
                                           {"scenarios", results}}.dump());
     return 0;
 }

@@ -19,6 +19,7 @@ struct BenchOptions {
     std::optional<Vec3d> target;      // default: the surface point nearest the top of the surface
     bool json = false;
     std::string mode = "frames";      // frames | segment | interaction (bench_modes.cpp)
+    std::string renderer;             // the OpenGL renderer and EGL platform, reported with the figures
 };
 
 int run_bench(Viewer& viewer, const BenchOptions& options, int width, int height);

@@ -30,7 +30,8 @@ int run_headless(std::unique_ptr<Session> session, const std::string& image_name
     viewer.set_window_size(options.width, options.height);
     if (options.maximised) viewer.set_maximised(options.maximised);
     if (options.bench) {
-        const BenchOptions& b = *options.bench;
+        BenchOptions b = *options.bench;
+        b.renderer = render::describe_current_context() + " (EGL " + context->platform() + ")";
         if (b.mode == "segment") return run_segment_bench(viewer, b, options.width, options.height);
         if (b.mode == "interaction") return run_interaction_bench(viewer, b, options.width, options.height);
         return run_bench(viewer, b, options.width, options.height);

@@ -1,11 +1,12 @@
 // Headless rendering: the phantom's surface renders (EGL surfaceless, offscreen framebuffer) to an
 // image matching the stored reference within a small per-pixel tolerance and is not blank;
 // re-uploading only the fragments the mesher reports gives the same picture as uploading all;
-// the camera's named views and the PNG writer behave.
+// so does the EGL device platform; the camera's named views and the PNG writer behave.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <glm/gtc/matrix_transform.hpp>
+#include <thread>
 
 #include "liveset/render/orbit_camera.hpp"
 #include "liveset/render/png_writer.hpp"
@@ -54,6 +55,30 @@ TEST(HeadlessRender, PhantomSurfaceMatchesTheReferenceImage) {
     const auto d = compare(img, ref, 16);
     // Headless llvmpipe output is byte-identical run to run; other CPUs / Xvfb may differ by a
     // little at a few pixels.
+    EXPECT_LT(d.mean_abs, 1.0) << "max " << d.max_abs;
+    EXPECT_LT(d.fraction_over, 0.005) << "max " << d.max_abs;
+}
+
+// The EGL device platform (how a headless NVIDIA server gives a context) draws the same picture:
+// here Mesa's software device, on a thread of its own so that the shared context stays untouched.
+TEST(HeadlessRender, TheDevicePlatformDrawsTheReferenceToo) {
+    std::string platform, error;
+    render::Image img;
+    std::thread([&] {
+        try {
+            render::HeadlessContext context(render::EglPlatform::kDevice);
+            platform = context.platform();
+            auto s = testing::truth_session();
+            render::SurfaceBuffers buffers;
+            buffers.upload_all(s->mesher());
+            img = render_scene(*s, buffers, "superior", 320, 240);
+        } catch (const std::exception& e) {
+            error = e.what();
+        }
+    }).join();
+    ASSERT_EQ(error, "");
+    EXPECT_EQ(platform, "device");
+    const auto d = compare(img, render::read_png(kReference), 16);
     EXPECT_LT(d.mean_abs, 1.0) << "max " << d.max_abs;
     EXPECT_LT(d.fraction_over, 0.005) << "max " << d.max_abs;
 }

@@ -5,7 +5,8 @@
 // more than 0.005 of Dice. Also:
 // a bad script is refused with one line naming the entry, before anything runs; a "display" entry's
 // zoom and window/level reach the slice pane's pixels (a second window re-grades the same slice);
-// the cut rule, chosen by a script, cuts a handle at the target.
+// the cut rule, chosen by a script, cuts a handle at the target; `--bench` reports the renderer
+// and its four scenarios, of which only the repairing ones rebuild fragments.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -233,6 +234,32 @@ TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
     const CliResult nodisplay = run_cli("view " + image + " --headless");
     EXPECT_EQ(nodisplay.rc, 1);
     EXPECT_NE(nodisplay.err.find("--script or --bench"), std::string::npos);
+}
+
+TEST(ViewBench, ReportsTheRendererAndOnlyTheRepairingScenariosRebuildFragments) {
+    const fs::path dir = work_dir();
+    PhantomOptions o;
+    o.size = 48;
+    const Phantom ph = make_phantom(o);
+    write_image(ph.image, (dir / "bench.nii.gz").string());
+    write_label_image(ph.truth, (dir / "bench_truth.nii.gz").string());
+    const CliResult r = run_cli("view " + (dir / "bench.nii.gz").string() + " --mask " + (dir / "bench_truth.nii.gz").string() +
+                                " --headless --bench --bench-frames 3 --size 480x320 --json");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_NE(j["renderer"].get<std::string>().find("(EGL surfaceless)"), std::string::npos) << j["renderer"];
+    ASSERT_EQ(j["scenarios"].size(), 4u);
+    const char* names[] = {"static", "agents moving", "repairing p=0.1", "repairing p=0.5"};
+    for (std::size_t k = 0; k < 4; ++k) {
+        const nlohmann::json& sc = j["scenarios"][k];
+        EXPECT_EQ(sc["scenario"], names[k]);
+        EXPECT_EQ(sc["frames"], 3);
+        EXPECT_GT(sc["triangles"].get<double>(), 0.0);
+        EXPECT_GE(sc["frame_ms"].get<double>(), sc["draw_ms"].get<double>());
+        EXPECT_NEAR(sc["fps"].get<double>(), 1000.0 / sc["frame_ms"].get<double>(), 1e-6 * sc["fps"].get<double>());
+        if (k < 2) EXPECT_EQ(sc["fragments_per_frame"].get<double>(), 0.0) << names[k];  // nothing edits the surface
+        else EXPECT_GT(sc["fragments_per_frame"].get<double>(), 0.0) << names[k];
+    }
 }
 
 }  // namespace
