@@ -28,13 +28,14 @@ bool has_extension(const char* all, const char* name) {
 bool has_client_extension(const char* name) { return has_extension(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), name); }
 
 // The EGL devices, hardware first (Mesa's software device says EGL_MESA_device_software), each
-// group in the driver's order.
+// group in the driver's order; the driver's order alone where devices cannot be queried.
 std::vector<EGLDeviceEXT> devices_hardware_first() {
     EGLint n = 0;
     if (!eglQueryDevicesEXT(0, nullptr, &n) || n <= 0) return {};
     std::vector<EGLDeviceEXT> devices(static_cast<std::size_t>(n));
     if (!eglQueryDevicesEXT(n, devices.data(), &n)) return {};
     devices.resize(static_cast<std::size_t>(std::max(n, 0)));
+    if (!has_client_extension("EGL_EXT_device_query") && !has_client_extension("EGL_EXT_device_base")) return devices;
     std::stable_partition(devices.begin(), devices.end(), [](EGLDeviceEXT d) {
         return !has_extension(eglQueryDeviceStringEXT(d, EGL_EXTENSIONS), "EGL_MESA_device_software");
     });
