@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The viewer's frame benchmark (the paper's FPS experiment: static, 200 agents moving, repairing at
-# p = 0.1 and 0.5) and its interaction latency, headless, on whatever OpenGL this machine gives
-# (a GPU through EGL's device platform, else Mesa). Writes one JSON file per run into OUTDIR.
+# p = 0.1 and 0.5) and its interaction latency, headless, on whatever OpenGL this machine's EGL
+# gives (surfaceless, else an EGL device: Mesa's llvmpipe or a GPU driver). Writes one JSON file per run into OUTDIR.
 #   usage: scripts/gpu_frame_bench.sh OUTDIR GM_PHI [PHANTOM_T1 PHANTOM_PHI]
 #   env:   LIVESET (./build/liveset), FRAMES (1000), SIZES ("1280x720 1920x1080")
 # GM_PHI: the BrainWeb grey-matter φ of the README's 8-seed segmentation (segment --out-phi).

@@ -25,17 +25,15 @@ bool has_extension(const char* all, const char* name) {
     return false;
 }
 
-bool has_client_extension(const char* name) { return has_extension(eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS), name); }
-
 // The EGL devices, hardware first (Mesa's software device says EGL_MESA_device_software), each
 // group in the driver's order; the driver's order alone where devices cannot be queried.
-std::vector<EGLDeviceEXT> devices_hardware_first() {
+std::vector<EGLDeviceEXT> devices_hardware_first(bool can_query) {
     EGLint n = 0;
     if (!eglQueryDevicesEXT(0, nullptr, &n) || n <= 0) return {};
     std::vector<EGLDeviceEXT> devices(static_cast<std::size_t>(n));
     if (!eglQueryDevicesEXT(n, devices.data(), &n)) return {};
     devices.resize(static_cast<std::size_t>(std::max(n, 0)));
-    if (!has_client_extension("EGL_EXT_device_query") && !has_client_extension("EGL_EXT_device_base")) return devices;
+    if (!can_query) return devices;
     std::stable_partition(devices.begin(), devices.end(), [](EGLDeviceEXT d) {
         return !has_extension(eglQueryDeviceStringEXT(d, EGL_EXTENSIONS), "EGL_MESA_device_software");
     });
@@ -72,25 +70,25 @@ bool HeadlessContext::try_display(void* native) {
 
 HeadlessContext::HeadlessContext(EglPlatform platform) {
     keep_driver_mapped();
-    const bool surfaceless = has_client_extension("EGL_EXT_platform_base") && has_client_extension("EGL_MESA_platform_surfaceless");
-    const bool device = has_client_extension("EGL_EXT_platform_base") && has_client_extension("EGL_EXT_platform_device") &&
-                        (has_client_extension("EGL_EXT_device_enumeration") || has_client_extension("EGL_EXT_device_base"));
+    const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    const auto has = [&](const char* name) { return has_extension(client, name); };
+    const bool base = has("EGL_EXT_platform_base");
+    const bool surfaceless = base && has("EGL_MESA_platform_surfaceless");
+    const bool device = base && has("EGL_EXT_platform_device") && (has("EGL_EXT_device_enumeration") || has("EGL_EXT_device_base"));
     // The EXT entry point: eglGetPlatformDisplay through epoxy aborts before any display exists.
-    if (platform != EglPlatform::kDevice && surfaceless &&
+    if (platform == EglPlatform::kAutomatic && surfaceless &&
         try_display(eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr))) {
         platform_ = "surfaceless";
         return;
     }
-    if (platform != EglPlatform::kSurfaceless && device) {
-        for (EGLDeviceEXT d : devices_hardware_first()) {
+    if (device) {
+        for (EGLDeviceEXT d : devices_hardware_first(has("EGL_EXT_device_query") || has("EGL_EXT_device_base"))) {
             if (try_display(eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, d, nullptr))) {
                 platform_ = "device";
                 return;
             }
         }
     }
-    if (platform == EglPlatform::kSurfaceless && !surfaceless)
-        fail("EGL lacks the surfaceless platform (install Mesa: libegl1, libgl1-mesa-dri)");
     if (platform == EglPlatform::kDevice && !device) fail("EGL lacks the device platform (EGL_EXT_platform_device)");
     if (!surfaceless && !device)
         fail("EGL offers neither the surfaceless nor the device platform (install Mesa: libegl1, libgl1-mesa-dri; or a GPU driver)");

@@ -9,9 +9,8 @@
 namespace liveset::render {
 
 enum class EglPlatform {
-    kAutomatic,    // surfaceless where EGL offers it, else the first EGL device (hardware before software)
-    kSurfaceless,  // Mesa's surfaceless platform only
-    kDevice,       // an enumerated EGL device only (hardware before software)
+    kAutomatic,  // surfaceless where EGL offers it, else the first EGL device (hardware before software)
+    kDevice,     // an enumerated EGL device only (hardware before software)
 };
 
 class HeadlessContext {
