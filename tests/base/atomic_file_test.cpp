@@ -2,7 +2,6 @@
 // leaves the old file and no temporary; the temporary keeps the target's extension; a fatal-signal
 // handler can remove the temporaries of writes in flight.
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
@@ -11,18 +10,14 @@
 #include <string>
 
 #include "liveset/base/atomic_file.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path fresh_dir(const std::string& name) {
-    const fs::path d = fs::temp_directory_path() / ("liveset_atomic_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-}
+using testing::scratch_dir;
 
 std::string slurp(const fs::path& p) {
     std::ifstream in(p, std::ios::binary);
@@ -38,7 +33,7 @@ std::size_t entries(const fs::path& dir) {
 }
 
 TEST(AtomicFile, ReplacesTheFileWholeAndLeavesNothingElse) {
-    const fs::path dir = fresh_dir("whole");
+    const fs::path dir = scratch_dir("atomic_whole");
     const fs::path target = dir / "report.json";
     write_file_atomically(target, "first");
     write_file_atomically(target, std::string(100000, 'x'));
@@ -48,7 +43,7 @@ TEST(AtomicFile, ReplacesTheFileWholeAndLeavesNothingElse) {
 }
 
 TEST(AtomicFile, AFailedWriteKeepsTheOldFileAndNoTemporary) {
-    const fs::path dir = fresh_dir("failed");
+    const fs::path dir = scratch_dir("atomic_failed");
     const fs::path target = dir / "mesh.ply";
     write_file_atomically(target, "old");
     EXPECT_THROW(write_file_atomically(target,
@@ -70,7 +65,7 @@ TEST(AtomicFile, AFailedWriteKeepsTheOldFileAndNoTemporary) {
 }
 
 TEST(AtomicFile, TheTemporaryKeepsTheExtensionAndGoesWithoutACommit) {
-    const fs::path dir = fresh_dir("temp");
+    const fs::path dir = scratch_dir("atomic_temp");
     {
         AtomicFile file(dir / "seg.nii.gz");
         EXPECT_EQ(file.temp_path().parent_path(), dir);
@@ -93,7 +88,7 @@ TEST(AtomicFile, TheTemporaryKeepsTheExtensionAndGoesWithoutACommit) {
 }
 
 TEST(AtomicFile, ASignalHandlerCanDiscardTheWritesInFlight) {
-    const fs::path dir = fresh_dir("signal");
+    const fs::path dir = scratch_dir("atomic_signal");
     AtomicFile a(dir / "a.lsrecovery"), b(dir / "b.png");
     a.create();
     b.create();

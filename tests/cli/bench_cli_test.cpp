@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -17,22 +16,17 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_run.hpp"
+#include "scratch_dir.hpp"
 
 namespace {
 
 using liveset::testing::lines;
 using liveset::testing::run_cli;
+using liveset::testing::scratch_dir;
 using liveset::testing::slurp;
 using Result = liveset::testing::CliResult;
 
 namespace fs = std::filesystem;
-
-fs::path scratch_dir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("liveset_bench_cli_" + std::to_string(::getpid()) + "_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
 
 std::vector<std::string> split(const std::string& s, char sep) {
     std::vector<std::string> parts;
@@ -45,7 +39,7 @@ std::vector<std::string> split(const std::string& s, char sep) {
 }  // namespace
 
 TEST(BenchCli, Fig3WritesCsvAndPng) {
-    const fs::path out = scratch_dir("fig3");
+    const fs::path out = scratch_dir("bench_fig3");
     const Result r = run_cli("--threads 2 bench fig3 --steps 40 --lattice 30 --box 14 --verify-every 10 --out " + out.string());
     ASSERT_EQ(r.rc, 0) << r.err << r.out;
     EXPECT_NE(r.out.find("mesh checks"), std::string::npos) << r.out;
@@ -77,7 +71,7 @@ TEST(BenchCli, Fig3WritesCsvAndPng) {
 }
 
 TEST(BenchCli, Fig3RefusesBadArgumentsWithOneLine) {
-    const fs::path base = scratch_dir("bad");
+    const fs::path base = scratch_dir("bench_bad");
     const fs::path file = base / "a-file";
     std::ofstream(file) << "not a directory\n";
     const std::string ok_out = " --out " + (base / "out").string();
@@ -98,7 +92,7 @@ TEST(BenchCli, Fig3RefusesBadArgumentsWithOneLine) {
 // bench soak: a short run on a small phantom passes every invariant and mesh check and logs one
 // line per check; a broken input is refused in one line.
 TEST(BenchCli, SoakChecksTheLevelSetAndTheMeshesAndLogsMemory) {
-    const fs::path dir = scratch_dir("soak");
+    const fs::path dir = scratch_dir("bench_soak");
     ASSERT_EQ(run_cli("phantom --size 48 --quiet --out " + (dir / "ph").string()).rc, 0);
     const std::string common = (dir / "ph" / "truth_gm.nii.gz").string() + " --image " + (dir / "ph" / "t1.nii.gz").string();
     const Result r = run_cli("bench soak " + common + " --iterations 1200 --check-every 400 --json --log " + (dir / "soak.jsonl").string());

@@ -2,13 +2,14 @@
 #pragma once
 
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+
+#include "scratch_dir.hpp"
 
 namespace liveset::testing {
 
@@ -25,8 +26,7 @@ inline std::string slurp(const std::filesystem::path& p) {
 }
 
 inline CliResult run_cli(const std::string& args) {
-    const auto dir = std::filesystem::temp_directory_path() / ("liveset_cli_run_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
+    const auto dir = scratch_dir("cli_run");
     const std::string cmd = std::string(LIVESET_CLI_PATH) + " " + args + " >" + (dir / "out").string() + " 2>" +
                             (dir / "err").string() + " </dev/null";
     const int status = std::system(cmd.c_str());

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "cli_run.hpp"
+#include "scratch_dir.hpp"
 
 using liveset::testing::lines;
 using liveset::testing::run_cli;
@@ -43,8 +44,7 @@ TEST(Cli, FlowReportsAVanishingBoxAsJson) {
 }
 
 TEST(Cli, FlowWritesItsCsvAtomically) {
-    const auto csv = std::filesystem::temp_directory_path() / "liveset_cli_flow.csv";
-    std::filesystem::remove(csv);
+    const auto csv = liveset::testing::scratch_dir("cli_flow") / "flow.csv";
     const Result r = run_cli("flow --lattice 20 --box 8 --quiet --csv " + csv.string());
     ASSERT_EQ(r.rc, 0) << r.err;
     const std::string text = slurp(csv);

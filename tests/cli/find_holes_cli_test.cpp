@@ -10,18 +10,13 @@
 
 #include "cli_run.hpp"
 #include "liveset/io/image_io.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
 
 using testing::run_cli;
-
-std::filesystem::path fresh_dir(const std::string& name) {
-    const auto d = std::filesystem::temp_directory_path() / ("liveset_find_holes_" + name + "_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(d);
-    std::filesystem::create_directories(d);
-    return d;
-}
+using testing::scratch_dir;
 
 double radius(int x, int y, int z) { return std::sqrt((x - 32.0) * (x - 32.0) + (y - 32.0) * (y - 32.0) + (z - 32.0) * (z - 32.0)); }
 bool in_shell(int x, int y, int z) { return radius(x, y, z) > 21 && radius(x, y, z) <= 25; }
@@ -48,7 +43,7 @@ void write_fixture(const std::filesystem::path& dir) {
 }
 
 TEST(FindHolesCli, ClosesTheFindersHolesWithoutGrowingOutOfTheSheet) {
-    const auto dir = fresh_dir("close");
+    const auto dir = scratch_dir("find_holes_close");
     write_fixture(dir);
     const std::string io = (dir / "seg.nii.gz").string() + " --image " + (dir / "t1.nii.gz").string() + " --sheet-lower 75 --sheet-upper 115";
     auto r = run_cli("holes " + io + " --json");
@@ -80,7 +75,7 @@ TEST(FindHolesCli, ClosesTheFindersHolesWithoutGrowingOutOfTheSheet) {
 }
 
 TEST(FindHolesCli, BadCombinationsGetOneLineAndNonZeroExit) {
-    const auto dir = fresh_dir("bad");
+    const auto dir = scratch_dir("find_holes_bad");
     write_fixture(dir);
     const std::string base = "repair " + (dir / "seg.nii.gz").string() + " --image " + (dir / "t1.nii.gz").string() + " --out-mask " +
                              (dir / "x.nii.gz").string();

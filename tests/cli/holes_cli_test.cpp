@@ -11,11 +11,13 @@
 
 #include "cli_run.hpp"
 #include "liveset/io/image_io.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
 
 using testing::run_cli;
+using testing::scratch_dir;
 
 // 64^3: WM 130 (r <= 21), GM 100 (21 < r <= 25), CSF 50; the mask is the GM shell minus a drill of
 // radius 3 along +x from the centre.
@@ -25,8 +27,7 @@ struct Files {
 
 Files write_shell() {
     Files f;
-    f.dir = std::filesystem::temp_directory_path() / ("liveset_holes_cli_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(f.dir);
+    f.dir = scratch_dir("holes_cli");
     const Lattice lat({64, 64, 64});
     Grid<float> image(lat, 50.0f);
     Grid<std::uint8_t> mask(lat, 0);
@@ -108,7 +109,7 @@ TEST(HolesCli, BadInputGetsOneLineAndNonZeroExit) {
 TEST(HolesCli, BrainDemoRepairMeetsTheChecksAgainstTheTruth) {
     const std::filesystem::path data = std::filesystem::path(LIVESET_DATA_DIR) / "brainweb";
     ASSERT_TRUE(std::filesystem::exists(data / "t1.mha")) << "BrainWeb data not found in " << data;
-    const auto dir = std::filesystem::temp_directory_path() / ("liveset_demo_brain_repair_" + std::to_string(::getpid()));
+    const auto dir = scratch_dir("holes_demo_brain_repair") / "out";  // the demo makes its --out folder
     const auto r = run_cli("--threads 2 demo --brain --repair --out " + dir.string() + " --quiet");
     ASSERT_EQ(r.rc, 0) << r.err;
     std::ifstream in(dir / "report.json");

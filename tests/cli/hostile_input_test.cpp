@@ -6,7 +6,6 @@
 // a bounded time and address space, and leaves no output file behind.
 #include <gtest/gtest.h>
 #include <sys/mount.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -19,6 +18,7 @@
 #include "cli/cli_run.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/levelset/shapes.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using namespace liveset;
@@ -39,9 +39,7 @@ constexpr const char* kLimits = "ulimit -v 4000000; ";
 class HostileInput : public ::testing::Test {
 protected:
     static void SetUpTestSuite() {
-        dir_ = fs::temp_directory_path() / ("liveset_hostile_" + std::to_string(::getpid()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
+        dir_ = liveset::testing::scratch_dir("hostile");
         // Good inputs: a 24^3 image with a bright ball, its mask and its φ.
         Grid<float> image(Lattice({24, 24, 24}));
         Grid<std::uint8_t> mask(image.lattice(), 0);

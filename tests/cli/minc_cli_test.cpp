@@ -37,7 +37,7 @@ namespace {
 
 class MincCli : public liveset::testing::MincFolderTest {
 protected:
-    MincCli() : MincFolderTest("liveset_minc_cli_") {}
+    MincCli() : MincFolderTest("minc_cli_") {}
 };
 
 // The phantom's voxels on an oblique lattice whose axes run roughly left-to-right,

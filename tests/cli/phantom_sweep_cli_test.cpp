@@ -10,15 +10,16 @@
 #include <string>
 
 #include "cli_run.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
 
 using testing::run_cli;
+using testing::scratch_dir;
 
 void expect_closed_with_dice_up(int size, int seed) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("liveset_sweep_" + std::to_string(::getpid()) + "_" + std::to_string(size) + "_" + std::to_string(seed));
+    const auto dir = scratch_dir("sweep_" + std::to_string(size) + "_" + std::to_string(seed)) / "out";  // the demo makes its --out folder
     const auto r = run_cli("--threads 1 demo --size " + std::to_string(size) + " --seed " + std::to_string(seed) +
                            " --json --no-view --out " + dir.string());
     std::filesystem::remove_all(dir);

@@ -14,18 +14,13 @@
 #include "liveset/eval/topology.hpp"
 #include "liveset/io/image_io.hpp"
 #include "rod_shell.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
 
 using testing::run_cli;
-
-std::filesystem::path fresh_dir(const std::string& name) {
-    const auto d = std::filesystem::temp_directory_path() / ("liveset_repair_flags_" + name + "_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(d);
-    std::filesystem::create_directories(d);
-    return d;
-}
+using testing::scratch_dir;
 
 std::size_t added_voxels(const std::filesystem::path& before, const std::filesystem::path& after) {
     const Grid<std::uint8_t> a = read_label_image(before.string()), b = read_label_image(after.string());
@@ -40,7 +35,7 @@ std::size_t added_voxels(const std::filesystem::path& before, const std::filesys
 // --band-only raises nothing (nothing outside the mask is in the band), nor does --between-share 0.5
 // (a between voxel must then lie in the band).
 TEST(RepairFlagsCli, BandOnlyLeavesABrightHoleThatTheBetweenTestCloses) {
-    const auto dir = fresh_dir("band");
+    const auto dir = scratch_dir("repair_flags_band");
     const Lattice lat({64, 64, 64});
     Grid<float> image(lat, 50.0f);
     Grid<std::uint8_t> mask(lat, 0);
@@ -77,7 +72,7 @@ TEST(RepairFlagsCli, BandOnlyLeavesABrightHoleThatTheBetweenTestCloses) {
 // 32^3 shell (9 < r <= 12) whose mask took in a one-voxel rod of the core's tissue along x (a
 // handle: genus 1). `--decision cut` aimed at the rod removes rod voxels only and leaves genus 0.
 TEST(RepairFlagsCli, CutRemovesOnlyTheHandle) {
-    const auto dir = fresh_dir("cut");
+    const auto dir = scratch_dir("repair_flags_cut");
     const testing::RodShell c = testing::rod_shell();
     ASSERT_EQ(mask_topology(c.mask).genus, 1);
     write_image(c.image, (dir / "t1.nii.gz").string());
@@ -90,7 +85,7 @@ TEST(RepairFlagsCli, CutRemovesOnlyTheHandle) {
 }
 
 TEST(RepairFlagsCli, BadCombinationsGetOneLineAndNonZeroExit) {
-    const auto dir = fresh_dir("bad");
+    const auto dir = scratch_dir("repair_flags_bad");
     const Lattice lat({16, 16, 16});
     Grid<float> image(lat, 50.0f);
     Grid<std::uint8_t> mask(lat, 0);

@@ -2,8 +2,6 @@
 // the image, the segmentation stays inside it, the report counts it; bad input is one line.
 #include <gtest/gtest.h>
 
-#include <unistd.h>
-
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -13,6 +11,7 @@
 #include "cli_run.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/segment/brain_mask.hpp"
+#include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
 using liveset::testing::lines;
@@ -22,11 +21,7 @@ using namespace liveset;
 namespace {
 
 fs::path work_dir() {
-    static const fs::path dir = [] {
-        const fs::path d = fs::temp_directory_path() / ("liveset_roi_cli_" + std::to_string(::getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
+    static const fs::path dir = liveset::testing::scratch_dir("roi_cli");
     return dir;
 }
 

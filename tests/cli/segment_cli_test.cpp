@@ -24,6 +24,7 @@
 #include "liveset/preprocess/bias_correction.hpp"
 #include "liveset/segment/brain_mask.hpp"
 #include "liveset/segment/intensity.hpp"
+#include "scratch_dir.hpp"
 
 extern char** environ;
 
@@ -37,11 +38,7 @@ using namespace liveset;
 namespace {
 
 fs::path work_dir() {
-    static const fs::path dir = [] {
-        const fs::path d = fs::temp_directory_path() / ("liveset_segment_cli_" + std::to_string(::getpid()));
-        fs::create_directories(d);
-        return d;
-    }();
+    static const fs::path dir = liveset::testing::scratch_dir("segment_cli");
     return dir;
 }
 

@@ -20,6 +20,7 @@
 #include "dicom_writer.hpp"
 #include "liveset/io/image_io.hpp"
 #include "io/minc_tools.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
@@ -34,9 +35,7 @@ protected:
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         std::string name = info->name();  // "Case/param" for parameterised tests
         for (char& c : name) c = (c == '/') ? '_' : c;
-        dir_ = fs::temp_directory_path() / ("liveset_io_" + std::to_string(::getpid()) + "_" + name);
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
+        dir_ = testing::scratch_dir("io_" + name);
     }
     void TearDown() override {
         std::error_code ec;

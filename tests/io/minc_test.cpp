@@ -34,7 +34,7 @@ using testing::rotation;
 // A fresh folder per test; fails the test up front when minc-tools are missing.
 class Minc : public testing::MincFolderTest {
 protected:
-    Minc() : MincFolderTest("liveset_minc_") {}
+    Minc() : MincFolderTest("minc_") {}
 };
 
 

@@ -6,7 +6,6 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -18,6 +17,7 @@
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset::testing {
 
@@ -157,18 +157,15 @@ inline Mat3d rotation(Vec3d a, double deg) {
             a.z * a.x * C - a.y * s, a.z * a.y * C + a.x * s, c + a.z * a.z * C};
 }
 
-// A fresh folder per test (named after `prefix`, the process and the test), removed afterwards
-// unless LIVESET_KEEP is set; fails the test up front when minc-tools are missing.
+// A fresh scratch folder per test (named after `prefix` and the test), removed afterwards unless
+// LIVESET_KEEP is set; fails the test up front when minc-tools are missing.
 class MincFolderTest : public ::testing::Test {
 protected:
     explicit MincFolderTest(std::string prefix) : prefix_(std::move(prefix)) {}
     void SetUp() override {
         const std::string missing = missing_minc_tools();
         ASSERT_TRUE(missing.empty()) << missing;
-        dir_ = std::filesystem::temp_directory_path() /
-               (prefix_ + std::to_string(::getpid()) + "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        std::filesystem::remove_all(dir_);
-        std::filesystem::create_directories(dir_);
+        dir_ = scratch_dir(prefix_ + ::testing::UnitTest::GetInstance()->current_test_info()->name());
     }
     void TearDown() override {
         std::error_code ec;

@@ -9,6 +9,7 @@
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/mesh/mesh_io.hpp"
 #include "mesh/mesh_test_fields.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
@@ -18,10 +19,7 @@ namespace fs = std::filesystem;
 class MeshIo : public ::testing::Test {
 protected:
     void SetUp() override {
-        dir_ = fs::temp_directory_path() /
-               ("liveset_mesh_io_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
+        dir_ = testing::scratch_dir("mesh_io_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
         // 90° rotation about z, anisotropic spacing, offset origin.
         lattice_ = Lattice({20, 18, 16}, {0.5, 0.8, 1.25}, {-10.0, 3.0, 7.5}, Mat3d{0, -1, 0, 1, 0, 0, 0, 0, 1});
         Grid<float> phi = testing::sphere_field({20, 18, 16}, {9.6, 8.7, 7.4}, 5.5);

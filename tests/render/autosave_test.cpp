@@ -20,6 +20,7 @@
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/recovery.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
@@ -36,9 +37,7 @@ struct Fixture {
 const Fixture& fixture() {
     static const Fixture f = [] {
         Fixture x;
-        x.dir = fs::temp_directory_path() / ("liveset_autosave_test_" + std::to_string(::getpid()));
-        fs::remove_all(x.dir);
-        fs::create_directories(x.dir);
+        x.dir = testing::scratch_dir("autosave_test");
         PhantomOptions o;
         o.size = 64;
         const Phantom ph = make_phantom(o);

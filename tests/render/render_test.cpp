@@ -13,6 +13,7 @@
 #include "liveset/render/scene_renderer.hpp"
 #include "liveset/render/surface_buffers.hpp"
 #include "render/render_test_util.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
@@ -158,8 +159,7 @@ TEST(OrbitCamera, NamedViewsLookFromWhereTheySay) {
 }
 
 TEST(PngWriter, WritesAtomicallyAndRoundTrips) {
-    const fs::path dir = fs::temp_directory_path() / ("liveset_png_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
+    const fs::path dir = testing::scratch_dir("png");
     render::Image img{3, 2, {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 1, 2, 3, 255, 4, 5, 6, 255, 7, 8, 9, 255}};
     render::write_png((dir / "a.png").string(), img);
     EXPECT_EQ(render::read_png((dir / "a.png").string()).rgba, img.rgba);

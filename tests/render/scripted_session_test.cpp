@@ -21,6 +21,7 @@
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/render/png_writer.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
@@ -30,11 +31,7 @@ using testing::run_cli;
 using testing::CliResult;
 
 fs::path work_dir() {
-    static const fs::path d = [] {
-        const fs::path p = fs::temp_directory_path() / ("liveset_script_test_" + std::to_string(::getpid()));
-        fs::create_directories(p);
-        return p;
-    }();
+    static const fs::path d = testing::scratch_dir("script_test");
     return d;
 }
 

@@ -17,6 +17,7 @@
 #include "liveset/render/slice_display.hpp"
 #include "liveset/render/slice_renderer.hpp"
 #include "render/render_test_util.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
@@ -226,8 +227,7 @@ TEST(CursorCoordinates, OneBasedVoxelsAndMillimetresRoundTrip) {
 // the RAS millimetres of voxels and aff2axcodes the letters each lattice axis points to.
 TEST(CursorCoordinates, MillimetresAndLettersAgreeWithNibabel) {
     if (std::system("/usr/bin/python3 -c 'import nibabel' >/dev/null 2>&1") != 0) GTEST_SKIP() << "needs /usr/bin/python3 with nibabel";
-    const auto dir = std::filesystem::temp_directory_path() / ("liveset_slice_nib_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
+    const auto dir = testing::scratch_dir("slice_nib");
     const Mat3d d{0, 0, -1, 1, 0, 0, 0, -1, 0};  // i -> +y (P), j -> -z (I), k -> -x (R)
     const Lattice l({7, 9, 5}, {1.5, 0.8, 2.2}, {12.0, -20.5, 33.0}, d);
     write_image(Grid<float>(l, 1.0f), (dir / "img.nii.gz").string());
@@ -261,8 +261,7 @@ TEST(CursorCoordinates, MillimetresAndLettersAgreeWithNibabel) {
 // same letters.
 TEST(EdgeLetters, ReorientedCopiesShowTheSameAnatomy) {
     if (std::system("/usr/bin/python3 -c 'import nibabel' >/dev/null 2>&1") != 0) GTEST_SKIP() << "needs /usr/bin/python3 with nibabel";
-    const auto dir = std::filesystem::temp_directory_path() / ("liveset_slice_reorient_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
+    const auto dir = testing::scratch_dir("slice_reorient");
     const Grid<float>& original = testing::phantom64().image;
     write_image(original, (dir / "lps.nii.gz").string());
     const std::string cmd = "cd " + dir.string() +

@@ -18,6 +18,7 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/window.hpp"
+#include "scratch_dir.hpp"
 #include "workspace.hpp"
 
 namespace liveset {
@@ -36,9 +37,7 @@ struct Fixture {
 const Fixture& fixture() {
     static const Fixture f = [] {
         Fixture x;
-        x.dir = fs::temp_directory_path() / ("liveset_view_workspace_" + std::to_string(::getpid()));
-        fs::remove_all(x.dir);
-        fs::create_directories(x.dir);
+        x.dir = testing::scratch_dir("view_workspace");
         PhantomOptions o;
         o.size = 48;
         x.ph = make_phantom(o);

@@ -16,6 +16,7 @@
 #include "liveset/render/png_writer.hpp"
 #include "liveset/render/slice_geometry.hpp"
 #include "liveset/render/slice_renderer.hpp"
+#include "scratch_dir.hpp"
 #include "session/hole_phantom.hpp"
 
 namespace liveset {
@@ -26,11 +27,7 @@ using testing::run_cli;
 using testing::CliResult;
 
 fs::path work_dir() {
-    static const fs::path d = [] {
-        const fs::path p = fs::temp_directory_path() / ("liveset_viewer_holes_" + std::to_string(::getpid()));
-        fs::create_directories(p);
-        return p;
-    }();
+    static const fs::path d = testing::scratch_dir("viewer_holes");
     return d;
 }
 

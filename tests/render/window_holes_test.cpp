@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "liveset/io/image_io.hpp"
+#include "scratch_dir.hpp"
 #include "session/hole_phantom.hpp"
 
 namespace liveset {
@@ -26,9 +27,7 @@ Vec3i vec(const nlohmann::json& j) { return {j[0].get<int>(), j[1].get<int>(), j
 TEST(WindowHoles, FindHolesThenClickTheFirstRowUnderXvfb) {
     if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
         GTEST_SKIP() << "xvfb-run, xauth and xdotool are needed (scripts/setup.sh installs them)";
-    const fs::path dir = fs::temp_directory_path() / ("liveset_window_holes_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = testing::scratch_dir("window_holes");
     const testing::DrilledPhantom& d = testing::drilled_phantom();
     const std::string image = (dir / "t1.nii.gz").string(), mask = (dir / "drilled.nii.gz").string(), log = (dir / "events.jsonl").string();
     write_image(d.phantom.image, image);

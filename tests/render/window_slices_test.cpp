@@ -17,6 +17,7 @@
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/render/png_writer.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
@@ -33,9 +34,7 @@ std::array<int, 3> rgb_at(const render::Image& img, int x, int y) {
 TEST(WindowSlices, ZoomPanWindowLevelOpacityAndTypedCursorUnderXvfb) {
     if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
         GTEST_SKIP() << "xvfb-run, xauth and xdotool are needed (scripts/setup.sh installs them)";
-    const fs::path dir = fs::temp_directory_path() / ("liveset_window_slices_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = testing::scratch_dir("window_slices");
     PhantomOptions o;
     o.size = 48;
     const Phantom ph = make_phantom(o);

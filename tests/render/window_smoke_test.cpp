@@ -16,6 +16,7 @@
 #include "liveset/levelset/sparse_field.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/recovery.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 namespace {
@@ -27,8 +28,7 @@ bool have(const char* tool) { return std::system((std::string("command -v ") + t
 TEST(WindowSmoke, DragClickKeysAndAButtonUnderXvfb) {
     if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
         GTEST_SKIP() << "xvfb-run, xauth and xdotool are needed (scripts/setup.sh installs them)";
-    const fs::path dir = fs::temp_directory_path() / ("liveset_window_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
+    const fs::path dir = testing::scratch_dir("window");
     PhantomOptions o;
     o.size = 64;
     const Phantom ph = make_phantom(o);
@@ -94,9 +94,7 @@ TEST(WindowSmoke, DragClickKeysAndAButtonUnderXvfb) {
 TEST(WindowSmoke, TheRestoreDialogRestoresUnsavedWorkUnderXvfb) {
     if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
         GTEST_SKIP() << "xvfb-run, xauth and xdotool are needed (scripts/setup.sh installs them)";
-    const fs::path dir = fs::temp_directory_path() / ("liveset_window_recovery_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const fs::path dir = testing::scratch_dir("window_recovery");
     PhantomOptions o;
     o.size = 48;
     const Phantom ph = make_phantom(o);

@@ -13,6 +13,7 @@
 
 #include "cli_common.hpp"
 #include "render/render_test_util.hpp"
+#include "scratch_dir.hpp"
 #include "viewer.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/repair_presets.hpp"
@@ -42,11 +43,7 @@ SessionOptions options() {
 }
 
 fs::path work_dir() {
-    static const fs::path d = [] {
-        const fs::path p = fs::temp_directory_path() / ("liveset_workspace_test_" + std::to_string(::getpid()));
-        fs::create_directories(p);
-        return p;
-    }();
+    static const fs::path d = testing::scratch_dir("workspace_test");
     return d;
 }
 

@@ -3,22 +3,17 @@
 #pragma once
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <bit>
 #include <filesystem>
 #include <string>
 
 #include "liveset/session/recovery.hpp"
+#include "scratch_dir.hpp"
 
 namespace liveset {
 
-inline std::filesystem::path fresh_dir(const std::string& name) {
-    const std::filesystem::path d = std::filesystem::temp_directory_path() / ("liveset_recovery_" + name + "_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(d);
-    std::filesystem::create_directories(d);
-    return d;
-}
+inline std::filesystem::path fresh_dir(const std::string& name) { return testing::scratch_dir("recovery_" + name); }
 
 inline RecoveryState sample_state() {
     const Mat3d flip{-1, 0, 0, 0, 0, 1, 0, 1, 0};
