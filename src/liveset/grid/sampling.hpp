@@ -20,6 +20,21 @@ inline float trilinear(const Grid<float>& g, Vec3d p) {
     const int y0 = std::min(static_cast<int>(y), std::max(d.y - 2, 0));
     const int z0 = std::min(static_cast<int>(z), std::max(d.z - 2, 0));
     const double fx = x - x0, fy = y - y0, fz = z - z0;
+    if (d.x >= 2 && d.y >= 2 && d.z >= 2) {
+        // The cell's 8 corners are inside the lattice: read them directly (the same values, so the
+        // same bits, as the clamped reads below, without 8 clamps and index products).
+        const Lattice& l = g.lattice();
+        const std::size_t sy = l.stride_y(), sz = l.stride_z();
+        const float* v = g.values().data() + l.index({x0, y0, z0});
+        const auto at = [&](std::size_t o) { return static_cast<double>(v[o]); };
+        const double c00 = at(0) * (1 - fx) + at(1) * fx;
+        const double c10 = at(sy) * (1 - fx) + at(sy + 1) * fx;
+        const double c01 = at(sz) * (1 - fx) + at(sz + 1) * fx;
+        const double c11 = at(sy + sz) * (1 - fx) + at(sy + sz + 1) * fx;
+        const double c0 = c00 * (1 - fy) + c10 * fy;
+        const double c1 = c01 * (1 - fy) + c11 * fy;
+        return static_cast<float>(c0 * (1 - fz) + c1 * fz);
+    }
     auto v = [&](int i, int j, int k) { return static_cast<double>(g.clamped({x0 + i, y0 + j, z0 + k})); };
     const double c00 = v(0, 0, 0) * (1 - fx) + v(1, 0, 0) * fx;
     const double c10 = v(0, 1, 0) * (1 - fx) + v(1, 1, 0) * fx;

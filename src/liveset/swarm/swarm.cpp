@@ -60,6 +60,7 @@
 #include <tbb/parallel_for.h>
 
 #include "liveset/grid/digital_topology.hpp"
+#include "liveset/grid/radix_sort.hpp"
 #include "liveset/grid/sampling.hpp"
 
 namespace liveset {
@@ -358,11 +359,13 @@ StepReport Swarm::move(const SparseField& field) {
                 next = clamp_to_box(x + tangential - pull, dims);
             }
             // Off the zero layer: Newton re-projection.
-            if (std::abs(trilinear(phi, next)) > 1.0) {
+            float at_next = trilinear(phi, next);
+            if (std::abs(at_next) > 1.0) {
                 next = project(phi, next, 8);
                 reprojected[i] = 1;
+                at_next = trilinear(phi, next);
             }
-            on_surface[i] = std::abs(trilinear(phi, next)) < 0.5 ? 1 : 0;
+            on_surface[i] = std::abs(at_next) < 0.5 ? 1 : 0;
             agents_[i].position = next;
             agents_[i].velocity = next - x;
         }
@@ -378,12 +381,14 @@ StepReport Swarm::move(const SparseField& field) {
 
 namespace {
 
-// The agents' edits merged per point (summed, clamped to ±0.5), in point order.
+// The agents' edits merged per point (summed in agent order, clamped to ±0.5), in point order.
 std::vector<ZeroLayerEdit> merge_edits(const std::vector<std::vector<ZeroLayerEdit>>& per_agent) {
     std::vector<ZeroLayerEdit> all;
+    std::size_t total = 0;
+    for (const auto& v : per_agent) total += v.size();
+    all.reserve(total);
     for (const auto& v : per_agent) all.insert(all.end(), v.begin(), v.end());
-    std::stable_sort(all.begin(), all.end(),
-                     [](const ZeroLayerEdit& a, const ZeroLayerEdit& b) { return a.point < b.point; });
+    stable_radix_sort(all, [](const ZeroLayerEdit& e) { return e.point; });  // equal points: agent order
     std::vector<ZeroLayerEdit> merged;
     for (std::size_t k = 0; k < all.size();) {
         const PointIndex p = all[k].point;
