@@ -20,9 +20,10 @@ inline float trilinear(const Grid<float>& g, Vec3d p) {
     const int y0 = std::min(static_cast<int>(y), std::max(d.y - 2, 0));
     const int z0 = std::min(static_cast<int>(z), std::max(d.z - 2, 0));
     const double fx = x - x0, fy = y - y0, fz = z - z0;
-    if (d.x >= 2 && d.y >= 2 && d.z >= 2) {
+    if (d.x >= 2 && d.y >= 2 && d.z >= 2 && x0 >= 0 && y0 >= 0 && z0 >= 0) {
         // The cell's 8 corners are inside the lattice: read them directly (the same values, so the
-        // same bits, as the clamped reads below, without 8 clamps and index products).
+        // same bits, as the clamped reads below, without 8 clamps and index products). A position
+        // that is not a number never gets here: it takes the clamped reads, inside the lattice.
         const Lattice& l = g.lattice();
         const std::size_t sy = l.stride_y(), sz = l.stride_z();
         const float* v = g.values().data() + l.index({x0, y0, z0});
