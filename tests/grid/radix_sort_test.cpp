@@ -32,7 +32,8 @@ TEST(RadixSort, GivesStableSortsOrderForEveryKeyWidth) {
                 v[i] = {range == 0xffffffffu ? next() : next() % range, static_cast<std::uint32_t>(i)};
             std::vector<Item> expected = v;
             std::stable_sort(expected.begin(), expected.end(), [](const Item& a, const Item& b) { return a.key < b.key; });
-            stable_radix_sort(v, [](const Item& e) { return e.key; });
+            std::vector<Item> scratch(3, Item{7, 7});  // stale contents must not matter
+            stable_radix_sort(v, [](const Item& e) { return e.key; }, scratch);
             EXPECT_EQ(v, expected) << "range " << range << ", n " << n;
         }
     }

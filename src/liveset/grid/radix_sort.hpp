@@ -9,12 +9,13 @@
 
 namespace liveset {
 
-// Sorts v by key(element) (a std::uint32_t), keeping the input order of equal keys.
+// Sorts v by key(element) (a std::uint32_t), keeping the input order of equal keys; `scratch` is
+// working space (its contents are lost; pass the same vector again to reuse its memory).
 template <class T, class Key>
-void stable_radix_sort(std::vector<T>& v, Key key) {
+void stable_radix_sort(std::vector<T>& v, Key key, std::vector<T>& scratch) {
     std::uint32_t top = 0;
     for (const T& e : v) top |= key(e);
-    std::vector<T> scratch(v.size());
+    scratch.resize(v.size());
     for (int shift = 0; shift < 32 && (top >> shift) != 0; shift += 8) {
         std::array<std::size_t, 257> start{};
         for (const T& e : v) ++start[((key(e) >> shift) & 255u) + 1];

@@ -16,6 +16,7 @@
 #include <string>
 #include <utility>
 
+#include "liveset/grid/radix_sort.hpp"
 #include "liveset/grid/sampling.hpp"
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/layer_value.hpp"
@@ -239,16 +240,7 @@ void sort_indices(std::vector<PointIndex>& v, std::vector<PointIndex>& scratch) 
         std::sort(v.begin(), v.end());
         return;
     }
-    PointIndex top = 0;
-    for (const PointIndex i : v) top |= i;
-    scratch.resize(v.size());
-    for (int shift = 0; shift < 32 && (top >> shift) != 0; shift += 8) {
-        std::size_t count[257] = {};
-        for (const PointIndex i : v) ++count[((i >> shift) & 0xFFu) + 1];
-        for (int b = 0; b < 256; ++b) count[b + 1] += count[b];
-        for (const PointIndex i : v) scratch[count[(i >> shift) & 0xFFu]++] = i;
-        v.swap(scratch);
-    }
+    stable_radix_sort(v, [](PointIndex i) { return i; }, scratch);
 }
 
 }  // namespace

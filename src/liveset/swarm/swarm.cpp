@@ -388,7 +388,8 @@ std::vector<ZeroLayerEdit> merge_edits(const std::vector<std::vector<ZeroLayerEd
     for (const auto& v : per_agent) total += v.size();
     all.reserve(total);
     for (const auto& v : per_agent) all.insert(all.end(), v.begin(), v.end());
-    stable_radix_sort(all, [](const ZeroLayerEdit& e) { return e.point; });  // equal points: agent order
+    std::vector<ZeroLayerEdit> scratch;
+    stable_radix_sort(all, [](const ZeroLayerEdit& e) { return e.point; }, scratch);  // equal points: agent order
     std::vector<ZeroLayerEdit> merged;
     for (std::size_t k = 0; k < all.size();) {
         const PointIndex p = all[k].point;
