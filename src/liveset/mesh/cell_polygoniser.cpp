@@ -13,6 +13,8 @@
 
 namespace liveset {
 
+static_assert(mc::kEdges == 12, "CellPolygoniser::edge_offset_ holds 12 edges");
+
 namespace {
 
 // Edges whose vertex a cell creates when cells are visited in z, y, x order and every crossing cell
@@ -102,6 +104,14 @@ void CellPolygoniser::prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi) {
     px_ = hi.x - lo.x + 1;
     py_ = hi.y - lo.y + 1;
     slice_ = static_cast<std::size_t>(px_) * static_cast<std::size_t>(py_) * 3;
+    const std::size_t row_step = static_cast<std::size_t>(px_) * 3;
+    for (int parity = 0; parity < 2; ++parity)
+        for (std::size_t e = 0; e < mc::kEdgeStarts.size(); ++e) {
+            const mc::EdgeStart& es = mc::kEdgeStarts[e];
+            edge_offset_[static_cast<std::size_t>(parity)][e] =
+                static_cast<std::size_t>(parity ^ es.dz) * slice_ + static_cast<std::size_t>(es.dy) * row_step +
+                static_cast<std::size_t>(es.dx) * 3 + static_cast<std::size_t>(es.axis);
+        }
     const std::size_t need = 2 * slice_;
     if (g_.size() < need) g_.resize(need, 0);  // generation 0 is never current: new entries are unset
     renew_slot(0);
@@ -158,20 +168,18 @@ namespace {
 
 void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& out) {
     const auto& tables = mc::kTables;
-    // G offset of the cell's minimum corner; a corner (dx, dy, dz) adds dx*3 + dy*px*3 and picks the
-    // slot of its z slice.
+    // G offset of the cell's minimum corner; edge e adds edge_offset_[z parity][e] (its corner's
+    // dx*3 + dy*px*3 and the slot of its z slice).
     const std::size_t row = (static_cast<std::size_t>(c.y - lo_.y) * static_cast<std::size_t>(px_) +
                              static_cast<std::size_t>(c.x - lo_.x)) * 3;
-    const std::size_t row_step = static_cast<std::size_t>(px_) * 3;
     const int slot0 = c.z & 1;
+    const std::size_t* offset = edge_offset_[static_cast<std::size_t>(slot0)].data();
     std::uint32_t v[mc::kEdges];
     for (unsigned mask = tables.edges[static_cast<std::size_t>(cs)]; mask != 0; mask &= mask - 1) {
         const int e = std::countr_zero(mask);
         const mc::EdgeStart& es = mc::kEdgeStarts[static_cast<std::size_t>(e)];
         const int slot = slot0 ^ es.dz;
-        const std::size_t gi = static_cast<std::size_t>(slot) * slice_ + row + static_cast<std::size_t>(es.dy) * row_step +
-                               static_cast<std::size_t>(es.dx) * 3 + static_cast<std::size_t>(es.axis);
-        std::uint64_t& entry = g_[gi];
+        std::uint64_t& entry = g_[row + offset[e]];
         if ((entry & 0xFFFF'FFFF'0000'0000ull) == generation_[slot]) {
             v[e] = static_cast<std::uint32_t>(entry);
             continue;
@@ -190,18 +198,14 @@ void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Mesh& out) {
     const auto& tables = mc::kTables;
     const std::size_t row = (static_cast<std::size_t>(c.y - lo_.y) * static_cast<std::size_t>(px_) +
                              static_cast<std::size_t>(c.x - lo_.x)) * 3;
-    const std::size_t row_step = static_cast<std::size_t>(px_) * 3;
-    const int slot0 = c.z & 1;
-    const auto gindex = [&](const mc::EdgeStart& es) {
-        return static_cast<std::size_t>(slot0 ^ es.dz) * slice_ + row + static_cast<std::size_t>(es.dy) * row_step +
-               static_cast<std::size_t>(es.dx) * 3 + static_cast<std::size_t>(es.axis);
-    };
+    const std::size_t* offset = edge_offset_[static_cast<std::size_t>(c.z & 1)].data();
+    std::uint32_t* g = gid_.data() + row;
     const unsigned edges = tables.edges[static_cast<std::size_t>(cs)];
     const unsigned owned = kOwnedEdges[static_cast<std::size_t>((c.x == lo_.x) | (c.y == lo_.y) << 1 | (c.z == lo_.z) << 2)];
     std::uint32_t v[mc::kEdges];
     for (unsigned mask = edges & ~owned; mask != 0; mask &= mask - 1) {  // created by an earlier cell
         const int e = std::countr_zero(mask);
-        v[e] = gid_[gindex(mc::kEdgeStarts[static_cast<std::size_t>(e)])];
+        v[e] = g[offset[e]];
     }
     for (unsigned mask = edges & owned; mask != 0; mask &= mask - 1) {
         const int e = std::countr_zero(mask);
@@ -210,7 +214,7 @@ void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Mesh& out) {
             throw std::length_error("mesh has too many vertices for 32-bit indices");
         const auto id = static_cast<std::uint32_t>(out.vertices.size() + deferred_.size());
         deferred_.push_back({{c.x + es.dx, c.y + es.dy, c.z + es.dz}, es.axis});  // computed by finish_vertices()
-        gid_[gindex(es)] = id;
+        g[offset[e]] = id;
         v[e] = id;
         ++computed_;
     }

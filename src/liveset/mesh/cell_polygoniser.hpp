@@ -141,6 +141,9 @@ private:
     std::size_t sy_ = 0, sz_ = 0;
     int px_ = 0, py_ = 0;
     std::size_t slice_ = 0;  // entries per slice
+    // G entry of edge e of a cell, relative to the cell's row offset, for a cell in an even (0) or
+    // odd (1) z layer: the edge's slice slot, row, x and axis folded into one offset per box.
+    std::array<std::array<std::size_t, 12>, 2> edge_offset_{};
     int layer_ = INT_MIN;    // cell layer z currently being polygonised
     std::size_t computed_ = 0;
     std::size_t cells_ = 0;
