@@ -70,6 +70,16 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
             }
         }
     }
+    if (n > 0) {
+        row_of_ = FastDivider(static_cast<std::uint32_t>(d.x));
+        single_row_.resize(static_cast<std::size_t>(d.y) * static_cast<std::size_t>(d.z));
+        for (int z = 0; z < d.z; ++z)
+            for (int y = 0; y < d.y; ++y) {
+                const std::uint32_t fy = single_[1][static_cast<std::size_t>(y)], fz = single_[2][static_cast<std::size_t>(z)];
+                single_row_[static_cast<std::size_t>(y) + static_cast<std::size_t>(d.y) * static_cast<std::size_t>(z)] =
+                    ((fy | fz) & kSpansFragments) != 0 ? kSpansFragments : fy + fz;
+            }
+    }
     for (FragmentId id = 0; id < n; ++id) {
         Fragment& f = fragments_[id];
         const Vec3i fc = fragment_coord(id);
@@ -256,28 +266,31 @@ std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, st
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, changed.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
         Scratch::Local& local = scratch_->locals.local();
         const std::uint32_t* sx = single_[0].data();
-        const std::uint32_t* sy = single_[1].data();
-        const std::uint32_t* sz = single_[2].data();
+        const std::uint32_t* srow = single_row_.data();
+        const auto nx = static_cast<std::uint32_t>(signs_.dims.x);
+        const std::size_t wpr = signs_.words_per_row;
+        std::uint64_t* words = signs_.words.data();
         FragmentId last = kSpansFragments;  // the fragment flagged for the previous point, if single
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             if (k + 16 < r.end()) __builtin_prefetch(values.data() + changed[k + 16]);  // X is scattered over the lattice
             const PointIndex x = changed[k];
-            const Vec3i p = decode_.coord(x);
-            const std::uint32_t fx = sx[p.x], fy = sy[p.y], fz = sz[p.z];
-            if (((fx | fy | fz) & kSpansFragments) == 0) {  // p and its stencil lie inside one fragment
-                const FragmentId f = fx + fy + fz;
+            const std::uint32_t row = row_of_.divide(x);  // y + dims.y * z
+            const std::uint32_t px = x - row * nx;
+            const std::uint32_t fx = sx[px], fyz = srow[row];
+            if (((fx | fyz) & kSpansFragments) == 0) {  // the point and its stencil lie inside one fragment
+                const FragmentId f = fx + fyz;
                 if (f != last) flag(f, local.flagged);
                 last = f;
             } else {
-                for_each_affected(p, [&](FragmentId f) { flag(f, local.flagged); });
+                for_each_affected(decode_.coord(x), [&](FragmentId f) { flag(f, local.flagged); });
             }
             const bool now = is_inside(values[x]);
-            const std::uint64_t bit = std::uint64_t{1} << (p.x & 63);
-            std::atomic_ref<std::uint64_t> word(signs_.words[signs_.word_of(p)]);
+            const std::uint64_t bit = std::uint64_t{1} << (px & 63);
+            std::atomic_ref<std::uint64_t> word(words[static_cast<std::size_t>(row) * wpr + (px >> 6)]);
             if (((word.load(std::memory_order_relaxed) & bit) != 0) != now) {
                 const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed)
                                               : word.fetch_and(~bit, std::memory_order_relaxed);
-                if (((old & bit) != 0) != now) mark_flipped(p);  // exactly one thread sees the flip
+                if (((old & bit) != 0) != now) mark_flipped(decode_.coord(x));  // exactly one thread sees the flip
             }
         }
     });

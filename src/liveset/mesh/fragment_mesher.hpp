@@ -132,6 +132,11 @@ private:
     // fragment-id stride, or kSpansFragments when the wide range spans two fragments.
     std::array<std::vector<std::uint32_t>, 3> single_;
     static constexpr std::uint32_t kSpansFragments = 0x8000'0000u;
+    // Per point row (y, z), index y + dims.y * z: single_[1][y] + single_[2][z], or kSpansFragments
+    // when either spans; with row_of_ (index / dims.x) a changed point's fragment and sign-bit word
+    // take one division instead of a full decode.
+    std::vector<std::uint32_t> single_row_;
+    FastDivider row_of_;
     std::array<std::vector<int>, 3> cell_fragment_, cell_offset_;  // per axis: cell c -> c / S, c % S
     SignBits signs_;              // is_inside() per lattice point, as last meshed
     bool initialised_ = false;    // signs_ and the row bitmaps are valid
