@@ -17,23 +17,34 @@
 
 namespace liveset::detail {
 
+// layer_value() for a side fixed at compile time: the six neighbours in the order -x, +x, -y, +y,
+// -z, +z, unrolled.
+template <bool Outside, class IsInner>
+[[gnu::always_inline]] inline float layer_value_side(const Grid<float>& phi, const Grid<std::int8_t>& status, PointIndex i,
+                                                     Vec3i c, const IsInner& is_inner) {
+    const Lattice& lat = phi.lattice();
+    const Vec3i d = lat.dims();
+    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    float best = Outside ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+    const auto offer = [&](PointIndex q) {
+        if (!is_inner(status[q])) return;
+        best = Outside ? std::min(best, phi[q] + 1.0f) : std::max(best, phi[q] - 1.0f);
+    };
+    if (c.x != 0) offer(i - 1);
+    if (c.x != d.x - 1) offer(i + 1);
+    if (c.y != 0) offer(i - sy);
+    if (c.y != d.y - 1) offer(i + sy);
+    if (c.z != 0) offer(i - sz);
+    if (c.z != d.z - 1) offer(i + sz);
+    return best;
+}
+
 // Returns ±inf when the point has no neighbour for which is_inner(status) holds. `c` is the
 // lattice coordinate of i (callers in hot loops decode it without division).
 template <class IsInner>
 float layer_value(const Grid<float>& phi, const Grid<std::int8_t>& status, PointIndex i, Vec3i c, bool outside,
                   const IsInner& is_inner) {
-    const Lattice& lat = phi.lattice();
-    const Vec3i d = lat.dims();
-    const PointIndex stride[3] = {1, static_cast<PointIndex>(lat.stride_y()), static_cast<PointIndex>(lat.stride_z())};
-    float best = outside ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
-    for (int a = 0; a < 3; ++a)
-        for (int dir = -1; dir <= 1; dir += 2) {
-            if ((dir < 0 && c[a] == 0) || (dir > 0 && c[a] == d[a] - 1)) continue;
-            const PointIndex q = dir < 0 ? i - stride[a] : i + stride[a];
-            if (!is_inner(status[q])) continue;
-            best = outside ? std::min(best, phi[q] + 1.0f) : std::max(best, phi[q] - 1.0f);
-        }
-    return best;
+    return outside ? layer_value_side<true>(phi, status, i, c, is_inner) : layer_value_side<false>(phi, status, i, c, is_inner);
 }
 
 }  // namespace liveset::detail

@@ -93,9 +93,10 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
 }
 
 float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
+    const Vec3i c = decoder_.coord(i);
+    if (k == 1) return detail::layer_value(phi_, status_, i, c, outside, [](std::int8_t s) { return s == 0 || s == kPendZero; });
     const std::int8_t inner = static_cast<std::int8_t>(outside ? k - 1 : -(k - 1));
-    const auto is_inner = [&](std::int8_t s) { return k == 1 ? (s == 0 || s == kPendZero) : s == inner; };
-    return detail::layer_value(phi_, status_, i, decoder_.coord(i), outside, is_inner);
+    return detail::layer_value(phi_, status_, i, c, outside, [inner](std::int8_t s) { return s == inner; });
 }
 
 // Whitaker's layer rule pushed outwards instead of pulled: every point of level k-1 (final by

@@ -431,7 +431,7 @@ ChangedPoints SparseField::restore(std::span<const PointState> states) {
     return changed;
 }
 
-void SparseField::mark_pending(PointIndex i, std::vector<RegionPoint>& region) {
+[[gnu::always_inline]] inline void SparseField::mark_pending(PointIndex i, std::vector<RegionPoint>& region) {
     const std::int8_t s = status_[i];
     if (is_temp(s)) return;
     region.push_back({i, s, phi_[i]});
@@ -453,6 +453,9 @@ void SparseField::collect_ball(PointIndex seed, std::vector<RegionPoint>& region
 }
 
 void SparseField::collect_band(std::vector<RegionPoint>& region) {
+    // Room for the band and an outer ring as large as the outermost lists (so the region grows
+    // without copying itself on most steps).
+    region.reserve(region.size() + band_size() + layer(-layers_).size() + layer(layers_).size());
     // Marking changes statuses, never the lists, so iterating the lists here is safe.
     for (const auto& list : lists_)
         for (PointIndex i : list) mark_pending(i, region);

@@ -25,12 +25,14 @@ float half_point_normal(const Grid<float>& phi, Vec3i p, int a, int dir) {
 }
 
 // half_point_normal() for points whose whole stencil (±2 along a, ±1 across) is inside the
-// lattice: the same arithmetic in the same order, so bit-identical, without per-read clamping.
-[[gnu::always_inline]] inline float half_point_normal_interior(const float* v, std::size_t i, const std::size_t stride[3], int a, int dir) {
-    const int b = (a + 1) % 3, c = (a + 2) % 3;
-    const std::size_t j = dir > 0 ? i + stride[a] : i - stride[a];
+// lattice: the same arithmetic in the same order, so bit-identical, without per-read clamping; the
+// axis and the direction are compile-time constants, so the three axes unroll.
+template <int A, int Dir>
+[[gnu::always_inline]] inline float half_point_normal_interior(const float* v, std::size_t i, const std::size_t stride[3]) {
+    constexpr int b = (A + 1) % 3, c = (A + 2) % 3;
+    const std::size_t j = Dir > 0 ? i + stride[A] : i - stride[A];
     const std::size_t sb = stride[b], sc = stride[c];
-    const float ga = static_cast<float>(dir) * (v[j] - v[i]);
+    const float ga = static_cast<float>(Dir) * (v[j] - v[i]);
     const float gb = 0.25f * (v[i + sb] + v[j + sb] - v[i - sb] - v[j - sb]);
     const float gc = 0.25f * (v[i + sc] + v[j + sc] - v[i - sc] - v[j - sc]);
     const float len = std::sqrt(ga * ga + gb * gb + gc * gc);
@@ -52,7 +54,9 @@ float mean_curvature(const Grid<float>& phi, Vec3i p) {
         const std::size_t stride[3] = {1, l.stride_y(), l.stride_z()};
         const std::size_t i = l.index(p);
         const float* v = phi.values().data();
-        for (int a = 0; a < 3; ++a) k += half_point_normal_interior(v, i, stride, a, +1) - half_point_normal_interior(v, i, stride, a, -1);
+        k += half_point_normal_interior<0, +1>(v, i, stride) - half_point_normal_interior<0, -1>(v, i, stride);
+        k += half_point_normal_interior<1, +1>(v, i, stride) - half_point_normal_interior<1, -1>(v, i, stride);
+        k += half_point_normal_interior<2, +1>(v, i, stride) - half_point_normal_interior<2, -1>(v, i, stride);
         return k;
     }
     for (int a = 0; a < 3; ++a) k += half_point_normal(phi, p, a, +1) - half_point_normal(phi, p, a, -1);
