@@ -268,8 +268,6 @@ std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, st
         const std::uint32_t* sx = single_[0].data();
         const std::uint32_t* srow = single_row_.data();
         const auto nx = static_cast<std::uint32_t>(signs_.dims.x);
-        const std::size_t wpr = signs_.words_per_row;
-        std::uint64_t* words = signs_.words.data();
         FragmentId last = kSpansFragments;  // the fragment flagged for the previous point, if single
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             if (k + 16 < r.end()) __builtin_prefetch(values.data() + changed[k + 16]);  // X is scattered over the lattice
@@ -286,7 +284,7 @@ std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, st
             }
             const bool now = is_inside(values[x]);
             const std::uint64_t bit = std::uint64_t{1} << (px & 63);
-            std::atomic_ref<std::uint64_t> word(words[static_cast<std::size_t>(row) * wpr + (px >> 6)]);
+            std::atomic_ref<std::uint64_t> word(signs_.words[signs_.word_of(row, px)]);
             if (((word.load(std::memory_order_relaxed) & bit) != 0) != now) {
                 const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed)
                                               : word.fetch_and(~bit, std::memory_order_relaxed);

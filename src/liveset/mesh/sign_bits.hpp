@@ -20,11 +20,8 @@ struct SignBits {
         return words.data() + (static_cast<std::size_t>(y) + static_cast<std::size_t>(dims.y) * static_cast<std::size_t>(z)) *
                                   words_per_row;
     }
-    // Word and bit of point (x, y, z).
-    std::size_t word_of(Vec3i p) const {
-        return (static_cast<std::size_t>(p.y) + static_cast<std::size_t>(dims.y) * static_cast<std::size_t>(p.z)) * words_per_row +
-               (static_cast<std::size_t>(p.x) >> 6);
-    }
+    // Word holding point x of point row `row` (= y + dims.y * z).
+    std::size_t word_of(std::size_t row, std::uint32_t x) const { return row * words_per_row + (static_cast<std::size_t>(x) >> 6); }
 };
 
 // The four point rows around cell row (y, z): corner bit k of a cell = row k>>1 at x + (k & 1).
