@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "liveset/grid/large_page_allocator.hpp"
 #include "liveset/grid/lattice.hpp"
 
 namespace liveset {
@@ -48,7 +49,7 @@ public:
 
 private:
     Lattice lattice_;
-    std::vector<T> data_;
+    std::vector<T, LargePageAllocator<T>> data_;
 };
 
 }  // namespace liveset
