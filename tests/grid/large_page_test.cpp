@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include "liveset/grid/grid.hpp"
@@ -14,9 +13,7 @@ using namespace liveset;
 
 namespace {
 
-constexpr std::uintptr_t kHugePage = std::uintptr_t{2} << 20;
-
-bool huge_page_aligned(const void* p) { return reinterpret_cast<std::uintptr_t>(p) % kHugePage == 0; }
+bool huge_page_aligned(const void* p) { return reinterpret_cast<std::uintptr_t>(p) % detail::kHugePage == 0; }
 
 // The VmFlags of the mapping holding `p` in /proc/self/smaps ("" when not found).
 std::string vm_flags_at(const void* p) {

@@ -11,6 +11,7 @@
 namespace liveset {
 
 namespace detail {
+inline constexpr std::size_t kHugePage = std::size_t{2} << 20;   // the blocks' alignment and granule
 inline constexpr std::size_t kLargeBlock = std::size_t{4} << 20;  // from here on: huge-page blocks
 void* allocate_large(std::size_t bytes);                          // throws std::bad_alloc
 void free_large(void* p) noexcept;
@@ -26,18 +27,18 @@ struct LargePageAllocator {
 
     T* allocate(std::size_t n) {
         if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_array_new_length();
-        if (n * sizeof(T) < detail::kLargeBlock) return std::allocator<T>{}.allocate(n);
+        if (!large(n)) return std::allocator<T>{}.allocate(n);
         return static_cast<T*>(detail::allocate_large(n * sizeof(T)));
     }
     void deallocate(T* p, std::size_t n) noexcept {
-        if (n * sizeof(T) < detail::kLargeBlock) {
-            std::allocator<T>{}.deallocate(p, n);
-            return;
-        }
-        detail::free_large(p);
+        if (large(n)) detail::free_large(p);
+        else std::allocator<T>{}.deallocate(p, n);
     }
     template <class U>
     bool operator==(const LargePageAllocator<U>&) const noexcept { return true; }
+
+private:
+    static bool large(std::size_t n) { return n * sizeof(T) >= detail::kLargeBlock; }
 };
 
 }  // namespace liveset

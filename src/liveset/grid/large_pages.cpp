@@ -10,7 +10,6 @@
 namespace liveset::detail {
 
 void* allocate_large(std::size_t bytes) {
-    constexpr std::size_t kHugePage = std::size_t{2} << 20;
     const std::size_t rounded = (bytes + kHugePage - 1) / kHugePage * kHugePage;
     void* p = std::aligned_alloc(kHugePage, rounded);
     if (p == nullptr) throw std::bad_alloc();
