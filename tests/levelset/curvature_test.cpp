@@ -48,16 +48,8 @@ TEST(Curvature, SpeedRejectsBadWeight) {
     EXPECT_THROW(CurvatureSpeed(NAN), std::invalid_argument);
 }
 
-// The difference-of-normals formula written out with clamped reads everywhere (the reference);
-// mean_curvature's unclamped interior fast path must agree with it bit for bit.
-TEST(Curvature, InteriorFastPathIsBitIdenticalToClampedFormula) {
-    const liveset::Lattice lat({9, 8, 7});
-    liveset::Grid<float> phi(lat);
-    std::uint32_t state = 99;
-    for (float& v : phi.values()) {
-        state = state * 1664525u + 1013904223u;
-        v = static_cast<float>(state >> 8) / static_cast<float>(1u << 24) * 4.0f - 2.0f;
-    }
+namespace {
+void check_fast_path_against_reference(const Grid<float>& phi) {
     const auto reference = [&](liveset::Vec3i p) {
         float k = 0.0f;
         for (int a = 0; a < 3; ++a) {
@@ -85,4 +77,29 @@ TEST(Curvature, InteriorFastPathIsBitIdenticalToClampedFormula) {
                 const float got = liveset::mean_curvature(phi, p), want = reference(p);
                 ASSERT_EQ(std::bit_cast<std::uint32_t>(got), std::bit_cast<std::uint32_t>(want)) << x << "," << y << "," << z;
             }
+}
+}  // namespace
+
+// The difference-of-normals formula written out with clamped, scalar reads everywhere (the
+// reference); mean_curvature's unclamped interior fast path must agree with it bit for
+// bit: on random values, and on plateaus with steps of 1e-7 to 1e-5, where half-point normals
+// are exactly 0 or straddle the 1e-6 length below which a normal counts as 0.
+TEST(Curvature, InteriorFastPathIsBitIdenticalToClampedFormula) {
+    for (const bool plateaus : {false, true}) {
+        SCOPED_TRACE(plateaus ? "plateaus" : "random");
+        const liveset::Lattice lat({9, 8, 7});
+        liveset::Grid<float> phi(lat);
+        std::uint32_t state = 99;
+        for (float& v : phi.values()) {
+            state = state * 1664525u + 1013904223u;
+            const float u = static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
+            if (!plateaus) {
+                v = u * 4.0f - 2.0f;
+            } else {
+                const float steps[] = {0.0f, 0.0f, 0.0f, 1e-7f, 5e-7f, 1e-6f, 2e-6f, 1e-5f};
+                v = 0.5f + steps[(state >> 4) % 8] * (u < 0.5f ? -1.0f : 1.0f);
+            }
+        }
+        check_fast_path_against_reference(phi);
+    }
 }

@@ -100,44 +100,44 @@ float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
 }
 
 // Whitaker's layer rule pushed outwards instead of pulled: every point of level k-1 (final by
-// then) offers φ ± 1 to its pending neighbours on its side, which keep the min (outside) or max
-// (inside). A point is in layer k iff some neighbour is in layer k-1 (the zero layer for k = 1),
-// and min/max are exact and order-free, so this gives the pull rule's bits (inner_layer_value,
-// the invariant checker) while visiting 6 neighbours of each source instead of of every pending
-// point at every level (the pull re-asked the points of outer layers and the ring at each level).
-// Needs the region to hold the whole band (collect_band, init_from_sdf): no final point outside
-// it can be a pending point's inner neighbour. A partial region (unite_in_box) uses the pull.
-void SparseField::sweep_whole_band(std::span<const RegionPoint> region) {
-    const float inf = std::numeric_limits<float>::infinity();
-    std::vector<PointIndex> from;
-    for (const RegionPoint& r : region) {
-        const std::int8_t s = status_[r.point];
-        if (s == kPendZero) from.push_back(r.point);
-        else if (s == kPendPos) phi_[r.point] = inf;  // the old value is in the region record
-        else if (s == kPendNeg) phi_[r.point] = -inf;
-    }
-    // A point takes its layer when first reached; later offers of the same level still count.
-    std::vector<PointIndex> reached;
+// then) offers φ ± 1 to its neighbours on its side that are pending or far, which keep the min
+// (outside) or max (inside). A point is in layer k iff some neighbour is in layer k-1 (the zero
+// layer for k = 1), and min/max are exact and order-free, so this gives the pull rule's bits
+// (inner_layer_value, the invariant checker) while visiting the 6 neighbours of each source
+// instead of those of every pending point at every level (the pull re-asked the points of outer
+// layers at each level). A far point reached joins the region then (its record: far, ±(N+1));
+// one not reached stays as it is, so no ring of far points around the band is collected first.
+// Needs the region to hold the whole band (collect_band, init_from_sdf): no final point outside it
+// can be a pending point's inner neighbour. A partial region (unite_in_box) uses the pull.
+void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero) {
+    const std::int8_t far_out = far_outside(), far_in = far_inside();
+    // A point takes its layer and the first offer when first reached; later offers of the same
+    // level still count. The level lists are kept between steps (cleared, never freed).
+    std::vector<PointIndex>& from = sweep_from_.v;
+    std::vector<PointIndex>& reached = sweep_next_.v;
+    from.assign(zero.begin(), zero.end());
     for (int k = 1; k <= layers_ && !from.empty(); ++k) {
         reached.clear();
         const auto up = static_cast<std::int8_t>(k), down = static_cast<std::int8_t>(-k);
         for (const PointIndex i : from) {
             const float v = phi_[i];
             const bool out = k == 1 || status_[i] > 0, in = k == 1 || status_[i] < 0;
-            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
+            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) __attribute__((always_inline)) {
                 const std::int8_t s = status_[q];
-                if (out && (s == kPendPos || s == up)) {
-                    if (s == kPendPos) {
-                        status_[q] = up;
-                        reached.push_back(q);
-                    }
+                if (out && s == up) {
                     phi_[q] = std::min(phi_[q], v + 1.0f);
-                } else if (in && (s == kPendNeg || s == down)) {
-                    if (s == kPendNeg) {
-                        status_[q] = down;
-                        reached.push_back(q);
-                    }
+                } else if (in && s == down) {
                     phi_[q] = std::max(phi_[q], v - 1.0f);
+                } else if (out && (s == kPendPos || s == far_out)) {
+                    if (s == far_out) region.push_back({q, s, phi_[q]});
+                    status_[q] = up;
+                    phi_[q] = v + 1.0f;
+                    reached.push_back(q);
+                } else if (in && (s == kPendNeg || s == far_in)) {
+                    if (s == far_in) region.push_back({q, s, phi_[q]});
+                    status_[q] = down;
+                    phi_[q] = v - 1.0f;
+                    reached.push_back(q);
                 }
             });
         }
@@ -207,6 +207,7 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
     };
     const float far = static_cast<float>(layers_ + 1);
     auto parts = detail::ordered_chunks<Part>(region.size(), [&](std::size_t b, std::size_t e, Part& out) {
+        out.changed.reserve(e - b);  // most region points change
         for (std::size_t n = b; n < e; ++n) {
             const RegionPoint& r = region[n];
             const PointIndex i = r.point;

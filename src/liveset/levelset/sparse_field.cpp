@@ -147,11 +147,11 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {
             phi_[i] = phi_[i] < 0 ? -far : far;
         }
     }
+    // Every other point is far: the sweep reaches the new layers from the zero layer.
     std::vector<RegionPoint> region;
-    region.reserve(zero.size() * 4);
+    region.reserve(zero.size() * (2 * static_cast<std::size_t>(layers_) + 1));
     for (PointIndex i : zero) mark_pending(i, region);
-    for (PointIndex i : zero) collect_ball(i, region);
-    sweep_whole_band(region);
+    sweep_whole_band(region, zero);
     finish(region);
     sign_changes_.clear();
 }
@@ -368,7 +368,8 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
 
     // 3. The front passes to the neighbours on the other side: an L∓1 neighbour of a leaving point
     //    enters the zero layer with the value implied by the old zero layer's new values.
-    std::vector<RegionPoint> region;
+    std::vector<RegionPoint>& region = region_.v;
+    region.clear();
     for (std::size_t k = 0; k < n; ++k) {
         if (move[k] == 0) continue;
         const std::int8_t from = move[k] > 0 ? std::int8_t{-1} : std::int8_t{1};
@@ -393,13 +394,13 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     }
 
     // 4-5. Outer layers from the new zero layer: a local update re-layers outwards from the
-    //    changed points only (relayer_changes, relayer.cpp); a global one the whole band
-    //    plus its outer ring. 6. Bookkeeping and the change report.
+    //    changed points only (relayer_changes, relayer.cpp); a global one the whole band,
+    //    and the far points it reaches. 6. Bookkeeping and the change report.
     if (scope == RepairScope::kLocal) {
         relayer_changes(region);
     } else {
-        collect_band(region);
-        sweep_whole_band(region);
+        std::vector<PointIndex> zero = collect_band(region);
+        sweep_whole_band(region, zero);
     }
     return finish(region);
 }
@@ -452,20 +453,20 @@ void SparseField::collect_ball(PointIndex seed, std::vector<RegionPoint>& region
     }
 }
 
-void SparseField::collect_band(std::vector<RegionPoint>& region) {
-    // Room for the band and an outer ring as large as the outermost lists (so the region grows
-    // without copying itself on most steps).
+std::vector<PointIndex> SparseField::collect_band(std::vector<RegionPoint>& region) {
+    // Room for the band and as many far points reached as the outermost lists hold (so the
+    // region grows without copying itself on most steps).
     region.reserve(region.size() + band_size() + layer(-layers_).size() + layer(layers_).size());
-    // Marking changes statuses, never the lists, so iterating the lists here is safe.
+    std::vector<PointIndex> zero;  // the new zero layer: every band point now pending on it
+    zero.reserve(layer(0).size() + layer(0).size() / 4);
+    // Marking changes statuses, never the lists, so iterating the lists here is safe. A point
+    // enters the new zero layer only from L0 or L±1, and every list point is visited once.
     for (const auto& list : lists_)
-        for (PointIndex i : list) mark_pending(i, region);
-    for (int side : {-layers_, layers_}) {
-        const std::int8_t far = side > 0 ? far_outside() : far_inside();
-        for (PointIndex i : layer(side))
-            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
-                if (status_[q] == far) mark_pending(q, region);
-            });
-    }
+        for (PointIndex i : list) {
+            mark_pending(i, region);
+            if (status_[i] == kPendZero) zero.push_back(i);
+        }
+    return zero;
 }
 
 ActivitySnapshot SparseField::activity_snapshot(std::uint64_t next_speed_serial) const {

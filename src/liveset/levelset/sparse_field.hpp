@@ -50,7 +50,7 @@ enum class RepairScope {
 
 // How a global step repairs the band (docs/ARCHITECTURE.md, "Incremental step").
 enum class StepMode {
-    kFullBand,     // the reference: re-layers the whole band and its outer ring every step
+    kFullBand,     // the reference: re-layers the whole band every step
     kIncremental,  // re-layers only outwards from what moved (same bits); can let stretches sleep
 };
 
@@ -175,10 +175,13 @@ private:
     // re-evaluating only what a change at the level below can reach; appends what it marks.
     void relayer_changes(std::vector<RegionPoint>& region);  // relayer.cpp, as the sweeps and finish
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
-    void collect_band(std::vector<RegionPoint>& region);
+    // Marks the whole band pending (appending what it marks); returns the new zero layer.
+    std::vector<PointIndex> collect_band(std::vector<RegionPoint>& region);
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
     void sweep_layers(std::span<const RegionPoint> region);       // any region (pull)
-    void sweep_whole_band(std::span<const RegionPoint> region);   // the whole band (push, same bits)
+    // The whole band (push, same bits) from the new zero layer `zero`; appends the
+    // far points it reaches to the region.
+    void sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero);
     float inner_layer_value(PointIndex i, int k, bool outside) const;
     struct ListMove {
         std::size_t region_index;
@@ -203,6 +206,20 @@ private:
     FrontActivity activity_;                    // sleeping stretches of front (kIncremental)
     std::vector<PointIndex> sign_changes_;      // points whose sign of φ the last update changed
     IndexDecoder decoder_;  // division-free index -> coordinate for the hot loops
+    // Working memory of one update, kept so that a global step does not allocate (and fault in)
+    // band-sized buffers every time; not part of the state, so a copy of the field starts empty.
+    template <class T>
+    struct Scratch {
+        std::vector<T> v;
+        Scratch() = default;
+        Scratch(const Scratch&) {}
+        Scratch& operator=(const Scratch&) { return *this; }
+        Scratch(Scratch&&) noexcept = default;
+        Scratch& operator=(Scratch&&) noexcept = default;
+        ~Scratch() = default;
+    };
+    Scratch<RegionPoint> region_;                  // repair_band's region
+    Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
 };
 
 }  // namespace liveset
