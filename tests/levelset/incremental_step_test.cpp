@@ -24,16 +24,24 @@ StepOptions mode(StepMode m) {
     return o;
 }
 
-// Steps `reference` (full band) and `fast` (incremental) side by side; every `edit_every` steps a
-// random local edit is applied to both, and every `undo_every` steps the last step is undone on both
-// with restore(). Fails at the first difference.
+// The incremental step that only propagates changes (never re-layers the whole band), and the
+// default one that re-layers whole when most of a small front moves.
+StepOptions propagating() {
+    StepOptions o = mode(StepMode::kIncremental);
+    o.dense_front_max = 0;
+    return o;
+}
+
+// Steps `reference` (full band) and `fast` (incremental, `fast_options`) side by side; every
+// `edit_every` steps a random local edit is applied to both, and every `undo_every` steps the last
+// step is undone on both with restore(). Fails at the first difference.
 void run_side_by_side(SparseField& reference, SparseField& fast, const Speed& speed, int steps, int edit_every,
-                      int undo_every, std::uint32_t seed) {
+                      int undo_every, std::uint32_t seed, const StepOptions& fast_options = propagating()) {
     std::mt19937 rng(seed);
     for (int s = 1; s <= steps; ++s) {
         const SparseField before = fast;
         const StepResult r = reference.step(speed, mode(StepMode::kFullBand));
-        const StepResult f = fast.step(speed, mode(StepMode::kIncremental));
+        const StepResult f = fast.step(speed, fast_options);
         ASSERT_EQ(r.dt, f.dt) << "step " << s;
         ASSERT_EQ(r.zero_layer, f.zero_layer) << "step " << s;
         ASSERT_TRUE(same_state(reference, fast)) << "step " << s;
@@ -84,6 +92,29 @@ TEST(IncrementalStep, GrowingAndStallingFrontEqualsTheFullBandStepBitwise) {
             SparseField fast = reference;
             const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0, 0.05f, 28);
             run_side_by_side(reference, fast, speed, 300, 9, 17, 9u + static_cast<std::uint32_t>(threads));
+        });
+    }
+}
+
+// The default incremental step switches between whole-band re-layering (most of the front moves)
+// and change propagation (a cap moves, or the front stalls) from step to step: still the
+// reference's bits, reports and invariants.
+TEST(IncrementalStep, SwitchingToTheWholeBandWhenMostOfTheFrontMovesKeepsTheBits) {
+    for (int threads : {1, 2}) {
+        tbb::task_arena arena(threads);
+        arena.execute([&] {
+            SparseField reference = blob_seed();
+            SparseField fast = reference;
+            const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0);
+            run_side_by_side(reference, fast, speed, 300, 7, 23, 15u + static_cast<std::uint32_t>(threads),
+                             mode(StepMode::kIncremental));
+        });
+        arena.execute([&] {
+            SparseField reference = blob_seed(40, 9.0);
+            SparseField fast = reference;
+            const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0, 0.05f, 28);
+            run_side_by_side(reference, fast, speed, 200, 9, 17, 19u + static_cast<std::uint32_t>(threads),
+                             mode(StepMode::kIncremental));
         });
     }
 }

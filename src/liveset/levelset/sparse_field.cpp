@@ -183,6 +183,8 @@ void validate(const StepOptions& o) {
     if (o.mode != StepMode::kFullBand && o.mode != StepMode::kIncremental) throw std::invalid_argument("unknown step mode");
     if (o.sleep_after < 0 || o.sleep_after > 1'000'000)
         throw std::invalid_argument("steps before a still stretch of front sleeps must be in [0, 1000000] (0: never)");
+    if (o.dense_front_max > 1'000'000'000)
+        throw std::invalid_argument("largest front re-layered whole must be at most 1000000000 points (0: never)");
     if (o.sleep_after > 0 && o.mode != StepMode::kIncremental)
         throw std::invalid_argument("sleeping stretches of front need the incremental step (StepMode::kIncremental)");
 }

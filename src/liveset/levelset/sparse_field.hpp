@@ -66,6 +66,12 @@ struct StepOptions {
     // wakes it. 0 (the default) never sleeps: kIncremental is then the full-band step bit for bit.
     // `liveset segment` uses 20 (sleeping_step(), segmentation.hpp). At most 1 000 000.
     int sleep_after = 0;
+    // kIncremental only: when at least 3/4 of a zero layer of at most this many points moves in a
+    // step, the band is re-layered whole (the push sweep) instead of outwards from the changes:
+    // the same bits (local ≡ global), and cheaper there on one thread (docs/BENCHMARKS.md, session
+    // 25; beyond it the propagation's parallel passes pay on two). 0: always propagate. At most
+    // 1 000 000 000.
+    std::size_t dense_front_max = 30'000;
 };
 
 // Throws std::invalid_argument with a one-line message on an option out of range.
