@@ -7,6 +7,8 @@
 
 #include <algorithm>
 #include <random>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "levelset_test_util.hpp"
@@ -35,13 +37,18 @@ StepOptions propagating() {
 // Steps `reference` (full band) and `fast` (incremental, `fast_options`) side by side; every
 // `edit_every` steps a random local edit is applied to both, and every `undo_every` steps the last
 // step is undone on both with restore(). Fails at the first difference.
+// Counts in `whole_band` (when given) the fast steps that re-layered the whole band.
 void run_side_by_side(SparseField& reference, SparseField& fast, const Speed& speed, int steps, int edit_every,
-                      int undo_every, std::uint32_t seed, const StepOptions& fast_options = propagating()) {
+                      int undo_every, std::uint32_t seed, const StepOptions& fast_options = propagating(),
+                      int* whole_band = nullptr) {
     std::mt19937 rng(seed);
     for (int s = 1; s <= steps; ++s) {
         const SparseField before = fast;
         const StepResult r = reference.step(speed, mode(StepMode::kFullBand));
         const StepResult f = fast.step(speed, fast_options);
+        if (whole_band != nullptr && f.whole_band) ++*whole_band;
+        ASSERT_TRUE(r.whole_band) << "step " << s;
+        ASSERT_TRUE(fast_options.dense_front_max > 0 || !f.whole_band) << "step " << s;
         ASSERT_EQ(r.dt, f.dt) << "step " << s;
         ASSERT_EQ(r.zero_layer, f.zero_layer) << "step " << s;
         ASSERT_TRUE(same_state(reference, fast)) << "step " << s;
@@ -76,9 +83,10 @@ SparseField blob_seed(int n = 40, double radius = 4.0) {
 
 TEST(IncrementalStep, GrowingAndStallingFrontEqualsTheFullBandStepBitwise) {
     // Growth from a seed until the front stalls and oscillates at the blob's wavy edge (≈ 60
-    // steps), then hundreds of steps of the stalled regime, with edits and undo in between. Two
-    // cases: the whole front moves (about 2/3 of the zero layer changes each step, so the repair
-    // takes the whole band) and only a cap moves (x ≥ 28, about 1/3: the repair stays local).
+    // steps), then hundreds of steps of the stalled regime, with edits and undo in between, by
+    // change propagation only. Two cases: the whole front moves (about 2/3 of the zero layer
+    // changes each step, so the propagation reaches most of the band) and only a cap moves
+    // (x ≥ 28, about 1/3: the repair stays local).
     for (int threads : {1, 2}) {
         tbb::task_arena arena(threads);
         arena.execute([&] {
@@ -102,21 +110,40 @@ TEST(IncrementalStep, GrowingAndStallingFrontEqualsTheFullBandStepBitwise) {
 TEST(IncrementalStep, SwitchingToTheWholeBandWhenMostOfTheFrontMovesKeepsTheBits) {
     for (int threads : {1, 2}) {
         tbb::task_arena arena(threads);
+        int whole_band = 0;  // of 300 + 200 steps
         arena.execute([&] {
             SparseField reference = blob_seed();
             SparseField fast = reference;
             const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0);
             run_side_by_side(reference, fast, speed, 300, 7, 23, 15u + static_cast<std::uint32_t>(threads),
-                             mode(StepMode::kIncremental));
+                             mode(StepMode::kIncremental), &whole_band);
         });
         arena.execute([&] {
             SparseField reference = blob_seed(40, 9.0);
             SparseField fast = reference;
             const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0, 0.05f, 28);
             run_side_by_side(reference, fast, speed, 200, 9, 17, 19u + static_cast<std::uint32_t>(threads),
-                             mode(StepMode::kIncremental));
+                             mode(StepMode::kIncremental), &whole_band);
         });
+        // Both repairs ran, many times each (the growth is dense, the stalled fronts are not).
+        EXPECT_GE(whole_band, 50) << threads << " threads";
+        EXPECT_LE(whole_band, 450) << threads << " threads";
     }
+}
+
+TEST(IncrementalStep, DenseFrontMaxIsValidated) {
+    StepOptions o = mode(StepMode::kIncremental);
+    o.dense_front_max = 1'000'000'001;
+    try {
+        validate(o);
+        FAIL() << "accepted 1 000 000 001";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("re-layered whole"), std::string::npos) << e.what();
+    }
+    o.dense_front_max = 0;
+    EXPECT_NO_THROW(validate(o));
+    o.dense_front_max = 1'000'000'000;
+    EXPECT_NO_THROW(validate(o));
 }
 
 TEST(IncrementalStep, MeanCurvatureFlowOfTheBoxEqualsTheFullBandStepBitwise) {
@@ -133,25 +160,28 @@ TEST(IncrementalStep, MeanCurvatureFlowOfTheBoxEqualsTheFullBandStepBitwise) {
 }
 
 TEST(IncrementalStep, OneAndTwoThreadsGiveTheSameStateReportsAndListOrder) {
-    auto run = [](int threads, std::vector<std::vector<PointIndex>>& reports) {
-        tbb::task_arena arena(threads);
-        SparseField f = blob_seed();
-        arena.execute([&] {
-            const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0);
-            std::mt19937 rng(3);
-            for (int s = 0; s < 200; ++s) {
-                reports.push_back(f.step(speed, mode(StepMode::kIncremental)).changed.points);
-                if (s % 13 == 0) reports.push_back(f.apply_edits(random_edit(f, rng)).points);
-            }
-        });
-        return f;
-    };
-    std::vector<std::vector<PointIndex>> r1, r2;
-    const SparseField a = run(1, r1);
-    const SparseField b = run(2, r2);
-    EXPECT_TRUE(same_state(a, b));
-    EXPECT_EQ(r1, r2);
-    expect_same_list_order(a, b);
+    // Change propagation only, and the default step (which re-layers the whole band on dense steps).
+    for (const StepOptions& options : {propagating(), mode(StepMode::kIncremental)}) {
+        auto run = [&](int threads, std::vector<std::vector<PointIndex>>& reports) {
+            tbb::task_arena arena(threads);
+            SparseField f = blob_seed();
+            arena.execute([&] {
+                const BlobSpeed speed({19.5, 19.5, 19.5}, 13.0);
+                std::mt19937 rng(3);
+                for (int s = 0; s < 200; ++s) {
+                    reports.push_back(f.step(speed, options).changed.points);
+                    if (s % 13 == 0) reports.push_back(f.apply_edits(random_edit(f, rng)).points);
+                }
+            });
+            return f;
+        };
+        std::vector<std::vector<PointIndex>> r1, r2;
+        const SparseField a = run(1, r1);
+        const SparseField b = run(2, r2);
+        EXPECT_TRUE(same_state(a, b));
+        EXPECT_EQ(r1, r2);
+        expect_same_list_order(a, b);
+    }
 }
 
 // The same with sleeping on a front of several 4 096-point chunks (the rate pass joins per-chunk
@@ -162,7 +192,7 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenSleepingOnAFrontOfSeveralChunks) 
         SparseField f = blob_seed(72, 8.0);
         arena.execute([&] {
             const BlobSpeed speed({35.5, 35.5, 35.5}, 26.0);
-            StepOptions o = mode(StepMode::kIncremental);
+            StepOptions o = propagating();
             o.sleep_after = 5;
             for (int s = 0; s < 160; ++s) {
                 const StepResult r = f.step(speed, o);
@@ -197,7 +227,7 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenManyPointsChangeLayer) {
             for (int s = 1; s <= 40; ++s) {
                 const SparseField before = fast;
                 const StepResult r = reference.step(speed, mode(StepMode::kFullBand));
-                const StepResult f = fast.step(speed, mode(StepMode::kIncremental));
+                const StepResult f = fast.step(speed, propagating());  // the propagation's parallel passes
                 ASSERT_TRUE(same_state(reference, fast)) << "step " << s;
                 ASSERT_EQ(sorted(r.changed.points), sorted(f.changed.points)) << "step " << s;
                 ASSERT_EQ(sorted(f.changed.points), brute_force_changes(before, fast)) << "step " << s;

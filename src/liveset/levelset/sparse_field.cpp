@@ -277,6 +277,7 @@ StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& op
     StepResult result;
     result.zero_layer = zero_layer().size();
     result.awake = result.zero_layer;
+    result.whole_band = true;
     const auto edits = compute_step(speed, options, &result.dt);
     result.changed = commit(edits, RepairScope::kGlobal);
     return result;

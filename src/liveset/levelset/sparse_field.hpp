@@ -51,7 +51,8 @@ enum class RepairScope {
 // How a global step repairs the band (docs/ARCHITECTURE.md, "Incremental step").
 enum class StepMode {
     kFullBand,     // the reference: re-layers the whole band every step
-    kIncremental,  // re-layers only outwards from what moved (same bits); can let stretches sleep
+    kIncremental,  // re-layers outwards from what moved, or the whole band when most of a small
+                   // front moves (same bits either way); can let stretches sleep
 };
 
 struct StepOptions {
@@ -88,6 +89,7 @@ struct StepResult {
     double dt = 0.0;               // time step taken
     std::size_t zero_layer = 0;    // zero-layer size before the step
     std::size_t awake = 0;         // zero-layer points evaluated (all of them unless sleeping)
+    bool whole_band = false;       // the repair re-layered the whole band (kFullBand; a dense kIncremental step)
     ChangedPoints changed;         // points whose φ or status changed
     std::vector<PointIndex> sign_changes;  // the points of `changed` whose sign of φ changed
 };
@@ -129,7 +131,7 @@ public:
     // One global step of ∂φ/∂t = |∇φ| F with a CFL time step (|Δφ| ≤ cfl and the parabolic bound
     // dt ≤ 1/(4·curvature weight), the explicit scheme's stability limit), multithreaded over the
     // zero layer. Both modes give the same φ, statuses and change report (as a set); kIncremental
-    // costs what moved, kFullBand the band.
+    // costs what moved (the band when most of a small front moves), kFullBand the band.
     StepResult step(const Speed& speed, const StepOptions& options = {});
     // The Δφ a global step would apply (one edit per zero-layer point) and its time step.
     std::vector<ZeroLayerEdit> compute_step(const Speed& speed, const StepOptions& options, double* dt) const;
