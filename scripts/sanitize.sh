@@ -76,7 +76,8 @@ case "$mode" in
     # The library's own test programs (atomic file writer, grid, level set, mesher, segmentation, swarm, evaluation,
     # phantom, session, image IO), each run whole in one process; the CLI, viewer and rendering
     # tests (which need the whole sanitized `liveset` binary) run with `asan`.
-    core=(base grid levelset mesh segment swarm eval phantom session io)
+    # Longest first (docs/RELIABILITY.md), so that two at a time finish together.
+    core=(segment levelset swarm session mesh io phantom eval grid base)
     asan_core_skip='BrainWebRepair.*:BrainWeb.WholeBrain*:BrainWeb.SeedsAloneFollow*:PhantomSegmentation.*:Repair.SwarmClosesThePhantomPerforations'
     cmake --preset asan >/dev/null
     cmake --build --preset asan -j "$jobs" --target "${core[@]/%/_tests}"
