@@ -5,8 +5,9 @@ Bins each iteration by the front it started from (ITK: the active layer after th
 iteration; liveset: the zero layer after the previous iteration) and prints the median ms per
 iteration of both programs per bin and their ratio. The first table uses liveset's growth phase
 only (before its zero layer first passes 150 000 points); the second, the fronts above that, where
-liveset's run goes on into convergence and lets still stretches sleep (ITK needs about 900
-iterations to reach them: --iterations 900). A bin one program never reached says so.
+liveset's run goes on into convergence and lets still stretches sleep (ITK's front grows more
+slowly: about 800 iterations to 200 000 points, 1 100 to 250 000, so run it with --iterations 1700).
+A bin one program never reached says so.
 
 Usage: scripts/itk_per_iteration.py ITK_LOG LIVESET_LOG   (both JSON lines, from --log)
 """
