@@ -13,9 +13,30 @@
 #include <cstdint>
 #include <limits>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 #include "liveset/grid/grid.hpp"
 
 namespace liveset::detail {
+
+// std::min(a, b) and std::max(a, b) with their bits, as MINSS / MAXSS where there is SSE (GCC
+// compiles std::min of floats to a branch).
+[[gnu::always_inline]] inline float min_of(float a, float b) {
+#if defined(__SSE2__)
+    return _mm_cvtss_f32(_mm_min_ss(_mm_set_ss(b), _mm_set_ss(a)));  // b < a ? b : a
+#else
+    return std::min(a, b);
+#endif
+}
+[[gnu::always_inline]] inline float max_of(float a, float b) {
+#if defined(__SSE2__)
+    return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(b), _mm_set_ss(a)));  // b > a ? b : a, i.e. a < b ? b : a
+#else
+    return std::max(a, b);
+#endif
+}
 
 // layer_value() for a side fixed at compile time: the six neighbours in the order -x, +x, -y, +y,
 // -z, +z, unrolled.
@@ -25,10 +46,14 @@ template <bool Outside, class IsInner>
     const Lattice& lat = phi.lattice();
     const Vec3i d = lat.dims();
     const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
-    float best = Outside ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+    constexpr float none = Outside ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+    float best = none;
+    // Without a branch on the neighbour's status (unpredictable in a moving band): a neighbour
+    // not in the inner layer offers φ ± ∞ = ±∞, which never wins; φ − 1 is φ + (−1) bit for bit.
+    const float step[2] = {none, Outside ? 1.0f : -1.0f};
     const auto offer = [&](PointIndex q) {
-        if (!is_inner(status[q])) return;
-        best = Outside ? std::min(best, phi[q] + 1.0f) : std::max(best, phi[q] - 1.0f);
+        const float candidate = phi[q] + step[is_inner(status[q]) ? 1 : 0];
+        best = Outside ? min_of(best, candidate) : max_of(best, candidate);
     };
     if (c.x != 0) offer(i - 1);
     if (c.x != d.x - 1) offer(i + 1);

@@ -4,11 +4,13 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numeric>
+
 
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/layer_value.hpp"
@@ -25,6 +27,40 @@ using detail::kPendZero;
 using detail::parallel_range;
 
 bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
+
+// What a neighbour's status makes of an offer in the push sweep, looked up instead of branched on
+// (a band neighbour's status is unpredictable): keep it; keep the min (the same layer, outside) or
+// the max (inside); or claim it (pending or far on the offer's side: it takes the offer). Each is
+// one clamp of the old value to [lo, hi], which gives std::min's and std::max's bits.
+enum SweepAction : std::uint8_t { kKeep, kMin, kMax, kClaimUp, kClaimDown, kClaimUpFar, kClaimDownFar };
+
+// rules[side][status as a byte]: the action (low byte) and the status after it (high byte) at
+// level k; side 0 for an outside source, 1 for an inside one (level 1's zero layer offers both ways).
+using SweepRules = std::array<std::array<std::uint16_t, 256>, 2>;
+
+SweepRules sweep_rules(int k, std::int8_t far_out, std::int8_t far_in) {
+    const auto at = [](std::int8_t s) { return static_cast<std::uint8_t>(s); };
+    const auto up = static_cast<std::int8_t>(k), down = static_cast<std::int8_t>(-k);
+    SweepRules rules{};
+    for (auto& r : rules)
+        for (int s = 0; s < 256; ++s) r[static_cast<std::size_t>(s)] = static_cast<std::uint16_t>(s << 8);
+    const auto set = [&](int side, std::int8_t s, SweepAction x, std::int8_t after) {
+        rules[static_cast<std::size_t>(side)][at(s)] = static_cast<std::uint16_t>(x | (at(after) << 8));
+    };
+    for (int side = 0; side < 2; ++side) {
+        if (side == 0 || k == 1) {
+            set(side, up, kMin, up);
+            set(side, kPendPos, kClaimUp, up);
+            set(side, far_out, kClaimUpFar, up);
+        }
+        if (side == 1 || k == 1) {
+            set(side, down, kMax, down);
+            set(side, kPendNeg, kClaimDown, down);
+            set(side, far_in, kClaimDownFar, down);
+        }
+    }
+    return rules;
+}
 
 }  // namespace
 
@@ -112,36 +148,46 @@ float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
 void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero) {
     const std::int8_t far_out = far_outside(), far_in = far_inside();
     // A point takes its layer and the first offer when first reached; later offers of the same
-    // level still count. The level lists are kept between steps (cleared, never freed).
+    // level still count. The level lists are kept between steps (never shrunk), sized to the most
+    // a level can reach (6 per source) so that a claim is a store and a count.
     std::vector<PointIndex>& from = sweep_from_.v;
     std::vector<PointIndex>& reached = sweep_next_.v;
-    from.assign(zero.begin(), zero.end());
-    for (int k = 1; k <= layers_ && !from.empty(); ++k) {
-        reached.clear();
-        const auto up = static_cast<std::int8_t>(k), down = static_cast<std::int8_t>(-k);
-        for (const PointIndex i : from) {
-            const float v = phi_[i];
-            const bool out = k == 1 || status_[i] > 0, in = k == 1 || status_[i] < 0;
-            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) __attribute__((always_inline)) {
-                const std::int8_t s = status_[q];
-                if (out && s == up) {
-                    phi_[q] = std::min(phi_[q], v + 1.0f);
-                } else if (in && s == down) {
-                    phi_[q] = std::max(phi_[q], v - 1.0f);
-                } else if (out && (s == kPendPos || s == far_out)) {
-                    if (s == far_out) region.push_back({q, s, phi_[q]});
-                    status_[q] = up;
-                    phi_[q] = v + 1.0f;
-                    reached.push_back(q);
-                } else if (in && (s == kPendNeg || s == far_in)) {
-                    if (s == far_in) region.push_back({q, s, phi_[q]});
-                    status_[q] = down;
-                    phi_[q] = v - 1.0f;
-                    reached.push_back(q);
-                }
+    if (from.size() < zero.size()) from.resize(zero.size());
+    std::copy(zero.begin(), zero.end(), from.begin());
+    std::size_t n_from = zero.size();
+    // Raw pointers and copies, read once: a store through std::int8_t (a char type, which may
+    // alias anything) would otherwise make the compiler reload every member after each write.
+    float* const phi = phi_.values().data();
+    std::int8_t* const status = status_.values().data();
+    const Lattice lat = lattice();
+    const IndexDecoder decoder = decoder_;
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    for (int k = 1; k <= layers_ && n_from > 0; ++k) {
+        if (reached.size() < 6 * n_from) reached.resize(6 * n_from);
+        const SweepRules rule = sweep_rules(k, far_out, far_in);
+        std::size_t n_reached = 0;
+        PointIndex* const next = reached.data();
+        for (std::size_t f = 0; f < n_from; ++f) {
+            const PointIndex i = from[f];
+            const float v = phi[i];
+            const float offer_up = v + 1.0f, offer_down = v - 1.0f;
+            // The clamp per SweepAction: keep, min, max, then the claims (near and far) take the offer.
+            const float lo[7] = {-inf, -inf, offer_down, offer_up, offer_down, offer_up, offer_down};
+            const float hi[7] = {inf, offer_up, inf, offer_up, offer_down, offer_up, offer_down};
+            const std::uint16_t* const r = rule[status[i] < 0 ? 1 : 0].data();  // the source's side
+            for_each_neighbor6(lat, decoder, i, [&](PointIndex q) __attribute__((always_inline)) {
+                const std::uint16_t e = r[static_cast<std::uint8_t>(status[q])];
+                const unsigned x = e & 0xFFu;
+                if (x >= kClaimUpFar) [[unlikely]]
+                    region.push_back({q, status[q], phi[q]});
+                phi[q] = detail::max_of(detail::min_of(phi[q], hi[x]), lo[x]);
+                status[q] = static_cast<std::int8_t>(e >> 8);
+                next[n_reached] = q;
+                n_reached += x >= kClaimUp ? 1 : 0;
             });
         }
         from.swap(reached);
+        n_from = n_reached;
     }
 }
 
@@ -206,27 +252,36 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
         std::vector<ListMove> moved;  // the points whose layer changed
     };
     const float far = static_cast<float>(layers_ + 1);
+    const std::int8_t far_out = far_outside(), far_in = far_inside();
+    float* const phi = phi_.values().data();  // raw: see sweep_whole_band
+    std::int8_t* const status = status_.values().data();
     auto parts = detail::ordered_chunks<Part>(region.size(), [&](std::size_t b, std::size_t e, Part& out) {
-        out.changed.reserve(e - b);  // most region points change
+        out.changed.resize(e - b);  // most region points change: a store and a count each
+        PointIndex* const changed = out.changed.data();
+        std::size_t n_changed = 0;
         for (std::size_t n = b; n < e; ++n) {
             const RegionPoint& r = region[n];
             const PointIndex i = r.point;
-            std::int8_t s = status_[i];
+            std::int8_t s = status[i];
+            float v = phi[i];
             if (s == kPendZero) {
                 s = 0;
             } else if (s == kPendPos) {
-                s = far_outside();
-                phi_[i] = far;
+                s = far_out;
+                v = far;
+                phi[i] = v;
             } else if (s == kPendNeg) {
-                s = far_inside();
-                phi_[i] = -far;
+                s = far_in;
+                v = -far;
+                phi[i] = v;
             }
-            status_[i] = s;
+            status[i] = s;
             if (s != r.old_status) out.moved.push_back({n, s});
-            if (s != r.old_status || std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(r.old_phi))
-                out.changed.push_back(i);
-            if ((phi_[i] < 0.0f) != (r.old_phi < 0.0f)) out.signs.push_back(i);
+            changed[n_changed] = i;
+            n_changed += (s != r.old_status || !same_bits(v, r.old_phi)) ? 1 : 0;
+            if ((v < 0.0f) != (r.old_phi < 0.0f)) out.signs.push_back(i);
         }
+        out.changed.resize(n_changed);
     });
     std::vector<ListMove> moved;
     detail::join_parts(parts, &Part::moved, moved);

@@ -464,10 +464,19 @@ std::vector<PointIndex> SparseField::collect_band(std::vector<RegionPoint>& regi
     zero.reserve(layer(0).size() + layer(0).size() / 4);
     // Marking changes statuses, never the lists, so iterating the lists here is safe. A point
     // enters the new zero layer only from L0 or L±1, and every list point is visited once.
+    const float* const phi = phi_.values().data();  // raw: a status store could alias the members
+    std::int8_t* const status = status_.values().data();
     for (const auto& list : lists_)
         for (PointIndex i : list) {
-            mark_pending(i, region);
-            if (status_[i] == kPendZero) zero.push_back(i);
+            const std::int8_t s = status[i];
+            if (s == kPendZero) {  // already marked: a zero-layer point of this update (step 3)
+                zero.push_back(i);
+                continue;
+            }
+            if (is_temp(s)) continue;
+            region.push_back({i, s, phi[i]});
+            status[i] = s == 0 ? kPendZero : (s > 0 ? kPendPos : kPendNeg);
+            if (s == 0) zero.push_back(i);
         }
     return zero;
 }
