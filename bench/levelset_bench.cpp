@@ -1,5 +1,5 @@
-// Level-set benchmarks: the box mean-curvature-flow experiment (ms per step, 1 and 2 threads),
-// local bump updates on spheres of growing lattices (must stay flat), and level-set memory.
+// Level-set benchmarks: the box mean-curvature-flow experiment (ms per step, 1 and 2 threads), the
+// difference-of-normals curvature per zero-layer point, local bump updates on spheres of growing lattices (must stay flat), and level-set memory.
 // Results and the commands that produced them: docs/BENCHMARKS.md.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -9,9 +9,11 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <vector>
 
 #include "liveset/levelset/curvature_flow.hpp"
 #include "liveset/levelset/shapes.hpp"
+#include "liveset/levelset/speed.hpp"
 
 using namespace liveset;
 
@@ -43,6 +45,31 @@ BENCHMARK(BM_BoxFlow)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)->Unit(bench
 
 // A radius-3 Gaussian bump raised or lowered (towards the centre point) on a sphere of radius 0.4·N in N³: each iteration is
 // one local update (edits at the ~30 zero-layer points of the bump + layer repair around them).
+// mean_curvature at every zero-layer point (|φ| ≤ 0.5, lattice order) of a radius-30 sphere's
+// signed distance in 100³: ns per point, the calls independent as in the rate pass.
+void BM_MeanCurvature(benchmark::State& state) {
+    Grid<float> phi(Lattice({100, 100, 100}));
+    const shapes::Sphere sphere({50.0, 50.0, 50.0}, 30.0);
+    std::vector<Vec3i> zero;
+    for (int z = 0; z < 100; ++z)
+        for (int y = 0; y < 100; ++y)
+            for (int x = 0; x < 100; ++x) {
+                const auto v = static_cast<float>(sphere(Vec3d{double(x), double(y), double(z)}));
+                phi({x, y, z}) = v;
+                if (std::abs(v) <= 0.5f) zero.push_back({x, y, z});
+            }
+    std::vector<float> kappa(zero.size());
+    for (auto _ : state) {
+        for (std::size_t n = 0; n < zero.size(); ++n) kappa[n] = mean_curvature(phi, zero[n]);
+        benchmark::DoNotOptimize(kappa.data());
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * zero.size()));
+    state.counters["ns_per_point"] = benchmark::Counter(static_cast<double>(zero.size()),
+                                                        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_MeanCurvature)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
+
 void BM_LocalBump(benchmark::State& state) {
     const int n = static_cast<int>(state.range(0));
     static std::map<int, std::unique_ptr<SparseField>> cache;  // building 512³ takes seconds
