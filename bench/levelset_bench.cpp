@@ -1,5 +1,6 @@
 // Level-set benchmarks: the box mean-curvature-flow experiment (ms per step, 1 and 2 threads), the
-// difference-of-normals curvature per zero-layer point, local bump updates on spheres of growing lattices (must stay flat), and level-set memory.
+// difference-of-normals curvature per zero-layer point, local bump updates on spheres of growing
+// lattices (must stay flat), and level-set memory.
 // Results and the commands that produced them: docs/BENCHMARKS.md.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -43,8 +44,6 @@ void BM_BoxFlow(benchmark::State& state) {
 }
 BENCHMARK(BM_BoxFlow)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// A radius-3 Gaussian bump raised or lowered (towards the centre point) on a sphere of radius 0.4·N in N³: each iteration is
-// one local update (edits at the ~30 zero-layer points of the bump + layer repair around them).
 // mean_curvature at every zero-layer point (|φ| ≤ 0.5, lattice order) of a radius-30 sphere's
 // signed distance in 100³: ns per point, the calls independent as in the rate pass.
 void BM_MeanCurvature(benchmark::State& state) {
@@ -70,6 +69,8 @@ void BM_MeanCurvature(benchmark::State& state) {
 }
 BENCHMARK(BM_MeanCurvature)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
 
+// A radius-3 Gaussian bump raised or lowered (towards the centre point) on a sphere of radius 0.4·N in N³: each iteration is
+// one local update (edits at the ~30 zero-layer points of the bump + layer repair around them).
 void BM_LocalBump(benchmark::State& state) {
     const int n = static_cast<int>(state.range(0));
     static std::map<int, std::unique_ptr<SparseField>> cache;  // building 512³ takes seconds

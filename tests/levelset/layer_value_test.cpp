@@ -1,5 +1,5 @@
 // The outer-layer rule (layer_value.hpp, branch-free with SSE min/max) against the rule written out
-// with branches and std::min / std::max: the same bits on random values, ties and signed zeros.
+// with branches and std::min / std::max: the same bits on random values, ties and zeros.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -37,7 +37,7 @@ TEST(LayerValue, BranchFreeRuleHasTheBitsOfTheWrittenOutRule) {
         state = state * 1664525u + 1013904223u;
         return state >> 8;
     };
-    // Few distinct values, so that ties (equal offers) and ±0 offers (φ = ∓1) are common.
+    // Few distinct values, so that ties (equal offers), zero offers (φ = ∓1) and signed-zero values are common.
     const float values[] = {-1.0f, 1.0f, -0.0f, 0.0f, 0.25f, -0.25f, 1.5f, -1.5f, 3.0f, -3.0f};
     for (int round = 0; round < 20; ++round) {
         for (float& v : phi.values()) v = values[next() % 10];

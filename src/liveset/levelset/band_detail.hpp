@@ -24,6 +24,8 @@ inline constexpr std::int8_t kPendZero = 101;  // on the new zero layer
 inline constexpr std::size_t kParallelMin = 4096;  // below this, loops run serially
 
 inline bool is_temp(std::int8_t s) { return s >= kPendPos || s <= kPendNeg; }
+// The pending code a band point of status s takes when an update marks it.
+inline std::int8_t pending_of(std::int8_t s) { return s == 0 ? kPendZero : (s > 0 ? kPendPos : kPendNeg); }
 
 template <class F>
 void for_each_neighbor6(const Lattice& lat, const IndexDecoder& decode, PointIndex i, F&& f) {

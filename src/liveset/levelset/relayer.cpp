@@ -11,7 +11,6 @@
 #include <limits>
 #include <numeric>
 
-
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/layer_value.hpp"
 #include "liveset/levelset/sparse_field.hpp"

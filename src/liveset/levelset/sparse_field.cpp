@@ -439,7 +439,7 @@ ChangedPoints SparseField::restore(std::span<const PointState> states) {
     const std::int8_t s = status_[i];
     if (is_temp(s)) return;
     region.push_back({i, s, phi_[i]});
-    status_[i] = s == 0 ? kPendZero : (s > 0 ? kPendPos : kPendNeg);
+    status_[i] = detail::pending_of(s);
 }
 
 void SparseField::collect_ball(PointIndex seed, std::vector<RegionPoint>& region) {
@@ -475,7 +475,7 @@ std::vector<PointIndex> SparseField::collect_band(std::vector<RegionPoint>& regi
             }
             if (is_temp(s)) continue;
             region.push_back({i, s, phi[i]});
-            status[i] = s == 0 ? kPendZero : (s > 0 ? kPendPos : kPendNeg);
+            status[i] = detail::pending_of(s);
             if (s == 0) zero.push_back(i);
         }
     return zero;
