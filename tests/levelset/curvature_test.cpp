@@ -1,9 +1,12 @@
 // Mean curvature by difference of normals against analytic shapes: sphere 2/r, cylinder 1/r, plane 0.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 #include "liveset/levelset/shapes.hpp"
 #include "liveset/levelset/speed.hpp"
@@ -70,19 +73,53 @@ void check_fast_path_against_reference(const Grid<float>& phi) {
         }
         return k;
     };
+    // central_gradient's norm, written out with clamped reads (one-sided at the border).
+    const auto reference_gradient_norm = [&](liveset::Vec3i p) {
+        float g[3];
+        for (int a = 0; a < 3; ++a) {
+            liveset::Vec3i lo = p, hi = p;
+            lo[a] = std::max(p[a] - 1, 0);
+            hi[a] = std::min(p[a] + 1, phi.dims()[a] - 1);
+            g[a] = (phi(hi) - phi(lo)) / static_cast<float>(hi[a] - lo[a]);
+        }
+        return std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    };
+    std::vector<liveset::PointIndex> points;
     for (int z = 0; z < 7; ++z)
         for (int y = 0; y < 8; ++y)
             for (int x = 0; x < 9; ++x) {
                 const liveset::Vec3i p{x, y, z};
                 const float got = liveset::mean_curvature(phi, p), want = reference(p);
                 ASSERT_EQ(std::bit_cast<std::uint32_t>(got), std::bit_cast<std::uint32_t>(want)) << x << "," << y << "," << z;
+                points.push_back(phi.lattice().index(p));
             }
+    // The batched form (four stencils per pass), over every point in a scrambled order and over
+    // a count that leaves a partial last batch.
+    for (std::size_t n = 0; n < points.size(); ++n) std::swap(points[n], points[(n * 7919) % points.size()]);
+    points.pop_back();
+    std::vector<liveset::CurvatureAndGradient> batch(points.size());
+    liveset::mean_curvature_and_gradient(phi, points, batch);
+    for (std::size_t n = 0; n < points.size(); ++n) {
+        const liveset::Vec3i p = phi.lattice().coord(points[n]);
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(batch[n].kappa), std::bit_cast<std::uint32_t>(reference(p))) << p.x << "," << p.y << "," << p.z;
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(batch[n].gradient_norm), std::bit_cast<std::uint32_t>(reference_gradient_norm(p)))
+            << p.x << "," << p.y << "," << p.z;
+    }
+    // CurvatureSpeed's batched rates against Speed's formula, sample by sample.
+    const liveset::CurvatureSpeed speed(0.7f);
+    std::vector<double> rates(points.size());
+    speed.rates(phi, points, rates);
+    for (std::size_t n = 0; n < points.size(); ++n) {
+        const liveset::Vec3i p = phi.lattice().coord(points[n]);
+        const double want = liveset::rate_of(speed.at(phi, p), phi, p);
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(rates[n]), std::bit_cast<std::uint64_t>(want)) << p.x << "," << p.y << "," << p.z;
+    }
 }
 }  // namespace
 
 // The difference-of-normals formula written out with clamped, scalar reads everywhere (the
-// reference); mean_curvature's unclamped interior fast path must agree with it bit for
-// bit: on random values, and on plateaus with steps of 1e-7 to 1e-5, where half-point normals
+// reference); mean_curvature's unclamped interior fast path, the batched curvature and central
+// |∇φ|, and CurvatureSpeed's batched rates must agree with it (and rate_of) bit for bit: on random values, and on plateaus with steps of 1e-7 to 1e-5, where half-point normals
 // are exactly 0 or straddle the 1e-6 length below which a normal counts as 0.
 TEST(Curvature, InteriorFastPathIsBitIdenticalToClampedFormula) {
     for (const bool plateaus : {false, true}) {

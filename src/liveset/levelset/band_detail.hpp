@@ -52,21 +52,27 @@ void parallel_range(std::size_t n, F&& f) {
     });
 }
 
+// Runs f(begin, end) over the fixed chunks [c·K, (c+1)·K) of [0, n), in parallel from kParallelMin up.
+inline constexpr std::size_t kChunk = 4096;
+template <class F>
+void for_chunks(std::size_t n, F&& f) {
+    const std::size_t chunks = (n + kChunk - 1) / kChunk;
+    const auto run = [&](std::size_t c) { f(c * kChunk, std::min(n, (c + 1) * kChunk)); };
+    if (n < kParallelMin) {
+        for (std::size_t c = 0; c < chunks; ++c) run(c);
+    } else {
+        tbb::parallel_for(std::size_t{0}, chunks, run);
+    }
+}
+
 // Runs f(begin, end, part) over the fixed chunks [c·K, (c+1)·K) of [0, n), in parallel from
 // kParallelMin up, each chunk appending to its own Part; returns the parts in chunk order. The
 // chunks do not depend on the thread count, so outputs joined in that order are the serial loop's,
 // whatever the scheduling.
 template <class Part, class F>
 std::vector<Part> ordered_chunks(std::size_t n, F&& f) {
-    constexpr std::size_t kChunk = 4096;
-    const std::size_t chunks = (n + kChunk - 1) / kChunk;
-    std::vector<Part> parts(chunks);
-    const auto run = [&](std::size_t c) { f(c * kChunk, std::min(n, (c + 1) * kChunk), parts[c]); };
-    if (n < kParallelMin) {
-        for (std::size_t c = 0; c < chunks; ++c) run(c);
-    } else {
-        tbb::parallel_for(std::size_t{0}, chunks, run);
-    }
+    std::vector<Part> parts((n + kChunk - 1) / kChunk);
+    for_chunks(n, [&](std::size_t b, std::size_t e) { f(b, e, parts[b / kChunk]); });
     return parts;
 }
 

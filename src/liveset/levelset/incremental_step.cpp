@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdint>
 
-#include "liveset/grid/sampling.hpp"
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/sparse_field.hpp"
 
@@ -34,16 +33,14 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
         std::vector<double> rate;
     };
     auto rates = detail::ordered_chunks<Rates>(zero.size(), [&](std::size_t b, std::size_t e, Rates& out) {
+        std::vector<PointIndex> points;
         for (std::size_t n = b; n < e; ++n) {
-            const Vec3i p = decoder_.coord(zero[n]);
-            if (sleep_after > 0 && !activity_.awake(p, steps_, sleep_after)) continue;
-            const SpeedSample s = speed.at(phi_, p);
-            double r = 0.0;
-            if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi_, p, s.propagation);
-            if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi_, p));
+            if (sleep_after > 0 && !activity_.awake(decoder_.coord(zero[n]), steps_, sleep_after)) continue;
             out.at.push_back(static_cast<std::uint32_t>(n));
-            out.rate.push_back(r);
+            points.push_back(zero[n]);
         }
+        out.rate.resize(points.size());
+        speed.rates(phi_, points, out.rate);
     });
     std::vector<std::uint32_t> at;
     std::vector<double> rate;

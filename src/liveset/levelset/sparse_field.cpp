@@ -17,7 +17,6 @@
 #include <utility>
 
 #include "liveset/grid/radix_sort.hpp"
-#include "liveset/grid/sampling.hpp"
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/layer_value.hpp"
 
@@ -192,13 +191,8 @@ void validate(const StepOptions& o) {
 std::vector<double> SparseField::zero_rates(const Speed& speed) const {
     const auto zero = zero_layer();
     std::vector<double> rate(zero.size());
-    parallel_range(zero.size(), [&](std::size_t n) {
-        const Vec3i p = decoder_.coord(zero[n]);
-        const SpeedSample s = speed.at(phi_, p);
-        double r = 0.0;
-        if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi_, p, s.propagation);
-        if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi_, p));
-        rate[n] = r;
+    detail::for_chunks(zero.size(), [&](std::size_t b, std::size_t e) {
+        speed.rates(phi_, zero.subspan(b, e - b), std::span(rate).subspan(b, e - b));
     });
     return rate;
 }

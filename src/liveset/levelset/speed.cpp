@@ -5,9 +5,15 @@
 #include <emmintrin.h>
 #endif
 
+#include <algorithm>
+#include <array>
 #include <atomic>
+#include <cstddef>
 #include <cmath>
 #include <stdexcept>
+
+#include "liveset/grid/index_decoder.hpp"
+#include "liveset/grid/sampling.hpp"
 
 namespace liveset {
 
@@ -44,48 +50,52 @@ template <int A, int Dir>
 }
 
 #if defined(__SSE2__)
-// The six half-point normals of an interior point four lanes at a time (x86-64's baseline SSE2):
-// lanes (x+, x-, y+, y-) and (z+, z-, z+, z-). Each lane does half_point_normal_interior's
-// arithmetic in its order, and SSE's square root and division round exactly as the scalar ones,
-// so the curvature has the same bits; the six square roots and divisions (most of the scalar
-// form's time) become two of each.
-[[gnu::always_inline]] inline __m128 lanes(float a, float b, float c, float e) { return _mm_set_ps(e, c, b, a); }
+// The curvature and the central |∇φ| of four interior points at once, one point per lane (x86-64's
+// baseline SSE2). Each lane does half_point_normal_interior's and central_gradient's arithmetic in
+// their order, and SSE's square root and division round exactly as the scalar ones, so every lane
+// has the single call's bits; four points' chains of square roots and divisions run side by side.
+struct Stencil4 {
+    const float* v;
+    std::ptrdiff_t i[4];
+    // The four points' values at offset o.
+    [[gnu::always_inline]] __m128 at(std::ptrdiff_t o) const { return _mm_set_ps(v[i[3] + o], v[i[2] + o], v[i[1] + o], v[i[0] + o]); }
+};
 
 [[gnu::always_inline]] inline __m128 quarter_difference(__m128 p1, __m128 p2, __m128 m1, __m128 m2) {
     return _mm_mul_ps(_mm_set1_ps(0.25f), _mm_sub_ps(_mm_sub_ps(_mm_add_ps(p1, p2), m1), m2));
 }
 
-[[gnu::always_inline]] inline __m128 unit_normal_lanes(__m128 ga, __m128 gb, __m128 gc) {
-    const __m128 sq = _mm_add_ps(_mm_add_ps(_mm_mul_ps(ga, ga), _mm_mul_ps(gb, gb)), _mm_mul_ps(gc, gc));
-    const __m128 len = _mm_sqrt_ps(sq);
+// The unit normal's component along a from its differences along a (ga) and across (gb, gc).
+[[gnu::always_inline]] inline __m128 unit_normal(__m128 ga, __m128 gb, __m128 gc) {
+    const __m128 len = _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(ga, ga), _mm_mul_ps(gb, gb)), _mm_mul_ps(gc, gc)));
     return _mm_and_ps(_mm_cmpgt_ps(len, _mm_set1_ps(1e-6f)), _mm_div_ps(ga, len));
 }
 
-float interior_curvature_sse2(const float* v, std::size_t i, std::size_t sy, std::size_t sz) {
-    const float c = v[i], xp = v[i + 1], xm = v[i - 1], yp = v[i + sy], ym = v[i - sy], zp = v[i + sz], zm = v[i - sz];
-    const __m128 sign = lanes(1.0f, -1.0f, 1.0f, -1.0f);
-    const __m128 centre = _mm_set1_ps(c);
-    // Lanes x+, x-, y+, y-: the x normals' b and c are y and z, the y normals' are z and x.
-    const __m128 ga_a = _mm_mul_ps(_mm_sub_ps(lanes(xp, xm, yp, ym), centre), sign);
-    const __m128 gb_a = quarter_difference(lanes(yp, yp, zp, zp), lanes(v[i + 1 + sy], v[i - 1 + sy], v[i + sy + sz], v[i - sy + sz]),
-                                           lanes(ym, ym, zm, zm), lanes(v[i + 1 - sy], v[i - 1 - sy], v[i + sy - sz], v[i - sy - sz]));
-    const __m128 gc_a = quarter_difference(lanes(zp, zp, xp, xp), lanes(v[i + 1 + sz], v[i - 1 + sz], v[i + sy + 1], v[i - sy + 1]),
-                                           lanes(zm, zm, xm, xm), lanes(v[i + 1 - sz], v[i - 1 - sz], v[i + sy - 1], v[i - sy - 1]));
-    // Lanes z+, z-, z+, z-: b and c are x and y.
-    const float zpx = v[i + sz + 1], zmx = v[i - sz + 1], zpxm = v[i + sz - 1], zmxm = v[i - sz - 1];
-    const float zpy = v[i + sz + sy], zmy = v[i - sz + sy], zpym = v[i + sz - sy], zmym = v[i - sz - sy];
-    const __m128 ga_b = _mm_mul_ps(_mm_sub_ps(lanes(zp, zm, zp, zm), centre), sign);
-    const __m128 gb_b = quarter_difference(_mm_set1_ps(xp), lanes(zpx, zmx, zpx, zmx), _mm_set1_ps(xm), lanes(zpxm, zmxm, zpxm, zmxm));
-    const __m128 gc_b = quarter_difference(_mm_set1_ps(yp), lanes(zpy, zmy, zpy, zmy), _mm_set1_ps(ym), lanes(zpym, zmym, zpym, zmym));
-    const __m128 n_a = unit_normal_lanes(ga_a, gb_a, gc_a), n_b = unit_normal_lanes(ga_b, gb_b, gc_b);
-    // (+) - (-) per axis: lanes 0 and 2 of n - swap(n).
-    const __m128 d_a = _mm_sub_ps(n_a, _mm_shuffle_ps(n_a, n_a, _MM_SHUFFLE(2, 3, 0, 1)));
-    const __m128 d_b = _mm_sub_ps(n_b, _mm_shuffle_ps(n_b, n_b, _MM_SHUFFLE(2, 3, 0, 1)));
-    float k = 0.0f;
-    k += _mm_cvtss_f32(d_a);
-    k += _mm_cvtss_f32(_mm_movehl_ps(d_a, d_a));
-    k += _mm_cvtss_f32(d_b);
-    return k;
+void curvature_and_gradient4(const Stencil4& st, std::ptrdiff_t sy, std::ptrdiff_t sz, float kappa[4], float gradient_norm[4]) {
+    const __m128 c = st.at(0), xp = st.at(1), xm = st.at(-1), yp = st.at(sy), ym = st.at(-sy), zp = st.at(sz), zm = st.at(-sz);
+    const __m128 xpyp = st.at(1 + sy), xpym = st.at(1 - sy), xmyp = st.at(-1 + sy), xmym = st.at(-1 - sy);
+    const __m128 xpzp = st.at(1 + sz), xpzm = st.at(1 - sz), xmzp = st.at(-1 + sz), xmzm = st.at(-1 - sz);
+    const __m128 ypzp = st.at(sy + sz), ypzm = st.at(sy - sz), ymzp = st.at(-sy + sz), ymzm = st.at(-sy - sz);
+    const __m128 minus = _mm_set1_ps(-1.0f);
+    // Half-point normals along x (across: y, z), y (across: z, x) and z (across: x, y); the minus
+    // side's difference is multiplied by -1 as the scalar form's static_cast<float>(Dir) is.
+    const __m128 nxp = unit_normal(_mm_sub_ps(xp, c), quarter_difference(yp, xpyp, ym, xpym), quarter_difference(zp, xpzp, zm, xpzm));
+    const __m128 nxm = unit_normal(_mm_mul_ps(minus, _mm_sub_ps(xm, c)), quarter_difference(yp, xmyp, ym, xmym),
+                                   quarter_difference(zp, xmzp, zm, xmzm));
+    const __m128 nyp = unit_normal(_mm_sub_ps(yp, c), quarter_difference(zp, ypzp, zm, ypzm), quarter_difference(xp, xpyp, xm, xmyp));
+    const __m128 nym = unit_normal(_mm_mul_ps(minus, _mm_sub_ps(ym, c)), quarter_difference(zp, ymzp, zm, ymzm),
+                                   quarter_difference(xp, xpym, xm, xmym));
+    const __m128 nzp = unit_normal(_mm_sub_ps(zp, c), quarter_difference(xp, xpzp, xm, xmzp), quarter_difference(yp, ypzp, ym, ymzp));
+    const __m128 nzm = unit_normal(_mm_mul_ps(minus, _mm_sub_ps(zm, c)), quarter_difference(xp, xpzm, xm, xmzm),
+                                   quarter_difference(yp, ypzm, ym, ymzm));
+    __m128 k = _mm_setzero_ps();  // the scalar form's k = 0, then += per axis
+    k = _mm_add_ps(k, _mm_sub_ps(nxp, nxm));
+    k = _mm_add_ps(k, _mm_sub_ps(nyp, nym));
+    k = _mm_add_ps(k, _mm_sub_ps(nzp, nzm));
+    _mm_storeu_ps(kappa, k);
+    const __m128 two = _mm_set1_ps(2.0f);
+    const __m128 gx = _mm_div_ps(_mm_sub_ps(xp, xm), two), gy = _mm_div_ps(_mm_sub_ps(yp, ym), two), gz = _mm_div_ps(_mm_sub_ps(zp, zm), two);
+    _mm_storeu_ps(gradient_norm, _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(gx, gx), _mm_mul_ps(gy, gy)), _mm_mul_ps(gz, gz))));
 }
 #endif
 
@@ -104,7 +114,11 @@ float mean_curvature(const Grid<float>& phi, Vec3i p) {
         const std::size_t i = l.index(p);
         const float* v = phi.values().data();
 #if defined(__SSE2__)
-        return interior_curvature_sse2(v, i, l.stride_y(), l.stride_z());
+        const auto at = static_cast<std::ptrdiff_t>(i);
+        float kappa[4], gradient_norm[4];
+        curvature_and_gradient4({v, {at, at, at, at}}, static_cast<std::ptrdiff_t>(l.stride_y()),
+                                static_cast<std::ptrdiff_t>(l.stride_z()), kappa, gradient_norm);
+        return kappa[0];
 #else
         const std::size_t stride[3] = {1, l.stride_y(), l.stride_z()};
         k += half_point_normal_interior<0, +1>(v, i, stride) - half_point_normal_interior<0, -1>(v, i, stride);
@@ -115,6 +129,72 @@ float mean_curvature(const Grid<float>& phi, Vec3i p) {
     }
     for (int a = 0; a < 3; ++a) k += half_point_normal(phi, p, a, +1) - half_point_normal(phi, p, a, -1);
     return k;
+}
+
+void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIndex> points, std::span<CurvatureAndGradient> out) {
+    if (out.size() != points.size()) throw std::invalid_argument("mean_curvature_and_gradient: output size differs from the points'");
+    const Lattice& l = phi.lattice();
+    const IndexDecoder decoder(l);
+    const Vec3i d = l.dims();
+#if defined(__SSE2__)
+    const auto sy = static_cast<std::ptrdiff_t>(l.stride_y()), sz = static_cast<std::ptrdiff_t>(l.stride_z());
+    Stencil4 st{phi.values().data(), {}};
+    std::size_t slot[4];  // where each filled lane's result goes
+    int filled = 0;
+    const auto flush = [&] {
+        for (int k = filled; k < 4; ++k) st.i[k] = st.i[0];  // a partial batch repeats its first point
+        float kappa[4], gradient_norm[4];
+        curvature_and_gradient4(st, sy, sz, kappa, gradient_norm);
+        for (int k = 0; k < filled; ++k) out[slot[k]] = {kappa[k], gradient_norm[k]};
+        filled = 0;
+    };
+#endif
+    for (std::size_t n = 0; n < points.size(); ++n) {
+        const Vec3i p = decoder.coord(points[n]);
+#if defined(__SSE2__)
+        if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x <= d.x - 2 && p.y <= d.y - 2 && p.z <= d.z - 2) {
+            st.i[filled] = static_cast<std::ptrdiff_t>(points[n]);
+            slot[filled++] = n;
+            if (filled == 4) flush();
+            continue;
+        }
+#endif
+        out[n] = {mean_curvature(phi, p), norm(central_gradient(phi, p))};
+    }
+#if defined(__SSE2__)
+    if (filled > 0) flush();
+#endif
+}
+
+double rate_of(SpeedSample s, const Grid<float>& phi, Vec3i p) {
+    double r = 0.0;
+    if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi, p, s.propagation);
+    if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi, p));
+    return r;
+}
+
+void Speed::rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const {
+    if (out.size() != points.size()) throw std::invalid_argument("Speed::rates: output size differs from the points'");
+    const IndexDecoder decoder(phi.lattice());
+    for (std::size_t n = 0; n < points.size(); ++n) {
+        const Vec3i p = decoder.coord(points[n]);
+        out[n] = rate_of(at(phi, p), phi, p);
+    }
+}
+
+void CurvatureSpeed::rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const {
+    if (out.size() != points.size()) throw std::invalid_argument("Speed::rates: output size differs from the points'");
+    std::array<CurvatureAndGradient, 256> batch;
+    for (std::size_t b = 0; b < points.size(); b += batch.size()) {
+        const std::size_t m = std::min(batch.size(), points.size() - b);
+        mean_curvature_and_gradient(phi, points.subspan(b, m), std::span(batch).first(m));
+        for (std::size_t k = 0; k < m; ++k) {
+            const float curvature = weight_ * batch[k].kappa;  // at()'s curvature part
+            double r = 0.0;  // rate_of's sum (0.0 + x makes a -0.0 +0.0, as there)
+            if (curvature != 0.0f) r += static_cast<double>(curvature) * batch[k].gradient_norm;
+            out[b + k] = r;
+        }
+    }
 }
 
 CurvatureSpeed::CurvatureSpeed(float weight) : weight_(weight) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
 #include "liveset/grid/grid.hpp"
 
@@ -29,6 +30,11 @@ public:
     std::uint64_t serial() const { return serial_; }
     // F at zero-layer point p. Must be thread-safe (called concurrently) and deterministic.
     virtual SpeedSample at(const Grid<float>& phi, Vec3i p) const = 0;
+    // The rate |∇φ|·F (what a step multiplies by dt) at each zero-layer point of `points` (lattice
+    // indices) into `out`, of the same size: at()'s propagation part times the Godunov upwind |∇φ|
+    // plus its curvature part times the central |∇φ|, in double (rate_of). A speed may override
+    // it with a faster form of exactly these bits (a batched curvature). Thread-safe like at().
+    virtual void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const;
     // Upper bound of the coefficient w in the curvature part w·κ, for the parabolic time-step
     // bound dt ≤ 1/(4w). Zero when the speed has no curvature part.
     virtual float curvature_weight() const = 0;
@@ -43,6 +49,17 @@ private:
 // differences along a and averaged central differences across, then κ = Σ_a (n_a(p+½e_a) − n_a(p−½e_a)).
 float mean_curvature(const Grid<float>& phi, Vec3i p);
 
+// mean_curvature() and the norm of central_gradient() at each of `points` into `out` (the same
+// size), four interior stencils at a time: the same bits as the single calls.
+struct CurvatureAndGradient {
+    float kappa;
+    float gradient_norm;
+};
+void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIndex> points, std::span<CurvatureAndGradient> out);
+
+// Speed::rate's formula for a sample `s` taken at p.
+double rate_of(SpeedSample s, const Grid<float>& phi, Vec3i p);
+
 // F = weight · κ: mean curvature flow (the paper's Figure 3 experiment).
 class CurvatureSpeed final : public Speed {
 public:
@@ -50,6 +67,7 @@ public:
     SpeedSample at(const Grid<float>& phi, Vec3i p) const override {
         return {0.0f, weight_ * mean_curvature(phi, p)};
     }
+    void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;
     float curvature_weight() const override { return weight_; }
 
 private:

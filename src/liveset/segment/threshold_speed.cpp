@@ -1,12 +1,17 @@
 // Threshold speed (paper Eq. 2-3), tabulated per voxel.
 #include "liveset/segment/threshold_speed.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "liveset/grid/index_decoder.hpp"
+#include "liveset/grid/sampling.hpp"
 
 namespace liveset {
 
@@ -55,6 +60,27 @@ SpeedSample ThresholdSpeed::at(const Grid<float>& phi, Vec3i p) const {
     const PointIndex i = phi.lattice().index(p);
     if (roi_ && (*roi_)[i] == 0) return {propagation_[i], 0.0f};
     return {propagation_[i], curvature_weight() * mean_curvature(phi, p)};
+}
+
+// rate_of(at(phi, p), phi, p) at each point, the curvature and the central |∇φ| batched.
+void ThresholdSpeed::rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const {
+    if (out.size() != points.size()) throw std::invalid_argument("Speed::rates: output size differs from the points'");
+    const IndexDecoder decoder(phi.lattice());
+    const float weight = curvature_weight();
+    std::array<CurvatureAndGradient, 256> batch;
+    for (std::size_t b = 0; b < points.size(); b += batch.size()) {
+        const std::size_t m = std::min(batch.size(), points.size() - b);
+        mean_curvature_and_gradient(phi, points.subspan(b, m), std::span(batch).first(m));
+        for (std::size_t k = 0; k < m; ++k) {
+            const PointIndex i = points[b + k];
+            const float propagation = propagation_[i];
+            double r = 0.0;
+            if (propagation != 0.0f) r += static_cast<double>(propagation) * upwind_gradient_norm(phi, decoder.coord(i), propagation);
+            const float curvature = roi_ && (*roi_)[i] == 0 ? 0.0f : weight * batch[k].kappa;
+            if (curvature != 0.0f) r += static_cast<double>(curvature) * batch[k].gradient_norm;
+            out[b + k] = r;
+        }
+    }
 }
 
 }  // namespace liveset

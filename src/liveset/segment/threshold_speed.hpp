@@ -38,6 +38,7 @@ public:
     ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi = nullptr);
 
     SpeedSample at(const Grid<float>& phi, Vec3i p) const override;
+    void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;
     float curvature_weight() const override { return static_cast<float>(0.5 * params_.alpha); }
 
     const ThresholdParams& params() const { return params_; }
