@@ -1,5 +1,5 @@
 // Level-set benchmarks: the box mean-curvature-flow experiment (ms per step, 1 and 2 threads), the
-// difference-of-normals curvature per zero-layer point, local bump updates on spheres of growing
+// difference-of-normals curvature per zero-layer point (single and batched), local bump updates on spheres of growing
 // lattices (must stay flat), and level-set memory.
 // Results and the commands that produced them: docs/BENCHMARKS.md.
 #include <benchmark/benchmark.h>
@@ -45,7 +45,7 @@ void BM_BoxFlow(benchmark::State& state) {
 BENCHMARK(BM_BoxFlow)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // mean_curvature at every zero-layer point (|φ| ≤ 0.5, lattice order) of a radius-30 sphere's
-// signed distance in 100³: ns per point, the calls independent as in the rate pass.
+// signed distance in 100³: ns per point, one call at a time (a speed's at(); steps use the batch below).
 void BM_MeanCurvature(benchmark::State& state) {
     Grid<float> phi(Lattice({100, 100, 100}));
     const shapes::Sphere sphere({50.0, 50.0, 50.0}, 30.0);
@@ -68,6 +68,32 @@ void BM_MeanCurvature(benchmark::State& state) {
                                                         benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_MeanCurvature)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
+
+// The same points through the batched form a step uses (Speed::rates): the curvature and the
+// central |∇φ| of four stencils per SSE2 pass, from lattice indices.
+void BM_CurvatureAndGradientBatched(benchmark::State& state) {
+    const Lattice lat({100, 100, 100});
+    Grid<float> phi(lat);
+    const shapes::Sphere sphere({50.0, 50.0, 50.0}, 30.0);
+    std::vector<PointIndex> zero;
+    for (int z = 0; z < 100; ++z)
+        for (int y = 0; y < 100; ++y)
+            for (int x = 0; x < 100; ++x) {
+                const auto v = static_cast<float>(sphere(Vec3d{double(x), double(y), double(z)}));
+                phi({x, y, z}) = v;
+                if (std::abs(v) <= 0.5f) zero.push_back(lat.index({x, y, z}));
+            }
+    std::vector<CurvatureAndGradient> out(zero.size());
+    for (auto _ : state) {
+        mean_curvature_and_gradient(phi, zero, out);
+        benchmark::DoNotOptimize(out.data());
+        benchmark::ClobberMemory();
+    }
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * zero.size()));
+    state.counters["ns_per_point"] = benchmark::Counter(static_cast<double>(zero.size()),
+                                                        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_CurvatureAndGradientBatched)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
 
 // A radius-3 Gaussian bump raised or lowered (towards the centre point) on a sphere of radius 0.4·N in N³: each iteration is
 // one local update (edits at the ~30 zero-layer points of the bump + layer repair around them).

@@ -263,18 +263,22 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
             const PointIndex i = r.point;
             std::int8_t s = status[i];
             float v = phi[i];
+            // Only a pending status is written: the sweeps left every other one final, and a
+            // store to a line another chunk's points share would make the cores fight over it.
             if (s == kPendZero) {
                 s = 0;
+                status[i] = s;
             } else if (s == kPendPos) {
                 s = far_out;
                 v = far;
+                status[i] = s;
                 phi[i] = v;
             } else if (s == kPendNeg) {
                 s = far_in;
                 v = -far;
+                status[i] = s;
                 phi[i] = v;
             }
-            status[i] = s;
             if (s != r.old_status) out.moved.push_back({n, s});
             changed[n_changed] = i;
             n_changed += (s != r.old_status || !same_bits(v, r.old_phi)) ? 1 : 0;

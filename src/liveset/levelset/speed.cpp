@@ -61,6 +61,13 @@ struct Stencil4 {
     [[gnu::always_inline]] __m128 at(std::ptrdiff_t o) const { return _mm_set_ps(v[i[3] + o], v[i[2] + o], v[i[1] + o], v[i[0] + o]); }
 };
 
+// One point in every lane (a single call): one load per value.
+struct Stencil1 {
+    const float* v;
+    std::ptrdiff_t i;
+    [[gnu::always_inline]] __m128 at(std::ptrdiff_t o) const { return _mm_set1_ps(v[i + o]); }
+};
+
 [[gnu::always_inline]] inline __m128 quarter_difference(__m128 p1, __m128 p2, __m128 m1, __m128 m2) {
     return _mm_mul_ps(_mm_set1_ps(0.25f), _mm_sub_ps(_mm_sub_ps(_mm_add_ps(p1, p2), m1), m2));
 }
@@ -71,7 +78,8 @@ struct Stencil4 {
     return _mm_and_ps(_mm_cmpgt_ps(len, _mm_set1_ps(1e-6f)), _mm_div_ps(ga, len));
 }
 
-void curvature_and_gradient4(const Stencil4& st, std::ptrdiff_t sy, std::ptrdiff_t sz, float kappa[4], float gradient_norm[4]) {
+template <class Stencil>
+[[gnu::always_inline]] inline void curvature_and_gradient4(const Stencil& st, std::ptrdiff_t sy, std::ptrdiff_t sz, float kappa[4], float gradient_norm[4]) {
     const __m128 c = st.at(0), xp = st.at(1), xm = st.at(-1), yp = st.at(sy), ym = st.at(-sy), zp = st.at(sz), zm = st.at(-sz);
     const __m128 xpyp = st.at(1 + sy), xpym = st.at(1 - sy), xmyp = st.at(-1 + sy), xmym = st.at(-1 - sy);
     const __m128 xpzp = st.at(1 + sz), xpzm = st.at(1 - sz), xmzp = st.at(-1 + sz), xmzm = st.at(-1 - sz);
@@ -116,7 +124,7 @@ float mean_curvature(const Grid<float>& phi, Vec3i p) {
 #if defined(__SSE2__)
         const auto at = static_cast<std::ptrdiff_t>(i);
         float kappa[4], gradient_norm[4];
-        curvature_and_gradient4({v, {at, at, at, at}}, static_cast<std::ptrdiff_t>(l.stride_y()),
+        curvature_and_gradient4(Stencil1{v, at}, static_cast<std::ptrdiff_t>(l.stride_y()),
                                 static_cast<std::ptrdiff_t>(l.stride_z()), kappa, gradient_norm);
         return kappa[0];
 #else
