@@ -68,15 +68,23 @@ void ThresholdSpeed::rates(const Grid<float>& phi, std::span<const PointIndex> p
     const IndexDecoder decoder(phi.lattice());
     const float weight = curvature_weight();
     std::array<CurvatureAndGradient, 256> batch;
+    std::array<float, 256> propagation;
+    std::array<bool, 256> curved;
     for (std::size_t b = 0; b < points.size(); b += batch.size()) {
         const std::size_t m = std::min(batch.size(), points.size() - b);
+        // The per-voxel tables first, in a loop of independent loads: their cache misses (a
+        // brain's tables are tens of MB) overlap instead of waiting one by one in the loop below.
+        for (std::size_t k = 0; k < m; ++k) {
+            propagation[k] = propagation_[points[b + k]];
+            curved[k] = roi_ == nullptr || (*roi_)[points[b + k]] != 0;
+        }
         mean_curvature_and_gradient(phi, points.subspan(b, m), std::span(batch).first(m));
         for (std::size_t k = 0; k < m; ++k) {
             const PointIndex i = points[b + k];
-            const float propagation = propagation_[i];
             double r = 0.0;
-            if (propagation != 0.0f) r += static_cast<double>(propagation) * upwind_gradient_norm(phi, decoder.coord(i), propagation);
-            const float curvature = roi_ && (*roi_)[i] == 0 ? 0.0f : weight * batch[k].kappa;
+            if (propagation[k] != 0.0f)
+                r += static_cast<double>(propagation[k]) * upwind_gradient_norm(phi, decoder.coord(i), propagation[k]);
+            const float curvature = curved[k] ? weight * batch[k].kappa : 0.0f;
             if (curvature != 0.0f) r += static_cast<double>(curvature) * batch[k].gradient_norm;
             out[b + k] = r;
         }
