@@ -143,7 +143,7 @@ void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIn
     if (out.size() != points.size()) throw std::invalid_argument("mean_curvature_and_gradient: output size differs from the points'");
     const Lattice& l = phi.lattice();
     const IndexDecoder decoder(l);
-    const Vec3i d = l.dims();
+    [[maybe_unused]] const Vec3i d = l.dims();  // the interior test of the SSE2 batch
 #if defined(__SSE2__)
     const auto sy = static_cast<std::ptrdiff_t>(l.stride_y()), sz = static_cast<std::ptrdiff_t>(l.stride_z());
     Stencil4 st{phi.values().data(), {}};
