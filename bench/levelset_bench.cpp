@@ -44,54 +44,55 @@ void BM_BoxFlow(benchmark::State& state) {
 }
 BENCHMARK(BM_BoxFlow)->Arg(1)->Arg(2)->Iterations(1)->Repetitions(3)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// mean_curvature at every zero-layer point (|φ| ≤ 0.5, lattice order) of a radius-30 sphere's
-// signed distance in 100³: ns per point, one call at a time (a speed's at(); steps use the batch below).
+// A radius-30 sphere's signed distance in 100³ and its zero-layer points (|φ| ≤ 0.5), lattice order.
+struct SphereZeroLayer {
+    Grid<float> phi{Lattice({100, 100, 100})};
+    std::vector<PointIndex> zero;
+    SphereZeroLayer() {
+        const shapes::Sphere sphere({50.0, 50.0, 50.0}, 30.0);
+        for (int z = 0; z < 100; ++z)
+            for (int y = 0; y < 100; ++y)
+                for (int x = 0; x < 100; ++x) {
+                    const auto v = static_cast<float>(sphere(Vec3d{double(x), double(y), double(z)}));
+                    phi({x, y, z}) = v;
+                    if (std::abs(v) <= 0.5f) zero.push_back(phi.lattice().index({x, y, z}));
+                }
+    }
+};
+
+void count_per_point(benchmark::State& state, std::size_t points) {
+    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * points));
+    state.counters["ns_per_point"] = benchmark::Counter(static_cast<double>(points),
+                                                        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+
+// mean_curvature at every zero-layer point of the sphere: ns per point, one call at a time (a
+// speed's at(); steps use the batch below), the calls independent.
 void BM_MeanCurvature(benchmark::State& state) {
-    Grid<float> phi(Lattice({100, 100, 100}));
-    const shapes::Sphere sphere({50.0, 50.0, 50.0}, 30.0);
+    const SphereZeroLayer s;
     std::vector<Vec3i> zero;
-    for (int z = 0; z < 100; ++z)
-        for (int y = 0; y < 100; ++y)
-            for (int x = 0; x < 100; ++x) {
-                const auto v = static_cast<float>(sphere(Vec3d{double(x), double(y), double(z)}));
-                phi({x, y, z}) = v;
-                if (std::abs(v) <= 0.5f) zero.push_back({x, y, z});
-            }
+    for (const PointIndex i : s.zero) zero.push_back(s.phi.lattice().coord(i));
     std::vector<float> kappa(zero.size());
     for (auto _ : state) {
-        for (std::size_t n = 0; n < zero.size(); ++n) kappa[n] = mean_curvature(phi, zero[n]);
+        for (std::size_t n = 0; n < zero.size(); ++n) kappa[n] = mean_curvature(s.phi, zero[n]);
         benchmark::DoNotOptimize(kappa.data());
         benchmark::ClobberMemory();
     }
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * zero.size()));
-    state.counters["ns_per_point"] = benchmark::Counter(static_cast<double>(zero.size()),
-                                                        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    count_per_point(state, zero.size());
 }
 BENCHMARK(BM_MeanCurvature)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
 
 // The same points through the batched form a step uses (Speed::rates): the curvature and the
 // central |∇φ| of four stencils per SSE2 pass, from lattice indices.
 void BM_CurvatureAndGradientBatched(benchmark::State& state) {
-    const Lattice lat({100, 100, 100});
-    Grid<float> phi(lat);
-    const shapes::Sphere sphere({50.0, 50.0, 50.0}, 30.0);
-    std::vector<PointIndex> zero;
-    for (int z = 0; z < 100; ++z)
-        for (int y = 0; y < 100; ++y)
-            for (int x = 0; x < 100; ++x) {
-                const auto v = static_cast<float>(sphere(Vec3d{double(x), double(y), double(z)}));
-                phi({x, y, z}) = v;
-                if (std::abs(v) <= 0.5f) zero.push_back(lat.index({x, y, z}));
-            }
-    std::vector<CurvatureAndGradient> out(zero.size());
+    const SphereZeroLayer s;
+    std::vector<CurvatureAndGradient> out(s.zero.size());
     for (auto _ : state) {
-        mean_curvature_and_gradient(phi, zero, out);
+        mean_curvature_and_gradient(s.phi, s.zero, out);
         benchmark::DoNotOptimize(out.data());
         benchmark::ClobberMemory();
     }
-    state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * zero.size()));
-    state.counters["ns_per_point"] = benchmark::Counter(static_cast<double>(zero.size()),
-                                                        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    count_per_point(state, s.zero.size());
 }
 BENCHMARK(BM_CurvatureAndGradientBatched)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
 
