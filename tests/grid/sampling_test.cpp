@@ -1,16 +1,30 @@
-// Interpolation and gradients against analytic fields.
+// Interpolation and gradients against analytic fields and written-out formulas; branch-free min/max.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <vector>
 
+#include "liveset/grid/float_min_max.hpp"
 #include "liveset/grid/sampling.hpp"
 
 using namespace liveset;
 
 namespace {
+// A 7×6×5 field of values in [-3, 3) from a fixed generator; with `flat`, about a quarter of them
+// 0.5 (so that some differences are exactly zero).
+Grid<float> random_field(std::uint32_t state, bool flat) {
+    Grid<float> g(Lattice({7, 6, 5}));
+    for (float& v : g.values()) {
+        state = state * 1664525u + 1013904223u;
+        v = flat && (state >> 28) < 4 ? 0.5f : static_cast<float>(state >> 8) / static_cast<float>(1u << 24) * 6.0f - 3.0f;
+    }
+    return g;
+}
+
 Grid<float> linear_field() {
     Grid<float> g(Lattice({8, 8, 8}));
     for (int z = 0; z < 8; ++z)
@@ -98,13 +112,8 @@ TEST(Sampling, UpwindGradientPicksTheUpwindSide) {
 // central_gradient's unclamped interior path against the clamped one-sided formula written out
 // here (the reference) at every point of a random field: the same bits everywhere.
 TEST(Sampling, CentralGradientInteriorPathIsBitIdenticalToTheClampedFormula) {
-    const Lattice lat({7, 6, 5});
-    Grid<float> g(lat);
-    std::uint32_t state = 7;
-    for (float& v : g.values()) {
-        state = state * 1664525u + 1013904223u;
-        v = static_cast<float>(state >> 8) / static_cast<float>(1u << 24) * 6.0f - 3.0f;
-    }
+    const Grid<float> g = random_field(7, false);
+    const Lattice& lat = g.lattice();
     for (int z = 0; z < 5; ++z)
         for (int y = 0; y < 6; ++y)
             for (int x = 0; x < 7; ++x) {
@@ -118,4 +127,46 @@ TEST(Sampling, CentralGradientInteriorPathIsBitIdenticalToTheClampedFormula) {
                     EXPECT_EQ(std::bit_cast<std::uint32_t>(d[a]), std::bit_cast<std::uint32_t>(want)) << p << " axis " << a;
                 }
             }
+}
+
+// min_of / max_of against std::min / std::max, bit for bit: signed zeros (which one wins a tie
+// matters), infinities, and random values.
+TEST(Sampling, BranchFreeMinMaxHaveStdMinMaxBits) {
+    std::vector<float> v = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, std::numeric_limits<float>::infinity(),
+                            -std::numeric_limits<float>::infinity(), 1e-30f, -1e-30f};
+    std::uint32_t state = 3;
+    for (int n = 0; n < 64; ++n) {
+        state = state * 1664525u + 1013904223u;
+        v.push_back(static_cast<float>(state >> 8) / static_cast<float>(1u << 24) * 4.0f - 2.0f);
+    }
+    for (const float a : v)
+        for (const float b : v) {
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(min_of(a, b)), std::bit_cast<std::uint32_t>(std::min(a, b))) << a << " " << b;
+            EXPECT_EQ(std::bit_cast<std::uint32_t>(max_of(a, b)), std::bit_cast<std::uint32_t>(std::max(a, b))) << a << " " << b;
+        }
+}
+
+// upwind_gradient_norm (unclamped interior path, branch-free one-sided choices) against the Godunov
+// formula written out with clamped reads and std::min/std::max, at every point of a field with
+// random values and flat runs (zero differences), for both signs of the speed: the same bits.
+TEST(Sampling, UpwindGradientHasTheBitsOfTheWrittenOutFormula) {
+    const Grid<float> g = random_field(11, true);
+    for (const float speed : {0.7f, -0.7f})
+        for (int z = 0; z < 5; ++z)
+            for (int y = 0; y < 6; ++y)
+                for (int x = 0; x < 7; ++x) {
+                    const Vec3i p{x, y, z};
+                    float sum = 0.0f;
+                    for (int a = 0; a < 3; ++a) {
+                        Vec3i lo = p, hi = p;
+                        lo[a] -= 1;
+                        hi[a] += 1;
+                        const float dm = g(p) - g.clamped(lo), dp = g.clamped(hi) - g(p);
+                        const float a1 = speed > 0 ? std::min(dm, 0.0f) : std::max(dm, 0.0f);
+                        const float a2 = speed > 0 ? std::max(dp, 0.0f) : std::min(dp, 0.0f);
+                        sum += std::max(a1 * a1, a2 * a2);
+                    }
+                    const float want = std::sqrt(sum), got = upwind_gradient_norm(g, p, speed);
+                    EXPECT_EQ(std::bit_cast<std::uint32_t>(got), std::bit_cast<std::uint32_t>(want)) << p << " speed " << speed;
+                }
 }

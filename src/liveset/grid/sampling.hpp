@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "liveset/grid/float_min_max.hpp"
 #include "liveset/grid/grid.hpp"
 
 namespace liveset {
@@ -84,14 +85,15 @@ inline Vec3f interpolated_gradient(const Grid<float>& g, Vec3d p) {
 // Information flows from where the front comes from: for F > 0 the upwind choice is
 // max(D-,0)/min(D+,0) mirrored, see Osher & Fedkiw, "Level Set Methods", ch. 6.
 inline float upwind_gradient_norm(const Grid<float>& g, Vec3i p, float speed) {
-    // One axis's squared upwind difference from its backward (D-) and forward (D+) differences.
+    // One axis's squared upwind difference from its backward (D-) and forward (D+) differences,
+    // with std::min's and std::max's bits but no branch on the differences' signs (min_of).
     const auto axis = [speed](float dm, float dp) {
         if (speed > 0) {  // φ increases: equivalent to outward speed -F < 0
-            const float a1 = std::min(dm, 0.0f), a2 = std::max(dp, 0.0f);
-            return std::max(a1 * a1, a2 * a2);
+            const float a1 = min_of(dm, 0.0f), a2 = max_of(dp, 0.0f);
+            return max_of(a1 * a1, a2 * a2);
         }
-        const float a1 = std::max(dm, 0.0f), a2 = std::min(dp, 0.0f);
-        return std::max(a1 * a1, a2 * a2);
+        const float a1 = max_of(dm, 0.0f), a2 = min_of(dp, 0.0f);
+        return max_of(a1 * a1, a2 * a2);
     };
     const Vec3i d = g.dims();
     float sum = 0.0f;

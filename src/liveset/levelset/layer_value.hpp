@@ -9,34 +9,13 @@
 // is one-sided across the front.
 #pragma once
 
-#include <algorithm>
 #include <cstdint>
 #include <limits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
-
+#include "liveset/grid/float_min_max.hpp"
 #include "liveset/grid/grid.hpp"
 
 namespace liveset::detail {
-
-// std::min(a, b) and std::max(a, b) with their bits, as MINSS / MAXSS where there is SSE (GCC
-// compiles std::min of floats to a branch).
-[[gnu::always_inline]] inline float min_of(float a, float b) {
-#if defined(__SSE2__)
-    return _mm_cvtss_f32(_mm_min_ss(_mm_set_ss(b), _mm_set_ss(a)));  // b < a ? b : a
-#else
-    return std::min(a, b);
-#endif
-}
-[[gnu::always_inline]] inline float max_of(float a, float b) {
-#if defined(__SSE2__)
-    return _mm_cvtss_f32(_mm_max_ss(_mm_set_ss(b), _mm_set_ss(a)));  // b > a ? b : a, i.e. a < b ? b : a
-#else
-    return std::max(a, b);
-#endif
-}
 
 // layer_value() for a side fixed at compile time: the six neighbours in the order -x, +x, -y, +y,
 // -z, +z, unrolled.

@@ -61,6 +61,23 @@ SweepRules sweep_rules(int k, std::int8_t far_out, std::int8_t far_in) {
     return rules;
 }
 
+// What a change's neighbour of each status becomes when level k's claim reaches it: its pending
+// code if it is claimed (not temporary, in layer ±k or beyond, and for k > 1 on the change's
+// side), else itself. rules[side][status as a byte], side 1 for a change outside (status > 0).
+using ClaimRules = std::array<std::array<std::int8_t, 256>, 2>;
+
+ClaimRules claim_rules(int k, int layers) {
+    ClaimRules rules{};
+    for (int side = 0; side < 2; ++side)
+        for (int b = 0; b < 256; ++b) {
+            const auto s = static_cast<std::int8_t>(b);
+            const bool claimed = !detail::is_temp(s) && std::abs(s) >= k && std::abs(s) <= layers + 1 &&
+                                 (k == 1 || (s > 0) == (side == 1));
+            rules[static_cast<std::size_t>(side)][static_cast<std::size_t>(b)] = claimed ? (s > 0 ? kPendPos : kPendNeg) : s;
+        }
+    return rules;
+}
+
 }  // namespace
 
 // Level k re-evaluates the points still pending from level k-1 plus every neighbour, not yet final,
@@ -79,20 +96,33 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
     struct Part {
         std::vector<std::size_t> next, changed;
     };
+    std::int8_t* const status = status_.values().data();  // raw: see sweep_whole_band
+    const Lattice lat = lattice();
+    const IndexDecoder decoder = decoder_;
     for (int k = 1; k <= layers_; ++k) {
         // Claim (serial: the first changed point in order claims, as the region's order needs):
         // only the statuses are read here; a claimed point's old φ is read in the parallel pass.
+        // Without a branch on a neighbour's status: every neighbour's status is rewritten through
+        // the level's table and recorded, and the count moves on only for a claim.
         const std::size_t first_new = region.size();
+        const ClaimRules rule = claim_rules(k, layers_);
+        std::vector<RegionPoint>& claims = claims_.v;
+        if (claims.size() < 6 * changed.size()) claims.resize(6 * changed.size());
+        std::size_t n_claims = 0;
         for (const std::size_t c : changed) {
             const PointIndex p = region[c].point;
-            const bool out = status_[p] > 0;  // the side of a change beyond L0 (kPendPos > 0)
-            for_each_neighbor6(lattice(), decoder_, p, [&](PointIndex q) {
-                const std::int8_t s = status_[q];
-                if (detail::is_temp(s) || std::abs(s) < k || (k > 1 && (s > 0) != out)) return;
-                region.push_back({q, s, 0.0f});
-                status_[q] = s > 0 ? kPendPos : kPendNeg;
-                pending.push_back(region.size() - 1);
+            const std::int8_t* const r = rule[status[p] > 0 ? 1 : 0].data();  // the change's side (kPendPos > 0)
+            for_each_neighbor6(lat, decoder, p, [&](PointIndex q) __attribute__((always_inline)) {
+                const std::int8_t s = status[q];
+                const std::int8_t after = r[static_cast<std::uint8_t>(s)];
+                status[q] = after;
+                claims[n_claims] = {q, s, 0.0f};
+                n_claims += after != s ? 1 : 0;
             });
+        }
+        for (std::size_t m = 0; m < n_claims; ++m) {
+            region.push_back(claims[m]);
+            pending.push_back(region.size() - 1);
         }
         if (pending.empty()) break;
         // Decide (reads only; Jacobi within a level, so any thread order agrees) ...
@@ -179,7 +209,7 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
                 const unsigned x = e & 0xFFu;
                 if (x >= kClaimUpFar) [[unlikely]]
                     region.push_back({q, status[q], phi[q]});
-                phi[q] = detail::max_of(detail::min_of(phi[q], hi[x]), lo[x]);
+                phi[q] = max_of(min_of(phi[q], hi[x]), lo[x]);
                 status[q] = static_cast<std::int8_t>(e >> 8);
                 next[n_reached] = q;
                 n_reached += x >= kClaimUp ? 1 : 0;

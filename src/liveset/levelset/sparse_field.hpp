@@ -228,6 +228,7 @@ private:
     };
     Scratch<RegionPoint> region_;                  // repair_band's region
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
+    Scratch<RegionPoint> claims_;                  // relayer_changes' claims of one level
 };
 
 }  // namespace liveset
