@@ -104,25 +104,29 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         // only the statuses are read here; a claimed point's old φ is read in the parallel pass.
         // Without a branch on a neighbour's status: every neighbour's status is rewritten through
         // the level's table and recorded, and the count moves on only for a claim.
+        // The claims go to the region in blocks of changed points, so the buffer stays small.
         const std::size_t first_new = region.size();
         const ClaimRules rule = claim_rules(k, layers_);
+        constexpr std::size_t kClaimBlock = 4096;
         std::vector<RegionPoint>& claims = claims_.v;
-        if (claims.size() < 6 * changed.size()) claims.resize(6 * changed.size());
-        std::size_t n_claims = 0;
-        for (const std::size_t c : changed) {
-            const PointIndex p = region[c].point;
-            const std::int8_t* const r = rule[status[p] > 0 ? 1 : 0].data();  // the change's side (kPendPos > 0)
-            for_each_neighbor6(lat, decoder, p, [&](PointIndex q) __attribute__((always_inline)) {
-                const std::int8_t s = status[q];
-                const std::int8_t after = r[static_cast<std::uint8_t>(s)];
-                status[q] = after;
-                claims[n_claims] = {q, s, 0.0f};
-                n_claims += after != s ? 1 : 0;
-            });
-        }
-        for (std::size_t m = 0; m < n_claims; ++m) {
-            region.push_back(claims[m]);
-            pending.push_back(region.size() - 1);
+        claims.resize(6 * kClaimBlock);
+        for (std::size_t b = 0; b < changed.size(); b += kClaimBlock) {
+            std::size_t n_claims = 0;
+            for (std::size_t n = b; n < std::min(changed.size(), b + kClaimBlock); ++n) {
+                const PointIndex p = region[changed[n]].point;
+                const std::int8_t* const r = rule[status[p] > 0 ? 1 : 0].data();  // the change's side (kPendPos > 0)
+                for_each_neighbor6(lat, decoder, p, [&](PointIndex q) __attribute__((always_inline)) {
+                    const std::int8_t s = status[q];
+                    const std::int8_t after = r[static_cast<std::uint8_t>(s)];
+                    status[q] = after;
+                    claims[n_claims] = {q, s, 0.0f};
+                    n_claims += after != s ? 1 : 0;
+                });
+            }
+            for (std::size_t m = 0; m < n_claims; ++m) {
+                region.push_back(claims[m]);
+                pending.push_back(region.size() - 1);
+            }
         }
         if (pending.empty()) break;
         // Decide (reads only; Jacobi within a level, so any thread order agrees) ...
