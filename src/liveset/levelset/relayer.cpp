@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <limits>
 #include <numeric>
+#include <vector>
 
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/layer_value.hpp"
@@ -64,18 +65,26 @@ SweepRules sweep_rules(int k, std::int8_t far_out, std::int8_t far_in) {
 // What a change's neighbour of each status becomes when level k's claim reaches it: its pending
 // code if it is claimed (not temporary, in layer ±k or beyond, and for k > 1 on the change's
 // side), else itself. rules[side][status as a byte], side 1 for a change outside (status > 0).
+// Built once for every k and number of layers (a local edit of a few points must not pay for it).
 using ClaimRules = std::array<std::array<std::int8_t, 256>, 2>;
 
-ClaimRules claim_rules(int k, int layers) {
-    ClaimRules rules{};
-    for (int side = 0; side < 2; ++side)
-        for (int b = 0; b < 256; ++b) {
-            const auto s = static_cast<std::int8_t>(b);
-            const bool claimed = !detail::is_temp(s) && std::abs(s) >= k && std::abs(s) <= layers + 1 &&
-                                 (k == 1 || (s > 0) == (side == 1));
-            rules[static_cast<std::size_t>(side)][static_cast<std::size_t>(b)] = claimed ? (s > 0 ? kPendPos : kPendNeg) : s;
-        }
-    return rules;
+const ClaimRules& claim_rules(int k, int layers) {
+    constexpr int kMax = SparseField::kMaxLayers;
+    static const std::vector<ClaimRules> all = [] {
+        std::vector<ClaimRules> tables(static_cast<std::size_t>(kMax * kMax));
+        for (int n = 1; n <= kMax; ++n)
+            for (int level = 1; level <= n; ++level)
+                for (int side = 0; side < 2; ++side)
+                    for (int b = 0; b < 256; ++b) {
+                        const auto s = static_cast<std::int8_t>(b);
+                        const bool claimed = !detail::is_temp(s) && std::abs(s) >= level && std::abs(s) <= n + 1 &&
+                                             (level == 1 || (s > 0) == (side == 1));
+                        tables[static_cast<std::size_t>((n - 1) * kMax + level - 1)][static_cast<std::size_t>(side)]
+                              [static_cast<std::size_t>(b)] = claimed ? detail::pending_of(s) : s;
+                    }
+        return tables;
+    }();
+    return all[static_cast<std::size_t>((layers - 1) * kMax + k - 1)];
 }
 
 }  // namespace
@@ -106,7 +115,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         // the level's table and recorded, and the count moves on only for a claim.
         // The claims go to the region in blocks of changed points, so the buffer stays small.
         const std::size_t first_new = region.size();
-        const ClaimRules rule = claim_rules(k, layers_);
+        const ClaimRules& rule = claim_rules(k, layers_);
         constexpr std::size_t kClaimBlock = 4096;
         std::vector<RegionPoint>& claims = claims_.v;
         claims.resize(6 * kClaimBlock);
