@@ -1,6 +1,7 @@
 // Sparse-field initialisation: from signed distances, masks and seeds; invariants; bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -99,4 +100,43 @@ TEST(SparseFieldInit, AThrowingInitialisationLeavesTheFieldAsItWas) {
     EXPECT_TRUE(std::equal(phi.begin(), phi.end(), f.phi().values().begin()));
     EXPECT_TRUE(std::equal(status.begin(), status.end(), f.status().values().begin()));
     EXPECT_EQ(f.zero_layer().size(), zero);
+}
+
+// init_from_sdf(sdf, lo, hi) evaluates only the box, where sdf ≥ N + 1 outside it: the same φ,
+// statuses and list order as evaluating the whole lattice. Seed spheres (one clipped by a corner
+// of the lattice, overlapping pairs, N = 1..3), and a step function whose sign change lies on the
+// box's faces, so that the points pulled onto the zero layer lie just outside the box.
+TEST(SparseFieldInit, InABoxHasTheBitsOfTheWholeLattice) {
+    const Lattice lat({37, 29, 31});
+    const std::vector<shapes::Sphere> spheres = {shapes::Sphere({1.5, 2.0, 0.5}, 3.0), shapes::Sphere({20.2, 14.7, 15.1}, 4.4),
+                                                 shapes::Sphere({24.0, 15.0, 16.0}, 2.5), shapes::Sphere({30.0, 20.0, 9.0}, 0.5)};
+    for (int layers : {1, 2, 3}) {
+        const shapes::SeedSpheres sdf(lat, spheres);
+        const double reach = layers + 1.0;
+        Vec3i lo{1000, 1000, 1000}, hi{-1000, -1000, -1000};
+        for (const shapes::Sphere& s : spheres)
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = std::min(lo[a], static_cast<int>(std::floor(s.center[a] - s.radius - reach)));
+                hi[a] = std::max(hi[a], static_cast<int>(std::ceil(s.center[a] + s.radius + reach)));
+            }
+        SparseField whole(lat, layers), boxed(lat, layers);
+        whole.init_from_sdf(sdf);
+        boxed.init_from_sdf(shapes::Sphere({18, 14, 15}, 6));  // an earlier front, replaced
+        boxed.init_from_sdf(sdf, lo, hi);
+        EXPECT_TRUE(liveset::testing::same_state(whole, boxed)) << "layers " << layers;
+        liveset::testing::expect_same_list_order(whole, boxed);
+        expect_valid(boxed, "seeds in a box");
+    }
+    const auto step = [](Vec3d p) { return p.x >= 10 && p.x <= 20 && p.y >= 8 && p.y <= 18 && p.z >= 5 && p.z <= 25 ? -10.0 : 10.0; };
+    SparseField whole(lat, 2), boxed(lat, 2);
+    whole.init_from_sdf(step);
+    boxed.init_from_sdf(step, {10, 8, 5}, {20, 18, 25});
+    EXPECT_TRUE(liveset::testing::same_state(whole, boxed));
+    liveset::testing::expect_same_list_order(whole, boxed);
+    EXPECT_EQ(boxed.status()({9, 12, 12}), 0);  // pulled onto the zero layer from outside the box
+    expect_valid(boxed, "step in a box");
+    // A value that is not finite inside the box is refused before anything changes.
+    EXPECT_THROW(boxed.init_from_sdf([](Vec3d p) { return p.x == 12 ? NAN : 10.0; }, {10, 8, 5}, {20, 18, 25}),
+                 std::invalid_argument);
+    EXPECT_TRUE(liveset::testing::same_state(whole, boxed));
 }

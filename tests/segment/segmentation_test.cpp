@@ -2,11 +2,14 @@
 // the region of interest stops the front, interrupts stop the loop, thread count does not matter.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 
 #include <tbb/global_control.h>
 
+#include "liveset/levelset/shapes.hpp"
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
 
@@ -136,4 +139,28 @@ TEST(Segmentation, SameResultForAnyThreadCount) {
         return std::vector<float>(field.phi().values().begin(), field.phi().values().end());
     };
     EXPECT_EQ(run(1), run(2));
+}
+
+// init_from_seeds evaluates the spheres only in their bounding box: the same φ, statuses and
+// zero-layer order as the union evaluated over the whole lattice (seeds at a corner and an edge
+// of the lattice, a tiny one whose radius becomes 0.5, overlapping ones; N = 1 and 3).
+TEST(Segmentation, SeedsInitialiseOnlyTheirBoxWithTheBitsOfTheWholeLattice) {
+    const Lattice lat({41, 33, 27});
+    const SeedBall seeds[] = {{{0, 0, 0}, 3.0}, {{40, 16, 13}, 2.0}, {{20, 16, 13}, 0.1}, {{22, 17, 12}, 4.5}};
+    for (int layers : {1, 3}) {
+        SparseField boxed(lat, layers), whole(lat, layers);
+        init_from_seeds(boxed, seeds);
+        std::vector<shapes::Sphere> spheres;
+        for (const SeedBall& s : seeds) spheres.emplace_back(s.center, std::max(s.radius, 0.5));
+        whole.init_from_sdf(shapes::SeedSpheres(lat, spheres));
+        const auto pb = boxed.phi().values(), pw = whole.phi().values();
+        const auto sb = boxed.status().values(), sw = whole.status().values();
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < pb.size(); ++i)
+            differ += std::bit_cast<std::uint32_t>(pb[i]) != std::bit_cast<std::uint32_t>(pw[i]) || sb[i] != sw[i];
+        EXPECT_EQ(differ, 0u) << "layers " << layers;
+        const auto zb = boxed.zero_layer(), zw = whole.zero_layer();
+        EXPECT_TRUE(std::equal(zb.begin(), zb.end(), zw.begin(), zw.end())) << "layers " << layers;
+        EXPECT_GT(zb.size(), 100u);
+    }
 }

@@ -104,6 +104,10 @@ public:
     // --- initialisation (each replaces the whole state) -------------------------------------
     // From a signed distance (index-space position -> distance in voxels, negative inside).
     void init_from_sdf(const std::function<double(Vec3d)>& sdf);
+    // The same, evaluating `sdf` only in the box [lo, hi] (inclusive, clipped to the lattice):
+    // it must be ≥ N + 1 at every lattice point outside the box (as for unite_in_box). Same bits
+    // as the whole-lattice form; cost grows with the box, plus a fill of φ and the statuses.
+    void init_from_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo, Vec3i hi);
     // From a binary mask on the same lattice dimensions (non-zero = inside).
     void init_from_mask(const Grid<std::uint8_t>& mask);
 
@@ -172,7 +176,7 @@ private:
         float old_phi;
     };
 
-    void evaluate_sdf(const std::function<double(Vec3d)>& sdf);
+    void evaluate_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo, Vec3i hi);  // φ, far outside the box
     std::vector<double> zero_rates(const Speed& speed) const;  // |∇φ|F at each zero-layer point
     double time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const;
     StepResult step_full_band(const Speed& speed, const StepOptions& options);
