@@ -104,6 +104,26 @@ TEST(TissueModel, TheWindowFollowsALinearChangeOfIntensityUnits) {
     EXPECT_NEAR(b.upper, 7.3 * a.upper + 300, 7.3 * 0.05);
 }
 
+// Intensities of both signs (z-scored or CT-like units, exact zeros of both signs among them):
+// the model of the values shifted by −100 is the shifted model, so the sort that finds the
+// histogram's quantiles orders negative floats correctly.
+TEST(TissueModel, NegativeIntensitiesGiveTheShiftedModel) {
+    std::vector<float> v = sample(kT1, 0.25, 100000, 9);
+    std::vector<float> shifted(v.size());
+    for (std::size_t i = 0; i < v.size(); ++i) shifted[i] = v[i] - 100.0f;
+    for (std::size_t i = 0; i < 40; ++i) shifted[i * 97] = i % 2 == 0 ? 0.0f : -0.0f;
+    const TissueModel a = fit_tissue_model(v), b = fit_tissue_model(shifted);
+    ASSERT_TRUE(a.usable() && b.usable()) << a.degenerate << b.degenerate;
+    ASSERT_EQ(b.classes.size(), 3u);
+    for (std::size_t c = 0; c < 3; ++c) {
+        EXPECT_NEAR(b.classes[c].mean, a.classes[c].mean - 100.0, 0.3) << c;
+        EXPECT_NEAR(b.classes[c].sigma, a.classes[c].sigma, 0.3) << c;
+    }
+    const std::vector<double> ta = otsu_thresholds(v, 3), tb = otsu_thresholds(shifted, 3);
+    ASSERT_EQ(ta.size(), tb.size());
+    for (std::size_t k = 0; k < ta.size(); ++k) EXPECT_NEAR(tb[k], ta[k] - 100.0, 1.0) << k;
+}
+
 TEST(TissueModel, SeedsInTwoClassesAreWarnedAbout) {
     const TissueModel m = fit_tissue_model(sample(kT1, 0.25, 100000, 5));
     std::vector<float> seeds(60, 97.0f);

@@ -2,10 +2,14 @@
 #include "liveset/segment/tissue_model.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
+
+#include "liveset/grid/radix_sort.hpp"
 
 namespace liveset {
 
@@ -31,8 +35,19 @@ double quantile_sorted(const std::vector<float>& v, double q) {
 }
 
 // Non-empty bins of the values between the options' quantiles.
+// Ascending order of finite floats by an LSD radix sort on their bits turned into unsigned order
+// (the order std::sort gives, up to the order of −0 and +0, which no sum or quantile below
+// tells apart); 1.8 M brain voxels sort in a few linear passes (std::sort took 6 % of a set-up).
+void sort_values(std::vector<float>& v) {
+    std::vector<float> scratch;
+    stable_radix_sort(v, [](float x) {
+        const auto b = std::bit_cast<std::uint32_t>(x);
+        return (b & 0x80000000u) != 0 ? ~b : b | 0x80000000u;
+    }, scratch);
+}
+
 std::vector<Bin> histogram(std::vector<float> v, const TissueModelOptions& o, std::size_t& used) {
-    std::sort(v.begin(), v.end());
+    sort_values(v);
     const double lo = quantile_sorted(v, o.low_quantile), hi = quantile_sorted(v, o.high_quantile);
     if (!(hi > lo)) throw std::invalid_argument("the region's intensities are flat: no tissue classes to model");
     std::vector<double> n(static_cast<std::size_t>(o.bins), 0.0), s(n), s2(n);
