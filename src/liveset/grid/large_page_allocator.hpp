@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <vector>
 
 namespace liveset {
 
@@ -40,5 +41,10 @@ struct LargePageAllocator {
 private:
     static bool large(std::size_t n) { return n * sizeof(T) >= detail::kLargeBlock; }
 };
+
+// A vector on the same blocks: for large temporaries (a copy of a brain's voxels, a read
+// buffer), whose 4 KiB page faults cost more than their use on a VM.
+template <class T>
+using LargeVector = std::vector<T, LargePageAllocator<T>>;
 
 }  // namespace liveset

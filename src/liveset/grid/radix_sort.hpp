@@ -11,8 +11,8 @@ namespace liveset {
 
 // Sorts v by key(element) (a std::uint32_t), keeping the input order of equal keys; `scratch` is
 // working space (its contents are lost; pass the same vector again to reuse its memory).
-template <class T, class Key>
-void stable_radix_sort(std::vector<T>& v, Key key, std::vector<T>& scratch) {
+template <class T, class Alloc, class Key>
+void stable_radix_sort(std::vector<T, Alloc>& v, Key key, std::vector<T, Alloc>& scratch) {
     std::uint32_t top = 0;
     for (const T& e : v) top |= key(e);
     scratch.resize(v.size());

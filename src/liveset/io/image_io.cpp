@@ -32,6 +32,7 @@
 #include <itkNrrdImageIOFactory.h>
 
 #include "liveset/base/atomic_file.hpp"
+#include "liveset/grid/large_page_allocator.hpp"
 #include "liveset/io/file_checks.hpp"
 #include "liveset/io/messages.hpp"
 #include "liveset/io/minc_world.hpp"
@@ -380,7 +381,7 @@ void with_pixels(const Source& src, std::size_t count, Sink&& sink) {
     }
     dispatch(src.io->GetComponentType(), src.path, [&](auto tag) {
         using T = typename decltype(tag)::type;
-        std::vector<T> buffer;
+        LargeVector<T> buffer;  // huge pages: a brain's voxels fault in 2 MiB at a time
         try {
             buffer.resize(count);
         } catch (const std::bad_alloc&) {

@@ -26,7 +26,7 @@ ActivitySnapshot FrontActivity::snapshot(std::uint64_t speed_serial) const {
     s.all_woken_at = all_woken_at_;
     s.speed_current = adopt_next_speed_ || (speed_serial != 0 && speed_serial == speed_serial_);
     s.blocks = {static_cast<int>(blocks_x_), static_cast<int>(blocks_y_), static_cast<int>(blocks_z_)};
-    s.stamps = stamp_;
+    s.stamps.assign(stamp_.begin(), stamp_.end());
     return s;
 }
 
@@ -40,7 +40,7 @@ void FrontActivity::restore(const ActivitySnapshot& s, const Lattice& lattice) {
     blocks_x_ = static_cast<std::size_t>(want.x);
     blocks_y_ = static_cast<std::size_t>(want.y);
     blocks_z_ = static_cast<std::size_t>(want.z);
-    stamp_ = s.stamps;
+    stamp_.assign(s.stamps.begin(), s.stamps.end());
     all_woken_at_ = s.all_woken_at;
     adopt_next_speed_ = s.speed_current;
 }

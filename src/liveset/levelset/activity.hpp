@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "liveset/grid/large_page_allocator.hpp"
 #include "liveset/grid/lattice.hpp"
 
 namespace liveset {
@@ -53,7 +54,7 @@ public:
 private:
     bool adopt_next_speed_ = false;
     std::size_t blocks_x_ = 0, blocks_y_ = 0, blocks_z_ = 0;
-    std::vector<std::int64_t> stamp_;  // per block: the last step that woke it
+    LargeVector<std::int64_t> stamp_;  // per block: the last step that woke it (huge pages)
     std::int64_t all_woken_at_ = 0;
     std::uint64_t speed_serial_ = 0;
 };

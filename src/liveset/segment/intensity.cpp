@@ -6,6 +6,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "liveset/grid/large_page_allocator.hpp"
+
 namespace liveset {
 
 namespace {
@@ -19,7 +21,8 @@ void check_roi(const Grid<float>& image, const Grid<std::uint8_t>* roi) {
 }
 
 // Value at fraction q in [0, 1] of `v` (linear interpolation between order statistics); reorders v.
-double quantile(std::vector<float>& v, double q) {
+template <class Alloc>
+double quantile(std::vector<float, Alloc>& v, double q) {
     const double pos = q * static_cast<double>(v.size() - 1);
     const auto lo = static_cast<std::size_t>(std::floor(pos));
     const std::size_t hi = std::min(lo + 1, v.size() - 1);
@@ -43,7 +46,7 @@ IntensityScale robust_scale(const Grid<float>& image, const Grid<std::uint8_t>* 
     const double lp = options.low_percentile, hp = options.high_percentile;
     if (!(lp >= 0.0 && hp <= 100.0 && lp < hp))
         throw std::invalid_argument("intensity percentiles must satisfy 0 <= low < high <= 100");
-    std::vector<float> v;
+    LargeVector<float> v;  // huge pages: a copy of a brain's voxels
     v.reserve(image.size());
     const std::span<const float> values = image.values();
     for (std::size_t i = 0; i < values.size(); ++i) {

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "liveset/grid/large_page_allocator.hpp"
 #include "liveset/grid/radix_sort.hpp"
 
 namespace liveset {
@@ -27,7 +28,7 @@ double gauss(double x, double mean, double sigma) {
     return std::exp(-0.5 * z * z) / (sigma * std::sqrt(2.0 * std::numbers::pi));
 }
 
-double quantile_sorted(const std::vector<float>& v, double q) {
+double quantile_sorted(std::span<const float> v, double q) {
     const double pos = q * static_cast<double>(v.size() - 1);
     const auto lo = static_cast<std::size_t>(std::floor(pos));
     const std::size_t hi = std::min(lo + 1, v.size() - 1);
@@ -38,15 +39,16 @@ double quantile_sorted(const std::vector<float>& v, double q) {
 // Ascending order of finite floats by an LSD radix sort on their bits turned into unsigned order
 // (the order std::sort gives, up to the order of −0 and +0, which no sum or quantile below
 // tells apart); 1.8 M brain voxels sort in a few linear passes (std::sort took 6 % of a set-up).
-void sort_values(std::vector<float>& v) {
-    std::vector<float> scratch;
+void sort_values(LargeVector<float>& v) {
+    LargeVector<float> scratch;
     stable_radix_sort(v, [](float x) {
         const auto b = std::bit_cast<std::uint32_t>(x);
         return (b & 0x80000000u) != 0 ? ~b : b | 0x80000000u;
     }, scratch);
 }
 
-std::vector<Bin> histogram(std::vector<float> v, const TissueModelOptions& o, std::size_t& used) {
+std::vector<Bin> histogram(std::span<const float> values, const TissueModelOptions& o, std::size_t& used) {
+    LargeVector<float> v(values.begin(), values.end());
     sort_values(v);
     const double lo = quantile_sorted(v, o.low_quantile), hi = quantile_sorted(v, o.high_quantile);
     if (!(hi > lo)) throw std::invalid_argument("the region's intensities are flat: no tissue classes to model");
@@ -248,7 +250,7 @@ TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOpt
     for (const float x : values)
         if (!std::isfinite(x)) throw std::invalid_argument("image has non-finite voxels");
     std::size_t used = 0;
-    const std::vector<Bin> bins = histogram(std::vector<float>(values.begin(), values.end()), o, used);
+    const std::vector<Bin> bins = histogram(values, o, used);
     if (bins.size() < static_cast<std::size_t>(2 * o.classes)) {
         std::ostringstream os;
         os << "the region has " << bins.size() << " distinct intensity levels: too few for " << o.classes << " tissue classes";
@@ -289,7 +291,7 @@ TissueModel fit_tissue_model(const Grid<float>& image, const Grid<std::uint8_t>*
         os << "tissue-model region " << region->dims() << " does not match the image " << image.dims();
         throw std::invalid_argument(os.str());
     }
-    std::vector<float> v;
+    LargeVector<float> v;
     v.reserve(image.size());
     const std::span<const float> values = image.values();
     for (std::size_t i = 0; i < values.size(); ++i)
@@ -312,7 +314,7 @@ std::vector<double> otsu_thresholds(std::span<const float> values, int classes, 
     for (const float x : values)
         if (!std::isfinite(x)) throw std::invalid_argument("image has non-finite voxels");
     std::size_t used = 0;
-    const std::vector<Bin> h = histogram(std::vector<float>(values.begin(), values.end()), o, used);
+    const std::vector<Bin> h = histogram(values, o, used);
     if (h.size() < static_cast<std::size_t>(classes)) throw std::invalid_argument("too few intensity levels to threshold");
     std::vector<double> t;
     for (const std::size_t s : otsu_splits(h, classes)) t.push_back(0.5 * (h[s - 1].mean + h[s].mean));
