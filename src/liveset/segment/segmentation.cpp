@@ -105,7 +105,8 @@ void init_from_seeds(SparseField& field, std::span<const SeedBall> seeds) {
     for (const SeedBall& s : seeds) spheres.emplace_back(s.center, std::max(s.radius, 0.5));
     const shapes::SeedSpheres sdf(field.lattice(), std::move(spheres));  // validates them
     // Outside the seeds' bounding box, grown by the far value N + 1 (and a point for rounding),
-    // every sphere's distance is above N + 1: only the box is evaluated (7 M voxels on BrainWeb).
+    // every sphere's distance is above N + 1: only the box is evaluated, not the whole lattice
+    // (the eight BrainWeb seeds span a quarter of its 7 M voxels).
     const double reach = field.layers() + 2.0;
     const Vec3i d = field.lattice().dims();
     Vec3i lo = d, hi{0, 0, 0};

@@ -35,7 +35,6 @@ double quantile_sorted(std::span<const float> v, double q) {
     return v[lo] + (pos - static_cast<double>(lo)) * (v[hi] - v[lo]);
 }
 
-// Non-empty bins of the values between the options' quantiles.
 // Ascending order of finite floats by an LSD radix sort on their bits turned into unsigned order
 // (the order std::sort gives, up to the order of −0 and +0, which no sum or quantile below
 // tells apart); 1.8 M brain voxels sort in a few linear passes (std::sort took 6 % of a set-up).
@@ -47,6 +46,7 @@ void sort_values(LargeVector<float>& v) {
     }, scratch);
 }
 
+// Non-empty bins of the values between the options' quantiles.
 std::vector<Bin> histogram(std::span<const float> values, const TissueModelOptions& o, std::size_t& used) {
     LargeVector<float> v(values.begin(), values.end());
     sort_values(v);
