@@ -182,6 +182,13 @@ TEST(Session, RemovingASeedBeforeAnyStepReinitialisesFromTheOthers) {
     EXPECT_TRUE(s.seed_at(ph.seeds[1].cast<double>()).has_value());
     EXPECT_FALSE(s.seed_at(ph.seeds[0].cast<double>(), 0.5).has_value() &&
                  norm((ph.seeds[0] - ph.seeds[1]).cast<double>()) > 4.0);
+    s.remove_seed(0);  // the last one: no front, every point far outside
+    EXPECT_EQ(s.field().band_size(), 0u);
+    const float far = static_cast<float>(s.field().layers() + 1);
+    std::size_t not_far = 0;
+    for (std::size_t i = 0; i < want.phi().size(); ++i)
+        not_far += s.field().phi()[static_cast<PointIndex>(i)] != far || s.field().status()[static_cast<PointIndex>(i)] != far;
+    EXPECT_EQ(not_far, 0u);
 }
 
 TEST(Session, KeepsTwentyActionsToUndo) {

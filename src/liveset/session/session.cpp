@@ -146,7 +146,7 @@ SessionUpdate Session::remove_seed(std::size_t index) {
         if (!marks_.pristine) return Change{};  // grown regions stay: only the list changes
         if (marks_.seeds.empty()) {
             const double far = field_.layers() + 1.0;
-            field_.init_from_sdf([far](Vec3d) { return far; });
+            field_.init_from_sdf([far](Vec3d) { return far; }, {0, 0, 0}, {0, 0, 0});  // far everywhere: no front
         } else {
             init_from_seeds(field_, marks_.seeds);
         }
