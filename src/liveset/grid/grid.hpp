@@ -49,7 +49,7 @@ public:
 
 private:
     Lattice lattice_;
-    std::vector<T, LargePageAllocator<T>> data_;
+    LargeVector<T> data_;
 };
 
 }  // namespace liveset

@@ -42,8 +42,8 @@ private:
     static bool large(std::size_t n) { return n * sizeof(T) >= detail::kLargeBlock; }
 };
 
-// A vector on the same blocks: for large temporaries (a copy of a brain's voxels, a read
-// buffer), whose 4 KiB page faults cost more than their use on a VM.
+// A vector on these blocks: a grid's storage, and large temporaries (a copy of a brain's voxels,
+// a read buffer) whose 4 KiB page faults would cost more than their use on a VM.
 template <class T>
 using LargeVector = std::vector<T, LargePageAllocator<T>>;
 
