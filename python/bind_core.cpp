@@ -108,7 +108,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
         const SegmentationHook hook = [&](const SegmentationProgress& p, const ChangedPoints&) {
             return interrupt.poll_with([&]() -> pyb::object {
                 return pyb::dict(pyb::arg("iteration") = p.iteration, pyb::arg("zero_layer") = p.zero_layer,
-                                 pyb::arg("band") = p.band, pyb::arg("changed") = p.changed, pyb::arg("flips") = p.flips,
+                                 pyb::arg("band") = p.band, pyb::arg("awake") = p.awake, pyb::arg("changed") = p.changed, pyb::arg("flips") = p.flips,
                                  pyb::arg("inside") = p.inside, pyb::arg("dt") = p.dt, pyb::arg("ms") = p.ms);
             });
         };

@@ -9,7 +9,10 @@ liveset's run goes on into convergence and lets still stretches sleep (ITK's fro
 slowly: about 800 iterations to 200 000 points, 1 100 to 250 000, so run it with --iterations 1700).
 A bin one program never reached says so.
 
-Usage: scripts/itk_per_iteration.py ITK_LOG LIVESET_LOG   (both JSON lines, from --log)
+Given several rounds (pairs of logs, each pair run back to back), each bin also shows every
+round's ratio and their median: on a noisy machine one pair can be off by 2x either way.
+
+Usage: scripts/itk_per_iteration.py ITK_LOG LIVESET_LOG [ITK_LOG LIVESET_LOG ...]   (JSON lines, from --log)
 """
 import json
 import statistics
@@ -37,33 +40,59 @@ def read(path, front_key):
     return out
 
 
-def table(itk, ls, bins):
-    print("| front size | ITK ms | liveset ms | ITK / liveset |")
-    print("|---|--:|--:|--:|")
+def split_growth(ls):
+    """liveset's iterations up to its zero layer first passing the last growth bin, and the rest."""
+    top = BINS[-1][1]
+    for n, (front, _) in enumerate(ls):
+        if front > top:
+            return ls[:n], ls[n:]
+    return ls, []
+
+
+def medians(rows, lo, hi):
+    ms = [m for f, m in rows if lo <= f < hi]
+    return statistics.median(ms) if ms else None
+
+
+def table(rounds, bins):
+    """rounds: [(itk rows, liveset rows)] for one table's part of each liveset run."""
+    several = len(rounds) > 1
+    head = "| front size | ITK ms | liveset ms | ITK / liveset |"
+    print(head + (" per round |" if several else ""))
+    print("|---|--:|--:|--:|" + ("---|" if several else ""))
     for lo, hi in bins:
-        a = [ms for f, ms in itk if lo <= f < hi]
-        b = [ms for f, ms in ls if lo <= f < hi]
-        if not a or not b:
-            print(f"| {lo}-{hi} | {len(a)} ITK / {len(b)} liveset iterations | | |")
+        per_round = []
+        for itk, ls in rounds:
+            a, b = medians(itk, lo, hi), medians(ls, lo, hi)
+            if a is not None and b is not None:
+                per_round.append((a, b))
+        if not per_round:
+            n_itk = sum(1 for itk, _ in rounds for f, _ in itk if lo <= f < hi)
+            n_ls = sum(1 for _, ls in rounds for f, _ in ls if lo <= f < hi)
+            print(f"| {lo}-{hi} | {n_itk} ITK / {n_ls} liveset iterations | | |" + (" |" if several else ""))
             continue
-        ma, mb = statistics.median(a), statistics.median(b)
-        print(f"| {lo}-{hi} | {ma:.2f} | {mb:.2f} | {ma / mb:.1f}x |")
+        ratios = [a / b for a, b in per_round]
+        ma = statistics.median(a for a, _ in per_round)
+        mb = statistics.median(b for _, b in per_round)
+        line = f"| {lo}-{hi} | {ma:.2f} | {mb:.2f} | {statistics.median(ratios):.1f}x |"
+        if several:
+            line += " " + " / ".join(f"{r:.1f}x" for r in ratios) + " |"
+        print(line)
 
 
 def main():
-    if len(sys.argv) != 3:
+    args = sys.argv[1:]
+    if not args or len(args) % 2:
         sys.exit(__doc__.strip().splitlines()[-1])
-    itk = read(sys.argv[1], "active_layer")
-    ls = read(sys.argv[2], "zero_layer")
-    top = BINS[-1][1]
-    growth = []
-    for front, ms in ls:
-        if front > top:
-            break
-        growth.append((front, ms))
-    table(itk, growth, BINS)
+    growth, late = [], []
+    for itk_path, ls_path in zip(args[0::2], args[1::2]):
+        itk = read(itk_path, "active_layer")
+        g, rest = split_growth(read(ls_path, "zero_layer"))
+        growth.append((itk, g))
+        late.append((itk, rest))
+    table(growth, BINS)
     print()
-    table(itk, ls[len(growth):], LATE_BINS)
+    table(late, LATE_BINS)
 
 
 if __name__ == "__main__":

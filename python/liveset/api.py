@@ -77,7 +77,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
     mu/epsilon: the window in normalised units, or mu_raw/epsilon_raw in the image's own; by
         default the tissue model's window for the seeds' class (``window_from="seeds"``: their
         statistics). n, alpha, iterations, classes, bias_correct: as the CLI.
-    progress: called with a dict (iteration, zero_layer, band, changed, flips, inside, dt, ms)
+    progress: called with a dict (iteration, zero_layer, band, awake, changed, flips, inside, dt, ms)
         after every step; an exception it raises stops the run and propagates.
 
     The GIL is released while it runs; Ctrl-C raises KeyboardInterrupt within a step. Bad input

@@ -144,6 +144,7 @@ def test_sigint_stops_a_segmentation_within_a_step(phantom):
 
     def progress(p):
         steps.append(p["iteration"])
+        assert p["awake"] <= p["band"]  # the step's evaluated zero-layer points
         if p["iteration"] == 3:
             os.kill(os.getpid(), signal.SIGINT)
 

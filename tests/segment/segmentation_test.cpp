@@ -84,6 +84,35 @@ TEST(Segmentation, RecoversABrightBallFromOneSeed) {
     EXPECT_EQ(r.inside, inside);
 }
 
+TEST(Segmentation, ProgressReportsThePointsEachStepEvaluated) {
+    // `awake` is the number of zero-layer points the step evaluated: the whole zero layer it
+    // started from under the exact step, and under sleeping too for the first `sleep_after` steps;
+    // fewer once still stretches sleep.
+    const Grid<float> img = ball_image();
+    const ThresholdSpeed speed(img, kParams);
+    for (const int sleep_after : {0, 5}) {
+        SparseField field(img.lattice(), 2);
+        init_from_seeds(field, kSeeds);
+        SegmentationOptions o;
+        if (sleep_after > 0) o.step = sleeping_step(sleep_after);
+        std::size_t before = field.zero_layer().size(), slept = 0;
+        run_segmentation(field, speed, o, [&](const SegmentationProgress& p, const ChangedPoints&) {
+            if (sleep_after == 0 || p.iteration <= sleep_after) {
+                EXPECT_EQ(p.awake, before) << p.iteration;
+            }
+            EXPECT_LE(p.awake, before) << p.iteration;
+            slept += before - p.awake;
+            before = p.zero_layer;
+            return true;
+        });
+        if (sleep_after == 0) {
+            EXPECT_EQ(slept, 0u);
+        } else {
+            EXPECT_GT(slept, 0u);
+        }
+    }
+}
+
 TEST(Segmentation, RegionOfInterestStopsTheFront) {
     const Grid<float> img = ball_image();
     Grid<std::uint8_t> roi(img.lattice(), 0);

@@ -79,6 +79,7 @@ SegmentationResult run_segmentation(SparseField& field, const Speed& speed, cons
         pr.iteration = it;
         pr.dt = step.dt;
         pr.changed = step.changed.size();
+        pr.awake = step.awake;
         pr.flips = convergence.record_step(field.phi(), step.sign_changes);  // only steps change the field here
         pr.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
         pr.zero_layer = field.zero_layer().size();

@@ -49,6 +49,7 @@ void validate(const SegmentationOptions& options);
 struct SegmentationProgress {
     int iteration = 0;          // 1-based
     std::size_t zero_layer = 0;  // after the step
+    std::size_t awake = 0;       // zero-layer points the step evaluated (the rest slept)
     std::size_t band = 0;
     std::size_t changed = 0;     // |X|
     std::size_t flips = 0;       // points that changed side in this step
