@@ -1,12 +1,15 @@
 // Level-set benchmarks: the box mean-curvature-flow experiment (ms per step, 1 and 2 threads), the
 // difference-of-normals curvature per zero-layer point (single and batched), local bump updates on spheres of growing
-// lattices (must stay flat), and level-set memory.
+// lattices (must stay flat), level-set memory, and what a small parallel loop costs after a serial
+// stretch (why a small step runs on one thread: StepOptions::parallel_band_min).
 // Results and the commands that produced them: docs/BENCHMARKS.md.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
 #include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
 
+#include <chrono>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -177,6 +180,29 @@ void BM_Memory(benchmark::State& state) {
     state.counters["rss_before_MB"] = before;
 }
 BENCHMARK(BM_Memory)->Arg(256)->Arg(512)->Iterations(1)->Unit(benchmark::kMillisecond);
+
+// One parallel loop over two 4 096-float chunks (a small step's loop) after `gap` µs of serial
+// work, on 1 or 2 threads: once the gap has let the oneTBB worker sleep, waking it costs the loop
+// more than the second core saves. Manual time: the loop alone.
+void BM_ParallelLoopAfterSerialGap(benchmark::State& state) {
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+    const auto gap = std::chrono::microseconds(state.range(1));
+    std::vector<float> v(8192, 1.0f);
+    for (auto _ : state) {
+        const auto serial_start = std::chrono::steady_clock::now();
+        while (std::chrono::steady_clock::now() - serial_start < gap) {
+        }
+        const auto start = std::chrono::steady_clock::now();
+        tbb::parallel_for(std::size_t{0}, std::size_t{2}, [&](std::size_t c) {
+            for (std::size_t i = c * 4096; i < (c + 1) * 4096; ++i) v[i] = v[i] * 1.0001f + 0.5f;
+        });
+        state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        benchmark::DoNotOptimize(v.data());
+    }
+}
+BENCHMARK(BM_ParallelLoopAfterSerialGap)
+    ->Args({1, 0})->Args({2, 0})->Args({1, 500})->Args({2, 500})
+    ->Iterations(2000)->Repetitions(3)->ReportAggregatesOnly(true)->UseManualTime()->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

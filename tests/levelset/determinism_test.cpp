@@ -1,9 +1,14 @@
-// Thread-count independence: 1 and 2 threads give bitwise-identical states and change lists.
+// Thread-count independence: 1 and 2 threads give bitwise-identical states and change lists; a
+// small band steps on the calling thread alone, with the same bits.
 #include <gtest/gtest.h>
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <atomic>
 #include <random>
+#include <stdexcept>
+#include <string>
 
 #include "levelset_test_util.hpp"
 #include "liveset/levelset/curvature_flow.hpp"
@@ -12,6 +17,13 @@ using namespace liveset;
 using namespace liveset::testing;
 
 namespace {
+
+StepOptions parallel_always() {
+    StepOptions o;
+    o.parallel_band_min = 0;  // the box's small band too: 2 threads run the parallel loops
+    return o;
+}
+
 SparseField run(int threads, std::vector<std::size_t>& changes) {
     tbb::task_arena arena(threads);
     SparseField f = make_box_field({});
@@ -19,12 +31,32 @@ SparseField run(int threads, std::vector<std::size_t>& changes) {
         const CurvatureSpeed speed;
         std::mt19937 rng(99);
         for (int s = 0; s < 150; ++s) {
-            changes.push_back(f.step(speed).changed.size());
+            changes.push_back(f.step(speed, parallel_always()).changed.size());
             if (s % 10 == 0) changes.push_back(f.apply_edits(random_edit(f, rng)).size());
         }
     });
     return f;
 }
+
+// Mean curvature flow that records the most threads its rates were evaluated under.
+class ConcurrencyProbe final : public Speed {
+public:
+    SpeedSample at(const Grid<float>& phi, Vec3i p) const override { return flow_.at(phi, p); }
+    void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override {
+        int seen = most_.load();
+        const int now = tbb::this_task_arena::max_concurrency();
+        while (now > seen && !most_.compare_exchange_weak(seen, now)) {
+        }
+        flow_.rates(phi, points, out);
+    }
+    float curvature_weight() const override { return flow_.curvature_weight(); }
+    int most_threads() const { return most_.load(); }
+
+private:
+    CurvatureSpeed flow_;
+    mutable std::atomic<int> most_{0};
+};
+
 }  // namespace
 
 TEST(Determinism, OneAndTwoThreadsGiveIdenticalResults) {
@@ -34,4 +66,45 @@ TEST(Determinism, OneAndTwoThreadsGiveIdenticalResults) {
     EXPECT_TRUE(same_state(a, b));
     EXPECT_EQ(c1, c2);
     expect_same_list_order(a, b);
+}
+
+// Under two threads, a band below parallel_band_min is stepped by one thread (the speed sees an
+// arena of one), a band at or above it by both; the states and change reports are the same bits,
+// for both step modes.
+TEST(Determinism, SmallBandStepsOnTheCallingThreadAloneWithTheSameBits) {
+    for (StepMode m : {StepMode::kFullBand, StepMode::kIncremental}) {
+        tbb::task_arena arena(2);
+        SparseField alone = make_box_field({}), shared = alone;
+        StepOptions small = parallel_always(), large = parallel_always();
+        small.mode = large.mode = m;
+        small.parallel_band_min = alone.band_size() * 2;  // the box flow's band only shrinks
+        const ConcurrencyProbe probe_alone, probe_shared;
+        arena.execute([&] {
+            for (int s = 0; s < 60; ++s) {
+                const StepResult a = alone.step(probe_alone, small);
+                const StepResult b = shared.step(probe_shared, large);
+                ASSERT_EQ(a.changed.points, b.changed.points) << "step " << s;
+                ASSERT_EQ(a.dt, b.dt) << "step " << s;
+            }
+        });
+        EXPECT_EQ(probe_alone.most_threads(), 1);
+        EXPECT_EQ(probe_shared.most_threads(), 2);
+        EXPECT_TRUE(same_state(alone, shared));
+        expect_same_list_order(alone, shared);
+    }
+}
+
+TEST(Determinism, ParallelBandMinIsValidated) {
+    StepOptions o;
+    o.parallel_band_min = 1'000'000'001;
+    try {
+        validate(o);
+        FAIL() << "accepted 1 000 000 001";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("several threads"), std::string::npos) << e.what();
+    }
+    o.parallel_band_min = 0;
+    EXPECT_NO_THROW(validate(o));
+    o.parallel_band_min = 1'000'000'000;
+    EXPECT_NO_THROW(validate(o));
 }

@@ -23,6 +23,7 @@ namespace {
 StepOptions mode(StepMode m) {
     StepOptions o;
     o.mode = m;
+    o.parallel_band_min = 0;  // small fields too: the 2-thread runs go through the parallel loops
     return o;
 }
 

@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <bit>
@@ -212,6 +213,8 @@ void validate(const StepOptions& o) {
         throw std::invalid_argument("steps before a still stretch of front sleeps must be in [0, 1000000] (0: never)");
     if (o.dense_front_max > 1'000'000'000)
         throw std::invalid_argument("largest front re-layered whole must be at most 1000000000 points (0: never)");
+    if (o.parallel_band_min > 1'000'000'000)
+        throw std::invalid_argument("smallest band stepped on several threads must be at most 1000000000 points (0: always)");
     if (o.sleep_after > 0 && o.mode != StepMode::kIncremental)
         throw std::invalid_argument("sleeping stretches of front need the incremental step (StepMode::kIncremental)");
 }
@@ -282,7 +285,17 @@ void SparseField::sort_lists(bool zero_only) {
 StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
     validate(options);
     ++steps_;
-    StepResult result = options.mode == StepMode::kFullBand ? step_full_band(speed, options) : step_incremental(speed, options);
+    StepResult result;
+    const auto run = [&] {
+        result = options.mode == StepMode::kFullBand ? step_full_band(speed, options) : step_incremental(speed, options);
+    };
+    if (band_size() < options.parallel_band_min) {
+        // One slot, one arena per calling thread: fields stepped on other threads never wait for it.
+        thread_local tbb::task_arena alone(1);
+        alone.execute(run);
+    } else {
+        run();
+    }
     activity_.wake_near(sign_changes_, lattice(), steps_);  // a no-op until a sleeping step ran
     result.sign_changes = std::move(sign_changes_);  // read by nothing after wake_near
     sign_changes_.clear();

@@ -73,6 +73,12 @@ struct StepOptions {
     // 25; beyond it the propagation's parallel passes pay on two). 0: always propagate. At most
     // 1 000 000 000.
     std::size_t dense_front_max = 30'000;
+    // A step over a band of fewer points runs on the calling thread alone (bitwise the same
+    // result): its loops are too short to pay for waking another thread, which costs tens of
+    // microseconds per parallel loop on a virtual machine (docs/BENCHMARKS.md, session 31: on the
+    // 2-core VM two threads were 1.3-1.6x slower than one below 30 000 front points). 0: always
+    // use the threads there are. At most 1 000 000 000.
+    std::size_t parallel_band_min = 300'000;
 };
 
 // Throws std::invalid_argument with a one-line message on an option out of range.
