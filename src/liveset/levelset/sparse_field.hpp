@@ -140,8 +140,9 @@ public:
     // --- updates ----------------------------------------------------------------------------
     // One global step of ∂φ/∂t = |∇φ| F with a CFL time step (|Δφ| ≤ cfl and the parabolic bound
     // dt ≤ 1/(4·curvature weight), the explicit scheme's stability limit), multithreaded over the
-    // zero layer (a band below options.parallel_band_min on the calling thread alone). Both modes give the same φ, statuses and change report (as a set); kIncremental
-    // costs what moved (the band when most of a small front moves), kFullBand the band.
+    // zero layer (a band below options.parallel_band_min on the calling thread alone). Both modes
+    // give the same φ, statuses and change report (as a set); kIncremental costs what moved (the
+    // band when most of a small front moves), kFullBand the band.
     StepResult step(const Speed& speed, const StepOptions& options = {});
     // The Δφ a global step would apply (one edit per zero-layer point) and its time step.
     std::vector<ZeroLayerEdit> compute_step(const Speed& speed, const StepOptions& options, double* dt) const;
