@@ -4,9 +4,9 @@
 
 #include <tbb/task_arena.h>
 
-#include <algorithm>
 #include <atomic>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
 
