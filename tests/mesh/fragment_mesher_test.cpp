@@ -298,6 +298,81 @@ TEST(FragmentMesher, SingleFragmentUpdateIsSurfaceProportional) {
     EXPECT_EQ(canonical_triangles(m.merged()), canonical_triangles(marching_cubes_naive(phi)));
 }
 
+// Brute force: the fragments owning a cell with a corner at p (those whose triangles a sign flip
+// at p can change).
+std::set<FragmentId> brute_reshaped(const FragmentMesher& m, Vec3i p) {
+    std::set<FragmentId> out;
+    const Vec3i d = m.lattice().dims();
+    for (int z = std::max(p.z - 1, 0); z <= std::min(p.z, d.z - 2); ++z)
+        for (int y = std::max(p.y - 1, 0); y <= std::min(p.y, d.y - 2); ++y)
+            for (int x = std::max(p.x - 1, 0); x <= std::min(p.x, d.x - 2); ++x) out.insert(m.fragment_of_cell({x, y, z}));
+    return out;
+}
+
+// A fragment whose cells' corner signs did not change keeps T and only recomputes V; one with a
+// flipped corner is re-polygonised. Either way the result is bit for bit a fresh mesher's.
+TEST(FragmentMesher, FragmentsWithoutASignFlipRefreshOnlyTheirVertices) {
+    Grid<float> phi = sphere_field({30, 28, 26}, {14.6, 13.4, 12.7}, 9);
+    FragmentMesher m(phi.lattice(), 6);
+    m.full_rebuild(phi);  // a scan keeps no vertex edges: the next rebuild of each fragment is a row pass
+    std::vector<PointIndex> all(phi.lattice().size());
+    for (PointIndex i = 0; i < all.size(); ++i) all[i] = i;
+    const auto scale = [&](float k) {  // moves every vertex (not where t is clamped), flips no sign
+        for (float& v : phi.values()) v = v > 0.0f ? v * k : v / k;
+    };
+    const auto expect_fresh = [&] {
+        FragmentMesher fresh(phi.lattice(), 6);
+        fresh.full_rebuild(phi);
+        expect_same_meshers(m, fresh);
+    };
+    const std::vector<Vertex> first(m.fragment(m.fragment_of_cell({14, 13, 3})).vertices.begin(),
+                                    m.fragment(m.fragment_of_cell({14, 13, 3})).vertices.end());
+    scale(1.3f);
+    ASSERT_EQ(m.update(phi, all).size(), m.fragment_count());
+    EXPECT_EQ(m.last_stats().vertices_only, 0u);  // after the scan: row passes
+    expect_fresh();
+    std::vector<std::uint64_t> stamps(m.fragment_count());
+    for (FragmentId f = 0; f < m.fragment_count(); ++f) stamps[f] = m.fragment(f).topology;
+    scale(0.8f);
+    ASSERT_EQ(m.update(phi, all).size(), m.fragment_count());
+    for (FragmentId f = 0; f < m.fragment_count(); ++f) ASSERT_EQ(m.fragment(f).topology, stamps[f]) << "T kept, stamp kept";
+    EXPECT_EQ(m.last_stats().vertices_only, m.fragment_count());
+    EXPECT_EQ(m.last_stats().cells_visited, 0u);
+    EXPECT_EQ(m.last_stats().rows_visited, 0u);
+    expect_fresh();
+    EXPECT_FALSE(same_vertices(m.fragment(m.fragment_of_cell({14, 13, 3})).vertices, first));  // they did move
+
+    // A flip at p re-polygonises exactly the fragments owning a cell with corner p; the other
+    // affected fragments refresh their vertices.
+    // p: next to the surface, on a fragment border in x (cells of two fragments), one point above
+    // one in z (the normal stencil reaches the fragments below, whose signs did not change).
+    Vec3i p{-1, -1, -1};
+    for (int z = 7; z < 26 && p.x < 0; z += 6)
+        for (int y = 1; y < 28 && p.x < 0; ++y)
+            for (int x = 6; x < 30 && p.x < 0; x += 6)
+                if (y % 6 >= 2 && std::abs(phi({x, y, z})) < 0.8f && phi({x, y, z}) != 0.0f) p = {x, y, z};
+    ASSERT_GE(p.x, 0);
+    phi(p) = -phi(p);
+    const std::vector<PointIndex> x{phi.lattice().index(p)};
+    const std::vector<FragmentId> u = m.update(phi, x);
+    const std::set<FragmentId> reshaped = brute_reshaped(m, p);
+    for (FragmentId f = 0; f < m.fragment_count(); ++f)
+        EXPECT_EQ(m.fragment(f).topology != stamps[f], reshaped.count(f) == 1) << "fragment " << f;
+    EXPECT_EQ(m.last_stats().fragments_rebuilt, u.size());
+    EXPECT_EQ(m.last_stats().vertices_only, u.size() - reshaped.size());
+    EXPECT_EQ(reshaped.size(), 2u);
+    EXPECT_EQ(u.size(), 4u);
+    expect_fresh();
+    EXPECT_EQ(canonical_triangles(m.merged()), canonical_triangles(marching_cubes_naive(phi)));
+
+    // A full rebuild from a zero layer (a new φ, as when a session loads one) polygonises every
+    // fragment anew; it may not refresh vertices on the old triangles.
+    phi = sphere_field({30, 28, 26}, {13.2, 14.1, 12.9}, 7);
+    m.full_rebuild(phi, all);
+    EXPECT_EQ(m.last_stats().vertices_only, 0u);
+    expect_fresh();
+}
+
 TEST(FragmentMesher, RejectsMismatchedGridAndBadIndices) {
     FragmentMesher m(Lattice(Vec3i{8, 8, 8}), 3);
     const Grid<float> wrong = random_field({8, 8, 9}, 1, false);

@@ -97,10 +97,7 @@ void CellPolygoniser::prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi) {
         decoder_dims_ = d;
     }
     lo_ = lo;
-    dims_ = d;
-    values_ = phi.values().data();
-    sy_ = phi.lattice().stride_y();
-    sz_ = phi.lattice().stride_z();
+    bind(phi);
     px_ = hi.x - lo.x + 1;
     py_ = hi.y - lo.y + 1;
     slice_ = static_cast<std::size_t>(px_) * static_cast<std::size_t>(py_) * 3;
@@ -120,6 +117,13 @@ void CellPolygoniser::prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi) {
     computed_ = 0;
     cells_ = 0;
     rows_ = 0;
+}
+
+void CellPolygoniser::bind(const Grid<float>& phi) {
+    dims_ = phi.dims();
+    values_ = phi.values().data();
+    sy_ = phi.lattice().stride_y();
+    sz_ = phi.lattice().stride_z();
 }
 
 void CellPolygoniser::renew_slot(int slot) {
@@ -229,7 +233,13 @@ void CellPolygoniser::finish_vertices(const Grid<float>& phi, Mesh& out) {
     for (std::size_t k = 0; k < deferred_.size(); ++k) {
         dst[k] = edge_vertex(phi, deferred_[k].p, deferred_[k].axis);
     }
-    deferred_.clear();
+}
+
+void CellPolygoniser::refresh_vertices(const Grid<float>& phi, std::span<const EdgeRef> edges, std::span<Vertex> out) {
+    if (edges.size() != out.size()) throw std::invalid_argument("refresh_vertices: one edge per vertex is needed");
+    bind(phi);
+    Vertex* dst = out.data();
+    for (std::size_t k = 0; k < edges.size(); ++k) dst[k] = edge_vertex(phi, edges[k].p, edges[k].axis);
 }
 
 void CellPolygoniser::polygonise_box(const Grid<float>& phi, Vec3i lo, Vec3i hi, Mesh& out,
@@ -280,7 +290,7 @@ void CellPolygoniser::polygonise_cells(const Grid<float>& phi, Vec3i lo, Vec3i h
 
 void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& signs, Vec3i lo, Vec3i hi,
                                       std::span<const std::uint64_t> rows_a, std::span<const std::uint64_t> rows_b, Mesh& out,
-                                      std::span<std::uint64_t> crossing_rows) {
+                                      std::span<std::uint64_t> crossing_rows, std::vector<EdgeRef>* vertex_edges) {
     prepare(phi, lo, hi);
     if (!(signs.dims == phi.dims())) throw std::invalid_argument("sign bits do not match the phi grid");
     const int ny = hi.y - lo.y;
@@ -288,6 +298,7 @@ void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& si
     const std::size_t nwords = (nrows + 63) / 64;
     if (rows_a.size() < nwords || rows_b.size() < nwords || crossing_rows.size() < nwords)
         throw std::invalid_argument("row bitmaps are smaller than the box's cell rows");
+    if (vertex_edges) vertex_edges->clear();
     if (ny <= 0 || hi.x <= lo.x) return;
     if (gid_.size() < 2 * slice_) gid_.resize(2 * slice_, 0);
     deferred_.clear();
@@ -320,6 +331,7 @@ void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& si
         }
     }
     finish_vertices(phi, out);
+    if (vertex_edges) vertex_edges->swap(deferred_);  // deferred_ is cleared at the next call
 }
 
 }  // namespace liveset

@@ -82,6 +82,12 @@ using CellKey = PointIndex;
 // Not thread-safe; use one per thread. Output is a deterministic function of (φ, box, cells).
 class CellPolygoniser {
 public:
+    // The lattice edge a vertex lies on: from point p one step along +axis.
+    struct EdgeRef {
+        Vec3i p;
+        int axis;
+    };
+
     // Visits every cell of the box in z, y, x order.
     void polygonise_box(const Grid<float>& phi, Vec3i lo, Vec3i hi, Mesh& out,
                         std::vector<CellKey>* crossing_cells = nullptr);
@@ -96,9 +102,16 @@ public:
     // be φ's sign bits). Sets in `crossing_rows` (same layout, cleared by the caller) the rows that
     // hold a crossing cell. Gives the same output as polygonise_box() when the listed rows include
     // every row of the box with a crossing.
+    // With `vertex_edges`, it is set to the edge of every vertex appended, in order (the input of
+    // refresh_vertices()).
     void polygonise_rows(const Grid<float>& phi, const SignBits& signs, Vec3i lo, Vec3i hi,
                          std::span<const std::uint64_t> rows_a, std::span<const std::uint64_t> rows_b, Mesh& out,
-                         std::span<std::uint64_t> crossing_rows);
+                         std::span<std::uint64_t> crossing_rows, std::vector<EdgeRef>* vertex_edges = nullptr);
+
+    // Recomputes out[k] as the vertex on edges[k] (sizes must match): the same function and bits as
+    // a polygonisation, for a mesh whose cells' signs did not change - its triangles are the same,
+    // only the vertices moved with φ.
+    void refresh_vertices(const Grid<float>& phi, std::span<const EdgeRef> edges, std::span<Vertex> out);
 
     // Lattice-edge vertices computed by the last call (each exactly once).
     std::size_t vertices_computed() const { return computed_; }
@@ -109,6 +122,7 @@ public:
 
 private:
     void prepare(const Grid<float>& phi, Vec3i lo, Vec3i hi);
+    void bind(const Grid<float>& phi);  // dims_, values_ and strides for edge_vertex()
     void enter_layer(int z);
     void renew_slot(int slot);
     void emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& out);
@@ -127,11 +141,7 @@ private:
     std::vector<std::uint64_t> g_;
     std::array<std::uint64_t, 2> generation_{};  // current generation per slot, in the high half
     std::vector<std::uint32_t> gid_;  // polygonise_rows()' G, same layout: vertex ids only
-    struct DeferredVertex {
-        Vec3i p;
-        int axis;
-    };
-    std::vector<DeferredVertex> deferred_;  // polygonise_rows()' vertices, ids assigned, not yet computed
+    std::vector<EdgeRef> deferred_;  // polygonise_rows()' vertices, ids assigned, not yet computed
     std::uint32_t next_generation_ = 1;
     IndexDecoder decoder_;  // for the lattice of dims decoder_dims_
     Vec3i decoder_dims_{};

@@ -41,6 +41,7 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
                           static_cast<std::size_t>(fdims_.z);
     fragments_.resize(n);
     flags_.assign(n, 0);
+    reshaped_.assign(n, 0);
     decode_ = IndexDecoder(lattice);
     signs_.dims = d;
     signs_.words_per_row = (static_cast<std::size_t>(std::max(d.x, 0)) + 63) / 64;
@@ -112,7 +113,7 @@ FragmentId FragmentMesher::fragment_of_cell(Vec3i cell) const {
 
 FragmentView FragmentMesher::fragment(FragmentId id) const {
     const Fragment& f = fragments_.at(id);
-    return {id, f.origin, f.extent, f.mesh.vertices, f.mesh.indices};
+    return {id, f.origin, f.extent, f.mesh.vertices, f.mesh.indices, f.topology};
 }
 
 void FragmentMesher::check_phi(const Grid<float>& phi) const {
@@ -160,14 +161,26 @@ std::vector<FragmentId> FragmentMesher::affected_fragments(std::span<const Point
 }
 
 void FragmentMesher::rebuild(const Grid<float>& phi, std::span<const FragmentId> ids, bool scan) {
-    std::atomic<std::size_t> visited{0}, rows{0}, computed{0};
+    static std::atomic<std::uint64_t> next_topology{1};  // process-wide: stamps never repeat across meshers
+    const std::uint64_t topology = next_topology.fetch_add(1, std::memory_order_relaxed);
+    std::atomic<std::size_t> visited{0}, rows{0}, computed{0}, vertices_only{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, ids.size(), 1), [&](const tbb::blocked_range<std::size_t>& r) {
         Scratch::Local& local = scratch_->locals.local();
-        std::size_t my_visited = 0, my_rows = 0, my_computed = 0;
+        std::size_t my_visited = 0, my_rows = 0, my_computed = 0, my_vertices_only = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             Fragment& f = fragments_[ids[i]];
+            const bool reshaped = reshaped_[ids[i]] != 0;
+            reshaped_[ids[i]] = 0;
+            if (!scan && !reshaped && f.edges_valid) {  // the same cells cross: T stays, V moves with φ
+                local.poly.refresh_vertices(phi, f.edges, f.mesh.vertices);
+                my_computed += f.edges.size();
+                ++my_vertices_only;
+                continue;
+            }
             const Vec3i hi = f.origin + f.extent;
             f.mesh.clear();
+            f.edges_valid = false;
+            f.topology = topology;
             local.rows.assign(f.rows.size(), 0);
             if (scan) {
                 local.crossing.clear();
@@ -180,7 +193,8 @@ void FragmentMesher::rebuild(const Grid<float>& phi, std::span<const FragmentId>
                     local.rows[bit >> 6] |= std::uint64_t{1} << (bit & 63);
                 }
             } else {
-                local.poly.polygonise_rows(phi, signs_, f.origin, hi, f.rows, f.pending, f.mesh, local.rows);
+                local.poly.polygonise_rows(phi, signs_, f.origin, hi, f.rows, f.pending, f.mesh, local.rows, &f.edges);
+                f.edges_valid = true;
                 my_visited += local.poly.cells_polygonised();
                 my_rows += local.poly.rows_visited();
             }
@@ -191,11 +205,13 @@ void FragmentMesher::rebuild(const Grid<float>& phi, std::span<const FragmentId>
         visited += my_visited;
         rows += my_rows;
         computed += my_computed;
+        vertices_only += my_vertices_only;
     });
     stats_.fragments_rebuilt = ids.size();
     stats_.cells_visited = visited;
     stats_.rows_visited = rows;
     stats_.vertices_computed = computed;
+    stats_.vertices_only = vertices_only;
 }
 
 void FragmentMesher::sync_signs(const Grid<float>& phi) {
@@ -215,6 +231,7 @@ void FragmentMesher::full_rebuild(const Grid<float>& phi, std::span<const PointI
     check_phi(phi);
     const std::vector<CellKey> cells = cells_around_points(lattice_, zero_layer);  // validates indices
     sync_signs(phi);
+    std::fill(reshaped_.begin(), reshaped_.end(), 1);  // any sign may differ from the last mesh: no vertex-only refresh
     for (Fragment& f : fragments_) {
         std::fill(f.rows.begin(), f.rows.end(), 0);
         std::fill(f.pending.begin(), f.pending.end(), 0);
@@ -241,7 +258,10 @@ void FragmentMesher::mark_flipped(Vec3i p) {
         for (int y = y0; y <= y1; ++y) {
             const int fy = cell_fragment_[1][static_cast<std::size_t>(y)], oy = cell_offset_[1][static_cast<std::size_t>(y)];
             for (int fx = fx0; fx <= fx1; ++fx) {
-                Fragment& f = fragments_[fragment_id({fx, fy, fz})];
+                const FragmentId id = fragment_id({fx, fy, fz});
+                std::atomic_ref<std::uint8_t> reshaped(reshaped_[id]);
+                if (reshaped.load(std::memory_order_relaxed) == 0) reshaped.store(1, std::memory_order_relaxed);
+                Fragment& f = fragments_[id];
                 const auto bit = static_cast<std::size_t>(oy + f.extent.y * oz);
                 const std::uint64_t mask = std::uint64_t{1} << (bit & 63);
                 if ((f.rows[bit >> 6] & mask) != 0) continue;  // a candidate anyway (rows are not written here)
@@ -318,6 +338,7 @@ std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span
         rebuild(phi, u, false);
     } catch (...) {
         for (FragmentId f : u) flags_[f] = 0;
+        std::fill(reshaped_.begin(), reshaped_.end(), 0);
         initialised_ = false;  // row bitmaps may be stale: the next update starts from scratch
         throw;
     }

@@ -17,6 +17,12 @@
 // holds the whole band but only a thin sheet of it flips sign. It never scans the fragment's cells,
 // so a single whole-lattice fragment (the paper's x100 case) costs O(surface) cell work plus one
 // bit per cell row. The only O(volume) pass is full_rebuild(φ) without a zero layer.
+//
+// Vertex-only refresh: a fragment's triangles depend only on the signs of its cells' corners. An
+// affected fragment none of whose cells has a corner whose sign flipped keeps its T and vertex ids;
+// only its vertices are recomputed, from the lattice edge kept per vertex (no row pass, no cases,
+// no G), and update() lists it in U like any other (its V changed, its T did not). Under a moving
+// front most fragments see values move every step but a sign flip only now and then.
 #pragma once
 
 #include <array>
@@ -42,6 +48,9 @@ struct FragmentView {
     Vec3i cell_extent{};  // number of owned cells per axis (smaller at the lattice's far border)
     std::span<const Vertex> vertices;       // V, index space
     std::span<const std::uint32_t> indices;  // T, 3 per triangle, local to V
+    // Changes whenever T is rebuilt (unique across meshers; 0 never): two views with the same stamp
+    // have the same T and vertex count, so a renderer re-uploads only V (a vertex-only refresh).
+    std::uint64_t topology = 0;
     MeshView mesh() const { return {vertices, indices}; }
 };
 
@@ -50,6 +59,7 @@ struct FragmentUpdateStats {
     std::size_t cells_visited = 0;       // cells polygonised (a scan: every cell of the fragments)
     std::size_t rows_visited = 0;        // candidate cell rows examined (0 for a scan)
     std::size_t vertices_computed = 0;   // edge vertices computed (border vertices count per fragment)
+    std::size_t vertices_only = 0;       // of fragments_rebuilt: refreshed with T unchanged (no sign flip)
 };
 
 // Thread safety: update()/full_rebuild() parallelise internally and must not run concurrently
@@ -102,6 +112,11 @@ private:
         // Bitmaps over the owned cell rows, bit (y - origin.y) + extent.y * (z - origin.z):
         std::vector<std::uint64_t> rows;     // rows holding a crossing cell, as last meshed
         std::vector<std::uint64_t> pending;  // rows with a cell corner whose sign flipped since then
+        // The lattice edge of every vertex, for a vertex-only refresh; valid after a row pass (a
+        // scan does not record them, so the fragment's next rebuild is a row pass).
+        std::vector<CellPolygoniser::EdgeRef> edges;
+        bool edges_valid = false;
+        std::uint64_t topology = 0;  // FragmentView::topology
     };
     struct Scratch;
 
@@ -126,6 +141,7 @@ private:
     Vec3i fdims_{};
     std::vector<Fragment> fragments_;
     std::vector<std::uint8_t> flags_;  // B
+    std::vector<std::uint8_t> reshaped_;  // per fragment: a corner of one of its cells flipped sign since it was meshed
     IndexDecoder decode_;
     std::array<std::vector<AxisRange>, 3> ranges_;  // per axis, indexed by point coordinate
     // Per axis and point coordinate: the one fragment coordinate of the wide range times the axis'

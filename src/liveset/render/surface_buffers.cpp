@@ -23,9 +23,19 @@ UploadStats SurfaceBuffers::upload(const FragmentMesher& mesher, std::span<const
     for (FragmentId id : ids) {
         const FragmentView view = mesher.fragment(id);
         FragmentBuffers& f = fragments_[id];
+        const auto vbytes = static_cast<GLsizeiptr>(view.vertices.size_bytes());
+        if (f.vao && f.topology != 0 && view.topology == f.topology && view.vertices.size() == f.vertices) {
+            glBindBuffer(GL_ARRAY_BUFFER, f.vbo);  // the same T: the moved vertices only, in place
+            glBufferSubData(GL_ARRAY_BUFFER, 0, vbytes, view.vertices.data());
+            ++stats.fragments;
+            ++stats.vertices_only;
+            stats.bytes += static_cast<std::size_t>(vbytes);
+            continue;
+        }
         triangles_ -= static_cast<std::size_t>(f.indices) / 3;
         if (view.indices.empty()) {
             f.indices = 0;  // keep the (now unused) buffers for the fragment's next triangles
+            f.topology = 0;
             continue;
         }
         if (!f.vao) {
@@ -43,11 +53,12 @@ UploadStats SurfaceBuffers::upload(const FragmentMesher& mesher, std::span<const
             glBindVertexArray(f.vao);
             glBindBuffer(GL_ARRAY_BUFFER, f.vbo);
         }
-        const auto vbytes = static_cast<GLsizeiptr>(view.vertices.size_bytes());
         const auto ibytes = static_cast<GLsizeiptr>(view.indices.size_bytes());
         glBufferData(GL_ARRAY_BUFFER, vbytes, view.vertices.data(), GL_DYNAMIC_DRAW);
         glBufferData(GL_ELEMENT_ARRAY_BUFFER, ibytes, view.indices.data(), GL_DYNAMIC_DRAW);
         f.indices = static_cast<GLsizei>(view.indices.size());
+        f.vertices = view.vertices.size();
+        f.topology = view.topology;
         triangles_ += view.indices.size() / 3;
         ++stats.fragments;
         stats.bytes += static_cast<std::size_t>(vbytes + ibytes);

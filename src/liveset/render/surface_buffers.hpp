@@ -7,6 +7,7 @@
 #include <epoxy/gl.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -18,6 +19,7 @@ namespace liveset::render {
 struct UploadStats {
     std::size_t fragments = 0;  // buffers re-uploaded
     std::size_t bytes = 0;      // vertex + index bytes sent
+    std::size_t vertices_only = 0;  // of `fragments`: T unchanged (FragmentView::topology), only V sent
 };
 
 class SurfaceBuffers {
@@ -27,7 +29,8 @@ public:
     SurfaceBuffers(const SurfaceBuffers&) = delete;
     SurfaceBuffers& operator=(const SurfaceBuffers&) = delete;
 
-    // Re-uploads fragments `ids` of `mesher` (the list FragmentMesher::update returned). The first
+    // Re-uploads fragments `ids` of `mesher` (the list FragmentMesher::update returned); a fragment
+    // whose T is the one uploaded last (same topology stamp) gets only its V, in place. The first
     // call, or one after the mesher's fragment count changed, sizes the buffer set to the mesher.
     UploadStats upload(const FragmentMesher& mesher, std::span<const FragmentId> ids);
     // Re-uploads every fragment.
@@ -43,6 +46,8 @@ private:
     struct FragmentBuffers {
         GLuint vao = 0, vbo = 0, ibo = 0;
         GLsizei indices = 0;
+        std::size_t vertices = 0;
+        std::uint64_t topology = 0;  // FragmentView::topology of the T uploaded (0: none)
     };
     void release();
     std::vector<FragmentBuffers> fragments_;
