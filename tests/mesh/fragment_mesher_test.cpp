@@ -163,6 +163,8 @@ void run_incremental(int fragment_size, std::uint32_t seed, int edits) {
 }
 
 TEST(FragmentMesher, IncrementalEditsMatchFullRebuild) {
+    run_incremental(1, 10, 100);  // sizes 1 and 2: a stencil spans up to four fragments per axis
+    run_incremental(2, 15, 100);
     run_incremental(3, 11, 300);
     run_incremental(5, 12, 200);
     run_incremental(7, 13, 200);

@@ -63,6 +63,14 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
             single_[a].resize(t.size());
             for (std::size_t v = 0; v < t.size(); ++v)
                 single_[a][v] = t[v].wide_lo == t[v].wide_hi ? static_cast<std::uint32_t>(t[v].wide_lo) * stride : kSpansFragments;
+            if (size_ >= 3) {  // [v - 2, v + 1] covers at most two fragments
+                spans_[a].resize(t.size());
+                for (std::size_t v = 0; v < t.size(); ++v) {
+                    const AxisRange& r = t[v];
+                    const auto bits = [&](int lo, int hi) { return static_cast<std::uint8_t>(((2u << (hi - r.wide_lo)) - 1) & ~((1u << (lo - r.wide_lo)) - 1)); };
+                    spans_[a][v] = {static_cast<std::uint32_t>(r.wide_lo) * stride, bits(r.wide_lo, r.wide_hi), bits(r.narrow_lo, r.narrow_hi)};
+                }
+            }
             cell_fragment_[a].resize(static_cast<std::size_t>(cells_[a]));
             cell_offset_[a].resize(static_cast<std::size_t>(cells_[a]));
             for (int c = 0; c < cells_[a]; ++c) {
@@ -73,6 +81,7 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
     }
     if (n > 0) {
         row_of_ = FastDivider(static_cast<std::uint32_t>(d.x));
+        z_of_row_ = FastDivider(static_cast<std::uint32_t>(d.y));
         single_row_.resize(static_cast<std::size_t>(d.y) * static_cast<std::size_t>(d.z));
         for (int z = 0; z < d.z; ++z)
             for (int y = 0; y < d.y; ++y) {
@@ -277,6 +286,33 @@ void FragmentMesher::flag(FragmentId f, std::vector<FragmentId>& flagged) {
     if (b.load(std::memory_order_relaxed) == 0 && b.exchange(1, std::memory_order_relaxed) == 0) flagged.push_back(f);
 }
 
+void FragmentMesher::flag_spanning(std::uint32_t px, std::uint32_t row, std::vector<FragmentId>& flagged,
+                                   std::uint64_t& last) {
+    const std::uint32_t z = z_of_row_.divide(row), y = row - z * static_cast<std::uint32_t>(lattice_.dims().y);
+    if (spans_[0].empty()) {  // fragment sizes 1 and 2
+        for_each_affected({static_cast<int>(px), static_cast<int>(y), static_cast<int>(z)}, [&](FragmentId f) { flag(f, flagged); });
+        return;
+    }
+    // for_each_affected's union of three boxes (wide on one axis, narrow on the others) as a set of
+    // the 8 corners (i, j, k) in {0, 1}^3 of the 2x2x2 fragments from the wide ranges' first ones;
+    // corner c = i + 2j + 4k. kX[m]: the corners whose i lies in the 2-bit mask m (kY, kZ: j, k).
+    static constexpr std::uint8_t kX[4] = {0x00, 0x55, 0xAA, 0xFF}, kY[4] = {0x00, 0x33, 0xCC, 0xFF}, kZ[4] = {0x00, 0x0F, 0xF0, 0xFF};
+    const Span& sx = spans_[0][px];
+    const Span& sy = spans_[1][y];
+    const Span& sz = spans_[2][z];
+    unsigned corners = (kX[sx.wide] & kY[sy.narrow] & kZ[sz.narrow]) | (kX[sx.narrow] & kY[sy.wide] & kZ[sz.narrow]) |
+                       (kX[sx.narrow] & kY[sy.narrow] & kZ[sz.wide]);
+    const std::uint32_t base = sx.base + sy.base + sz.base;
+    const std::uint64_t key = std::uint64_t{base} << 8 | corners;  // corners != 0: the point's own fragment
+    if (key == last) return;  // consecutive points of X often share their fragments
+    last = key;
+    const auto fx = 1u, fy = static_cast<std::uint32_t>(fdims_.x), fz = fy * static_cast<std::uint32_t>(fdims_.y);
+    for (; corners != 0; corners &= corners - 1) {
+        const unsigned c = static_cast<unsigned>(std::countr_zero(corners));
+        flag(base + (c & 1u) * fx + ((c >> 1) & 1u) * fy + (c >> 2) * fz, flagged);
+    }
+}
+
 std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed) {
     // Pass over X (parallel): flag the affected fragments in B, and update the sign bits; a point
     // whose sign flipped queues the rows of its cells - only those cells can start or stop
@@ -289,6 +325,7 @@ std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, st
         const std::uint32_t* srow = single_row_.data();
         const auto nx = static_cast<std::uint32_t>(signs_.dims.x);
         FragmentId last = kSpansFragments;  // the fragment flagged for the previous point, if single
+        std::uint64_t last_span = 0;        // the fragments flagged for the previous spanning point
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
             if (k + 16 < r.end()) __builtin_prefetch(values.data() + changed[k + 16]);  // X is scattered over the lattice
             const PointIndex x = changed[k];
@@ -300,7 +337,7 @@ std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, st
                 if (f != last) flag(f, local.flagged);
                 last = f;
             } else {
-                for_each_affected(decode_.coord(x), [&](FragmentId f) { flag(f, local.flagged); });
+                flag_spanning(px, row, local.flagged, last_span);
             }
             const bool now = is_inside(values[x]);
             const std::uint64_t bit = std::uint64_t{1} << (px & 63);

@@ -132,6 +132,11 @@ private:
     void sync_signs(const Grid<float>& phi);
     void mark_flipped(Vec3i p);
     void flag(FragmentId f, std::vector<FragmentId>& flagged);  // set B[f]; record f if this call set it  // queue the rows of the cells with corner p in their fragments' pending
+    // flag() every fragment affected by the point (px, row) whose stencil spans fragments, each once,
+    // unless they are the set `last` holds (the previous spanning point's, which it then records).
+    // Out of line: it keeps the X pass's common path small.
+    [[gnu::noinline]] void flag_spanning(std::uint32_t px, std::uint32_t row, std::vector<FragmentId>& flagged,
+                                         std::uint64_t& last);
     std::vector<FragmentId> flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed);
     void rebuild(const Grid<float>& phi, std::span<const FragmentId> ids, bool scan);
 
@@ -153,6 +158,15 @@ private:
     // take one division instead of a full decode.
     std::vector<std::uint32_t> single_row_;
     FastDivider row_of_;
+    // Per axis and point coordinate, for a spanning point (fragment size >= 3, where a wide range
+    // holds at most two fragment coordinates): the wide range's first fragment coordinate times the
+    // axis' stride, and as 2-bit masks over (first, first + 1) the wide and the narrow range.
+    struct Span {
+        std::uint32_t base;
+        std::uint8_t wide, narrow;
+    };
+    std::array<std::vector<Span>, 3> spans_;  // empty for fragment sizes 1 and 2
+    FastDivider z_of_row_;                    // row (y + dims.y * z) -> z
     std::array<std::vector<int>, 3> cell_fragment_, cell_offset_;  // per axis: cell c -> c / S, c % S
     SignBits signs_;              // is_inside() per lattice point, as last meshed
     bool initialised_ = false;    // signs_ and the row bitmaps are valid
