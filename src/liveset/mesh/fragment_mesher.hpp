@@ -130,8 +130,10 @@ private:
     template <class Visit>
     void for_each_affected(Vec3i p, Visit&& visit) const;
     void sync_signs(const Grid<float>& phi);
+    // Marks the fragments of the cells with corner p reshaped and queues those cell rows in their
+    // fragments' pending bitmaps (p's sign flipped).
     void mark_flipped(Vec3i p);
-    void flag(FragmentId f, std::vector<FragmentId>& flagged);  // set B[f]; record f if this call set it  // queue the rows of the cells with corner p in their fragments' pending
+    void flag(FragmentId f, std::vector<FragmentId>& flagged);  // set B[f]; record f if this call set it
     // flag() every fragment affected by the point (px, row) whose stencil spans fragments, each once,
     // unless they are the set `last` holds (the previous spanning point's, which it then records).
     // Out of line: it keeps the X pass's common path small.
