@@ -116,6 +116,7 @@ Figure3Result run_figure3(const Figure3Options& a) {
             c.out.rebuilt_sum += rebuilt;
             c.out.rebuilt_max = std::max(c.out.rebuilt_max, rebuilt);
             c.out.cells_sum += c.out.naive ? static_cast<std::size_t>(cells) * cells * cells : c.mesher.last_stats().cells_visited;
+            if (!c.out.naive) c.out.vertices_only_sum += c.mesher.last_stats().vertices_only;
         }
         if ((a.verify_every > 0 && step % a.verify_every == 0) || step == a.steps) {
             verify(step, phi, field.zero_layer(), cols);

@@ -37,6 +37,7 @@ struct Figure3Column {
     std::vector<double> cumulative;  // seconds after each step
     double total_s = 0.0;
     std::size_t rebuilt_sum = 0, rebuilt_max = 0;  // fragments re-polygonised per step
+    std::size_t vertices_only_sum = 0;             // of rebuilt_sum: T kept, only V recomputed
     std::size_t cells_sum = 0;                     // cells visited
 };
 
