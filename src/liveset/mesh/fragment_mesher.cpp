@@ -281,7 +281,6 @@ void FragmentMesher::mark_flipped(Vec3i p) {
     }
 }
 
-
 [[gnu::always_inline]] inline void FragmentMesher::flag(FragmentId f, std::vector<FragmentId>& flagged) {
     std::atomic_ref<std::uint8_t> b(flags_[f]);
     if (b.load(std::memory_order_relaxed) == 0 && b.exchange(1, std::memory_order_relaxed) == 0) flagged.push_back(f);
