@@ -324,12 +324,19 @@ std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, st
         const std::uint32_t* sx = single_[0].data();
         const std::uint32_t* srow = single_row_.data();
         const auto nx = static_cast<std::uint32_t>(signs_.dims.x);
+        // Locals, not members, so that the calls below (flag_spanning, mark_flipped) do not force
+        // them to be reloaded for every point.
+        const float* v = values.data();
+        const PointIndex* xs = changed.data();
+        const FastDivider row_of = row_of_;
+        std::uint64_t* words = signs_.words.data();
+        const std::size_t wpr = signs_.words_per_row;
         FragmentId last = kSpansFragments;  // the fragment flagged for the previous point, if single
         std::uint64_t last_span = 0;        // the fragments flagged for the previous spanning point
         for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            if (k + 16 < r.end()) __builtin_prefetch(values.data() + changed[k + 16]);  // X is scattered over the lattice
-            const PointIndex x = changed[k];
-            const std::uint32_t row = row_of_.divide(x);  // y + dims.y * z
+            if (k + 16 < r.end()) __builtin_prefetch(v + xs[k + 16]);  // X is scattered over the lattice
+            const PointIndex x = xs[k];
+            const std::uint32_t row = row_of.divide(x);  // y + dims.y * z
             const std::uint32_t px = x - row * nx;
             const std::uint32_t fx = sx[px], fyz = srow[row];
             if (((fx | fyz) & kSpansFragments) == 0) {  // the point and its stencil lie inside one fragment
@@ -339,9 +346,9 @@ std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, st
             } else {
                 flag_spanning(px, row, local.flagged, last_span);
             }
-            const bool now = is_inside(values[x]);
+            const bool now = is_inside(v[x]);
             const std::uint64_t bit = std::uint64_t{1} << (px & 63);
-            std::atomic_ref<std::uint64_t> word(signs_.words[signs_.word_of(row, px)]);
+            std::atomic_ref<std::uint64_t> word(words[row * wpr + (px >> 6)]);
             if (((word.load(std::memory_order_relaxed) & bit) != 0) != now) {
                 const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed)
                                               : word.fetch_and(~bit, std::memory_order_relaxed);
