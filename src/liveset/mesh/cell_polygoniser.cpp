@@ -229,10 +229,7 @@ void CellPolygoniser::finish_vertices(const Grid<float>& phi, Mesh& out) {
     // One simple loop over independent vertices: the φ loads of consecutive vertices overlap.
     const std::size_t first = out.vertices.size();
     out.vertices.resize(first + deferred_.size());
-    Vertex* dst = out.vertices.data() + first;
-    for (std::size_t k = 0; k < deferred_.size(); ++k) {
-        dst[k] = edge_vertex(phi, deferred_[k].p, deferred_[k].axis);
-    }
+    refresh_vertices(phi, deferred_, std::span<Vertex>(out.vertices).subspan(first));
 }
 
 void CellPolygoniser::refresh_vertices(const Grid<float>& phi, std::span<const EdgeRef> edges, std::span<Vertex> out) {

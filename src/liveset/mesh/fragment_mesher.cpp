@@ -382,7 +382,6 @@ std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span
         rebuild(phi, u, false);
     } catch (...) {
         for (FragmentId f : u) flags_[f] = 0;
-        std::fill(reshaped_.begin(), reshaped_.end(), 0);
         initialised_ = false;  // row bitmaps may be stale: the next update starts from scratch
         throw;
     }
