@@ -92,8 +92,10 @@ TEST(Activity, SleepingPointsNeverMoveAndTheAwakeSetIsTheRules) {
         ASSERT_TRUE(inv.ok()) << "step " << s << ": " << inv.summary();
         brute.wake(sign_changes(before, f), s);
         if (s % 29 == 0) {  // undo the step: the restored points wake the front around them
+            const SparseField stepped = f;
             const ChangedPoints x = f.restore(states_at(before, r.changed.points));
             ASSERT_TRUE(same_state(f, before));
+            ASSERT_TRUE(reports_sign_changes(x, stepped, f)) << "step " << s;
             brute.wake(x.points, s);
         }
         if (s % 17 == 0) {  // a local edit wakes the front around it

@@ -40,6 +40,24 @@ inline std::vector<PointIndex> sorted(std::vector<PointIndex> v) {
     return v;
 }
 
+// Every point whose sign of φ (φ < 0) differs between two states, sorted.
+inline std::vector<PointIndex> brute_force_sign_changes(const SparseField& before, const SparseField& after) {
+    std::vector<PointIndex> out;
+    const auto pa = before.phi().values(), pb = after.phi().values();
+    for (std::size_t i = 0; i < pa.size(); ++i)
+        if ((pa[i] < 0.0f) != (pb[i] < 0.0f)) out.push_back(static_cast<PointIndex>(i));
+    return out;
+}
+
+// An update's report of its sign changes is present and exact (what a mesher relies on).
+inline ::testing::AssertionResult reports_sign_changes(const ChangedPoints& x, const SparseField& before, const SparseField& after) {
+    if (!x.sign_changes) return ::testing::AssertionFailure() << "no sign changes reported";
+    if (sorted(*x.sign_changes) != brute_force_sign_changes(before, after))
+        return ::testing::AssertionFailure() << x.sign_changes->size() << " sign changes reported, "
+                                             << brute_force_sign_changes(before, after).size() << " by brute force";
+    return ::testing::AssertionSuccess();
+}
+
 // A random local edit: a Gaussian bump (raise or lower) of the given radius around a random
 // zero-layer point, or a handful of scattered single-point edits.
 inline std::vector<ZeroLayerEdit> random_edit(const SparseField& f, std::mt19937& rng, double radius = 3.0) {

@@ -33,6 +33,8 @@ TEST(LocalUpdate, RandomEditSequencesEqualTheGlobalRepairBitwise) {
             // X is exactly the set of points whose φ or status changed.
             ASSERT_EQ(sorted(xl.points), brute_force_changes(before, local)) << "edit " << e;
             ASSERT_EQ(sorted(xg.points), sorted(xl.points)) << "edit " << e;
+            ASSERT_TRUE(reports_sign_changes(xl, before, local)) << "edit " << e;
+            ASSERT_TRUE(reports_sign_changes(xg, before, global)) << "edit " << e;
             if (e % 25 == 0) expect_valid(local, "random edits");
         }
         expect_valid(local, "after random edits");

@@ -47,6 +47,7 @@ SparseField unite_both_ways(const SparseField& field, const shapes::Sphere& ball
     const ChangedPoints x = local.unite_in_box(floor3(ball.center - r), ceil3(ball.center + r), ball);
     EXPECT_TRUE(same_state(local, global));
     EXPECT_EQ(sorted(x.points), brute_force_changes(field, local));
+    EXPECT_TRUE(liveset::testing::reports_sign_changes(x, field, local));
     expect_valid(local, what.c_str());
     return local;
 }

@@ -114,11 +114,14 @@ TEST(FragmentMesher, UnionOfFragmentsEqualsWholeLattice) {
 
 // Random local edits: after every incremental update each fragment's V/T is bit-identical to a
 // fresh full rebuild, the union equals whole-lattice marching cubes, U equals the brute-force set
-// and fragments outside U are untouched.
+// and fragments outside U are untouched. A twin mesher told the sign changes (with some extra
+// points that did not flip) gives the same U and fragments.
 void run_incremental(int fragment_size, std::uint32_t seed, int edits) {
     Grid<float> phi = sphere_field({26, 24, 25}, {12.6, 11.4, 12.2}, 8);
     FragmentMesher m(phi.lattice(), fragment_size);
     m.full_rebuild(phi);
+    FragmentMesher told(phi.lattice(), fragment_size);
+    told.full_rebuild(phi);
     std::mt19937 rng(seed);
     const Vec3i d = phi.dims();
     for (int e = 0; e < edits; ++e) {
@@ -127,6 +130,7 @@ void run_incremental(int fragment_size, std::uint32_t seed, int edits) {
         std::uniform_real_distribution<float> val(-1.5f, 1.5f);
         const Vec3i centre{ux(rng), uy(rng), uz(rng)};
         std::vector<PointIndex> changed;
+        const Grid<float> old = phi;
         const int n = un(rng);
         for (int i = 0; i < n; ++i) {
             Vec3i p = centre + Vec3i{off(rng), off(rng), off(rng)};
@@ -144,6 +148,11 @@ void run_incremental(int fragment_size, std::uint32_t seed, int edits) {
         }
         const std::vector<FragmentId> predicted = m.affected_fragments(changed);
         const std::vector<FragmentId> u = m.update(phi, changed);
+        std::vector<PointIndex> flips;
+        for (PointIndex x : changed)
+            if (is_inside(old[x]) != is_inside(phi[x]) || (e % 3 == 0 && flips.empty())) flips.push_back(x);
+        ASSERT_EQ(told.update(phi, changed, flips), u) << "edit " << e;
+        expect_same_meshers(told, m);
         ASSERT_TRUE(std::is_sorted(u.begin(), u.end()));
         ASSERT_EQ(u, predicted);
         const std::set<FragmentId> brute = brute_affected(m, changed);
@@ -180,18 +189,26 @@ TEST(FragmentMesher, IncrementalStepsWithSleepingFrontMatchFullRebuild) {
     StepOptions options;
     options.mode = StepMode::kIncremental;
     options.sleep_after = 8;
-    FragmentMesher m(f.lattice(), 5);
+    FragmentMesher m(f.lattice(), 5), told(f.lattice(), 5);  // told: given the level set's sign changes
     m.full_rebuild(f.phi());
+    told.full_rebuild(f.phi());
     std::mt19937 rng(77);
     std::size_t slept = 0;
     for (int s = 1; s <= 160; ++s) {
         const StepResult r = f.step(speed, options);
         slept += r.zero_layer - r.awake;
         m.update(f.phi(), r.changed.points);
-        if (s % 23 == 0) m.update(f.phi(), f.apply_edits(testing::random_edit(f, rng)).points);
+        ASSERT_TRUE(r.changed.sign_changes.has_value());
+        told.update(f.phi(), r.changed.points, *r.changed.sign_changes);
+        if (s % 23 == 0) {
+            const ChangedPoints x = f.apply_edits(testing::random_edit(f, rng));
+            m.update(f.phi(), x.points);
+            told.update(f.phi(), x.points, *x.sign_changes);
+        }
         FragmentMesher fresh(f.lattice(), 5);
         fresh.full_rebuild(f.phi());
         expect_same_meshers(m, fresh);
+        expect_same_meshers(told, fresh);
         if (::testing::Test::HasFatalFailure()) FAIL() << "step " << s;
     }
     EXPECT_GT(slept, 10000u);  // the steps did let stretches of front sleep
@@ -382,6 +399,8 @@ TEST(FragmentMesher, RejectsMismatchedGridAndBadIndices) {
     const Grid<float> phi = random_field({8, 8, 8}, 1, false);
     const std::vector<PointIndex> bad{512};
     EXPECT_THROW(m.update(phi, bad), std::out_of_range);
+    const std::vector<PointIndex> good{511};
+    EXPECT_THROW(m.update(phi, good, bad), std::out_of_range);
 }
 
 }  // namespace

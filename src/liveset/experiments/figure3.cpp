@@ -100,7 +100,8 @@ Figure3Result run_figure3(const Figure3Options& a) {
     using clock = std::chrono::steady_clock;
     Figure3Result r;
     r.checks = 1;
-    const auto mesh_step = [&](int step, std::span<const PointIndex> changed) {
+    // Each column gets the step's X and its sign changes (ChangedPoints), as a session does.
+    const auto mesh_step = [&](int step, std::span<const PointIndex> changed, std::span<const PointIndex> signs) {
         const Grid<float>& phi = field.phi();
         r.changed_sum += changed.size();
         const std::size_t n = cols.size();
@@ -109,7 +110,7 @@ Figure3Result run_figure3(const Figure3Options& a) {
             std::size_t rebuilt = 1;
             const auto t0 = clock::now();
             if (c.out.naive) naive_scan(c, phi);
-            else rebuilt = c.mesher.update(phi, changed).size();
+            else rebuilt = c.mesher.update(phi, changed, signs).size();
             const auto t1 = clock::now();
             c.out.total_s += std::chrono::duration<double>(t1 - t0).count();
             c.out.cumulative.push_back(c.out.total_s);
@@ -124,7 +125,7 @@ Figure3Result run_figure3(const Figure3Options& a) {
         }
     };
     const FlowHook hook = [&](const SparseField&, const StepResult& s, const FlowStepRecord& rec) {
-        mesh_step(rec.step, s.changed.points);
+        mesh_step(rec.step, s.changed.points, *s.changed.sign_changes);
         return true;
     };
     // The driver's time step stays at 1/6 (the parabolic bound before session 15; the box vanishes
@@ -132,7 +133,7 @@ Figure3Result run_figure3(const Figure3Options& a) {
     // bound of 1/4 it vanishes after 941 steps, which would only add idle steps to every column.
     const BoxFlowReport rep = run_curvature_flow(field, a.steps, {.cfl = box.cfl, .max_dt = 1.0f / 6.0f}, hook);
     r.flow_steps = static_cast<int>(rep.steps.size());
-    for (int s = r.flow_steps + 1; s <= a.steps; ++s) mesh_step(s, {});
+    for (int s = r.flow_steps + 1; s <= a.steps; ++s) mesh_step(s, {}, {});
     for (const FlowStepRecord& rec : rep.steps) r.level_set_s += rec.ms / 1000.0;
     for (Column& c : cols) r.columns.push_back(std::move(c.out));
     return r;

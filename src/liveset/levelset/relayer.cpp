@@ -334,7 +334,7 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
     move_between_lists(region, moved);
     ChangedPoints changed;
     detail::join_parts(parts, &Part::changed, changed.points);
-    detail::join_parts(parts, &Part::signs, sign_changes_);
+    detail::join_parts(parts, &Part::signs, changed.sign_changes.emplace());
     return changed;
 }
 

@@ -181,7 +181,6 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf, Vec3i l
     for (PointIndex i : zero) mark_pending(i, region);
     sweep_whole_band(region, zero);
     finish(region);
-    sign_changes_.clear();
 }
 
 void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
@@ -296,9 +295,7 @@ StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
     } else {
         run();
     }
-    activity_.wake_near(sign_changes_, lattice(), steps_);  // a no-op until a sleeping step ran
-    result.sign_changes = std::move(sign_changes_);  // read by nothing after wake_near
-    sign_changes_.clear();
+    activity_.wake_near(*result.changed.sign_changes, lattice(), steps_);  // a no-op until a sleeping step ran
     return result;
 }
 
@@ -373,9 +370,8 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
 }
 
 ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
-    sign_changes_.clear();
     const std::size_t n = edits.size();
-    if (n == 0) return {};
+    if (n == 0) return {{}, std::vector<PointIndex>{}};
 
     // 1. New zero-layer values (all Δ were computed from the old state, so this is Jacobi).
     std::vector<float> old_phi(n);
@@ -452,6 +448,7 @@ ChangedPoints SparseField::restore(std::span<const PointState> states) {
         if (!std::isfinite(s.phi)) throw std::invalid_argument("restored value at " + point_text(lattice(), s.point) + " is not finite");
     }
     ChangedPoints changed;
+    changed.sign_changes.emplace();
     for (const PointState& s : states) {
         const PointIndex i = s.point;
         const std::int8_t old = status_[i];
@@ -462,6 +459,7 @@ ChangedPoints SparseField::restore(std::span<const PointState> states) {
             if (s.status >= -layers_ && s.status <= layers_) list_add(i, s.status);
             status_[i] = s.status;
         }
+        if ((phi_[i] < 0.0f) != (s.phi < 0.0f)) changed.sign_changes->push_back(i);
         phi_[i] = s.phi;
         changed.points.push_back(i);
     }

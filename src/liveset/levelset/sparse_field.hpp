@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <functional>
 #include <span>
+#include <optional>
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
@@ -33,6 +34,11 @@ namespace liveset {
 // X in the paper: lattice points whose φ or status changed in one update (the mesher's input).
 struct ChangedPoints {
     std::vector<PointIndex> points;
+    // The points of `points` whose sign of φ (φ < 0) changed, where the producer knows them (every
+    // SparseField update reports them); a mesher then reads φ only there. Unset for a set
+    // assembled elsewhere (a whole-state difference, a union kept by a caller), where a mesher
+    // must check the sign of every point.
+    std::optional<std::vector<PointIndex>> sign_changes;
     bool empty() const { return points.empty(); }
     std::size_t size() const { return points.size(); }
 };
@@ -96,8 +102,7 @@ struct StepResult {
     std::size_t zero_layer = 0;    // zero-layer size before the step
     std::size_t awake = 0;         // zero-layer points evaluated (all of them unless sleeping)
     bool whole_band = false;       // the repair re-layered the whole band (kFullBand; a dense kIncremental step)
-    ChangedPoints changed;         // points whose φ or status changed
-    std::vector<PointIndex> sign_changes;  // the points of `changed` whose sign of φ changed
+    ChangedPoints changed;         // points whose φ or status changed, and those whose sign changed
 };
 
 class SparseField {
@@ -223,7 +228,6 @@ private:
     double last_update_ms_ = 0.0;
     std::int64_t steps_ = 0;                    // global steps taken (the activity's clock)
     FrontActivity activity_;                    // sleeping stretches of front (kIncremental)
-    std::vector<PointIndex> sign_changes_;      // points whose sign of φ the last update changed
     IndexDecoder decoder_;  // division-free index -> coordinate for the hot loops
     // Working memory of one update, kept so that a global step does not allocate (and fault in)
     // band-sized buffers every time; not part of the state, so a copy of the field starts empty.

@@ -37,7 +37,7 @@ ChangedPoints SparseField::unite_in_box(Vec3i lo, Vec3i hi, const std::function<
                 const auto v = static_cast<float>(std::clamp(std::min(static_cast<double>(phi_[i]), s), -far, far));
                 if (std::bit_cast<std::uint32_t>(v) != std::bit_cast<std::uint32_t>(phi_[i])) value.emplace(i, v);
             }
-    if (value.empty()) return {};
+    if (value.empty()) return {{}, std::vector<PointIndex>{}};
     const auto v_at = [&](PointIndex i) {
         const auto it = value.find(i);
         return it == value.end() ? phi_[i] : it->second;
@@ -77,7 +77,6 @@ ChangedPoints SparseField::unite_in_box(Vec3i lo, Vec3i hi, const std::function<
         status_[i] = std::abs(v) <= 0.5f ? kPendZero : (v < 0 ? kPendNeg : kPendPos);
     }
     sweep_layers(region);
-    sign_changes_.clear();
     ChangedPoints changed = finish(region);
     activity_.wake_near(changed.points, lattice(), steps_);
     last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -24,6 +24,7 @@ struct FragmentMesher::Scratch {
         std::vector<CellKey> crossing;     // a scan's crossing cells
         std::vector<std::uint64_t> rows;   // the rebuilt fragment's new crossing rows
         std::vector<FragmentId> flagged;   // fragments this thread flagged in B during update()
+        Blocks blocks;
     };
     tbb::enumerable_thread_specific<Local> locals;
 };
@@ -58,19 +59,6 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
                 r.wide_lo = std::max(v - 2, 0) / size_;
                 r.wide_hi = std::min(v + 1, last) / size_;
             }
-            const std::uint32_t stride = a == 0 ? 1u : a == 1 ? static_cast<std::uint32_t>(fdims_.x)
-                                                              : static_cast<std::uint32_t>(fdims_.x) * static_cast<std::uint32_t>(fdims_.y);
-            single_[a].resize(t.size());
-            for (std::size_t v = 0; v < t.size(); ++v)
-                single_[a][v] = t[v].wide_lo == t[v].wide_hi ? static_cast<std::uint32_t>(t[v].wide_lo) * stride : kSpansFragments;
-            if (size_ >= 3) {  // [v - 2, v + 1] covers at most two fragments
-                spans_[a].resize(t.size());
-                for (std::size_t v = 0; v < t.size(); ++v) {
-                    const AxisRange& r = t[v];
-                    const auto bits = [&](int lo, int hi) { return static_cast<std::uint8_t>(((2u << (hi - r.wide_lo)) - 1) & ~((1u << (lo - r.wide_lo)) - 1)); };
-                    spans_[a][v] = {static_cast<std::uint32_t>(r.wide_lo) * stride, bits(r.wide_lo, r.wide_hi), bits(r.narrow_lo, r.narrow_hi)};
-                }
-            }
             cell_fragment_[a].resize(static_cast<std::size_t>(cells_[a]));
             cell_offset_[a].resize(static_cast<std::size_t>(cells_[a]));
             for (int c = 0; c < cells_[a]; ++c) {
@@ -79,17 +67,8 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
             }
         }
     }
-    if (n > 0) {
-        row_of_ = FastDivider(static_cast<std::uint32_t>(d.x));
-        z_of_row_ = FastDivider(static_cast<std::uint32_t>(d.y));
-        single_row_.resize(static_cast<std::size_t>(d.y) * static_cast<std::size_t>(d.z));
-        for (int z = 0; z < d.z; ++z)
-            for (int y = 0; y < d.y; ++y) {
-                const std::uint32_t fy = single_[1][static_cast<std::size_t>(y)], fz = single_[2][static_cast<std::size_t>(z)];
-                single_row_[static_cast<std::size_t>(y) + static_cast<std::size_t>(d.y) * static_cast<std::size_t>(z)] =
-                    ((fy | fz) & kSpansFragments) != 0 ? kSpansFragments : fy + fz;
-            }
-    }
+    if (n > 0) row_of_ = FastDivider(static_cast<std::uint32_t>(d.x));
+    if (n > 0 && size_ >= 3) build_span_tables();
     for (FragmentId id = 0; id < n; ++id) {
         Fragment& f = fragments_[id];
         const Vec3i fc = fragment_coord(id);
@@ -101,6 +80,40 @@ FragmentMesher::FragmentMesher(const Lattice& lattice, int fragment_size)
         f.rows.assign(words, 0);
         f.pending.assign(words, 0);
     }
+}
+
+void FragmentMesher::build_span_tables() {
+    // Per axis: 2-bit masks over the two fragment coordinates (first, first + 1) of a point's wide
+    // range, for the wide and the narrow range; then as 8-bit corner sets of the 2x2x2 block.
+    static constexpr std::uint8_t kX[4] = {0x00, 0x55, 0xAA, 0xFF}, kY[4] = {0x00, 0x33, 0xCC, 0xFF}, kZ[4] = {0x00, 0x0F, 0xF0, 0xFF};
+    struct Masks {
+        std::uint32_t first;
+        unsigned wide, narrow;
+    };
+    const auto masks = [&](int a, int v) {
+        const AxisRange& r = ranges_[static_cast<std::size_t>(a)][static_cast<std::size_t>(v)];
+        const auto bits = [&](int lo, int hi) { return ((2u << (hi - r.wide_lo)) - 1) & ~((1u << (lo - r.wide_lo)) - 1); };
+        return Masks{static_cast<std::uint32_t>(r.wide_lo), bits(r.wide_lo, r.wide_hi), bits(r.narrow_lo, r.narrow_hi)};
+    };
+    const Vec3i d = lattice_.dims();
+    const auto fx = static_cast<std::uint32_t>(fdims_.x), fxy = fx * static_cast<std::uint32_t>(fdims_.y);
+    x_spans_.resize(static_cast<std::size_t>(d.x));
+    for (int x = 0; x < d.x; ++x) {
+        const Masks m = masks(0, x);
+        x_spans_[static_cast<std::size_t>(x)] = m.first | std::uint64_t{kX[m.wide]} << 32 | std::uint64_t{kX[m.narrow]} << 40;
+    }
+    row_spans_.resize(static_cast<std::size_t>(d.y) * static_cast<std::size_t>(d.z));
+    for (int z = 0; z < d.z; ++z) {
+        const Masks mz = masks(2, z);
+        for (int y = 0; y < d.y; ++y) {
+            const Masks my = masks(1, y);
+            const std::uint64_t nn = kY[my.narrow] & kZ[mz.narrow];
+            const std::uint64_t wn = (kY[my.wide] & kZ[mz.narrow]) | (kY[my.narrow] & kZ[mz.wide]);
+            row_spans_[static_cast<std::size_t>(y) + static_cast<std::size_t>(d.y) * static_cast<std::size_t>(z)] =
+                (my.first * fx + mz.first * fxy) | nn << 32 | wn << 40;
+        }
+    }
+    for (unsigned c = 0; c < 8; ++c) corner_offset_[c] = (c & 1u) + ((c >> 1) & 1u) * fx + (c >> 2) * fxy;
 }
 
 FragmentMesher::~FragmentMesher() = default;
@@ -281,91 +294,106 @@ void FragmentMesher::mark_flipped(Vec3i p) {
     }
 }
 
+void FragmentMesher::claim(FragmentId f, std::vector<FragmentId>& flagged) {
+    if (std::atomic_ref<std::uint8_t>(flags_[f]).exchange(1, std::memory_order_relaxed) == 0) flagged.push_back(f);
+}
+
 [[gnu::always_inline]] inline void FragmentMesher::flag(FragmentId f, std::vector<FragmentId>& flagged) {
-    std::atomic_ref<std::uint8_t> b(flags_[f]);
-    if (b.load(std::memory_order_relaxed) == 0 && b.exchange(1, std::memory_order_relaxed) == 0) flagged.push_back(f);
+    if (std::atomic_ref<std::uint8_t>(flags_[f]).load(std::memory_order_relaxed) == 0) claim(f, flagged);
 }
 
-void FragmentMesher::flag_spanning(std::uint32_t px, std::uint32_t row, std::vector<FragmentId>& flagged,
-                                   std::uint64_t& last) {
-    const std::uint32_t z = z_of_row_.divide(row), y = row - z * static_cast<std::uint32_t>(lattice_.dims().y);
-    if (spans_[0].empty()) {  // fragment sizes 1 and 2
-        for_each_affected({static_cast<int>(px), static_cast<int>(y), static_cast<int>(z)}, [&](FragmentId f) { flag(f, flagged); });
-        return;
-    }
-    // for_each_affected's union of three boxes (wide on one axis, narrow on the others) as a set of
-    // the 8 corners (i, j, k) in {0, 1}^3 of the 2x2x2 fragments from the wide ranges' first ones;
-    // corner c = i + 2j + 4k. kX[m]: the corners whose i lies in the 2-bit mask m (kY, kZ: j, k).
-    static constexpr std::uint8_t kX[4] = {0x00, 0x55, 0xAA, 0xFF}, kY[4] = {0x00, 0x33, 0xCC, 0xFF}, kZ[4] = {0x00, 0x0F, 0xF0, 0xFF};
-    const Span& sx = spans_[0][px];
-    const Span& sy = spans_[1][y];
-    const Span& sz = spans_[2][z];
-    unsigned corners = (kX[sx.wide] & kY[sy.narrow] & kZ[sz.narrow]) | (kX[sx.narrow] & kY[sy.wide] & kZ[sz.narrow]) |
-                       (kX[sx.narrow] & kY[sy.narrow] & kZ[sz.wide]);
-    const std::uint32_t base = sx.base + sy.base + sz.base;
-    const std::uint64_t key = std::uint64_t{base} << 8 | corners;  // corners != 0: the point's own fragment
-    if (key == last) return;  // consecutive points of X often share their fragments
-    last = key;
-    const auto fx = 1u, fy = static_cast<std::uint32_t>(fdims_.x), fz = fy * static_cast<std::uint32_t>(fdims_.y);
-    for (; corners != 0; corners &= corners - 1) {
-        const unsigned c = static_cast<unsigned>(std::countr_zero(corners));
-        flag(base + (c & 1u) * fx + ((c >> 1) & 1u) * fy + (c >> 2) * fz, flagged);
-    }
+[[gnu::always_inline]] inline void FragmentMesher::sync_sign(const float* values, PointIndex x, std::uint32_t row, std::uint32_t px) {
+    const bool now = is_inside(values[x]);
+    const std::uint64_t bit = std::uint64_t{1} << (px & 63);
+    std::atomic_ref<std::uint64_t> word(signs_.words[row * signs_.words_per_row + (px >> 6)]);
+    if (((word.load(std::memory_order_relaxed) & bit) != 0) == now) return;
+    const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed) : word.fetch_and(~bit, std::memory_order_relaxed);
+    if (((old & bit) != 0) != now) mark_flipped(decode_.coord(x));  // exactly one thread sees the flip
 }
 
-std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed) {
+template <bool kSigns>
+void FragmentMesher::flag_points(const PointIndex* xs, std::size_t b, std::size_t e, const float* values, Blocks& blocks,
+                                 std::vector<FragmentId>& flagged) {
+    // First the points' corner sets OR-ed per block base into blocks.corners, without a branch that
+    // depends on the data (consecutive points of X often lie in different fragments: a box's
+    // opposite faces alternate in index order, so "same as the last point" mispredicts); then
+    // each distinct block's fragments are flagged once.
+    const std::uint64_t* const xsp = x_spans_.data();
+    const std::uint64_t* const rsp = row_spans_.data();
+    std::uint8_t* const seen = blocks.corners.data();
+    const FastDivider row_of = row_of_;
+    const auto nx = static_cast<std::uint32_t>(signs_.dims.x);
+    for (std::size_t k = b; k != e; ++k) {
+        if (kSigns && k + 16 < e) __builtin_prefetch(values + xs[k + 16]);  // X is scattered over the lattice
+        const PointIndex x = xs[k];
+        const std::uint32_t row = row_of.divide(x);  // y + dims.y * z
+        const std::uint32_t px = x - row * nx;
+        const std::uint64_t sx = xsp[px], sr = rsp[row];
+        const std::uint64_t halves = (sx & sr) >> 32;
+        const auto base = static_cast<std::uint32_t>(sx + sr);
+        const auto corners = static_cast<std::uint8_t>(halves | halves >> 8);  // never empty: the point's own fragment
+        const std::uint8_t before = seen[base];
+        seen[base] = before | corners;
+        if (before == 0) blocks.bases.push_back(base);
+        if constexpr (kSigns) sync_sign(values, x, row, px);
+    }
+    for (const FragmentId base : blocks.bases) {
+        for (unsigned corners = seen[base]; corners != 0; corners &= corners - 1)
+            flag(base + corner_offset_[static_cast<std::size_t>(std::countr_zero(corners))], flagged);
+        seen[base] = 0;
+    }
+    blocks.bases.clear();
+}
+
+std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed,
+                                                      std::optional<std::span<const PointIndex>> sign_changes) {
     // Pass over X (parallel): flag the affected fragments in B, and update the sign bits; a point
     // whose sign flipped queues the rows of its cells - only those cells can start or stop
-    // crossing; every other row that may cross now is in its fragment's row bitmap already.
+    // crossing; every other row that may cross now is in its fragment's row bitmap already. With
+    // the sign changes known, only those points' signs are synchronised (a second, short pass).
     for (auto& local : scratch_->locals) local.flagged.clear();
-    const std::span<const float> values = phi.values();
+    const float* const values = phi.values().data();
+    const bool check_signs = !sign_changes.has_value();
+    const auto nx = static_cast<std::uint32_t>(signs_.dims.x);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, changed.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
         Scratch::Local& local = scratch_->locals.local();
-        const std::uint32_t* sx = single_[0].data();
-        const std::uint32_t* srow = single_row_.data();
-        const auto nx = static_cast<std::uint32_t>(signs_.dims.x);
-        // Locals, not members, so that the calls below (flag_spanning, mark_flipped) do not force
-        // them to be reloaded for every point.
-        const float* v = values.data();
-        const PointIndex* xs = changed.data();
-        const FastDivider row_of = row_of_;
-        std::uint64_t* words = signs_.words.data();
-        const std::size_t wpr = signs_.words_per_row;
-        FragmentId last = kSpansFragments;  // the fragment flagged for the previous point, if single
-        std::uint64_t last_span = 0;        // the fragments flagged for the previous spanning point
-        for (std::size_t k = r.begin(); k != r.end(); ++k) {
-            if (k + 16 < r.end()) __builtin_prefetch(v + xs[k + 16]);  // X is scattered over the lattice
-            const PointIndex x = xs[k];
-            const std::uint32_t row = row_of.divide(x);  // y + dims.y * z
-            const std::uint32_t px = x - row * nx;
-            const std::uint32_t fx = sx[px], fyz = srow[row];
-            if (((fx | fyz) & kSpansFragments) == 0) {  // the point and its stencil lie inside one fragment
-                const FragmentId f = fx + fyz;
-                if (f != last) flag(f, local.flagged);
-                last = f;
-            } else {
-                flag_spanning(px, row, local.flagged, last_span);
-            }
-            const bool now = is_inside(v[x]);
-            const std::uint64_t bit = std::uint64_t{1} << (px & 63);
-            std::atomic_ref<std::uint64_t> word(words[row * wpr + (px >> 6)]);
-            if (((word.load(std::memory_order_relaxed) & bit) != 0) != now) {
-                const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed)
-                                              : word.fetch_and(~bit, std::memory_order_relaxed);
-                if (((old & bit) != 0) != now) mark_flipped(decode_.coord(x));  // exactly one thread sees the flip
-            }
+        std::vector<FragmentId>& flagged = local.flagged;
+        if (!x_spans_.empty()) {  // fragment sizes >= 3
+            if (local.blocks.corners.size() != fragments_.size()) local.blocks.corners.assign(fragments_.size(), 0);
+            if (check_signs) flag_points<true>(changed.data(), r.begin(), r.end(), values, local.blocks, flagged);
+            else flag_points<false>(changed.data(), r.begin(), r.end(), values, local.blocks, flagged);
+            return;
+        }
+        for (std::size_t k = r.begin(); k != r.end(); ++k) {  // fragment sizes 1 and 2
+            const PointIndex x = changed[k];
+            for_each_affected(decode_.coord(x), [&](FragmentId f) { flag(f, flagged); });
+            const std::uint32_t row = row_of_.divide(x);
+            if (check_signs) sync_sign(values, x, row, x - row * nx);
         }
     });
+    if (!check_signs) {
+        const std::span<const PointIndex> flips = *sign_changes;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, flips.size(), 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+            for (std::size_t k = r.begin(); k != r.end(); ++k) {
+                const std::uint32_t row = row_of_.divide(flips[k]);
+                sync_sign(values, flips[k], row, flips[k] - row * nx);
+            }
+        });
+    }
     std::vector<FragmentId> u;
     for (auto& local : scratch_->locals) u.insert(u.end(), local.flagged.begin(), local.flagged.end());
     std::sort(u.begin(), u.end());
     return u;
 }
 
-std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span<const PointIndex> changed) {
+std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span<const PointIndex> changed,
+                                               std::optional<std::span<const PointIndex>> sign_changes) {
     check_phi(phi);
     for (PointIndex x : changed)
         if (x >= lattice_.size()) throw std::out_of_range("changed point index outside the lattice");
+    if (sign_changes)
+        for (PointIndex x : *sign_changes)
+            if (x >= lattice_.size()) throw std::out_of_range("sign-change point index outside the lattice");
     if (fragments_.empty()) {
         stats_ = {};
         return {};
@@ -377,7 +405,7 @@ std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span
         return all;
     }
 
-    const std::vector<FragmentId> u = flag_and_flip(phi, changed);
+    const std::vector<FragmentId> u = flag_and_flip(phi, changed, sign_changes);
     try {
         rebuild(phi, u, false);
     } catch (...) {

@@ -28,6 +28,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -95,7 +96,12 @@ public:
     // sorted ascending. A fragment is affected when one of its cells has a corner in X (signs and
     // vertex positions) or a corner that is a 6-neighbour of a point of X (vertex normals read φ
     // through the central-difference stencil). φ must have this mesher's lattice dimensions.
-    std::vector<FragmentId> update(const Grid<float>& phi, std::span<const PointIndex> changed);
+    // `sign_changes`, when given, must hold every point whose sign of φ (is_inside) may differ from
+    // the last update's φ - the level set's ChangedPoints::sign_changes, or for several updates
+    // their union; extra points are harmless (each is checked). The pass over X then reads no φ
+    // values: only these points' signs are checked. Without it every point of X is checked.
+    std::vector<FragmentId> update(const Grid<float>& phi, std::span<const PointIndex> changed,
+                                   std::optional<std::span<const PointIndex>> sign_changes = std::nullopt);
 
     // The fragments update() would rebuild for `changed`, without rebuilding (sorted).
     std::vector<FragmentId> affected_fragments(std::span<const PointIndex> changed) const;
@@ -134,12 +140,23 @@ private:
     // fragments' pending bitmaps (p's sign flipped).
     void mark_flipped(Vec3i p);
     void flag(FragmentId f, std::vector<FragmentId>& flagged);  // set B[f]; record f if this call set it
-    // flag() every fragment affected by the point (px, row) whose stencil spans fragments, each once,
-    // unless they are the set `last` holds (the previous spanning point's, which it then records).
-    // Out of line: it keeps the X pass's common path small.
-    [[gnu::noinline]] void flag_spanning(std::uint32_t px, std::uint32_t row, std::vector<FragmentId>& flagged,
-                                         std::uint64_t& last);
-    std::vector<FragmentId> flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed);
+    [[gnu::noinline]] void claim(FragmentId f, std::vector<FragmentId>& flagged);  // flag()'s slow path: B[f] was clear
+    void build_span_tables();
+    std::vector<FragmentId> flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed,
+                                          std::optional<std::span<const PointIndex>> sign_changes);
+    // The X pass over xs[b, e): flag the affected fragments and, with kSigns, synchronise the sign
+    // bits (sizes >= 3; every loop value is a local, so the loop keeps them in registers).
+    // The X pass's per-thread working set: the corner sets per block base (all zero between
+    // calls) and the bases that hold one, in order of appearance.
+    struct Blocks {
+        std::vector<std::uint8_t> corners;
+        std::vector<FragmentId> bases;
+    };
+    template <bool kSigns>
+    void flag_points(const PointIndex* xs, std::size_t b, std::size_t e, const float* values, Blocks& blocks,
+                     std::vector<FragmentId>& flagged);
+    // Sets the sign bit of point x (row, px) to φ's sign; queues its cells when it flipped.
+    void sync_sign(const float* values, PointIndex x, std::uint32_t row, std::uint32_t px);
     void rebuild(const Grid<float>& phi, std::span<const FragmentId> ids, bool scan);
 
     Lattice lattice_;
@@ -151,24 +168,21 @@ private:
     std::vector<std::uint8_t> reshaped_;  // per fragment: a corner of one of its cells flipped sign since it was meshed
     IndexDecoder decode_;
     std::array<std::vector<AxisRange>, 3> ranges_;  // per axis, indexed by point coordinate
-    // Per axis and point coordinate: the one fragment coordinate of the wide range times the axis'
-    // fragment-id stride, or kSpansFragments when the wide range spans two fragments.
-    std::array<std::vector<std::uint32_t>, 3> single_;
-    static constexpr std::uint32_t kSpansFragments = 0x8000'0000u;
-    // Per point row (y, z), index y + dims.y * z: single_[1][y] + single_[2][z], or kSpansFragments
-    // when either spans; with row_of_ (index / dims.x) a changed point's fragment and sign-bit word
-    // take one division instead of a full decode.
-    std::vector<std::uint32_t> single_row_;
-    FastDivider row_of_;
-    // Per axis and point coordinate, for a spanning point (fragment size >= 3, where a wide range
-    // holds at most two fragment coordinates): the wide range's first fragment coordinate times the
-    // axis' stride, and as 2-bit masks over (first, first + 1) the wide and the narrow range.
-    struct Span {
-        std::uint32_t base;
-        std::uint8_t wide, narrow;
-    };
-    std::array<std::vector<Span>, 3> spans_;  // empty for fragment sizes 1 and 2
-    FastDivider z_of_row_;                    // row (y + dims.y * z) -> z
+    // The X pass's tables (fragment sizes >= 3, where a wide range holds at most two fragment
+    // coordinates per axis): a changed point's affected fragments are a subset of the 2x2x2 block
+    // of fragments from its wide ranges' first ones, corner c = i + 2j + 4k of that block at
+    // fragment id base + corner_offset_[c]. for_each_affected's union of three boxes (wide on one
+    // axis, narrow on the others) is (Xw & Yn & Zn) | (Xn & Yw & Zn) | (Xn & Yn & Zw) as 8-bit
+    // corner sets, split into a part per x and a part per point row, so a point costs one
+    // division (its row) and two table reads. Each entry packs base | a << 32 | b << 40:
+    //   x_spans_[x]:   base = the wide range's first fragment x; a = Xw, b = Xn
+    //   row_spans_[r]: base = the first fragment y and z times their id strides; a = Yn & Zn,
+    //                  b = (Yw & Zn) | (Yn & Zw)
+    // so (x & row) >> 32 holds the two halves of the corner set. Empty for sizes 1 and 2.
+    std::vector<std::uint64_t> x_spans_;    // per point x
+    std::vector<std::uint64_t> row_spans_;  // per point row y + dims.y * z
+    std::array<std::uint32_t, 8> corner_offset_{};
+    FastDivider row_of_;              // point index -> row (index / dims.x)
     std::array<std::vector<int>, 3> cell_fragment_, cell_offset_;  // per axis: cell c -> c / S, c % S
     SignBits signs_;              // is_inside() per lattice point, as last meshed
     bool initialised_ = false;    // signs_ and the row bitmaps are valid

@@ -99,6 +99,8 @@ bool Session::load_recovered(const Grid<float>& phi, const Grid<std::int8_t>& st
 void Session::reset_after_load() {
     for (PointIndex p : pending_) pending_flags_[p] = 0;  // the full rebuild covers them
     pending_.clear();
+    pending_signs_.clear();
+    pending_signs_known_ = true;
     mesher_.full_rebuild(field_.phi(), field_.zero_layer());
     for (FragmentId f = 0; f < mesher_.fragment_count(); ++f)
         if (!dirty_flags_[f]) {
@@ -421,9 +423,12 @@ SessionUpdate Session::finish_update(ChangedPoints changed, double level_set_ms)
                 pending_flags_[p] = 1;
                 pending_.push_back(p);
             }
+        if (changed.sign_changes) pending_signs_.insert(pending_signs_.end(), changed.sign_changes->begin(), changed.sign_changes->end());
+        else pending_signs_known_ = false;
     } else {
         const auto t0 = Clock::now();
-        u.fragments = mesher_.update(field_.phi(), changed.points);
+        u.fragments = changed.sign_changes ? mesher_.update(field_.phi(), changed.points, *changed.sign_changes)
+                                           : mesher_.update(field_.phi(), changed.points);
         u.mesh_ms = ms_since(t0);
         queue_dirty(u.fragments);
     }
@@ -451,9 +456,11 @@ void Session::set_deferred_meshing(bool on) {
 double Session::flush_mesh() {
     if (pending_.empty()) return 0.0;
     const auto t0 = Clock::now();
-    queue_dirty(mesher_.update(field_.phi(), pending_));
+    queue_dirty(pending_signs_known_ ? mesher_.update(field_.phi(), pending_, pending_signs_) : mesher_.update(field_.phi(), pending_));
     for (PointIndex p : pending_) pending_flags_[p] = 0;
     pending_.clear();
+    pending_signs_.clear();
+    pending_signs_known_ = true;
     return ms_since(t0);
 }
 

@@ -247,6 +247,8 @@ private:
     bool defer_mesh_ = false;
     std::vector<PointIndex> pending_;           // X accumulated while meshing is deferred
     std::vector<std::uint8_t> pending_flags_;   // lattice-sized while deferring: in pending_
+    std::vector<PointIndex> pending_signs_;     // the union of their sign changes (duplicates allowed)...
+    bool pending_signs_known_ = true;           // ...while every update reported them
     std::uint64_t revision_ = 0;
 };
 
