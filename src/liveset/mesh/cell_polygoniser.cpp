@@ -5,8 +5,13 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "liveset/grid/sampling.hpp"
 #include "liveset/mesh/mc_tables.hpp"
@@ -35,6 +40,59 @@ constexpr std::array<unsigned, 8> kOwnedEdges = [] {
         }
     return t;
 }();
+
+#if defined(__SSE2__)
+// edge_vertex_interior() for four edges at once, lane by lane: the same IEEE operations in the same
+// order (SSE's add, sub, mul, div and sqrt round exactly like the scalar ones, and the build turns
+// off FMA contraction), so the same bits; the three dependent divisions and the square root of a
+// vertex overlap with those of three others.
+void edge_vertices_interior4(const float* v, const CellPolygoniser::EdgeRef* e, std::ptrdiff_t sy, std::ptrdiff_t sz, Vertex* out) {
+    const float* pi[4];
+    const float* pj[4];
+    for (int l = 0; l < 4; ++l) {
+        const Vec3i p = e[l].p;
+        pi[l] = v + (p.x + p.y * sy + p.z * sz);
+        pj[l] = pi[l] + (e[l].axis == 0 ? 1 : e[l].axis == 1 ? sy : sz);
+    }
+    const auto at = [](const float* const (&p)[4], std::ptrdiff_t o) { return _mm_setr_ps(p[0][o], p[1][o], p[2][o], p[3][o]); };
+    const __m128 half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFF'FFFF));
+    const __m128 a = at(pi, 0), b = at(pj, 0);
+    __m128 t = _mm_div_ps(a, _mm_sub_ps(a, b));
+    const __m128 finite = _mm_cmplt_ps(_mm_and_ps(t, abs_mask), inf);  // false for NaN and ±inf
+    t = _mm_or_ps(_mm_and_ps(finite, t), _mm_andnot_ps(finite, half));
+    t = _mm_min_ps(_mm_max_ps(t, _mm_set1_ps(kEdgeVertexMargin)), _mm_set1_ps(1.0f - kEdgeVertexMargin));  // std::clamp of a finite t
+    const auto grad = [&](const float* const (&p)[4], std::ptrdiff_t s) { return _mm_mul_ps(_mm_sub_ps(at(p, s), at(p, -s)), half); };
+    const __m128 s = _mm_sub_ps(one, t);
+    const __m128 n0 = _mm_add_ps(_mm_mul_ps(s, grad(pi, 1)), _mm_mul_ps(t, grad(pj, 1)));
+    const __m128 n1 = _mm_add_ps(_mm_mul_ps(s, grad(pi, sy)), _mm_mul_ps(t, grad(pj, sy)));
+    const __m128 n2 = _mm_add_ps(_mm_mul_ps(s, grad(pi, sz)), _mm_mul_ps(t, grad(pj, sz)));
+    const __m128 len = _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(n0, n0), _mm_mul_ps(n1, n1)), _mm_mul_ps(n2, n2)));
+    const __m128 good = _mm_and_ps(_mm_cmplt_ps(len, inf), _mm_cmpgt_ps(len, _mm_set1_ps(1e-20f)));
+    const __m128 inv = _mm_div_ps(one, len);
+    // Per axis k: the lanes whose edge runs along k, and the degenerate normal (inside end to outside end).
+    const __m128i axis = _mm_setr_epi32(e[0].axis, e[1].axis, e[2].axis, e[3].axis);
+    const __m128 d = _mm_or_ps(_mm_and_ps(_mm_cmplt_ps(a, _mm_setzero_ps()), one), _mm_andnot_ps(_mm_cmplt_ps(a, _mm_setzero_ps()), _mm_set1_ps(-1.0f)));
+    const auto along = [&](int k) { return _mm_castsi128_ps(_mm_cmpeq_epi32(axis, _mm_set1_epi32(k))); };
+    const auto normal = [&](__m128 n, int k) { return _mm_or_ps(_mm_and_ps(good, _mm_mul_ps(n, inv)), _mm_andnot_ps(good, _mm_and_ps(along(k), d))); };
+    const auto position = [&](int k) {
+        const __m128 c = _mm_cvtepi32_ps(_mm_setr_epi32(e[0].p[k], e[1].p[k], e[2].p[k], e[3].p[k]));
+        return _mm_add_ps(c, _mm_and_ps(along(k), t));  // + 0 off the edge's axis: the coordinate itself
+    };
+    __m128 r0 = position(0), r1 = position(1), r2 = position(2), r3 = normal(n0, 0);
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);  // rows: (x, y, z, nx) of each vertex
+    const __m128 ny = normal(n1, 1), nz = normal(n2, 2);
+    const __m128 lo = _mm_unpacklo_ps(ny, nz), hi = _mm_unpackhi_ps(ny, nz);  // (ny, nz) of vertices 0, 1 | 2, 3
+    _mm_storeu_ps(&out[0].position[0], r0);
+    _mm_storel_pi(reinterpret_cast<__m64*>(&out[0].normal[1]), lo);
+    _mm_storeu_ps(&out[1].position[0], r1);
+    _mm_storeh_pi(reinterpret_cast<__m64*>(&out[1].normal[1]), lo);
+    _mm_storeu_ps(&out[2].position[0], r2);
+    _mm_storel_pi(reinterpret_cast<__m64*>(&out[2].normal[1]), hi);
+    _mm_storeu_ps(&out[3].position[0], r3);
+    _mm_storeh_pi(reinterpret_cast<__m64*>(&out[3].normal[1]), hi);
+}
+#endif
 
 }  // namespace
 
@@ -146,10 +204,15 @@ void CellPolygoniser::enter_layer(int z) {
     layer_ = z;
 }
 
+[[gnu::always_inline]] inline bool CellPolygoniser::interior(EdgeRef e) const {
+    const Vec3i p = e.p;
+    return p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (e.axis == 0) <= dims_.x - 2 && p.y + (e.axis == 1) <= dims_.y - 2 &&
+           p.z + (e.axis == 2) <= dims_.z - 2;
+}
+
 // Inlined into both emitters (no Vertex round trip through memory on the interior path).
 [[gnu::always_inline]] inline Vertex CellPolygoniser::edge_vertex(const Grid<float>& phi, Vec3i p, int ax) const {
-    if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x + (ax == 0) <= dims_.x - 2 && p.y + (ax == 1) <= dims_.y - 2 &&
-        p.z + (ax == 2) <= dims_.z - 2) {
+    if (interior({p, ax})) {
         const std::size_t i = static_cast<std::size_t>(p.x) + static_cast<std::size_t>(p.y) * sy_ + static_cast<std::size_t>(p.z) * sz_;
         return edge_vertex_interior(values_, i, p, ax, sy_, sz_);
     }
@@ -236,7 +299,18 @@ void CellPolygoniser::refresh_vertices(const Grid<float>& phi, std::span<const E
     if (edges.size() != out.size()) throw std::invalid_argument("refresh_vertices: one edge per vertex is needed");
     bind(phi);
     Vertex* dst = out.data();
-    for (std::size_t k = 0; k < edges.size(); ++k) dst[k] = edge_vertex(phi, edges[k].p, edges[k].axis);
+    const EdgeRef* e = edges.data();
+    std::size_t k = 0;
+#if defined(__SSE2__)
+    for (; k + 4 <= edges.size(); k += 4) {
+        if (interior(e[k]) && interior(e[k + 1]) && interior(e[k + 2]) && interior(e[k + 3])) {
+            edge_vertices_interior4(values_, e + k, static_cast<std::ptrdiff_t>(sy_), static_cast<std::ptrdiff_t>(sz_), dst + k);
+        } else {
+            for (std::size_t l = k; l < k + 4; ++l) dst[l] = edge_vertex(phi, e[l].p, e[l].axis);
+        }
+    }
+#endif
+    for (; k < edges.size(); ++k) dst[k] = edge_vertex(phi, e[k].p, e[k].axis);
 }
 
 void CellPolygoniser::polygonise_box(const Grid<float>& phi, Vec3i lo, Vec3i hi, Mesh& out,

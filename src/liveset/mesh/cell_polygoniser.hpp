@@ -134,6 +134,8 @@ private:
     // The vertex on the edge from p along +axis: edge_vertex_interior() on the cached values away
     // from the lattice's border, make_edge_vertex() next to it.
     Vertex edge_vertex(const Grid<float>& phi, Vec3i p, int axis) const;
+    // Both endpoints of the edge have all 6 neighbours in the lattice (edge_vertex_interior applies).
+    bool interior(EdgeRef e) const;
 
     // G: 2 slices * px * py * 3 entries, each (generation << 32 | vertex id). An entry is set only
     // when its generation equals its slot's current one, so a slice is cleared in O(1) by giving
