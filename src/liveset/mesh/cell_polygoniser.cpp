@@ -261,7 +261,7 @@ void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& o
     append_triangles(cs, v, out);
 }
 
-void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Mesh& out) {
+void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Emit& em) {
     const auto& tables = mc::kTables;
     const std::size_t row = (static_cast<std::size_t>(c.y - lo_.y) * static_cast<std::size_t>(px_) +
                              static_cast<std::size_t>(c.x - lo_.x)) * 3;
@@ -277,22 +277,36 @@ void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Mesh& out) {
     for (unsigned mask = edges & owned; mask != 0; mask &= mask - 1) {
         const int e = std::countr_zero(mask);
         const mc::EdgeStart& es = mc::kEdgeStarts[static_cast<std::size_t>(e)];
-        if (out.vertices.size() + deferred_.size() >= 0xFFFF'FFFFu)
-            throw std::length_error("mesh has too many vertices for 32-bit indices");
-        const auto id = static_cast<std::uint32_t>(out.vertices.size() + deferred_.size());
-        deferred_.push_back({{c.x + es.dx, c.y + es.dy, c.z + es.dz}, es.axis});  // computed by finish_vertices()
-        g[offset[e]] = id;
-        v[e] = id;
-        ++computed_;
+        *em.edge++ = {{c.x + es.dx, c.y + es.dy, c.z + es.dz}, es.axis};  // computed by finish_vertices()
+        g[offset[e]] = em.next_id;
+        v[e] = em.next_id++;
     }
-    append_triangles(cs, v, out);
+    const auto& tri = tables.triangles[static_cast<std::size_t>(cs)];
+    const int n = 3 * tables.triangle_count[static_cast<std::size_t>(cs)];
+    std::uint32_t* __restrict index = em.index;  // no overlap with the tables: a plain loop, no run-time alias checks
+#pragma GCC unroll 1
+    for (int k = 0; k < n; ++k) index[k] = v[tri[static_cast<std::size_t>(k)]];
+    em.index = index + n;
 }
 
-void CellPolygoniser::finish_vertices(const Grid<float>& phi, Mesh& out) {
+void CellPolygoniser::finish_vertices(const Grid<float>& phi, std::span<const EdgeRef> edges, Mesh& out) {
     // One simple loop over independent vertices: the φ loads of consecutive vertices overlap.
     const std::size_t first = out.vertices.size();
-    out.vertices.resize(first + deferred_.size());
-    refresh_vertices(phi, deferred_, std::span<Vertex>(out.vertices).subspan(first));
+    out.vertices.resize(first + edges.size());
+    refresh_vertices(phi, edges, std::span<Vertex>(out.vertices).subspan(first));
+}
+
+void CellPolygoniser::Emit::reserve(std::size_t first_id, std::size_t cells) {
+    // Room for the most a cell appends (5 triangles; 12 edges for a box's first cell), in the
+    // scratch arrays, which only grow: filled through raw cursors, copied out once at the end.
+    auto& p = *owner;
+    const std::size_t n_index = static_cast<std::size_t>(index - p.index_scratch_.data());
+    const std::size_t n_edge = static_cast<std::size_t>(edge - p.deferred_.data());
+    if (first_id + n_edge + mc::kEdges * cells >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
+    if (p.index_scratch_.size() < n_index + 15 * cells) p.index_scratch_.resize(std::max(2 * p.index_scratch_.size(), n_index + 15 * cells));
+    if (p.deferred_.size() < n_edge + mc::kEdges * cells) p.deferred_.resize(std::max(2 * p.deferred_.size(), n_edge + mc::kEdges * cells));
+    index = p.index_scratch_.data() + n_index;
+    edge = p.deferred_.data() + n_edge;
 }
 
 void CellPolygoniser::refresh_vertices(const Grid<float>& phi, std::span<const EdgeRef> edges, std::span<Vertex> out) {
@@ -372,7 +386,7 @@ void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& si
     if (vertex_edges) vertex_edges->clear();
     if (ny <= 0 || hi.x <= lo.x) return;
     if (gid_.size() < 2 * slice_) gid_.resize(2 * slice_, 0);
-    deferred_.clear();
+    Emit em{this, index_scratch_.data(), deferred_.data(), static_cast<std::uint32_t>(out.vertices.size())};
     const FastDivider div_y(static_cast<std::uint32_t>(ny));
     const std::size_t wpr = signs.words_per_row;
     const auto k0 = static_cast<std::size_t>(lo.x) >> 6, k1 = static_cast<std::size_t>(hi.x - 1) >> 6;
@@ -392,17 +406,21 @@ void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& si
                 if (to < 64) cross &= (std::uint64_t{1} << to) - 1;
                 if (cross == 0) continue;
                 any = true;
+                em.reserve(out.vertices.size(), static_cast<std::size_t>(std::min(to, 64) - std::max(from, 0)));  // the word's cells in the box
                 for (; cross != 0; cross &= cross - 1) {
                     const int x = static_cast<int>(64 * k) + std::countr_zero(cross);
-                    emit_cell_owned({x, y, z}, cr.cell_case(x), out);
+                    emit_cell_owned({x, y, z}, cr.cell_case(x), em);
                     ++cells_;
                 }
             }
             if (any) crossing_rows[r >> 6] |= std::uint64_t{1} << (r & 63);
         }
     }
-    finish_vertices(phi, out);
-    if (vertex_edges) vertex_edges->swap(deferred_);  // deferred_ is cleared at the next call
+    out.indices.insert(out.indices.end(), index_scratch_.data(), em.index);
+    const std::span<const EdgeRef> edges(deferred_.data(), em.edge);
+    computed_ = edges.size();
+    finish_vertices(phi, edges, out);
+    if (vertex_edges) vertex_edges->assign(edges.begin(), edges.end());
 }
 
 }  // namespace liveset

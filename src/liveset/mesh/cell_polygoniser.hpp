@@ -129,8 +129,18 @@ private:
     // emit_cell() for polygonise_rows(), which visits every crossing cell of the box: a cell creates
     // exactly the vertices of the edges it is the first visited cell of (kOwnedEdges) and reads the
     // others from gid_, with no generation test.
-    void emit_cell_owned(Vec3i c, int cs, Mesh& out);
-    void finish_vertices(const Grid<float>& phi, Mesh& out);  // computes deferred_ into out.vertices
+    // polygonise_rows()' raw cursors into index_scratch_ and deferred_, and the next vertex id.
+    struct Emit {
+        CellPolygoniser* owner;
+        std::uint32_t* index;
+        EdgeRef* edge;
+        std::uint32_t next_id;
+        // Makes room for `cells` more cells (growing the scratch arrays, which may move them);
+        // first_id: the id of the call's first vertex.
+        void reserve(std::size_t first_id, std::size_t cells);
+    };
+    void emit_cell_owned(Vec3i c, int cs, Emit& em);
+    void finish_vertices(const Grid<float>& phi, std::span<const EdgeRef> edges, Mesh& out);  // appends their vertices
     // The vertex on the edge from p along +axis: edge_vertex_interior() on the cached values away
     // from the lattice's border, make_edge_vertex() next to it.
     Vertex edge_vertex(const Grid<float>& phi, Vec3i p, int axis) const;
@@ -143,7 +153,10 @@ private:
     std::vector<std::uint64_t> g_;
     std::array<std::uint64_t, 2> generation_{};  // current generation per slot, in the high half
     std::vector<std::uint32_t> gid_;  // polygonise_rows()' G, same layout: vertex ids only
-    std::vector<EdgeRef> deferred_;  // polygonise_rows()' vertices, ids assigned, not yet computed
+    // polygonise_rows()' scratch (sized to the most it ever needed, filled from the front): the
+    // vertices' edges, ids assigned, not yet computed; and the triangles' vertex ids.
+    std::vector<EdgeRef> deferred_;
+    std::vector<std::uint32_t> index_scratch_;
     std::uint32_t next_generation_ = 1;
     IndexDecoder decoder_;  // for the lattice of dims decoder_dims_
     Vec3i decoder_dims_{};

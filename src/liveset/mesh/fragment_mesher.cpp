@@ -389,11 +389,15 @@ std::vector<FragmentId> FragmentMesher::flag_and_flip(const Grid<float>& phi, st
 std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span<const PointIndex> changed,
                                                std::optional<std::span<const PointIndex>> sign_changes) {
     check_phi(phi);
-    for (PointIndex x : changed)
-        if (x >= lattice_.size()) throw std::out_of_range("changed point index outside the lattice");
-    if (sign_changes)
-        for (PointIndex x : *sign_changes)
-            if (x >= lattice_.size()) throw std::out_of_range("sign-change point index outside the lattice");
+    // Validated before anything changes; the largest index, a loop the compiler vectorises.
+    const auto largest = [](std::span<const PointIndex> xs) {
+        PointIndex m = 0;
+        for (const PointIndex x : xs) m = std::max(m, x);
+        return m;
+    };
+    if (!changed.empty() && largest(changed) >= lattice_.size()) throw std::out_of_range("changed point index outside the lattice");
+    if (sign_changes && !sign_changes->empty() && largest(*sign_changes) >= lattice_.size())
+        throw std::out_of_range("sign-change point index outside the lattice");
     if (fragments_.empty()) {
         stats_ = {};
         return {};
