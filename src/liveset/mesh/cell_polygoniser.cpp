@@ -261,7 +261,8 @@ void CellPolygoniser::emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& o
     append_triangles(cs, v, out);
 }
 
-void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Emit& em) {
+// Inlined into the row pass: a call passed the cell through the stack and stalled reloading it.
+[[gnu::always_inline]] inline void CellPolygoniser::emit_cell_owned(Vec3i c, int cs, Emit& em) {
     const auto& tables = mc::kTables;
     const std::size_t row = (static_cast<std::size_t>(c.y - lo_.y) * static_cast<std::size_t>(px_) +
                              static_cast<std::size_t>(c.x - lo_.x)) * 3;
