@@ -125,7 +125,7 @@ Figure3Result run_figure3(const Figure3Options& a) {
         }
     };
     const FlowHook hook = [&](const SparseField&, const StepResult& s, const FlowStepRecord& rec) {
-        mesh_step(rec.step, s.changed.points, *s.changed.sign_changes);
+        mesh_step(rec.step, s.changed.points, s.changed.sign_changes.value());
         return true;
     };
     // The driver's time step stays at 1/6 (the parabolic bound before session 15; the box vanishes

@@ -295,7 +295,7 @@ StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
     } else {
         run();
     }
-    activity_.wake_near(*result.changed.sign_changes, lattice(), steps_);  // a no-op until a sleeping step ran
+    activity_.wake_near(result.changed.sign_changes.value(), lattice(), steps_);  // a no-op until a sleeping step ran
     return result;
 }
 

@@ -72,7 +72,8 @@ void edge_vertices_interior4(const float* v, const CellPolygoniser::EdgeRef* e, 
     const __m128 inv = _mm_div_ps(one, len);
     // Per axis k: the lanes whose edge runs along k, and the degenerate normal (inside end to outside end).
     const __m128i axis = _mm_setr_epi32(e[0].axis, e[1].axis, e[2].axis, e[3].axis);
-    const __m128 d = _mm_or_ps(_mm_and_ps(_mm_cmplt_ps(a, _mm_setzero_ps()), one), _mm_andnot_ps(_mm_cmplt_ps(a, _mm_setzero_ps()), _mm_set1_ps(-1.0f)));
+    const __m128 inside = _mm_cmplt_ps(a, _mm_setzero_ps());  // is_inside(a): false for -0 and NaN
+    const __m128 d = _mm_or_ps(_mm_and_ps(inside, one), _mm_andnot_ps(inside, _mm_set1_ps(-1.0f)));
     const auto along = [&](int k) { return _mm_castsi128_ps(_mm_cmpeq_epi32(axis, _mm_set1_epi32(k))); };
     const auto normal = [&](__m128 n, int k) { return _mm_or_ps(_mm_and_ps(good, _mm_mul_ps(n, inv)), _mm_andnot_ps(good, _mm_and_ps(along(k), d))); };
     const auto position = [&](int k) {
@@ -304,7 +305,9 @@ void CellPolygoniser::Emit::reserve(std::size_t first_id, std::size_t cells) {
     const std::size_t n_index = static_cast<std::size_t>(index - p.index_scratch_.data());
     const std::size_t n_edge = static_cast<std::size_t>(edge - p.deferred_.data());
     if (first_id + n_edge + mc::kEdges * cells >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
-    if (p.index_scratch_.size() < n_index + 15 * cells) p.index_scratch_.resize(std::max(2 * p.index_scratch_.size(), n_index + 15 * cells));
+    constexpr std::size_t kMaxIndices = 3 * mc::kMaxTriangles;
+    if (p.index_scratch_.size() < n_index + kMaxIndices * cells)
+        p.index_scratch_.resize(std::max(2 * p.index_scratch_.size(), n_index + kMaxIndices * cells));
     if (p.deferred_.size() < n_edge + mc::kEdges * cells) p.deferred_.resize(std::max(2 * p.deferred_.size(), n_edge + mc::kEdges * cells));
     index = p.index_scratch_.data() + n_index;
     edge = p.deferred_.data() + n_edge;

@@ -126,9 +126,6 @@ private:
     void enter_layer(int z);
     void renew_slot(int slot);
     void emit_cell(const Grid<float>& phi, Vec3i c, int cs, Mesh& out);
-    // emit_cell() for polygonise_rows(), which visits every crossing cell of the box: a cell creates
-    // exactly the vertices of the edges it is the first visited cell of (kOwnedEdges) and reads the
-    // others from gid_, with no generation test.
     // polygonise_rows()' raw cursors into index_scratch_ and deferred_, and the next vertex id.
     struct Emit {
         CellPolygoniser* owner;
@@ -139,6 +136,9 @@ private:
         // first_id: the id of the call's first vertex.
         void reserve(std::size_t first_id, std::size_t cells);
     };
+    // emit_cell() for polygonise_rows(), which visits every crossing cell of the box: a cell creates
+    // exactly the vertices of the edges it is the first visited cell of (kOwnedEdges) and reads the
+    // others from gid_, with no generation test.
     void emit_cell_owned(Vec3i c, int cs, Emit& em);
     void finish_vertices(const Grid<float>& phi, std::span<const EdgeRef> edges, Mesh& out);  // appends their vertices
     // The vertex on the edge from p along +axis: edge_vertex_interior() on the cached values away

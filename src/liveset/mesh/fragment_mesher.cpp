@@ -314,10 +314,11 @@ void FragmentMesher::claim(FragmentId f, std::vector<FragmentId>& flagged) {
 template <bool kSigns>
 void FragmentMesher::flag_points(const PointIndex* xs, std::size_t b, std::size_t e, const float* values, Blocks& blocks,
                                  std::vector<FragmentId>& flagged) {
-    // First the points' corner sets OR-ed per block base into blocks.corners, without a branch that
-    // depends on the data (consecutive points of X often lie in different fragments: a box's
-    // opposite faces alternate in index order, so "same as the last point" mispredicts); then
-    // each distinct block's fragments are flagged once.
+    // First the points' corner sets OR-ed per block base into blocks.corners, with no compare
+    // against the previous point's fragments (consecutive points of X often lie in different
+    // fragments: a box's opposite faces alternate in index order, so "same as the last point"
+    // mispredicts); then each distinct block's fragments are flagged once.
+    blocks.bases.reserve(blocks.bases.size() + (e - b));  // the loop below then cannot throw
     const std::uint64_t* const xsp = x_spans_.data();
     const std::uint64_t* const rsp = row_spans_.data();
     std::uint8_t* const seen = blocks.corners.data();
@@ -409,12 +410,17 @@ std::vector<FragmentId> FragmentMesher::update(const Grid<float>& phi, std::span
         return all;
     }
 
-    const std::vector<FragmentId> u = flag_and_flip(phi, changed, sign_changes);
+    std::vector<FragmentId> u;
     try {
+        u = flag_and_flip(phi, changed, sign_changes);
         rebuild(phi, u, false);
-    } catch (...) {
-        for (FragmentId f : u) flags_[f] = 0;
-        initialised_ = false;  // row bitmaps may be stale: the next update starts from scratch
+    } catch (...) {  // e.g. out of memory: forget every partial state, the next update starts from scratch
+        std::fill(flags_.begin(), flags_.end(), 0);
+        for (auto& local : scratch_->locals) {
+            std::fill(local.blocks.corners.begin(), local.blocks.corners.end(), 0);
+            local.blocks.bases.clear();
+        }
+        initialised_ = false;  // sign bits and row bitmaps may be stale
         throw;
     }
     for (FragmentId f : u) flags_[f] = 0;

@@ -96,10 +96,11 @@ public:
     // sorted ascending. A fragment is affected when one of its cells has a corner in X (signs and
     // vertex positions) or a corner that is a 6-neighbour of a point of X (vertex normals read φ
     // through the central-difference stencil). φ must have this mesher's lattice dimensions.
-    // `sign_changes`, when given, must hold every point whose sign of φ (is_inside) may differ from
-    // the last update's φ - the level set's ChangedPoints::sign_changes, or for several updates
-    // their union; extra points are harmless (each is checked). The pass over X then reads no φ
-    // values: only these points' signs are checked. Without it every point of X is checked.
+    // `sign_changes`, when given, must hold every point of X whose sign of φ (is_inside) may differ
+    // from the φ this mesher last meshed (update or full_rebuild) - the level set's
+    // ChangedPoints::sign_changes, or for several updates their union. A listed point whose sign
+    // did not change is harmless (each is checked). The pass over X then reads no φ values: only
+    // these points' signs are checked. Without it every point of X is checked.
     std::vector<FragmentId> update(const Grid<float>& phi, std::span<const PointIndex> changed,
                                    std::optional<std::span<const PointIndex>> sign_changes = std::nullopt);
 
@@ -144,14 +145,14 @@ private:
     void build_span_tables();
     std::vector<FragmentId> flag_and_flip(const Grid<float>& phi, std::span<const PointIndex> changed,
                                           std::optional<std::span<const PointIndex>> sign_changes);
-    // The X pass over xs[b, e): flag the affected fragments and, with kSigns, synchronise the sign
-    // bits (sizes >= 3; every loop value is a local, so the loop keeps them in registers).
     // The X pass's per-thread working set: the corner sets per block base (all zero between
     // calls) and the bases that hold one, in order of appearance.
     struct Blocks {
         std::vector<std::uint8_t> corners;
         std::vector<FragmentId> bases;
     };
+    // The X pass over xs[b, e): flag the affected fragments and, with kSigns, synchronise the sign
+    // bits (sizes >= 3; every loop value is a local, so the loop keeps them in registers).
     template <bool kSigns>
     void flag_points(const PointIndex* xs, std::size_t b, std::size_t e, const float* values, Blocks& blocks,
                      std::vector<FragmentId>& flagged);

@@ -80,7 +80,7 @@ SegmentationResult run_segmentation(SparseField& field, const Speed& speed, cons
         pr.dt = step.dt;
         pr.changed = step.changed.size();
         pr.awake = step.awake;
-        pr.flips = convergence.record_step(field.phi(), *step.changed.sign_changes);  // only steps change the field here
+        pr.flips = convergence.record_step(field.phi(), step.changed.sign_changes.value());  // only steps change the field here
         pr.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
         pr.zero_layer = field.zero_layer().size();
         pr.band = field.band_size();

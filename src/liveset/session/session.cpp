@@ -418,13 +418,19 @@ SessionUpdate Session::finish_update(ChangedPoints changed, double level_set_ms)
     SessionUpdate u;
     u.level_set_ms = level_set_ms;
     if (defer_mesh_) {
+        // pending_flags_: bit 0 in pending_, bit 1 in pending_signs_ (a subset: a sign change is a change).
+        if (!changed.sign_changes && !changed.points.empty()) pending_signs_known_ = false;
+        if (changed.sign_changes)
+            for (PointIndex p : *changed.sign_changes)
+                if (!(pending_flags_[p] & 2)) {
+                    pending_signs_.push_back(p);
+                    pending_flags_[p] |= 2;
+                }
         for (PointIndex p : changed.points)
-            if (!pending_flags_[p]) {
-                pending_flags_[p] = 1;
+            if (!(pending_flags_[p] & 1)) {
                 pending_.push_back(p);
+                pending_flags_[p] |= 1;
             }
-        if (changed.sign_changes) pending_signs_.insert(pending_signs_.end(), changed.sign_changes->begin(), changed.sign_changes->end());
-        else pending_signs_known_ = false;
     } else {
         const auto t0 = Clock::now();
         u.fragments = changed.sign_changes ? mesher_.update(field_.phi(), changed.points, *changed.sign_changes)
@@ -454,7 +460,10 @@ void Session::set_deferred_meshing(bool on) {
 }
 
 double Session::flush_mesh() {
-    if (pending_.empty()) return 0.0;
+    if (pending_.empty()) {
+        pending_signs_known_ = true;
+        return 0.0;
+    }
     const auto t0 = Clock::now();
     queue_dirty(pending_signs_known_ ? mesher_.update(field_.phi(), pending_, pending_signs_) : mesher_.update(field_.phi(), pending_));
     for (PointIndex p : pending_) pending_flags_[p] = 0;

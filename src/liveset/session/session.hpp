@@ -246,9 +246,9 @@ private:
     std::vector<FragmentId> dirty_;
     bool defer_mesh_ = false;
     std::vector<PointIndex> pending_;           // X accumulated while meshing is deferred
-    std::vector<std::uint8_t> pending_flags_;   // lattice-sized while deferring: in pending_
-    std::vector<PointIndex> pending_signs_;     // the union of their sign changes (duplicates allowed)...
-    bool pending_signs_known_ = true;           // ...while every update reported them
+    std::vector<std::uint8_t> pending_flags_;   // lattice-sized while deferring: bit 0 in pending_, bit 1 in pending_signs_
+    std::vector<PointIndex> pending_signs_;     // the union of their sign changes (a subset of pending_)...
+    bool pending_signs_known_ = true;           // ...while every update with points reported them
     std::uint64_t revision_ = 0;
 };
 
