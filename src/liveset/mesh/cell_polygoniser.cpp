@@ -298,13 +298,13 @@ void CellPolygoniser::finish_vertices(const Grid<float>& phi, std::span<const Ed
     refresh_vertices(phi, edges, std::span<Vertex>(out.vertices).subspan(first));
 }
 
-void CellPolygoniser::Emit::reserve(std::size_t first_id, std::size_t cells) {
+void CellPolygoniser::Emit::reserve(std::size_t cells) {
     // Room for the most a cell appends (5 triangles; 12 edges for a box's first cell), in the
     // scratch arrays, which only grow: filled through raw cursors, copied out once at the end.
     auto& p = *owner;
     const std::size_t n_index = static_cast<std::size_t>(index - p.index_scratch_.data());
     const std::size_t n_edge = static_cast<std::size_t>(edge - p.deferred_.data());
-    if (first_id + n_edge + mc::kEdges * cells >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
+    if (next_id + mc::kEdges * cells >= 0xFFFF'FFFFu) throw std::length_error("mesh has too many vertices for 32-bit indices");
     constexpr std::size_t kMaxIndices = 3 * mc::kMaxTriangles;
     if (p.index_scratch_.size() < n_index + kMaxIndices * cells)
         p.index_scratch_.resize(std::max(2 * p.index_scratch_.size(), n_index + kMaxIndices * cells));
@@ -410,7 +410,7 @@ void CellPolygoniser::polygonise_rows(const Grid<float>& phi, const SignBits& si
                 if (to < 64) cross &= (std::uint64_t{1} << to) - 1;
                 if (cross == 0) continue;
                 any = true;
-                em.reserve(out.vertices.size(), static_cast<std::size_t>(std::min(to, 64) - std::max(from, 0)));  // the word's cells in the box
+                em.reserve(static_cast<std::size_t>(std::min(to, 64) - std::max(from, 0)));  // the word's cells in the box
                 for (; cross != 0; cross &= cross - 1) {
                     const int x = static_cast<int>(64 * k) + std::countr_zero(cross);
                     emit_cell_owned({x, y, z}, cr.cell_case(x), em);

@@ -132,9 +132,8 @@ private:
         std::uint32_t* index;
         EdgeRef* edge;
         std::uint32_t next_id;
-        // Makes room for `cells` more cells (growing the scratch arrays, which may move them);
-        // first_id: the id of the call's first vertex.
-        void reserve(std::size_t first_id, std::size_t cells);
+        // Makes room for `cells` more cells (growing the scratch arrays, which may move them).
+        void reserve(std::size_t cells);
     };
     // emit_cell() for polygonise_rows(), which visits every crossing cell of the box: a cell creates
     // exactly the vertices of the edges it is the first visited cell of (kOwnedEdges) and reads the

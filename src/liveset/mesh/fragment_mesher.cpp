@@ -305,7 +305,7 @@ void FragmentMesher::claim(FragmentId f, std::vector<FragmentId>& flagged) {
 [[gnu::always_inline]] inline void FragmentMesher::sync_sign(const float* values, PointIndex x, std::uint32_t row, std::uint32_t px) {
     const bool now = is_inside(values[x]);
     const std::uint64_t bit = std::uint64_t{1} << (px & 63);
-    std::atomic_ref<std::uint64_t> word(signs_.words[row * signs_.words_per_row + (px >> 6)]);
+    std::atomic_ref<std::uint64_t> word(signs_.words[signs_.word_of(row, px)]);
     if (((word.load(std::memory_order_relaxed) & bit) != 0) == now) return;
     const std::uint64_t old = now ? word.fetch_or(bit, std::memory_order_relaxed) : word.fetch_and(~bit, std::memory_order_relaxed);
     if (((old & bit) != 0) != now) mark_flipped(decode_.coord(x));  // exactly one thread sees the flip
