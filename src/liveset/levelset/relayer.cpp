@@ -31,32 +31,38 @@ bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std
 // What a neighbour's status makes of an offer in the push sweep, looked up instead of branched on
 // (a band neighbour's status is unpredictable): keep it; keep the min (the same layer, outside) or
 // the max (inside); or claim it (pending or far on the offer's side: it takes the offer). Each is
-// one clamp of the old value to [lo, hi], which gives std::min's and std::max's bits.
-enum SweepAction : std::uint8_t { kKeep, kMin, kMax, kClaimUp, kClaimDown, kClaimUpFar, kClaimDownFar };
+// one clamp of the old value to [lo, hi], which gives std::min's and std::max's bits; lo and hi are
+// picked from the source's four values {-inf, +inf, offer up, offer down} by index.
+enum SweepValue : std::uint32_t { kMinusInf, kPlusInf, kOfferUp, kOfferDown };
+// One rule, packed: the status after (byte 0), the index of lo (byte 1) and of hi (byte 2), and
+// two flags: claimed (joins the next level) and far (joins the region first).
+constexpr std::uint32_t kClaimed = 1u << 31, kFar = 1u << 30;
+constexpr std::uint32_t sweep_rule(std::uint8_t after, SweepValue lo, SweepValue hi, std::uint32_t flags) {
+    return after | (static_cast<std::uint32_t>(lo) << 8) | (static_cast<std::uint32_t>(hi) << 16) | flags;
+}
 
-// rules[side][status as a byte]: the action (low byte) and the status after it (high byte) at
-// level k; side 0 for an outside source, 1 for an inside one (level 1's zero layer offers both ways).
-using SweepRules = std::array<std::array<std::uint16_t, 256>, 2>;
+// rules[side][status as a byte] at level k; side 0 for an outside source, 1 for an inside one
+// (level 1's zero layer offers both ways).
+using SweepRules = std::array<std::array<std::uint32_t, 256>, 2>;
 
 SweepRules sweep_rules(int k, std::int8_t far_out, std::int8_t far_in) {
     const auto at = [](std::int8_t s) { return static_cast<std::uint8_t>(s); };
     const auto up = static_cast<std::int8_t>(k), down = static_cast<std::int8_t>(-k);
     SweepRules rules{};
     for (auto& r : rules)
-        for (int s = 0; s < 256; ++s) r[static_cast<std::size_t>(s)] = static_cast<std::uint16_t>(s << 8);
-    const auto set = [&](int side, std::int8_t s, SweepAction x, std::int8_t after) {
-        rules[static_cast<std::size_t>(side)][at(s)] = static_cast<std::uint16_t>(x | (at(after) << 8));
-    };
+        for (int s = 0; s < 256; ++s)
+            r[static_cast<std::size_t>(s)] = sweep_rule(static_cast<std::uint8_t>(s), kMinusInf, kPlusInf, 0);
+    const auto set = [&](int side, std::int8_t s, std::uint32_t rule) { rules[static_cast<std::size_t>(side)][at(s)] = rule; };
     for (int side = 0; side < 2; ++side) {
         if (side == 0 || k == 1) {
-            set(side, up, kMin, up);
-            set(side, kPendPos, kClaimUp, up);
-            set(side, far_out, kClaimUpFar, up);
+            set(side, up, sweep_rule(at(up), kMinusInf, kOfferUp, 0));                   // min
+            set(side, kPendPos, sweep_rule(at(up), kOfferUp, kOfferUp, kClaimed));       // claim
+            set(side, far_out, sweep_rule(at(up), kOfferUp, kOfferUp, kClaimed | kFar));  // claim a far point
         }
         if (side == 1 || k == 1) {
-            set(side, down, kMax, down);
-            set(side, kPendNeg, kClaimDown, down);
-            set(side, far_in, kClaimDownFar, down);
+            set(side, down, sweep_rule(at(down), kOfferDown, kPlusInf, 0));                   // max
+            set(side, kPendNeg, sweep_rule(at(down), kOfferDown, kOfferDown, kClaimed));
+            set(side, far_in, sweep_rule(at(down), kOfferDown, kOfferDown, kClaimed | kFar));
         }
     }
     return rules;
@@ -87,6 +93,34 @@ const ClaimRules& claim_rules(int k, int layers) {
     return all[static_cast<std::size_t>((layers - 1) * kMax + k - 1)];
 }
 
+// Which statuses a level-k point on one side takes its value from: layer ±(k-1) (at level 1 the
+// zero layer, pending or not), as a table by status byte, looked up instead of compared.
+struct InnerStatuses {
+    std::array<std::uint8_t, 256> outside{}, inside{};
+    explicit InnerStatuses(int k) {
+        const auto at = [](int s) { return static_cast<std::size_t>(static_cast<std::uint8_t>(static_cast<std::int8_t>(s))); };
+        if (k == 1) {
+            outside[at(0)] = inside[at(0)] = 1;
+            outside[at(kPendZero)] = inside[at(kPendZero)] = 1;
+        } else {
+            outside[at(k - 1)] = 1;
+            inside[at(-(k - 1))] = 1;
+        }
+    }
+};
+
+// Whitaker's layer rule at a pending point of level k (layer_value.hpp), inlined into the loops.
+[[gnu::always_inline]] inline float inner_layer_value(const Grid<float>& phi, const Grid<std::int8_t>& status,
+                                                      const IndexDecoder& decoder, PointIndex i, bool outside,
+                                                      const InnerStatuses& inner) {
+    const Vec3i c = decoder.coord(i);
+    const auto from = [](const std::array<std::uint8_t, 256>& t) {
+        return [&t](std::int8_t s) { return t[static_cast<std::uint8_t>(s)] != 0; };
+    };
+    return outside ? detail::layer_value_side<true>(phi, status, i, c, from(inner.outside))
+                   : detail::layer_value_side<false>(phi, status, i, c, from(inner.inside));
+}
+
 }  // namespace
 
 // Level k re-evaluates the points still pending from level k-1 plus every neighbour, not yet final,
@@ -106,6 +140,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         std::vector<std::size_t> next, changed;
     };
     std::int8_t* const status = status_.values().data();  // raw: see sweep_whole_band
+    float* const phi = phi_.values().data();
     const Lattice lat = lattice();
     const IndexDecoder decoder = decoder_;
     for (int k = 1; k <= layers_; ++k) {
@@ -141,40 +176,47 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         // Decide (reads only; Jacobi within a level, so any thread order agrees) ...
         value.resize(pending.size());
         outside.resize(pending.size());
+        const InnerStatuses inner(k);
         parallel_range(pending.size(), [&](std::size_t m) {
             RegionPoint& rp = region[pending[m]];
             if (pending[m] >= first_new) rp.old_phi = phi_[rp.point];
             outside[m] = status_[rp.point] == kPendPos;
-            value[m] = inner_layer_value(rp.point, k, outside[m] != 0);
+            value[m] = inner_layer_value(phi_, status_, decoder, rp.point, outside[m] != 0, inner);
         });
-        // ... then write, each chunk its own points; the lists join in chunk order.
+        // ... then write, each chunk its own points; the lists join in chunk order. Without a
+        // branch on whether a point settled (unpredictable; a mispredicted branch also stalls the
+        // next points' loads): every point's status and value are stored (a point that stays
+        // pending gets its own back), and the lists are a store and a count.
         auto parts = detail::ordered_chunks<Part>(pending.size(), [&](std::size_t b, std::size_t e, Part& out) {
+            out.next.resize(e - b);
+            out.changed.resize(e - b);
+            std::size_t* const next = out.next.data();
+            std::size_t* const changed_here = out.changed.data();
+            std::size_t n_next = 0, n_changed = 0;
             for (std::size_t m = b; m < e; ++m) {
                 const std::size_t r = pending[m];
                 const RegionPoint& rp = region[r];
-                if (std::isinf(value[m])) {  // not on layer k: stays pending (far if no layer takes it)
-                    out.next.push_back(r);
-                    if (std::abs(rp.old_status) == k) out.changed.push_back(r);
-                    continue;
-                }
+                const PointIndex p = rp.point;
+                // Not on layer k: stays pending (far if no layer takes it).
+                const bool stays = std::isinf(value[m]);
                 const auto layer = static_cast<std::int8_t>(outside[m] != 0 ? k : -k);
-                status_[rp.point] = layer;
-                phi_[rp.point] = value[m];
-                if (layer != rp.old_status || !same_bits(value[m], rp.old_phi)) out.changed.push_back(r);
+                const std::int8_t s = stays ? status[p] : layer;
+                const float v = stays ? phi[p] : value[m];
+                status[p] = s;
+                phi[p] = v;
+                next[n_next] = r;
+                n_next += stays ? 1 : 0;
+                changed_here[n_changed] = r;
+                n_changed += (stays ? std::abs(rp.old_status) == k : (layer != rp.old_status || !same_bits(v, rp.old_phi))) ? 1 : 0;
             }
+            out.next.resize(n_next);
+            out.changed.resize(n_changed);
         });
         pending.clear();
         changed.clear();
         detail::join_parts(parts, &Part::next, pending);
         detail::join_parts(parts, &Part::changed, changed);
     }
-}
-
-float SparseField::inner_layer_value(PointIndex i, int k, bool outside) const {
-    const Vec3i c = decoder_.coord(i);
-    if (k == 1) return detail::layer_value(phi_, status_, i, c, outside, [](std::int8_t s) { return s == 0 || s == kPendZero; });
-    const std::int8_t inner = static_cast<std::int8_t>(outside ? k - 1 : -(k - 1));
-    return detail::layer_value(phi_, status_, i, c, outside, [inner](std::int8_t s) { return s == inner; });
 }
 
 // Whitaker's layer rule pushed outwards instead of pulled: every point of level k-1 (final by
@@ -209,23 +251,21 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
         const SweepRules rule = sweep_rules(k, far_out, far_in);
         std::size_t n_reached = 0;
         PointIndex* const next = reached.data();
+        float value[4] = {-inf, inf, 0.0f, 0.0f};  // SweepValue order; the offers per source
         for (std::size_t f = 0; f < n_from; ++f) {
             const PointIndex i = from[f];
             const float v = phi[i];
-            const float offer_up = v + 1.0f, offer_down = v - 1.0f;
-            // The clamp per SweepAction: keep, min, max, then the claims (near and far) take the offer.
-            const float lo[7] = {-inf, -inf, offer_down, offer_up, offer_down, offer_up, offer_down};
-            const float hi[7] = {inf, offer_up, inf, offer_up, offer_down, offer_up, offer_down};
-            const std::uint16_t* const r = rule[status[i] < 0 ? 1 : 0].data();  // the source's side
+            value[kOfferUp] = v + 1.0f;
+            value[kOfferDown] = v - 1.0f;
+            const std::uint32_t* const r = rule[status[i] < 0 ? 1 : 0].data();  // the source's side
             for_each_neighbor6(lat, decoder, i, [&](PointIndex q) __attribute__((always_inline)) {
-                const std::uint16_t e = r[static_cast<std::uint8_t>(status[q])];
-                const unsigned x = e & 0xFFu;
-                if (x >= kClaimUpFar) [[unlikely]]
+                const std::uint32_t e = r[static_cast<std::uint8_t>(status[q])];
+                if (e & kFar) [[unlikely]]
                     region.push_back({q, status[q], phi[q]});
-                phi[q] = max_of(min_of(phi[q], hi[x]), lo[x]);
-                status[q] = static_cast<std::int8_t>(e >> 8);
+                phi[q] = max_of(min_of(phi[q], value[(e >> 16) & 0xFFu]), value[(e >> 8) & 0xFFu]);
+                status[q] = static_cast<std::int8_t>(e & 0xFFu);
                 next[n_reached] = q;
-                n_reached += x >= kClaimUp ? 1 : 0;
+                n_reached += e >> 31;
             });
         }
         from.swap(reached);
@@ -244,10 +284,11 @@ void SparseField::sweep_layers(std::span<const RegionPoint> region) {
     for (int k = 1; k <= layers_ && !pending.empty(); ++k) {
         value.assign(pending.size(), 0.0f);
         // Decide (reads only), then write: Jacobi within a layer, so any thread order agrees.
+        const InnerStatuses inner(k);
         parallel_range(pending.size(), [&](std::size_t m) {
             const PointIndex i = pending[m];
             const bool outside = status_[i] == kPendPos;
-            value[m] = inner_layer_value(i, k, outside);
+            value[m] = inner_layer_value(phi_, status_, decoder_, i, outside, inner);
         });
         next.clear();
         for (std::size_t m = 0; m < pending.size(); ++m) {
@@ -264,24 +305,49 @@ void SparseField::sweep_layers(std::span<const RegionPoint> region) {
 }
 
 // Moves the points whose layer changed between the lists: every removal, then every addition, each
-// in region order. A list's operations touch only its own points' slots, so each list is one task
-// once there are many moves; the lists come out the same on any thread count.
+// in region order. The moves are first bucketed by list (a stable counting sort), so that each
+// list walks only its own; a list's operations touch only its own points' slots, so each list is
+// one task once there are many moves; the lists come out the same on any thread count.
 void SparseField::move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves) {
     const int lists = 2 * layers_ + 1;
+    const auto list_of = [&](int layer) { return layer >= -layers_ && layer <= layers_ ? layer + layers_ : -1; };
+    // begin[l] .. begin[l + 1]: list l's points; counted one slot up, then summed.
+    std::array<std::size_t, 2 * kMaxLayers + 2> out_begin{}, in_begin{};
+    for (const ListMove& m : moves) {
+        const int from = list_of(region[m.region_index].old_status), to = list_of(m.layer);
+        if (from >= 0) ++out_begin[static_cast<std::size_t>(from) + 1];
+        if (to >= 0) ++in_begin[static_cast<std::size_t>(to) + 1];
+    }
+    for (int l = 0; l < lists; ++l) {
+        out_begin[static_cast<std::size_t>(l) + 1] += out_begin[static_cast<std::size_t>(l)];
+        in_begin[static_cast<std::size_t>(l) + 1] += in_begin[static_cast<std::size_t>(l)];
+    }
+    std::vector<PointIndex>& out = moved_out_.v;
+    std::vector<PointIndex>& in = moved_in_.v;
+    out.resize(out_begin[static_cast<std::size_t>(lists)]);
+    in.resize(in_begin[static_cast<std::size_t>(lists)]);
+    {
+        auto out_at = out_begin, in_at = in_begin;
+        for (const ListMove& m : moves) {
+            const RegionPoint& r = region[m.region_index];
+            const int from = list_of(r.old_status), to = list_of(m.layer);
+            if (from >= 0) out[out_at[static_cast<std::size_t>(from)]++] = r.point;
+            if (to >= 0) in[in_at[static_cast<std::size_t>(to)]++] = r.point;
+        }
+    }
     const auto for_lists = [&](const auto& per_list) {
         if (moves.size() < detail::kParallelMin) {
-            for (int l = 0; l < lists; ++l) per_list(l - layers_);
+            for (int l = 0; l < lists; ++l) per_list(static_cast<std::size_t>(l));
         } else {
-            tbb::parallel_for(0, lists, [&](int l) { per_list(l - layers_); });
+            tbb::parallel_for(0, lists, [&](int l) { per_list(static_cast<std::size_t>(l)); });
         }
     };
-    for_lists([&](int k) {
-        for (const ListMove& m : moves)
-            if (region[m.region_index].old_status == k) list_remove(region[m.region_index].point, k);
+    // A point leaves its old list before it enters its new one (both touch its slot).
+    for_lists([&](std::size_t l) {
+        for (std::size_t n = out_begin[l]; n < out_begin[l + 1]; ++n) list_remove(out[n], static_cast<int>(l) - layers_);
     });
-    for_lists([&](int k) {
-        for (const ListMove& m : moves)
-            if (m.layer == k) list_add(region[m.region_index].point, k);
+    for_lists([&](std::size_t l) {
+        for (std::size_t n = in_begin[l]; n < in_begin[l + 1]; ++n) list_add(in[n], static_cast<int>(l) - layers_);
     });
 }
 

@@ -388,11 +388,15 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         const float v = phi_[i];
         if (std::abs(v) <= 0.5f) return;
         const bool up = v > 0.5f;
-        bool blocked = false;
+        // Without a branch per neighbour (a moving band's statuses and values are unpredictable):
+        // a zero-layer neighbour beyond -0.5 (leaving inwards) blocks an outward move, and back.
+        // On the other side's values, x > 0.5 is -x < -0.5 bit for bit.
+        const float flip = up ? 1.0f : -1.0f;
+        unsigned blocked = 0;
         for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
-            if (status_[q] == 0 && (up ? phi_[q] < -0.5f : phi_[q] > 0.5f)) blocked = true;
+            blocked |= static_cast<unsigned>(status_[q] == 0) & static_cast<unsigned>(flip * phi_[q] < -0.5f);
         });
-        move[k] = blocked ? static_cast<std::int8_t>(up ? 2 : -2) : static_cast<std::int8_t>(up ? 1 : -1);
+        move[k] = blocked != 0 ? static_cast<std::int8_t>(up ? 2 : -2) : static_cast<std::int8_t>(up ? 1 : -1);
     });
     for (std::size_t k = 0; k < n; ++k)
         if (std::abs(move[k]) == 2) {
@@ -409,11 +413,8 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         const std::int8_t from = move[k] > 0 ? std::int8_t{-1} : std::int8_t{1};
         for_each_neighbor6(lattice(), decoder_, edits[k].point, [&](PointIndex q) {
             if (status_[q] != from) return;
-            float w = from > 0 ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
-            for_each_neighbor6(lattice(), decoder_, q, [&](PointIndex r) {
-                if (status_[r] != 0) return;
-                w = from > 0 ? std::min(w, phi_[r] + 1.0f) : std::max(w, phi_[r] - 1.0f);
-            });
+            // Over its zero-layer neighbours (not those entering it in this loop), φ + 1 or φ − 1.
+            const float w = detail::layer_value(phi_, status_, q, decoder_.coord(q), from > 0, [](std::int8_t s) { return s == 0; });
             region.push_back({q, status_[q], phi_[q]});
             status_[q] = kPendZero;
             phi_[q] = w;

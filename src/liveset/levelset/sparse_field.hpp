@@ -206,7 +206,6 @@ private:
     // The whole band (push, same bits) from the new zero layer `zero`; appends the
     // far points it reaches to the region.
     void sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero);
-    float inner_layer_value(PointIndex i, int k, bool outside) const;
     struct ListMove {
         std::size_t region_index;
         std::int8_t layer;  // the new status
@@ -244,6 +243,7 @@ private:
     Scratch<RegionPoint> region_;                  // repair_band's region
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
     Scratch<RegionPoint> claims_;                  // relayer_changes' claims of one level
+    Scratch<PointIndex> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
 };
 
 }  // namespace liveset
