@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <numeric>
 #include <vector>
 
 #include "liveset/levelset/band_detail.hpp"
@@ -129,15 +128,17 @@ struct InnerStatuses {
 // none of whose neighbours changed keeps both (the state before the update is the layers' fixed
 // point); a point whose layer is below k is final by then (it depends on levels below k-1 only).
 void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
-    std::vector<std::size_t> changed(region.size());  // region indices; level 0: every seed
-    std::iota(changed.begin(), changed.end(), std::size_t{0});
+    std::vector<PointIndex> changed;  // the points that changed at the level below; level 0: every seed
+    changed.reserve(region.size());
+    for (const RegionPoint& r : region) changed.push_back(r.point);
     std::vector<std::size_t> pending;
     for (std::size_t r = 0; r < region.size(); ++r)
         if (status_[region[r].point] == kPendPos || status_[region[r].point] == kPendNeg) pending.push_back(r);
     std::vector<float> value;
     std::vector<std::uint8_t> outside;  // the pending point's side (a seed's old status is 0)
     struct Part {
-        std::vector<std::size_t> next, changed;
+        std::vector<std::size_t> next;  // region indices
+        std::vector<PointIndex> changed;
     };
     std::int8_t* const status = status_.values().data();  // raw: see sweep_whole_band
     float* const phi = phi_.values().data();
@@ -157,7 +158,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         for (std::size_t b = 0; b < changed.size(); b += kClaimBlock) {
             std::size_t n_claims = 0;
             for (std::size_t n = b; n < std::min(changed.size(), b + kClaimBlock); ++n) {
-                const PointIndex p = region[changed[n]].point;
+                const PointIndex p = changed[n];
                 const std::int8_t* const r = rule[status[p] > 0 ? 1 : 0].data();  // the change's side (kPendPos > 0)
                 for_each_neighbor6(lat, decoder, p, [&](PointIndex q) __attribute__((always_inline)) {
                     const std::int8_t s = status[q];
@@ -191,7 +192,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
             out.next.resize(e - b);
             out.changed.resize(e - b);
             std::size_t* const next = out.next.data();
-            std::size_t* const changed_here = out.changed.data();
+            PointIndex* const changed_here = out.changed.data();
             std::size_t n_next = 0, n_changed = 0;
             for (std::size_t m = b; m < e; ++m) {
                 const std::size_t r = pending[m];
@@ -206,7 +207,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
                 phi[p] = v;
                 next[n_next] = r;
                 n_next += stays ? 1 : 0;
-                changed_here[n_changed] = r;
+                changed_here[n_changed] = p;
                 n_changed += (stays ? std::abs(rp.old_status) == k : (layer != rp.old_status || !same_bits(v, rp.old_phi))) ? 1 : 0;
             }
             out.next.resize(n_next);

@@ -273,7 +273,7 @@ void sort_indices(std::vector<PointIndex>& v, std::vector<PointIndex>& scratch) 
 
 void SparseField::sort_lists(bool zero_only) {
     zero_reordered_ = 0;
-    std::vector<PointIndex> scratch;
+    std::vector<PointIndex>& scratch = sort_scratch_.v;  // kept: a list-sized buffer is not faulted in every sort
     for (auto& list : lists_) {
         if (zero_only && &list != &lists_[static_cast<std::size_t>(layers_)]) continue;
         sort_indices(list, scratch);

@@ -244,6 +244,7 @@ private:
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
     Scratch<RegionPoint> claims_;                  // relayer_changes' claims of one level
     Scratch<PointIndex> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
+    Scratch<PointIndex> sort_scratch_;             // sort_lists' radix sort
 };
 
 }  // namespace liveset
