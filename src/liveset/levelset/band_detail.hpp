@@ -6,6 +6,8 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -68,9 +70,19 @@ void for_chunks(std::size_t n, F&& f) {
 // Runs f(begin, end, part) over the fixed chunks [c·K, (c+1)·K) of [0, n), in parallel from
 // kParallelMin up, each chunk appending to its own Part; returns the parts in chunk order. The
 // chunks do not depend on the thread count, so outputs joined in that order are the serial loop's,
-// whatever the scheduling.
+// whatever the scheduling. f must not depend on where the chunks end: on one thread [0, n) is one
+// chunk.
 template <class Part, class F>
 std::vector<Part> ordered_chunks(std::size_t n, F&& f) {
+    // On one thread (an arena of one, where a small step runs, or a process limited to one) the
+    // chunks would run in order anyway: one chunk gives the same joined outputs without a buffer
+    // per chunk and the copies that join them (join_parts moves a single part).
+    if (n > 0 && (tbb::this_task_arena::max_concurrency() == 1 ||
+                  tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism) == 1)) {
+        std::vector<Part> one(1);
+        f(std::size_t{0}, n, one.front());
+        return one;
+    }
     std::vector<Part> parts((n + kChunk - 1) / kChunk);
     for_chunks(n, [&](std::size_t b, std::size_t e) { f(b, e, parts[b / kChunk]); });
     return parts;
