@@ -186,7 +186,8 @@ TEST(IncrementalStep, OneAndTwoThreadsGiveTheSameStateReportsAndListOrder) {
 }
 
 // The same with sleeping on a front of several 4 096-point chunks (the rate pass joins per-chunk
-// arrays of awake points in chunk order): the same bits, reports and list order on 1 and 2 threads.
+// arrays of awake points in chunk order): the same bits, reports and list order on 1 thread (one
+// chunk) and 2 (several).
 TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenSleepingOnAFrontOfSeveralChunks) {
     auto run = [](int threads, std::vector<std::vector<PointIndex>>& reports, std::size_t& largest) {
         tbb::task_arena arena(threads);

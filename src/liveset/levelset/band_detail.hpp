@@ -68,10 +68,9 @@ void for_chunks(std::size_t n, F&& f) {
 }
 
 // Runs f(begin, end, part) over the fixed chunks [c·K, (c+1)·K) of [0, n), in parallel from
-// kParallelMin up, each chunk appending to its own Part; returns the parts in chunk order. The
-// chunks do not depend on the thread count, so outputs joined in that order are the serial loop's,
-// whatever the scheduling. f must not depend on where the chunks end: on one thread [0, n) is one
-// chunk.
+// kParallelMin up, each chunk appending to its own Part; returns the parts in chunk order (on one
+// thread, [0, n) as one chunk). f must not depend on where the chunks end, so the outputs joined in
+// that order are the serial loop's on any thread count, whatever the scheduling.
 template <class Part, class F>
 std::vector<Part> ordered_chunks(std::size_t n, F&& f) {
     // On one thread (an arena of one, where a small step runs, or a process limited to one) the
@@ -89,7 +88,8 @@ std::vector<Part> ordered_chunks(std::size_t n, F&& f) {
 }
 
 // Appends the member `field` of every part to `out`, in the parts' order (moved, not copied,
-// when there is one part and `out` is empty: a small update's only chunk).
+// when there is one part and `out` is empty: a small update's only chunk, or any update on one
+// thread).
 template <class Part, class T>
 void join_parts(std::vector<Part>& parts, std::vector<T> Part::*field, std::vector<T>& out) {
     if (parts.size() == 1 && out.empty()) {

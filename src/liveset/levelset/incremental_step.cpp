@@ -25,9 +25,10 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
     if (sleep_after > 0) activity_.begin_step(lattice(), speed.serial(), steps_);
 
     // Rates at the awake points (all of them when sleeping is off), exactly as zero_rates(). A
-    // sleeping point costs only its awake test: each 4 096-point chunk of the zero layer keeps its
-    // awake points and their rates in its own arrays, joined in chunk order (the zero layer's
-    // order, whatever the thread count), so the passes below run over the awake points only.
+    // sleeping point costs only its awake test: each 4 096-point chunk of the zero layer (one chunk
+    // on one thread) keeps its awake points and their rates in its own arrays, joined in chunk
+    // order (the zero layer's order, whatever the thread count), so the passes below run over the
+    // awake points only.
     struct Rates {
         std::vector<std::uint32_t> at;  // positions in the zero layer
         std::vector<double> rate;
