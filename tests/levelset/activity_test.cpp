@@ -212,3 +212,36 @@ TEST(Activity, ASavedSnapshotContinuesBitForBit) {
     SparseField other(Lattice({30, 40, 40}), 2);
     EXPECT_THROW(other.restore_activity(snap), std::invalid_argument);
 }
+
+// The stamps are 32-bit offsets from a base that moves up every 2^30 steps: the rule must read the
+// same far past 2^31 steps, a snapshot must hold the absolute steps, and a restored snapshot
+// (clock included) must continue with the same awake set.
+TEST(Activity, StampsKeepTheRuleFarPastThirtyTwoBits) {
+    const Lattice l({8, 8, 8});
+    constexpr int kAfter = 10;
+    constexpr std::uint64_t kSpeed = 7;
+    FrontActivity a;
+    a.begin_step(l, kSpeed, 1);
+    a.wake_near(std::vector<PointIndex>{l.index({7, 7, 7})}, l, 3);
+    const PointIndex p = l.index({1, 1, 1});  // block (0, 0, 0): stamp 0
+    for (const std::int64_t t : {std::int64_t{1} << 31, (std::int64_t{1} << 33) + 5, (std::int64_t{1} << 40) + 11}) {
+        a.begin_step(l, kSpeed, t);  // the same speed: nothing wakes but the point below
+        a.wake_near(std::vector<PointIndex>{p}, l, t);
+        EXPECT_TRUE(a.awake({1, 1, 1}, t + kAfter, kAfter)) << t;
+        EXPECT_TRUE(a.awake({3, 3, 3}, t + kAfter, kAfter)) << t;  // one block over
+        EXPECT_FALSE(a.awake({1, 1, 1}, t + kAfter + 1, kAfter)) << t;
+        EXPECT_FALSE(a.awake({5, 5, 5}, t, kAfter)) << t;  // two blocks over (woken at step 3 with (7, 7, 7))
+        EXPECT_FALSE(a.awake({7, 7, 7}, t, kAfter)) << t;  // woken at step 3, long asleep
+        ActivitySnapshot s = a.snapshot(kSpeed);
+        ASSERT_EQ(s.stamps.size(), 64u);
+        EXPECT_EQ(s.stamps[0], t);
+        s.clock = t + 4;
+        FrontActivity b;
+        b.restore(s, l);
+        for (int z = 0; z < 8; ++z)
+            for (int y = 0; y < 8; ++y)
+                for (int x = 0; x < 8; ++x)
+                    for (const std::int64_t now : {t + 4, t + kAfter, t + kAfter + 1})
+                        ASSERT_EQ(b.awake({x, y, z}, now, kAfter), a.awake({x, y, z}, now, kAfter)) << t << " " << x << y << z;
+    }
+}

@@ -9,12 +9,28 @@ namespace liveset {
 
 namespace {
 constexpr std::int64_t kNever = std::numeric_limits<std::int64_t>::min() / 2;
+// A stored offset this low means "never woken" (or woken so long ago that it no longer matters:
+// every window is at most 1 000 000 steps, far below 2^30).
+constexpr std::int32_t kNeverOffset = std::numeric_limits<std::int32_t>::min() / 2;
+constexpr std::int64_t kRebaseAfter = std::int64_t{1} << 30;
+
+std::int32_t offset_of(std::int64_t stamp, std::int64_t base) {
+    const std::int64_t d = stamp - base;  // callers keep it below 2^31 (rebase; restore's base)
+    return d <= kNeverOffset ? kNeverOffset : static_cast<std::int32_t>(std::min<std::int64_t>(d, std::numeric_limits<std::int32_t>::max()));
+}
+}  // namespace
+
+void FrontActivity::rebase(std::int64_t now) {
+    if (now - base_ < kRebaseAfter) return;
+    for (std::int32_t& s : stamp_) s = offset_of(base_ + s, now);
+    base_ = now;
 }
 
 void FrontActivity::reset() {
     stamp_.clear();
     stamp_.shrink_to_fit();
     blocks_x_ = blocks_y_ = blocks_z_ = 0;
+    base_ = 0;
     all_woken_at_ = 0;
     speed_serial_ = 0;
     adopt_next_speed_ = false;
@@ -26,7 +42,8 @@ ActivitySnapshot FrontActivity::snapshot(std::uint64_t speed_serial) const {
     s.all_woken_at = all_woken_at_;
     s.speed_current = adopt_next_speed_ || (speed_serial != 0 && speed_serial == speed_serial_);
     s.blocks = {static_cast<int>(blocks_x_), static_cast<int>(blocks_y_), static_cast<int>(blocks_z_)};
-    s.stamps.assign(stamp_.begin(), stamp_.end());
+    s.stamps.resize(stamp_.size());
+    for (std::size_t b = 0; b < stamp_.size(); ++b) s.stamps[b] = stamp_[b] == kNeverOffset ? kNever : base_ + stamp_[b];
     return s;
 }
 
@@ -40,7 +57,12 @@ void FrontActivity::restore(const ActivitySnapshot& s, const Lattice& lattice) {
     blocks_x_ = static_cast<std::size_t>(want.x);
     blocks_y_ = static_cast<std::size_t>(want.y);
     blocks_z_ = static_cast<std::size_t>(want.z);
-    stamp_.assign(s.stamps.begin(), s.stamps.end());
+    // The base at or above every stamp (a saved clock is; a damaged file need not be), so that
+    // every offset fits.
+    base_ = s.clock;
+    for (const std::int64_t t : s.stamps) base_ = std::max(base_, t);
+    stamp_.resize(s.stamps.size());
+    for (std::size_t b = 0; b < stamp_.size(); ++b) stamp_[b] = offset_of(s.stamps[b], base_);
     all_woken_at_ = s.all_woken_at;
     adopt_next_speed_ = s.speed_current;
 }
@@ -51,11 +73,13 @@ void FrontActivity::begin_step(const Lattice& lattice, std::uint64_t speed_seria
         blocks_x_ = static_cast<std::size_t>((d.x + 1) / 2);
         blocks_y_ = static_cast<std::size_t>((d.y + 1) / 2);
         blocks_z_ = static_cast<std::size_t>((d.z + 1) / 2);
-        stamp_.assign(blocks_x_ * blocks_y_ * blocks_z_, kNever);
+        base_ = now;
+        stamp_.assign(blocks_x_ * blocks_y_ * blocks_z_, kNeverOffset);
         speed_serial_ = speed_serial;
         all_woken_at_ = now - 1;  // this step is the first of the window
         return;
     }
+    rebase(now);
     if (adopt_next_speed_) {  // restored: this speed is the one the stamps were taken under
         adopt_next_speed_ = false;
         speed_serial_ = speed_serial;
@@ -69,13 +93,15 @@ void FrontActivity::begin_step(const Lattice& lattice, std::uint64_t speed_seria
 void FrontActivity::wake_near(std::span<const PointIndex> points, const Lattice& lattice, std::int64_t now) {
     if (stamp_.empty()) return;
     const auto bx = static_cast<int>(blocks_x_), by = static_cast<int>(blocks_y_), bz = static_cast<int>(blocks_z_);
+    rebase(now);
+    const std::int32_t at = offset_of(now, base_);
     for (PointIndex i : points) {
         const Vec3i p = lattice.coord(i);
         const Vec3i b{p.x >> 1, p.y >> 1, p.z >> 1};
         for (int z = std::max(b.z - 1, 0); z <= std::min(b.z + 1, bz - 1); ++z)
             for (int y = std::max(b.y - 1, 0); y <= std::min(b.y + 1, by - 1); ++y)
                 for (int x = std::max(b.x - 1, 0); x <= std::min(b.x + 1, bx - 1); ++x)
-                    stamp_[static_cast<std::size_t>(x) + blocks_x_ * (static_cast<std::size_t>(y) + blocks_y_ * static_cast<std::size_t>(z))] = now;
+                    stamp_[static_cast<std::size_t>(x) + blocks_x_ * (static_cast<std::size_t>(y) + blocks_y_ * static_cast<std::size_t>(z))] = at;
     }
 }
 

@@ -82,9 +82,10 @@ struct StepOptions {
     // A step over a band of fewer points runs on the calling thread alone (bitwise the same
     // result): its loops are too short to pay for waking another thread, which costs tens of
     // microseconds per parallel loop on a virtual machine (docs/BENCHMARKS.md, session 31: on the
-    // 2-core VM two threads were 1.3-1.6x slower than one below 30 000 front points). 0: always
-    // use the threads there are. At most 1 000 000 000.
-    std::size_t parallel_band_min = 300'000;
+    // 2-core VM two threads were 1.3-1.6x slower than one below 30 000 front points; session 35:
+    // with today's passes they break even at about 90 000 band points, 20 000 on BrainWeb's
+    // front). 0: always use the threads there are. At most 1 000 000 000.
+    std::size_t parallel_band_min = 100'000;
 };
 
 // Throws std::invalid_argument with a one-line message on an option out of range.
