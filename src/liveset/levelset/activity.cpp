@@ -26,6 +26,20 @@ void FrontActivity::rebase(std::int64_t now) {
     base_ = now;
 }
 
+FrontActivity::AwakeTest FrontActivity::awake_test(std::int64_t now, int sleep_after) const {
+    AwakeTest t;
+    t.stamp = stamp_.data();
+    t.blocks_x = blocks_x_;
+    t.blocks_y = blocks_y_;
+    const std::int64_t since = now - sleep_after;  // awake iff the last wake is at or after it
+    t.all = all_woken_at_ >= since;
+    const std::int64_t need = since - base_;  // the smallest offset that is
+    t.none = need > std::numeric_limits<std::int32_t>::max();
+    t.min_offset = static_cast<std::int32_t>(std::max<std::int64_t>(need, std::numeric_limits<std::int32_t>::min()));
+    if (t.none) t.min_offset = 0;
+    return t;
+}
+
 void FrontActivity::reset() {
     stamp_.clear();
     stamp_.shrink_to_fit();

@@ -36,14 +36,25 @@ public:
     void begin_step(const Lattice& lattice, std::uint64_t speed_serial, std::int64_t now);
     // Wakes the blocks within one block of each point (no-op when not enabled).
     void wake_near(std::span<const PointIndex> points, const Lattice& lattice, std::int64_t now);
+    // The rule at one step, for a loop over points: a point is awake iff the last wake of its
+    // block or of everything is at least now - sleep_after, so everything is awake when the last
+    // global wake is, and otherwise the test is one compare of the block's offset with a bound
+    // (valid until the next begin_step or wake_near).
+    struct AwakeTest {
+        const std::int32_t* stamp = nullptr;
+        std::size_t blocks_x = 0, blocks_y = 0;
+        bool all = true;    // the last global wake is within the window
+        bool none = false;  // no block's offset can reach the bound
+        std::int32_t min_offset = 0;
+        bool operator()(Vec3i p) const {
+            const std::size_t b = static_cast<std::size_t>(p.x >> 1) +
+                                  blocks_x * (static_cast<std::size_t>(p.y >> 1) + blocks_y * static_cast<std::size_t>(p.z >> 1));
+            return all || (!none && stamp[b] >= min_offset);
+        }
+    };
+    AwakeTest awake_test(std::int64_t now, int sleep_after) const;
     // Whether lattice point p is awake at step `now` under the rule with window `sleep_after`.
-    bool awake(Vec3i p, std::int64_t now, int sleep_after) const {
-        const std::size_t b = static_cast<std::size_t>(p.x >> 1) +
-                              blocks_x_ * (static_cast<std::size_t>(p.y >> 1) + blocks_y_ * static_cast<std::size_t>(p.z >> 1));
-        const std::int64_t stamp = base_ + stamp_[b];
-        const std::int64_t last = stamp > all_woken_at_ ? stamp : all_woken_at_;
-        return now - last <= sleep_after;
-    }
+    bool awake(Vec3i p, std::int64_t now, int sleep_after) const { return awake_test(now, sleep_after)(p); }
 
     // `speed_serial`: the serial of the speed the next step will use (0: none built yet).
     ActivitySnapshot snapshot(std::uint64_t speed_serial) const;

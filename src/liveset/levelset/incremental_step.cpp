@@ -33,13 +33,22 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
         std::vector<std::uint32_t> at;  // positions in the zero layer
         std::vector<double> rate;
     };
+    // The awake test reads the block stamps through locals (a store to the lists below could
+    // alias the members) and is skipped while everything is awake; a point is a store and a count.
+    const FrontActivity::AwakeTest awake =
+        sleep_after > 0 ? activity_.awake_test(steps_, sleep_after) : FrontActivity::AwakeTest{};
+    const IndexDecoder decoder = decoder_;
     auto rates = detail::ordered_chunks<Rates>(zero.size(), [&](std::size_t b, std::size_t e, Rates& out) {
-        std::vector<PointIndex> points;
+        std::vector<PointIndex> points(e - b);
+        out.at.resize(e - b);
+        std::size_t n_awake = 0;
         for (std::size_t n = b; n < e; ++n) {
-            if (sleep_after > 0 && !activity_.awake(decoder_.coord(zero[n]), steps_, sleep_after)) continue;
-            out.at.push_back(static_cast<std::uint32_t>(n));
-            points.push_back(zero[n]);
+            out.at[n_awake] = static_cast<std::uint32_t>(n);
+            points[n_awake] = zero[n];
+            n_awake += awake.all || awake(decoder.coord(zero[n])) ? 1 : 0;
         }
+        out.at.resize(n_awake);
+        points.resize(n_awake);
         out.rate.resize(points.size());
         speed.rates(phi_, points, out.rate);
     });
