@@ -34,9 +34,9 @@ FrontActivity::AwakeTest FrontActivity::awake_test(std::int64_t now, int sleep_a
     const std::int64_t since = now - sleep_after;  // awake iff the last wake is at or after it
     t.all = all_woken_at_ >= since;
     const std::int64_t need = since - base_;  // the smallest offset that is
-    t.none = need > std::numeric_limits<std::int32_t>::max();
-    t.min_offset = static_cast<std::int32_t>(std::max<std::int64_t>(need, std::numeric_limits<std::int32_t>::min()));
-    if (t.none) t.min_offset = 0;
+    t.none = need > std::numeric_limits<std::int32_t>::max();  // then min_offset is not read
+    t.min_offset = static_cast<std::int32_t>(std::clamp<std::int64_t>(need, std::numeric_limits<std::int32_t>::min(),
+                                                                      std::numeric_limits<std::int32_t>::max()));
     return t;
 }
 
