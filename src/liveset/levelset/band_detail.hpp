@@ -24,6 +24,7 @@ inline constexpr std::int8_t kPendPos = 100;   // to be re-layered, outside sign
 inline constexpr std::int8_t kPendNeg = -100;  // to be re-layered, inside sign
 inline constexpr std::int8_t kPendZero = 101;  // on the new zero layer
 inline constexpr std::size_t kParallelMin = 4096;  // below this, loops run serially
+inline constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;  // the list slot of a point not in the band
 
 inline bool is_temp(std::int8_t s) { return s >= kPendPos || s <= kPendNeg; }
 // The pending code a band point of status s takes when an update marks it.

@@ -1,7 +1,12 @@
 // Re-layering a repair region and settling it (see sparse_field.hpp for the scheme): the outer
 // layers from the new zero layer (the pull for any region, the push for the whole band, change
-// propagation for a local update), then the final statuses, X, the sign changes and the list moves.
+// propagation for a local update), then the final statuses, X, the sign changes and the list moves
+// (or, after a whole-band sweep, the lists rebuilt from its levels: relist, sparse_field.cpp).
 #include <tbb/parallel_for.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -9,6 +14,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "liveset/levelset/band_detail.hpp"
@@ -20,6 +26,7 @@ namespace liveset {
 namespace {
 
 using detail::for_each_neighbor6;
+using detail::kNoSlot;
 using detail::kPendNeg;
 using detail::kPendPos;
 using detail::kPendZero;
@@ -32,39 +39,69 @@ bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std
 // the max (inside); or claim it (pending or far on the offer's side: it takes the offer). Each is
 // one clamp of the old value to [lo, hi], which gives std::min's and std::max's bits; lo and hi are
 // picked from the source's four values {-inf, +inf, offer up, offer down} by index.
-enum SweepValue : std::uint32_t { kMinusInf, kPlusInf, kOfferUp, kOfferDown };
-// One rule, packed: the status after (byte 0), the index of lo (byte 1) and of hi (byte 2), and
-// two flags: claimed (joins the next level) and far (joins the region first).
-constexpr std::uint32_t kClaimed = 1u << 31, kFar = 1u << 30;
-constexpr std::uint32_t sweep_rule(std::uint8_t after, SweepValue lo, SweepValue hi, std::uint32_t flags) {
-    return after | (static_cast<std::uint32_t>(lo) << 8) | (static_cast<std::uint32_t>(hi) << 16) | flags;
-}
+enum SweepValue : std::uint8_t { kMinusInf, kPlusInf, kOfferUp, kOfferDown };
+// Flags: claimed (joins the next level) and far (joins the region first).
+constexpr std::uint8_t kClaimed = 1, kFar = 2;
 
-// rules[side][status as a byte] at level k; side 0 for an outside source, 1 for an inside one
-// (level 1's zero layer offers both ways).
-using SweepRules = std::array<std::array<std::uint32_t, 256>, 2>;
+// One side's rules at level k, a table per field (one byte load each, no unpacking): by status as
+// a byte, the status after, the indices of lo and hi, and the flags.
+struct SweepRule {
+    std::array<std::uint8_t, 256> after, lo, hi, flags;
+};
+// rules[side] at level k; side 0 for an outside source, 1 for an inside one (level 1's zero layer
+// offers both ways).
+using SweepRules = std::array<SweepRule, 2>;
 
 SweepRules sweep_rules(int k, std::int8_t far_out, std::int8_t far_in) {
     const auto at = [](std::int8_t s) { return static_cast<std::uint8_t>(s); };
     const auto up = static_cast<std::int8_t>(k), down = static_cast<std::int8_t>(-k);
     SweepRules rules{};
-    for (auto& r : rules)
-        for (int s = 0; s < 256; ++s)
-            r[static_cast<std::size_t>(s)] = sweep_rule(static_cast<std::uint8_t>(s), kMinusInf, kPlusInf, 0);
-    const auto set = [&](int side, std::int8_t s, std::uint32_t rule) { rules[static_cast<std::size_t>(side)][at(s)] = rule; };
+    for (SweepRule& r : rules)
+        for (int s = 0; s < 256; ++s) {  // keep: the status and the value as they are
+            const auto b = static_cast<std::size_t>(s);
+            r.after[b] = static_cast<std::uint8_t>(s);
+            r.lo[b] = kMinusInf;
+            r.hi[b] = kPlusInf;
+            r.flags[b] = 0;
+        }
+    const auto set = [&](int side, std::int8_t s, std::int8_t after, SweepValue lo, SweepValue hi, std::uint8_t flags) {
+        SweepRule& r = rules[static_cast<std::size_t>(side)];
+        r.after[at(s)] = at(after);
+        r.lo[at(s)] = lo;
+        r.hi[at(s)] = hi;
+        r.flags[at(s)] = flags;
+    };
     for (int side = 0; side < 2; ++side) {
         if (side == 0 || k == 1) {
-            set(side, up, sweep_rule(at(up), kMinusInf, kOfferUp, 0));                   // min
-            set(side, kPendPos, sweep_rule(at(up), kOfferUp, kOfferUp, kClaimed));       // claim
-            set(side, far_out, sweep_rule(at(up), kOfferUp, kOfferUp, kClaimed | kFar));  // claim a far point
+            set(side, up, up, kMinusInf, kOfferUp, 0);                   // min
+            set(side, kPendPos, up, kOfferUp, kOfferUp, kClaimed);       // claim
+            set(side, far_out, up, kOfferUp, kOfferUp, kClaimed | kFar);  // claim a far point
         }
         if (side == 1 || k == 1) {
-            set(side, down, sweep_rule(at(down), kOfferDown, kPlusInf, 0));                   // max
-            set(side, kPendNeg, sweep_rule(at(down), kOfferDown, kOfferDown, kClaimed));
-            set(side, far_in, sweep_rule(at(down), kOfferDown, kOfferDown, kClaimed | kFar));
+            set(side, down, down, kOfferDown, kPlusInf, 0);  // max
+            set(side, kPendNeg, down, kOfferDown, kOfferDown, kClaimed);
+            set(side, far_in, down, kOfferDown, kOfferDown, kClaimed | kFar);
         }
     }
     return rules;
+}
+
+// A level's claims into the lists of its two sides (status > 0: outside), in the order claimed:
+// a store to each list and a count (the side is unpredictable).
+void split_by_side(std::span<const PointIndex> claims, const std::int8_t* status, std::vector<PointIndex>& up,
+                   std::vector<PointIndex>& down) {
+    up.resize(claims.size());
+    down.resize(claims.size());
+    std::size_t n_up = 0, n_down = 0;
+    for (const PointIndex q : claims) {
+        const bool outside = status[q] > 0;
+        up[n_up] = q;
+        down[n_down] = q;
+        n_up += outside ? 1 : 0;
+        n_down += outside ? 0 : 1;
+    }
+    up.resize(n_up);
+    down.resize(n_down);
 }
 
 // What a change's neighbour of each status becomes when level k's claim reaches it: its pending
@@ -230,13 +267,14 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
 // one not reached stays as it is, so no ring of far points around the band is collected first.
 // Needs the region to hold the whole band (collect_band, init_from_sdf): no final point outside it
 // can be a pending point's inner neighbour. A partial region (unite_in_box) uses the pull.
-void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero) {
+void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero, bool relist) {
     const std::int8_t far_out = far_outside(), far_in = far_inside();
     // A point takes its layer and the first offer when first reached; later offers of the same
     // level still count. The level lists are kept between steps (never shrunk), sized to the most
     // a level can reach (6 per source) so that a claim is a store and a count.
     std::vector<PointIndex>& from = sweep_from_.v;
     std::vector<PointIndex>& reached = sweep_next_.v;
+    std::vector<PointIndex>& far_claims = sweep_far_.v;
     if (from.size() < zero.size()) from.resize(zero.size());
     std::copy(zero.begin(), zero.end(), from.begin());
     std::size_t n_from = zero.size();
@@ -247,28 +285,80 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
     const Lattice lat = lattice();
     const IndexDecoder decoder = decoder_;
     constexpr float inf = std::numeric_limits<float>::infinity();
+    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    // x - 1 < core.x (unsigned) iff 1 <= x <= dims.x - 2; a dimension below 3 has no such points.
+    const auto core_extent = [](int d) { return d >= 3 ? static_cast<std::uint32_t>(d - 2) : 0u; };
+    const struct {
+        std::uint32_t x, y, z;
+    } core{core_extent(lat.dims().x), core_extent(lat.dims().y), core_extent(lat.dims().z)};
+    constexpr std::size_t kSweepAhead = 16;
+    if (relist)
+        for (int k = 1; k <= layers_; ++k) {
+            lists_[static_cast<std::size_t>(layers_ + k)].clear();
+            lists_[static_cast<std::size_t>(layers_ - k)].clear();
+        }
     for (int k = 1; k <= layers_ && n_from > 0; ++k) {
-        if (reached.size() < 6 * n_from) reached.resize(6 * n_from);
+        // Grown geometrically: a growing front must not refill them every step.
+        if (reached.size() < 6 * n_from) reached.resize(std::max(6 * n_from, 2 * reached.size()));
+        if (far_claims.size() < 6 * n_from) far_claims.resize(std::max(6 * n_from, 2 * far_claims.size()));
         const SweepRules rule = sweep_rules(k, far_out, far_in);
-        std::size_t n_reached = 0;
+        std::size_t n_reached = 0, n_far = 0;
         PointIndex* const next = reached.data();
+        PointIndex* const far = far_claims.data();
         float value[4] = {-inf, inf, 0.0f, 0.0f};  // SweepValue order; the offers per source
         for (std::size_t f = 0; f < n_from; ++f) {
             const PointIndex i = from[f];
+            // The sources run roughly in lattice order, so a source's +z neighbour is usually the
+            // first touch of its line: fetch it for a source a few ahead (a hint; no effect on bits).
+            if (f + kSweepAhead < n_from) {
+                const PointIndex ahead = from[f + kSweepAhead] + sz;
+                __builtin_prefetch(status + ahead, 1);
+                __builtin_prefetch(phi + ahead, 1);
+            }
             const float v = phi[i];
             value[kOfferUp] = v + 1.0f;
             value[kOfferDown] = v - 1.0f;
-            const std::uint32_t* const r = rule[status[i] < 0 ? 1 : 0].data();  // the source's side
-            for_each_neighbor6(lat, decoder, i, [&](PointIndex q) __attribute__((always_inline)) {
-                const std::uint32_t e = r[static_cast<std::uint8_t>(status[q])];
-                if (e & kFar) [[unlikely]]
-                    region.push_back({q, status[q], phi[q]});
-                phi[q] = max_of(min_of(phi[q], value[(e >> 16) & 0xFFu]), value[(e >> 8) & 0xFFu]);
-                status[q] = static_cast<std::int8_t>(e & 0xFFu);
+            const SweepRule& r = rule[status[i] < 0 ? 1 : 0];  // the source's side
+            const auto visit = [&](PointIndex q) __attribute__((always_inline)) {
+                const auto s = static_cast<std::uint8_t>(status[q]);
+                const std::uint8_t flags = r.flags[s];
+                if (flags & kFar) [[unlikely]]
+                    far[n_far++] = q;  // no call here: the loop keeps its pointers in registers
+#if defined(__SSE2__)
+                // max_of(min_of(φ, hi), lo) on registers: a scalar load clears the upper lanes.
+                const __m128 below = _mm_min_ss(_mm_load_ss(value + r.hi[s]), _mm_load_ss(phi + q));
+                _mm_store_ss(phi + q, _mm_max_ss(_mm_load_ss(value + r.lo[s]), below));
+#else
+                phi[q] = max_of(min_of(phi[q], value[r.hi[s]]), value[r.lo[s]]);
+#endif
+                status[q] = static_cast<std::int8_t>(r.after[s]);
                 next[n_reached] = q;
-                n_reached += e >> 31;
-            });
+                n_reached += flags & kClaimed;
+            };
+            // A source off the lattice's faces (almost every one) visits its six neighbours
+            // without a test per neighbour; the same visits in the same order.
+            const Vec3i c = decoder.coord(i);
+            if (static_cast<std::uint32_t>(c.x - 1) < core.x && static_cast<std::uint32_t>(c.y - 1) < core.y &&
+                static_cast<std::uint32_t>(c.z - 1) < core.z) [[likely]] {
+                visit(i - 1);
+                visit(i + 1);
+                visit(i - sy);
+                visit(i + sy);
+                visit(i - sz);
+                visit(i + sz);
+            } else {
+                for_each_neighbor6(lat, decoder, i, visit);
+            }
         }
+        // The far points claimed join the region in the order reached; each was far (φ = its
+        // status, the invariant) on the side of the layer it took.
+        for (std::size_t n = 0; n < n_far; ++n) {
+            const std::int8_t was = status[far[n]] > 0 ? far_out : far_in;
+            region.push_back({far[n], was, static_cast<float>(was)});
+        }
+        if (relist)
+            split_by_side(std::span(next, n_reached), status, lists_[static_cast<std::size_t>(layers_ + k)],
+                          lists_[static_cast<std::size_t>(layers_ - k)]);
         from.swap(reached);
         n_from = n_reached;
     }
@@ -353,9 +443,10 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
 }
 
 // Settles every region point (a pending one is far), in parallel over fixed chunks; then moves the
-// points whose layer changed between the lists (move_between_lists). The change report and the
-// sign changes come in the region's order, whatever the thread count.
-ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
+// points whose layer changed between the lists (move_between_lists), unless the repair rebuilds
+// them (relist). The change report and the sign changes come in the region's order, whatever the
+// thread count.
+ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool move_lists) {
     struct Part {
         std::vector<PointIndex> changed, signs;
         std::vector<ListMove> moved;  // the points whose layer changed
@@ -364,10 +455,13 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
     const std::int8_t far_out = far_outside(), far_in = far_inside();
     float* const phi = phi_.values().data();  // raw: see sweep_whole_band
     std::int8_t* const status = status_.values().data();
+    std::uint32_t* const slot = slot_.values().data();
     auto parts = detail::ordered_chunks<Part>(region.size(), [&](std::size_t b, std::size_t e, Part& out) {
-        out.changed.resize(e - b);  // most region points change: a store and a count each
+        out.changed.resize(e - b);                // most region points change: a store and a count each
+        out.moved.resize(move_lists ? e - b : 0);  // and many move (unpredictably): the same
         PointIndex* const changed = out.changed.data();
-        std::size_t n_changed = 0;
+        ListMove* const moved = out.moved.data();
+        std::size_t n_changed = 0, n_moved = 0;
         for (std::size_t n = b; n < e; ++n) {
             const RegionPoint& r = region[n];
             const PointIndex i = r.point;
@@ -378,27 +472,29 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region) {
             if (s == kPendZero) {
                 s = 0;
                 status[i] = s;
-            } else if (s == kPendPos) {
-                s = far_out;
-                v = far;
+            } else if (s == kPendPos || s == kPendNeg) {  // left the band
+                s = s == kPendPos ? far_out : far_in;
+                v = s == far_out ? far : -far;
                 status[i] = s;
                 phi[i] = v;
-            } else if (s == kPendNeg) {
-                s = far_in;
-                v = -far;
-                status[i] = s;
-                phi[i] = v;
+                if (!move_lists) slot[i] = kNoSlot;
             }
-            if (s != r.old_status) out.moved.push_back({n, s});
+            if (move_lists) {
+                moved[n_moved] = {n, s};
+                n_moved += s != r.old_status ? 1 : 0;
+            }
             changed[n_changed] = i;
             n_changed += (s != r.old_status || !same_bits(v, r.old_phi)) ? 1 : 0;
             if ((v < 0.0f) != (r.old_phi < 0.0f)) out.signs.push_back(i);
         }
         out.changed.resize(n_changed);
+        out.moved.resize(n_moved);
     });
-    std::vector<ListMove> moved;
-    detail::join_parts(parts, &Part::moved, moved);
-    move_between_lists(region, moved);
+    if (move_lists) {
+        std::vector<ListMove> moved;
+        detail::join_parts(parts, &Part::moved, moved);
+        move_between_lists(region, moved);
+    }
     ChangedPoints changed;
     detail::join_parts(parts, &Part::changed, changed.points);
     detail::join_parts(parts, &Part::signs, changed.sign_changes.emplace());

@@ -29,10 +29,9 @@ using detail::for_each_neighbor6;
 using detail::is_temp;
 using detail::kPendNeg;
 using detail::kPendPos;
+using detail::kNoSlot;
 using detail::kPendZero;
 using detail::parallel_range;
-
-constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;
 
 std::string point_text(const Lattice& lat, PointIndex i) {
     const Vec3i c = lat.coord(i);
@@ -300,18 +299,18 @@ StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
 }
 
 StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& options) {
-    // Layer lists drift into a scattered order as points enter and leave; every few steps put
-    // them back in lattice order so the sweeps below walk memory mostly forwards.
-    if (++steps_since_sort_ >= 8) {
-        sort_lists();
-        steps_since_sort_ = 0;
-    }
     StepResult result;
     result.zero_layer = zero_layer().size();
     result.awake = result.zero_layer;
     result.whole_band = true;
     const auto edits = compute_step(speed, options, &result.dt);
     result.changed = commit(edits, RepairScope::kGlobal);
+    // The repair leaves the zero list in lattice order and the outer lists in the order the sweep
+    // claimed them (near lattice order); every few steps all of them are put back in lattice order.
+    if (++steps_since_sort_ >= 8) {
+        sort_lists();
+        steps_since_sort_ = 0;
+    }
     return result;
 }
 
@@ -434,10 +433,35 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     if (scope == RepairScope::kLocal) {
         relayer_changes(region);
     } else {
+        // The whole band is re-layered, so its lists are rebuilt from the sweep's levels rather
+        // than moved point by point.
         std::vector<PointIndex> zero = collect_band(region);
-        sweep_whole_band(region, zero);
+        sweep_whole_band(region, zero, /*relist=*/true);
+        ChangedPoints changed = finish(region, /*move_lists=*/false);
+        relist(zero);
+        return changed;
     }
     return finish(region);
+}
+
+void SparseField::relist(std::vector<PointIndex>& zero) {
+    lists_[static_cast<std::size_t>(layers_)].swap(zero);
+    sort_lists(true);  // the zero list in lattice order, and its slots
+    std::uint32_t* const slot = slot_.values().data();
+    const auto set_slots = [&](std::size_t l) {
+        const std::vector<PointIndex>& list = lists_[l];
+        for (std::size_t k = 0; k < list.size(); ++k) slot[list[k]] = static_cast<std::uint32_t>(k);
+    };
+    const int lists = 2 * layers_ + 1;
+    // Each list its own points' slots: one task per list when the band is large.
+    if (band_size() < detail::kParallelMin) {
+        for (int l = 0; l < lists; ++l)
+            if (l != layers_) set_slots(static_cast<std::size_t>(l));
+    } else {
+        tbb::parallel_for(0, lists, [&](int l) {
+            if (l != layers_) set_slots(static_cast<std::size_t>(l));
+        });
+    }
 }
 
 ChangedPoints SparseField::restore(std::span<const PointState> states) {

@@ -74,11 +74,12 @@ struct StepOptions {
     // `liveset segment` uses 20 (sleeping_step(), segmentation.hpp). At most 1 000 000.
     int sleep_after = 0;
     // kIncremental only: when at least 3/4 of a zero layer of at most this many points moves in a
-    // step, the band is re-layered whole (the push sweep) instead of outwards from the changes:
-    // the same bits (local ≡ global), and cheaper there on one thread (docs/BENCHMARKS.md, session
-    // 25; beyond it the propagation's parallel passes pay on two). 0: always propagate. At most
-    // 1 000 000 000.
-    std::size_t dense_front_max = 30'000;
+    // step, the band is re-layered whole (the push sweep, its lists rebuilt from the sweep's
+    // levels) instead of outwards from the changes: the same bits (local ≡ global), and cheaper
+    // there (docs/BENCHMARKS.md, session 36: 0.70-0.77x the propagation's time at 30 000-120 000
+    // moving front points, on one thread and on two; session 25 had set 30 000, when the whole-band
+    // step still moved its list entries one by one). 0: always propagate. At most 1 000 000 000.
+    std::size_t dense_front_max = 150'000;
     // A step over a band of fewer points runs on the calling thread alone (bitwise the same
     // result): its loops are too short to pay for waking another thread, which costs tens of
     // microseconds per parallel loop on a virtual machine (docs/BENCHMARKS.md, session 31: on the
@@ -205,13 +206,20 @@ private:
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
     void sweep_layers(std::span<const RegionPoint> region);       // any region (pull)
     // The whole band (push, same bits) from the new zero layer `zero`; appends the
-    // far points it reaches to the region.
-    void sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero);
+    // far points it reaches to the region. `relist`: the outer layers' lists become the points
+    // each level claims (in the order claimed), for relist() instead of finish's list moves.
+    void sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero, bool relist = false);
     struct ListMove {
-        std::size_t region_index;
-        std::int8_t layer;  // the new status
+        ListMove() {}  // left unset: finish sizes its buffer first and writes each entry it counts
+        ListMove(std::size_t index, std::int8_t new_layer) : region_index(static_cast<std::uint32_t>(index)), layer(new_layer) {}
+        std::uint32_t region_index;  // a region holds lattice points, fewer than 2^32
+        std::int8_t layer;           // the new status
     };
-    ChangedPoints finish(std::span<const RegionPoint> region);
+    // `move_lists` false: the lists are rebuilt instead (sweep_whole_band with relist, then relist()).
+    ChangedPoints finish(std::span<const RegionPoint> region, bool move_lists = true);
+    // After a relisting sweep and finish: the zero list becomes `zero` in lattice order, and every
+    // list point's slot is set.
+    void relist(std::vector<PointIndex>& zero);
     void move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves);
     void sort_lists(bool zero_only = false);  // each (or the zero) layer list in ascending point order
     void list_add(PointIndex i, int layer);
@@ -243,6 +251,7 @@ private:
     };
     Scratch<RegionPoint> region_;                  // repair_band's region
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
+    Scratch<PointIndex> sweep_far_;                // sweep_whole_band's far points claimed in one level
     Scratch<RegionPoint> claims_;                  // relayer_changes' claims of one level
     Scratch<PointIndex> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
     Scratch<PointIndex> sort_scratch_;             // sort_lists' radix sort
