@@ -295,7 +295,6 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
     const struct {
         std::uint32_t x, y, z;
     } core{core_extent(lat.dims().x), core_extent(lat.dims().y), core_extent(lat.dims().z)};
-    constexpr std::size_t kSweepAhead = 16;
     if (relist)
         for (int k = 1; k <= layers_; ++k) {
             lists_[static_cast<std::size_t>(layers_ + k)].clear();
@@ -314,8 +313,8 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
             const PointIndex i = from[f];
             // The sources run roughly in lattice order, so a source's +z neighbour is usually the
             // first touch of its line: fetch it for a source a few ahead (a hint; no effect on bits).
-            if (f + kSweepAhead < n_from) {
-                const PointIndex ahead = from[f + kSweepAhead] + sz;
+            if (f + detail::kAhead < n_from) {
+                const PointIndex ahead = from[f + detail::kAhead] + sz;
                 __builtin_prefetch(status + ahead, 1);
                 __builtin_prefetch(phi + ahead, 1);
             }
@@ -472,6 +471,10 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool move
         ListMove* const moved = out.moved.data();
         std::size_t n_changed = 0, n_moved = 0;
         for (std::size_t n = b; n < e; ++n) {
+            if (n + detail::kAhead < e) {  // the region's points are scattered: fetch ahead
+                __builtin_prefetch(status + points[n + detail::kAhead].point, 1);
+                __builtin_prefetch(phi + points[n + detail::kAhead].point, 0);
+            }
             const RegionPoint r = points[n];
             const PointIndex i = r.point;
             std::int8_t s = status[i];

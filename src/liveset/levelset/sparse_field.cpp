@@ -450,7 +450,10 @@ void SparseField::relist(std::vector<PointIndex>& zero) {
     std::uint32_t* const slot = slot_.values().data();
     const auto set_slots = [&](std::size_t l) {
         const std::vector<PointIndex>& list = lists_[l];
-        for (std::size_t k = 0; k < list.size(); ++k) slot[list[k]] = static_cast<std::uint32_t>(k);
+        for (std::size_t k = 0; k < list.size(); ++k) {
+            if (k + detail::kAhead < list.size()) __builtin_prefetch(slot + list[k + detail::kAhead], 1);
+            slot[list[k]] = static_cast<std::uint32_t>(k);
+        }
     };
     const int lists = 2 * layers_ + 1;
     // Each list its own points' slots: one task per list when the band is large.
@@ -525,7 +528,12 @@ std::vector<PointIndex> SparseField::collect_band(std::vector<RegionPoint>& regi
     const float* const phi = phi_.values().data();  // raw: a status store could alias the members
     std::int8_t* const status = status_.values().data();
     for (const auto& list : lists_)
-        for (PointIndex i : list) {
+        for (std::size_t n = 0; n < list.size(); ++n) {
+            if (n + detail::kAhead < list.size()) {  // a list's points are scattered: fetch ahead
+                __builtin_prefetch(status + list[n + detail::kAhead], 1);
+                __builtin_prefetch(phi + list[n + detail::kAhead], 0);
+            }
+            const PointIndex i = list[n];
             const std::int8_t s = status[i];
             if (s == kPendZero) {  // already marked: a zero-layer point of this update (step 3)
                 zero.push_back(i);
