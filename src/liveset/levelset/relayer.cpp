@@ -15,7 +15,6 @@
 #include <cstdint>
 #include <limits>
 #include <span>
-#include <type_traits>
 #include <vector>
 
 #include "liveset/levelset/band_detail.hpp"
@@ -271,7 +270,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
 // one not reached stays as it is, so no ring of far points around the band is collected first.
 // Needs the region to hold the whole band (collect_band, init_from_sdf): no final point outside it
 // can be a pending point's inner neighbour. A partial region (unite_in_box) uses the pull.
-void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero, bool relist) {
+void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero, bool keep_levels) {
     const std::int8_t far_out = far_outside(), far_in = far_inside();
     // A point takes its layer and the first offer when first reached; later offers of the same
     // level still count. The level lists are kept between steps (never shrunk), sized to the most
@@ -295,11 +294,11 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
     const struct {
         std::uint32_t x, y, z;
     } core{core_extent(lat.dims().x), core_extent(lat.dims().y), core_extent(lat.dims().z)};
-    if (relist)
-        for (int k = 1; k <= layers_; ++k) {
-            lists_[static_cast<std::size_t>(layers_ + k)].clear();
-            lists_[static_cast<std::size_t>(layers_ - k)].clear();
-        }
+    std::vector<std::vector<PointIndex>>& levels = level_claims_.v;
+    if (keep_levels) {
+        levels.resize(2 * static_cast<std::size_t>(layers_));
+        for (auto& l : levels) l.clear();  // a level the sweep does not reach claims nothing
+    }
     for (int k = 1; k <= layers_ && n_from > 0; ++k) {
         // Grown geometrically: a growing front must not refill them every step.
         if (reached.size() < 6 * n_from) reached.resize(std::max(6 * n_from, 2 * reached.size()));
@@ -359,9 +358,9 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
             const std::int8_t was = status[far[n]] > 0 ? far_out : far_in;
             region.push_back({far[n], was, static_cast<float>(was)});
         }
-        if (relist)
-            split_by_side(std::span(next, n_reached), status, lists_[static_cast<std::size_t>(layers_ + k)],
-                          lists_[static_cast<std::size_t>(layers_ - k)]);
+        if (keep_levels)
+            split_by_side(std::span(next, n_reached), status, levels[2 * static_cast<std::size_t>(k - 1)],
+                          levels[2 * static_cast<std::size_t>(k - 1) + 1]);
         from.swap(reached);
         n_from = n_reached;
     }
@@ -446,10 +445,10 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
 }
 
 // Settles every region point (a pending one is far), in parallel over fixed chunks; then moves the
-// points whose layer changed between the lists (move_between_lists), unless the repair rebuilds
-// them (relist). The change report and the sign changes come in the region's order, whatever the
+// points whose layer changed between the lists (move_between_lists), or rebuilds them (relist,
+// when a whole-band sweep kept its levels and much of the band moved). The change report and the sign changes come in the region's order, whatever the
 // thread count.
-ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool move_lists) {
+ChangedPoints SparseField::finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero) {
     struct Part {
         std::vector<PointIndex> changed, signs;
         std::vector<ListMove> moved;  // the points whose layer changed
@@ -458,15 +457,13 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool move
     const std::int8_t far_out = far_outside(), far_in = far_inside();
     float* const phi = phi_.values().data();  // raw: see sweep_whole_band
     std::int8_t* const status = status_.values().data();
-    std::uint32_t* const slot = slot_.values().data();
     const RegionPoint* const points = region.data();
     // The loop reads every pointer from locals copied by value (a status store, through a char
     // type, would otherwise make it reload them from the closure on every point) and counts
-    // without branching on a change (unpredictable); one loop per value of move_lists.
-    const auto settle = [=](std::size_t b, std::size_t e, Part& out, auto move_tag) {
-        constexpr bool kMove = decltype(move_tag)::value;
-        out.changed.resize(e - b);            // most region points change: a store and a count each
-        out.moved.resize(kMove ? e - b : 0);  // and many move (unpredictably): the same
+    // without branching on a change (unpredictable).
+    auto parts = detail::ordered_chunks<Part>(region.size(), [=](std::size_t b, std::size_t e, Part& out) {
+        out.changed.resize(e - b);  // most region points change: a store and a count each
+        out.moved.resize(e - b);    // and many move (unpredictably): the same
         PointIndex* const changed = out.changed.data();
         ListMove* const moved = out.moved.data();
         std::size_t n_changed = 0, n_moved = 0;
@@ -489,29 +486,29 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool move
                 v = s == far_out ? far : -far;
                 status[i] = s;
                 phi[i] = v;
-                if constexpr (!kMove) slot[i] = kNoSlot;
             }
             const std::size_t layer_changed = s != r.old_status ? 1 : 0;
-            if constexpr (kMove) {
-                moved[n_moved] = {n, s};
-                n_moved += layer_changed;
-            }
+            moved[n_moved] = {n, s};
+            n_moved += layer_changed;
             changed[n_changed] = i;
             n_changed += layer_changed | (same_bits(v, r.old_phi) ? 0u : 1u);
             if ((v < 0.0f) != (r.old_phi < 0.0f)) out.signs.push_back(i);
         }
         out.changed.resize(n_changed);
         out.moved.resize(n_moved);
-    };
-    auto parts = detail::ordered_chunks<Part>(region.size(), [&](std::size_t b, std::size_t e, Part& out) {
-        if (move_lists)
-            settle(b, e, out, std::true_type{});
-        else
-            settle(b, e, out, std::false_type{});
     });
-    if (move_lists) {
-        std::vector<ListMove> moved;
-        detail::join_parts(parts, &Part::moved, moved);
+    std::vector<ListMove> moved;
+    detail::join_parts(parts, &Part::moved, moved);
+    // Rebuilding costs a slot per band point and a sort of the zero list; moving, two slot updates
+    // per point that changed layer. A front growing from seeds moves 15-27 % of its region per
+    // step (BrainWeb), the box under curvature flow 0-10 %: rebuild from an eighth (measured:
+    // docs/BENCHMARKS.md, session 36).
+    if (relist_zero != nullptr && 8 * moved.size() >= region.size()) {
+        std::uint32_t* const slot = slot_.values().data();
+        for (const ListMove& m : moved)
+            if (m.layer == far_out || m.layer == far_in) slot[region[m.region_index].point] = kNoSlot;
+        relist(*relist_zero);
+    } else {
         move_between_lists(region, moved);
     }
     ChangedPoints changed;

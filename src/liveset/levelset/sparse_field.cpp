@@ -433,18 +433,20 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     if (scope == RepairScope::kLocal) {
         relayer_changes(region);
     } else {
-        // The whole band is re-layered, so its lists are rebuilt from the sweep's levels rather
-        // than moved point by point.
+        // The whole band is re-layered: its lists may be rebuilt from the sweep's levels (finish).
         std::vector<PointIndex> zero = collect_band(region);
-        sweep_whole_band(region, zero, /*relist=*/true);
-        ChangedPoints changed = finish(region, /*move_lists=*/false);
-        relist(zero);
-        return changed;
+        sweep_whole_band(region, zero, /*keep_levels=*/true);
+        return finish(region, &zero);
     }
     return finish(region);
 }
 
 void SparseField::relist(std::vector<PointIndex>& zero) {
+    std::vector<std::vector<PointIndex>>& levels = level_claims_.v;
+    for (int k = 1; k <= layers_; ++k) {
+        lists_[static_cast<std::size_t>(layers_ + k)].swap(levels[2 * static_cast<std::size_t>(k - 1)]);
+        lists_[static_cast<std::size_t>(layers_ - k)].swap(levels[2 * static_cast<std::size_t>(k - 1) + 1]);
+    }
     lists_[static_cast<std::size_t>(layers_)].swap(zero);
     sort_lists(true);  // the zero list in lattice order, and its slots
     std::uint32_t* const slot = slot_.values().data();

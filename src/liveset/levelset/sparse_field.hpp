@@ -206,19 +206,20 @@ private:
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
     void sweep_layers(std::span<const RegionPoint> region);       // any region (pull)
     // The whole band (push, same bits) from the new zero layer `zero`; appends the
-    // far points it reaches to the region. `relist`: the outer layers' lists become the points
-    // each level claims (in the order claimed), for relist() instead of finish's list moves.
-    void sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero, bool relist = false);
+    // far points it reaches to the region. `keep_levels`: each level's claims, split by side, are
+    // kept (in the order claimed) in level_claims_, for finish to rebuild the lists from.
+    void sweep_whole_band(std::vector<RegionPoint>& region, std::span<const PointIndex> zero, bool keep_levels = false);
     struct ListMove {
         ListMove() {}  // left unset: finish sizes its buffer first and writes each entry it counts
         ListMove(std::size_t index, std::int8_t new_layer) : region_index(static_cast<std::uint32_t>(index)), layer(new_layer) {}
         std::uint32_t region_index;  // a region holds lattice points, fewer than 2^32
         std::int8_t layer;           // the new status
     };
-    // `move_lists` false: the lists are rebuilt instead (sweep_whole_band with relist, then relist()).
-    ChangedPoints finish(std::span<const RegionPoint> region, bool move_lists = true);
-    // After a relisting sweep and finish: the zero list becomes `zero` in lattice order, and every
-    // list point's slot is set.
+    // `relist_zero` (the new zero layer, after a sweep that kept its levels): when at least an
+    // eighth of the region changed layer, the lists are rebuilt (relist) instead of moved.
+    ChangedPoints finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero = nullptr);
+    // The lists from the new zero layer (put in lattice order) and the levels' claims, and every
+    // list point's slot.
     void relist(std::vector<PointIndex>& zero);
     void move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves);
     void sort_lists(bool zero_only = false);  // each (or the zero) layer list in ascending point order
@@ -252,6 +253,7 @@ private:
     Scratch<RegionPoint> region_;                  // repair_band's region
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
     Scratch<PointIndex> sweep_far_;                // sweep_whole_band's far points claimed in one level
+    Scratch<std::vector<PointIndex>> level_claims_;  // its claims per level and side (2(k-1): outside, +1: inside)
     Scratch<RegionPoint> claims_;                  // relayer_changes' claims of one level
     Scratch<PointIndex> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
     Scratch<PointIndex> sort_scratch_;             // sort_lists' radix sort
