@@ -77,9 +77,10 @@ struct StepOptions {
     // step, the band is re-layered whole (the push sweep, its lists rebuilt from the sweep's
     // levels) instead of outwards from the changes: the same bits (local ≡ global), and cheaper
     // there (docs/BENCHMARKS.md, session 36: 0.70-0.77x the propagation's time at 30 000-120 000
-    // moving front points, on one thread and on two; session 25 had set 30 000, when the whole-band
-    // step still moved its list entries one by one). 0: always propagate. At most 1 000 000 000.
-    std::size_t dense_front_max = 150'000;
+    // front points growing everywhere, on one thread and on two; but on BrainWeb's 2-thread run
+    // the fronts of 60 000-150 000 points, where sleeping starts, were slower whole, so 60 000;
+    // session 25 had set 30 000). 0: always propagate. At most 1 000 000 000.
+    std::size_t dense_front_max = 60'000;
     // A step over a band of fewer points runs on the calling thread alone (bitwise the same
     // result): its loops are too short to pay for waking another thread, which costs tens of
     // microseconds per parallel loop on a virtual machine (docs/BENCHMARKS.md, session 31: on the
