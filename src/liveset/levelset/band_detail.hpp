@@ -59,6 +59,17 @@ void parallel_range(std::size_t n, F&& f) {
     });
 }
 
+// Runs f(l) for each of `lists` layer lists: one task per list when `parallel` (each list's work
+// touches only its own points' slots), else in order on the calling thread.
+template <class F>
+void for_each_list(int lists, bool parallel, F&& f) {
+    if (!parallel) {
+        for (int l = 0; l < lists; ++l) f(static_cast<std::size_t>(l));
+    } else {
+        tbb::parallel_for(0, lists, [&](int l) { f(static_cast<std::size_t>(l)); });
+    }
+}
+
 // Runs f(begin, end) over the fixed chunks [c·K, (c+1)·K) of [0, n), in parallel from kParallelMin up.
 inline constexpr std::size_t kChunk = 4096;
 template <class F>

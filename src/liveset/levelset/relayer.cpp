@@ -428,18 +428,12 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
             if (to >= 0) in[in_at[static_cast<std::size_t>(to)]++] = r.point;
         }
     }
-    const auto for_lists = [&](const auto& per_list) {
-        if (moves.size() < detail::kParallelMin) {
-            for (int l = 0; l < lists; ++l) per_list(static_cast<std::size_t>(l));
-        } else {
-            tbb::parallel_for(0, lists, [&](int l) { per_list(static_cast<std::size_t>(l)); });
-        }
-    };
+    const bool parallel = moves.size() >= detail::kParallelMin;
     // A point leaves its old list before it enters its new one (both touch its slot).
-    for_lists([&](std::size_t l) {
+    detail::for_each_list(lists, parallel, [&](std::size_t l) {
         for (std::size_t n = out_begin[l]; n < out_begin[l + 1]; ++n) list_remove(out[n], static_cast<int>(l) - layers_);
     });
-    for_lists([&](std::size_t l) {
+    detail::for_each_list(lists, parallel, [&](std::size_t l) {
         for (std::size_t n = in_begin[l]; n < in_begin[l + 1]; ++n) list_add(in[n], static_cast<int>(l) - layers_);
     });
 }

@@ -14,6 +14,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <span>
 #include <string>
 #include <utility>
 
@@ -32,6 +33,15 @@ using detail::kPendPos;
 using detail::kNoSlot;
 using detail::kPendZero;
 using detail::parallel_range;
+
+// Each point's position in its layer list, into the slot lattice (prefetched: the points are
+// scattered over it).
+void write_slots(std::span<const PointIndex> list, std::uint32_t* slot) {
+    for (std::size_t k = 0; k < list.size(); ++k) {
+        if (k + detail::kAhead < list.size()) __builtin_prefetch(slot + list[k + detail::kAhead], 1);
+        slot[list[k]] = static_cast<std::uint32_t>(k);
+    }
+}
 
 std::string point_text(const Lattice& lat, PointIndex i) {
     const Vec3i c = lat.coord(i);
@@ -276,7 +286,7 @@ void SparseField::sort_lists(bool zero_only) {
     for (auto& list : lists_) {
         if (zero_only && &list != &lists_[static_cast<std::size_t>(layers_)]) continue;
         sort_indices(list, scratch);
-        for (std::size_t k = 0; k < list.size(); ++k) slot_[list[k]] = static_cast<std::uint32_t>(k);
+        write_slots(list, slot_.values().data());
     }
 }
 
@@ -450,23 +460,9 @@ void SparseField::relist(std::vector<PointIndex>& zero) {
     lists_[static_cast<std::size_t>(layers_)].swap(zero);
     sort_lists(true);  // the zero list in lattice order, and its slots
     std::uint32_t* const slot = slot_.values().data();
-    const auto set_slots = [&](std::size_t l) {
-        const std::vector<PointIndex>& list = lists_[l];
-        for (std::size_t k = 0; k < list.size(); ++k) {
-            if (k + detail::kAhead < list.size()) __builtin_prefetch(slot + list[k + detail::kAhead], 1);
-            slot[list[k]] = static_cast<std::uint32_t>(k);
-        }
-    };
-    const int lists = 2 * layers_ + 1;
-    // Each list its own points' slots: one task per list when the band is large.
-    if (band_size() < detail::kParallelMin) {
-        for (int l = 0; l < lists; ++l)
-            if (l != layers_) set_slots(static_cast<std::size_t>(l));
-    } else {
-        tbb::parallel_for(0, lists, [&](int l) {
-            if (l != layers_) set_slots(static_cast<std::size_t>(l));
-        });
-    }
+    detail::for_each_list(2 * layers_ + 1, band_size() >= detail::kParallelMin, [&](std::size_t l) {
+        if (l != static_cast<std::size_t>(layers_)) write_slots(lists_[l], slot);
+    });
 }
 
 ChangedPoints SparseField::restore(std::span<const PointState> states) {
