@@ -442,11 +442,15 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
 // points whose layer changed between the lists (move_between_lists), or rebuilds them (relist,
 // when a whole-band sweep kept its levels and much of the band moved). The change report and the sign changes come in the region's order, whatever the
 // thread count.
-ChangedPoints SparseField::finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero) {
+ChangedPoints SparseField::finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero,
+                                  std::size_t* layer_changes) {
     struct Part {
         std::vector<PointIndex> changed, signs;
-        std::vector<ListMove> moved;  // the points whose layer changed
+        std::vector<ListMove> moved;  // the points whose layer changed (when the lists are moved)
+        std::size_t n_moved = 0;
     };
+    const bool record_moves = relist_zero == nullptr;
+    std::uint32_t* const slot = slot_.values().data();
     const float far = static_cast<float>(layers_ + 1);
     const std::int8_t far_out = far_outside(), far_in = far_inside();
     float* const phi = phi_.values().data();  // raw: see sweep_whole_band
@@ -456,8 +460,8 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, std::vect
     // type, would otherwise make it reload them from the closure on every point) and counts
     // without branching on a change (unpredictable).
     auto parts = detail::ordered_chunks<Part>(region.size(), [=](std::size_t b, std::size_t e, Part& out) {
-        out.changed.resize(e - b);  // most region points change: a store and a count each
-        out.moved.resize(e - b);    // and many move (unpredictably): the same
+        out.changed.resize(e - b);                   // most region points change: a store and a count each
+        if (record_moves) out.moved.resize(e - b);  // and many move (unpredictably): the same
         PointIndex* const changed = out.changed.data();
         ListMove* const moved = out.moved.data();
         std::size_t n_changed = 0, n_moved = 0;
@@ -480,30 +484,29 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, std::vect
                 v = s == far_out ? far : -far;
                 status[i] = s;
                 phi[i] = v;
+                if (!record_moves) slot[i] = kNoSlot;  // (a move takes it from its old list by its slot)
             }
             const std::size_t layer_changed = s != r.old_status ? 1 : 0;
-            moved[n_moved] = {n, s};
+            if (record_moves) moved[n_moved] = {n, s};
             n_moved += layer_changed;
             changed[n_changed] = i;
             n_changed += layer_changed | (same_bits(v, r.old_phi) ? 0u : 1u);
             if ((v < 0.0f) != (r.old_phi < 0.0f)) out.signs.push_back(i);
         }
         out.changed.resize(n_changed);
-        out.moved.resize(n_moved);
+        if (record_moves) out.moved.resize(n_moved);
+        out.n_moved = n_moved;
     });
-    std::vector<ListMove> moved;
-    detail::join_parts(parts, &Part::moved, moved);
-    // Rebuilding costs a slot per band point and a sort of the zero list; moving, two slot updates
-    // per point that changed layer. A front growing from seeds moves 15-27 % of its region per
-    // step (BrainWeb), the box under curvature flow 0-10 %: rebuild from an eighth (measured:
-    // docs/BENCHMARKS.md, session 36).
-    if (relist_zero != nullptr && 8 * moved.size() >= region.size()) {
-        std::uint32_t* const slot = slot_.values().data();
-        for (const ListMove& m : moved)
-            if (m.layer == far_out || m.layer == far_in) slot[region[m.region_index].point] = kNoSlot;
-        relist(*relist_zero);
-    } else {
+    if (layer_changes != nullptr) {
+        *layer_changes = 0;
+        for (const Part& p : parts) *layer_changes += p.n_moved;
+    }
+    if (record_moves) {
+        std::vector<ListMove> moved;
+        detail::join_parts(parts, &Part::moved, moved);
         move_between_lists(region, moved);
+    } else {
+        relist(*relist_zero);
     }
     ChangedPoints changed;
     detail::join_parts(parts, &Part::changed, changed.points);

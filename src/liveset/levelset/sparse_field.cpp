@@ -443,10 +443,20 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     if (scope == RepairScope::kLocal) {
         relayer_changes(region);
     } else {
-        // The whole band is re-layered: its lists may be rebuilt from the sweep's levels (finish).
+        // The whole band is re-layered. Its lists are rebuilt from the sweep's levels (finish,
+        // relist) when the last whole-band repair changed the layer of at least an eighth of its
+        // region, else its points are moved between them: rebuilding costs a slot per band point
+        // and a sort of the zero list, moving two slot updates per point that changed layer, and a
+        // front growing from seeds changes 15-27 % per step (BrainWeb), the box under curvature
+        // flow 0-10 % (docs/BENCHMARKS.md, sessions 36-37). Decided before the sweep, so that
+        // neither way pays for the other's records (the levels, the moves).
         std::vector<PointIndex> zero = collect_band(region);
-        sweep_whole_band(region, zero, /*keep_levels=*/true);
-        return finish(region, &zero);
+        const bool rebuild = relist_next_;
+        sweep_whole_band(region, zero, /*keep_levels=*/rebuild);
+        std::size_t layer_changes = 0;
+        ChangedPoints changed = finish(region, rebuild ? &zero : nullptr, &layer_changes);
+        relist_next_ = 8 * layer_changes >= region.size();
+        return changed;
     }
     return finish(region);
 }

@@ -216,9 +216,11 @@ private:
         std::uint32_t region_index;  // a region holds lattice points, fewer than 2^32
         std::int8_t layer;           // the new status
     };
-    // `relist_zero` (the new zero layer, after a sweep that kept its levels): when at least an
-    // eighth of the region changed layer, the lists are rebuilt (relist) instead of moved.
-    ChangedPoints finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero = nullptr);
+    // `relist_zero` (the new zero layer, after a sweep that kept its levels): the lists are
+    // rebuilt from the levels (relist) and no move is recorded; else the points that changed
+    // layer are moved between the lists. `layer_changes`: where to count those points.
+    ChangedPoints finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero = nullptr,
+                         std::size_t* layer_changes = nullptr);
     // The lists from the new zero layer (put in lattice order) and the levels' claims, and every
     // list point's slot.
     void relist(std::vector<PointIndex>& zero);
@@ -234,6 +236,9 @@ private:
     std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
     int steps_since_sort_ = 0;
+    // Whether the next whole-band repair rebuilds its lists (relist) rather than moving points
+    // between them: set by the last one's share of points that changed layer (repair_band).
+    bool relist_next_ = true;
     std::size_t zero_reordered_ = 0;  // zero-layer list insertions and removals since its last sort
     double last_update_ms_ = 0.0;
     std::int64_t steps_ = 0;                    // global steps taken (the activity's clock)
