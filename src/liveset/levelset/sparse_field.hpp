@@ -221,7 +221,7 @@ private:
     // layer are moved between the lists. `layer_changes`: where to count those points.
     ChangedPoints finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero = nullptr,
                          std::size_t* layer_changes = nullptr);
-    // The lists from the new zero layer (put in lattice order) and the levels' claims, and every
+    // The lists from the new zero layer (in lattice order) and the levels' claims, and every
     // list point's slot.
     void relist(std::vector<PointIndex>& zero);
     void move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves);
