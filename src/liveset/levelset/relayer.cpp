@@ -440,8 +440,8 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
 
 // Settles every region point (a pending one is far), in parallel over fixed chunks; then moves the
 // points whose layer changed between the lists (move_between_lists), or rebuilds them (relist,
-// when a whole-band sweep kept its levels and much of the band moved). The change report and the sign changes come in the region's order, whatever the
-// thread count.
+// given the new zero layer after a whole-band sweep that kept its levels). The change report and
+// the sign changes come in the region's order, whatever the thread count.
 ChangedPoints SparseField::finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero,
                                   std::size_t* layer_changes) {
     struct Part {

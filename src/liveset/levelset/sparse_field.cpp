@@ -451,8 +451,8 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         // flow 0-10 % (docs/BENCHMARKS.md, sessions 36-37). Decided before the sweep, so that
         // neither way pays for the other's records (the levels, the moves).
         // A rebuilding repair puts the new zero layer in lattice order first: the zero list then,
-        // and the sweep's first sources, run forwards through memory (0.93-0.99x the step's time
-        // below 60 000 front points, against sorting the zero list after the sweep).
+        // and the sweep's first sources, run forwards through memory (the sort is needed for the
+        // zero list anyway; before the sweep it gains at most a few per cent, session 37).
         std::vector<PointIndex> zero = collect_band(region);
         const bool rebuild = relist_next_;
         if (rebuild) sort_indices(zero, sort_scratch_.v);
