@@ -439,17 +439,16 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
 }
 
 // Settles every region point (a pending one is far), in parallel over fixed chunks; then moves the
-// points whose layer changed between the lists (move_between_lists), or rebuilds them (relist,
-// given the new zero layer after a whole-band sweep that kept its levels). The change report and
-// the sign changes come in the region's order, whatever the thread count.
-ChangedPoints SparseField::finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero,
-                                  std::size_t* layer_changes) {
+// points whose layer changed between the lists (move_between_lists), unless the caller rebuilds
+// them (relist). The change report and the sign changes come in the region's order, whatever the
+// thread count.
+ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool rebuilding_lists, std::size_t* layer_changes) {
     struct Part {
         std::vector<PointIndex> changed, signs;
         std::vector<ListMove> moved;  // the points whose layer changed (when the lists are moved)
         std::size_t n_moved = 0;
     };
-    const bool record_moves = relist_zero == nullptr;
+    const bool record_moves = !rebuilding_lists;
     std::uint32_t* const slot = slot_.values().data();
     const float far = static_cast<float>(layers_ + 1);
     const std::int8_t far_out = far_outside(), far_in = far_inside();
@@ -505,8 +504,6 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, std::vect
         std::vector<ListMove> moved;
         detail::join_parts(parts, &Part::moved, moved);
         move_between_lists(region, moved);
-    } else {
-        relist(*relist_zero);
     }
     ChangedPoints changed;
     detail::join_parts(parts, &Part::changed, changed.points);

@@ -29,8 +29,8 @@ namespace {
 using detail::for_each_neighbor6;
 using detail::is_temp;
 using detail::kPendNeg;
-using detail::kPendPos;
 using detail::kNoSlot;
+using detail::kPendPos;
 using detail::kPendZero;
 using detail::parallel_range;
 
@@ -443,8 +443,8 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     if (scope == RepairScope::kLocal) {
         relayer_changes(region);
     } else {
-        // The whole band is re-layered. Its lists are rebuilt from the sweep's levels (finish,
-        // relist) when the last whole-band repair changed the layer of at least an eighth of its
+        // The whole band is re-layered. Its lists are rebuilt from the sweep's levels (relist)
+        // when the last whole-band repair changed the layer of at least an eighth of its
         // region, else its points are moved between them: rebuilding costs a slot per band point
         // and a sort of the zero list, moving two slot updates per point that changed layer, and a
         // front growing from seeds changes 15-27 % per step (BrainWeb), the box under curvature
@@ -458,7 +458,8 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         if (rebuild) sort_indices(zero, sort_scratch_.v);
         sweep_whole_band(region, zero, /*keep_levels=*/rebuild);
         std::size_t layer_changes = 0;
-        ChangedPoints changed = finish(region, rebuild ? &zero : nullptr, &layer_changes);
+        ChangedPoints changed = finish(region, rebuild, &layer_changes);
+        if (rebuild) relist(zero);
         relist_next_ = 8 * layer_changes >= region.size();
         return changed;
     }

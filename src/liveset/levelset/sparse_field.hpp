@@ -216,10 +216,10 @@ private:
         std::uint32_t region_index;  // a region holds lattice points, fewer than 2^32
         std::int8_t layer;           // the new status
     };
-    // `relist_zero` (the new zero layer, after a sweep that kept its levels): the lists are
-    // rebuilt from the levels (relist) and no move is recorded; else the points that changed
-    // layer are moved between the lists. `layer_changes`: where to count those points.
-    ChangedPoints finish(std::span<const RegionPoint> region, std::vector<PointIndex>* relist_zero = nullptr,
+    // The points that changed layer are moved between the lists, unless `rebuilding_lists` (the
+    // caller then rebuilds them: relist): no move is recorded, and a point that leaves the band
+    // loses its slot here. `layer_changes`: where to count those points.
+    ChangedPoints finish(std::span<const RegionPoint> region, bool rebuilding_lists = false,
                          std::size_t* layer_changes = nullptr);
     // The lists from the new zero layer (in lattice order) and the levels' claims, and every
     // list point's slot.
