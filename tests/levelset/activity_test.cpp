@@ -245,3 +245,36 @@ TEST(Activity, StampsKeepTheRuleFarPastThirtyTwoBits) {
                         ASSERT_EQ(b.awake({x, y, z}, now, kAfter), a.awake({x, y, z}, now, kAfter)) << t << " " << x << y << z;
     }
 }
+
+// The row-cached scan (the step's filter over the zero-layer list) gives the point test's answer at
+// every point, in any order of visits: ascending, with jumps back and across rows, on a lattice of
+// odd dimensions (a last block of one point per axis), before anything sleeps and after.
+TEST(Activity, TheRowScanAgreesWithThePointTest) {
+    const Lattice l({7, 9, 5});
+    FrontActivity a;
+    constexpr std::uint64_t kSpeed = 1;
+    constexpr int kAfter = 3;
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<PointIndex> any(0, static_cast<PointIndex>(l.size() - 1));
+    std::vector<PointIndex> order(l.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<PointIndex>(i);
+    for (std::size_t k = 0; k + 5 < order.size(); k += 11) std::swap(order[k], order[k + 5]);  // back and forth
+    for (int k = 0; k < 40; ++k) order.push_back(any(rng));                                // and anywhere
+    int sleeping_seen = 0, awake_seen = 0;
+    for (std::int64_t t = 1; t <= 12; ++t) {
+        a.begin_step(l, kSpeed, t);
+        std::vector<PointIndex> woken;
+        if (t % 4 != 0)
+            for (int k = 0; k < 2; ++k) woken.push_back(any(rng));
+        a.wake_near(woken, l, t);
+        const FrontActivity::AwakeTest test = a.awake_test(t + 1, kAfter);
+        FrontActivity::AwakeScan scan(test, l);
+        for (const PointIndex i : order) {
+            const bool want = test(l.coord(i));
+            ASSERT_EQ(scan(i), want) << "step " << t << " point " << i;
+            (want ? awake_seen : sleeping_seen) += 1;
+        }
+    }
+    EXPECT_GT(sleeping_seen, 1000);  // the test saw both answers, many times
+    EXPECT_GT(awake_seen, 1000);
+}

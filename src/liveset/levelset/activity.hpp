@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "liveset/grid/index_decoder.hpp"
 #include "liveset/grid/large_page_allocator.hpp"
 #include "liveset/grid/lattice.hpp"
 
@@ -53,6 +54,39 @@ public:
         }
     };
     AwakeTest awake_test(std::int64_t now, int sleep_after) const;
+    // The same test for a loop over lattice indices in (mostly) ascending order, such as the sorted
+    // zero-layer list: the blocks of the lattice row (y, z) a point lies on are found once per row
+    // (two divisions), so a point on the last point's row costs a compare, a shift and its block's
+    // stamp. Stateful (the current row); one per loop.
+    class AwakeScan {
+    public:
+        AwakeScan(const AwakeTest& test, const Lattice& lattice)
+            : test_(test),
+              nx_(static_cast<std::uint32_t>(lattice.dims().x)),
+              ny_(static_cast<std::uint32_t>(lattice.dims().y)),
+              row_of_(nx_),
+              z_of_(ny_) {}
+        bool operator()(PointIndex i) {
+            if (test_.all) return true;
+            if (test_.none) return false;
+            if (i - row_start_ >= nx_) enter_row(i);  // unsigned: also a point before the row
+            return test_.stamp[row_blocks_ + ((i - row_start_) >> 1)] >= test_.min_offset;
+        }
+
+    private:
+        void enter_row(PointIndex i) {
+            const std::uint32_t row = row_of_.divide(i);  // y + dims.y * z
+            const std::uint32_t z = z_of_.divide(row);
+            const std::uint32_t y = row - z * ny_;
+            row_start_ = row * nx_;
+            row_blocks_ = test_.blocks_x * ((y >> 1) + test_.blocks_y * (z >> 1));
+        }
+        AwakeTest test_;
+        std::uint32_t nx_, ny_;
+        FastDivider row_of_, z_of_;
+        PointIndex row_start_ = 0;  // the row of index 0 to begin with, whose blocks start at 0
+        std::size_t row_blocks_ = 0;
+    };
     // Whether lattice point p is awake at step `now` under the rule with window `sleep_after`.
     bool awake(Vec3i p, std::int64_t now, int sleep_after) const { return awake_test(now, sleep_after)(p); }
 

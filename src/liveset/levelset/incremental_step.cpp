@@ -6,6 +6,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <span>
 
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/sparse_field.hpp"
@@ -37,20 +39,21 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
     // alias the members) and is skipped while everything is awake; a point is a store and a count.
     const FrontActivity::AwakeTest awake =
         sleep_after > 0 ? activity_.awake_test(steps_, sleep_after) : FrontActivity::AwakeTest{};
-    const IndexDecoder decoder = decoder_;
     auto rates = detail::ordered_chunks<Rates>(zero.size(), [&](std::size_t b, std::size_t e, Rates& out) {
-        std::vector<PointIndex> points(e - b);
-        out.at.resize(e - b);
+        // Buffers for every point, not filled first: late in a run most points sleep, and the
+        // zero layer is hundreds of thousands of points.
+        const auto at = std::make_unique_for_overwrite<std::uint32_t[]>(e - b);
+        const auto points = std::make_unique_for_overwrite<PointIndex[]>(e - b);
+        FrontActivity::AwakeScan is_awake(awake, lattice());
         std::size_t n_awake = 0;
         for (std::size_t n = b; n < e; ++n) {
-            out.at[n_awake] = static_cast<std::uint32_t>(n);
+            at[n_awake] = static_cast<std::uint32_t>(n);
             points[n_awake] = zero[n];
-            n_awake += awake.all || awake(decoder.coord(zero[n])) ? 1 : 0;
+            n_awake += is_awake(zero[n]) ? 1 : 0;
         }
-        out.at.resize(n_awake);
-        points.resize(n_awake);
-        out.rate.resize(points.size());
-        speed.rates(phi_, points, out.rate);
+        out.at.assign(at.get(), at.get() + n_awake);
+        out.rate.resize(n_awake);
+        speed.rates(phi_, std::span<const PointIndex>(points.get(), n_awake), out.rate);
     });
     std::vector<std::uint32_t> at;
     std::vector<double> rate;
