@@ -47,10 +47,11 @@ public:
         bool all = true;    // the last global wake is within the window
         bool none = false;  // no block's offset can reach the bound
         std::int32_t min_offset = 0;
+        // The first block of lattice row (y, z); x's block is (x >> 1) further on.
+        std::size_t row_blocks(std::size_t y, std::size_t z) const { return blocks_x * ((y >> 1) + blocks_y * (z >> 1)); }
+        bool block_awake(std::size_t b) const { return all || (!none && stamp[b] >= min_offset); }
         bool operator()(Vec3i p) const {
-            const std::size_t b = static_cast<std::size_t>(p.x >> 1) +
-                                  blocks_x * (static_cast<std::size_t>(p.y >> 1) + blocks_y * static_cast<std::size_t>(p.z >> 1));
-            return all || (!none && stamp[b] >= min_offset);
+            return block_awake(row_blocks(static_cast<std::size_t>(p.y), static_cast<std::size_t>(p.z)) + static_cast<std::size_t>(p.x >> 1));
         }
     };
     AwakeTest awake_test(std::int64_t now, int sleep_after) const;
@@ -67,10 +68,9 @@ public:
               row_of_(nx_),
               z_of_(ny_) {}
         bool operator()(PointIndex i) {
-            if (test_.all) return true;
-            if (test_.none) return false;
+            if (test_.all) return true;  // no row to find
             if (i - row_start_ >= nx_) enter_row(i);  // unsigned: also a point before the row
-            return test_.stamp[row_blocks_ + ((i - row_start_) >> 1)] >= test_.min_offset;
+            return test_.block_awake(row_blocks_ + ((i - row_start_) >> 1));
         }
 
     private:
@@ -79,7 +79,7 @@ public:
             const std::uint32_t z = z_of_.divide(row);
             const std::uint32_t y = row - z * ny_;
             row_start_ = row * nx_;
-            row_blocks_ = test_.blocks_x * ((y >> 1) + test_.blocks_y * (z >> 1));
+            row_blocks_ = test_.row_blocks(y, z);
         }
         AwakeTest test_;
         std::uint32_t nx_, ny_;
