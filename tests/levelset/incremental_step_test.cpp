@@ -262,6 +262,56 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenManyPointsChangeLayer) {
     expect_same_list_order(a, b);
 }
 
+// A front of more than 16 384 points: the propagation's claims and the full-band step's push sweep
+// split at a plane, the two sides at once and the seam after (relayer.cpp, split_sources). Still
+// the reference's bits, both steps' invariants and reports (against a brute-force diff), and on 1
+// and 2 threads the same states, reports and list orders.
+TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenALargeFrontsClaimsSplit) {
+    auto run = [](int threads, std::vector<std::vector<PointIndex>>& reports, std::size_t& smallest, SparseField& full) {
+        tbb::task_arena arena(threads);
+        SparseField reference = blob_seed(112, 44.0);
+        SparseField fast = reference;
+        arena.execute([&] {
+            const BlobSpeed speed({55.5, 55.5, 55.5}, 49.0, 0.02f);
+            std::mt19937 rng(11);
+            for (int s = 1; s <= 16; ++s) {
+                const SparseField before = fast;
+                const StepResult r = reference.step(speed, mode(StepMode::kFullBand));
+                const StepResult f = fast.step(speed, propagating());
+                smallest = std::min(smallest, f.changed.size());
+                ASSERT_GT(r.zero_layer, 16384u) << "step " << s << ": the push sweep should split its first level";
+                ASSERT_TRUE(same_state(reference, fast)) << "step " << s;
+                ASSERT_EQ(sorted(r.changed.points), sorted(f.changed.points)) << "step " << s;
+                ASSERT_EQ(sorted(f.changed.points), brute_force_changes(before, fast)) << "step " << s;
+                expect_valid(reference, "after a full-band step");
+                expect_valid(fast, "after a step");
+                reports.push_back(f.changed.points);
+                reports.push_back(r.changed.points);
+                if (s % 5 == 0) {
+                    const auto edits = random_edit(fast, rng);
+                    reference.apply_edits(edits, RepairScope::kLocal);
+                    reports.push_back(fast.apply_edits(edits, RepairScope::kLocal).points);
+                    ASSERT_TRUE(same_state(reference, fast)) << "edit after step " << s;
+                }
+            }
+        });
+        full = reference;
+        return fast;
+    };
+    std::vector<std::vector<PointIndex>> r1, r2;
+    std::size_t smallest1 = SIZE_MAX, smallest2 = SIZE_MAX;
+    SparseField full1(Lattice({1, 1, 1})), full2(Lattice({1, 1, 1}));
+    const SparseField a = run(1, r1, smallest1, full1);
+    const SparseField b = run(2, r2, smallest2, full2);
+    // The level-1 claims' sources are the zero layer's changes: more than the split's threshold.
+    EXPECT_GT(smallest1, 4u * 16384u) << "every step should change enough points for its claims to split";
+    EXPECT_TRUE(same_state(a, b));
+    EXPECT_TRUE(same_state(full1, full2));
+    EXPECT_EQ(r1, r2);
+    expect_same_list_order(a, b);
+    expect_same_list_order(full1, full2);
+}
+
 TEST(IncrementalStep, BadOptionsThrowOneLineMessages) {
     SparseField f = blob_seed(16);
     const CurvatureSpeed speed;

@@ -35,6 +35,8 @@ public:
           div_x_(nx_),
           div_xy_(nxy_) {}
 
+    std::uint32_t z(PointIndex i) const { return div_xy_.divide(i); }
+
     Vec3i coord(PointIndex i) const {
         const std::uint32_t z = div_xy_.divide(i);
         const std::uint32_t r = i - z * nxy_;
