@@ -263,7 +263,7 @@ TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenManyPointsChangeLayer) {
 }
 
 // A front of more than 16 384 points: the propagation's claims and the full-band step's push sweep
-// split at a plane, the two sides at once and the seam after (relayer.cpp, split_sources). Still
+// split at a plane, the two sides at once and the seam after (plane_split.hpp). Still
 // the reference's bits, both steps' invariants and reports (against a brute-force diff), and on 1
 // and 2 threads the same states, reports and list orders.
 TEST(IncrementalStep, OneAndTwoThreadsAgreeWhenALargeFrontsClaimsSplit) {

@@ -3,7 +3,6 @@
 // propagation for a local update), then the final statuses, X, the sign changes and the list moves
 // (or, after a whole-band sweep, the lists rebuilt from its levels: relist, sparse_field.cpp).
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_invoke.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -16,7 +15,6 @@
 #include <cstdint>
 #include <limits>
 #include <span>
-#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -163,50 +161,100 @@ struct InnerStatuses {
                    : detail::layer_value_side<false>(phi, status, i, c, from(inner.inside));
 }
 
-// A level's sources split at the plane z = mid, the median of their planes: those at least two
-// planes below it, those at least two above it, and the seam (mid - 1 .. mid + 1). A source's
-// claims reach only its own plane and the two next to it, so the first two sets touch disjoint
-// points (planes up to mid - 1, and from mid + 1 on) and may claim at once, each in source order,
-// then the seam: the same set of claims as in source order (a claim depends only on the point's
-// status and the claimer's side), in an order that depends only on the sources. The push sweep
-// splits its levels the same way (its visits also write only the source's neighbours).
-constexpr std::size_t kSplitClaimsMin = 16384;  // fewer sources claim (or push) in order, on one thread
+// The claims of `sources` at one level, in order (see relayer_changes), appended to `out` through
+// `buffer` a block of sources at a time (so the buffer stays small). Without a branch on a
+// neighbour's status: every neighbour's status is rewritten through the level's table and recorded,
+// and the count moves on only for a claim. What it reads on every visit is held in locals, not in
+// a closure or a parameter object in memory: a store through std::int8_t may alias any memory, so
+// those would be reloaded after every status store (as a closure: 10-20 % of a 1-thread run).
+template <class Record>
+void claim_from(std::span<const PointIndex> sources, const ClaimRules& rule, std::int8_t* status, const Lattice& lattice,
+                const IndexDecoder& index_decoder, std::vector<Record>& buffer, std::vector<Record>& out) {
+    const Lattice lat = lattice;  // locals (see above)
+    const IndexDecoder decoder = index_decoder;
+    constexpr std::size_t kClaimBlock = 4096;
+    buffer.resize(6 * kClaimBlock);
+    Record* const claims = buffer.data();
+    for (std::size_t b = 0; b < sources.size(); b += kClaimBlock) {
+        std::size_t n_claims = 0;
+        for (std::size_t n = b; n < std::min(sources.size(), b + kClaimBlock); ++n) {
+            const PointIndex p = sources[n];
+            const std::int8_t* const r = rule[status[p] > 0 ? 1 : 0].data();  // the change's side (kPendPos > 0)
+            for_each_neighbor6(lat, decoder, p, [&](PointIndex q) __attribute__((always_inline)) {
+                const std::int8_t s = status[q];
+                const std::int8_t after = r[static_cast<std::uint8_t>(s)];
+                status[q] = after;
+                claims[n_claims] = {q, s, 0.0f};
+                n_claims += after != s ? 1 : 0;
+            });
+        }
+        out.insert(out.end(), claims, claims + n_claims);
+    }
+}
 
-struct SplitSources {
-    std::span<const PointIndex> below, above, seam;
-};
-
-SplitSources split_sources(std::span<const PointIndex> sources, const IndexDecoder& decoder, int planes,
-                           std::vector<std::uint32_t>& z_of, std::vector<PointIndex>& points) {
-    const std::size_t n = sources.size();
-    z_of.resize(n);
-    std::vector<std::size_t> count(static_cast<std::size_t>(planes), 0);
-    for (std::size_t m = 0; m < n; ++m) {
-        const std::uint32_t z = decoder.z(sources[m]);
-        z_of[m] = z;
-        ++count[z];
+// One level of the push sweep from `sources`, in order (see sweep_whole_band): claims to `next` and
+// far points claimed to `far` (room for six per source); returns how many of each (as a pair: a
+// two-field struct here made GCC 12's loop take 8 % more instructions). What it reads on every
+// visit is held in locals (see claim_from).
+std::pair<std::size_t, std::size_t> sweep_from(std::span<const PointIndex> sources, const SweepRules& rule, float* phi,
+                                               std::int8_t* status, const Lattice& lattice,
+                                               const IndexDecoder& index_decoder, PointIndex* next, PointIndex* far) {
+    const Lattice lat = lattice;
+    const IndexDecoder decoder = index_decoder;
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    // x - 1 < core.x (unsigned) iff 1 <= x <= dims.x - 2; a dimension below 3 has no such points.
+    const auto core_extent = [](int d) { return d >= 3 ? static_cast<std::uint32_t>(d - 2) : 0u; };
+    const struct {
+        std::uint32_t x, y, z;
+    } core{core_extent(lat.dims().x), core_extent(lat.dims().y), core_extent(lat.dims().z)};
+    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    std::size_t n_reached = 0, n_far = 0;
+    float value[4] = {-inf, inf, 0.0f, 0.0f};  // SweepValue order; the offers per source
+    for (std::size_t f = 0; f < sources.size(); ++f) {
+        const PointIndex i = sources[f];
+        // The sources run roughly in lattice order, so a source's +z neighbour is usually the
+        // first touch of its line: fetch it for a source a few ahead (a hint; no effect on bits).
+        if (f + detail::kAhead < sources.size()) {
+            const PointIndex ahead = sources[f + detail::kAhead] + sz;
+            __builtin_prefetch(status + ahead, 1);
+            __builtin_prefetch(phi + ahead, 1);
+        }
+        const float v = phi[i];
+        value[kOfferUp] = v + 1.0f;
+        value[kOfferDown] = v - 1.0f;
+        const SweepRule& r = rule[status[i] < 0 ? 1 : 0];  // the source's side
+        const auto visit = [&](PointIndex q) __attribute__((always_inline)) {
+            const auto s = static_cast<std::uint8_t>(status[q]);
+            const std::uint8_t flags = r.flags[s];
+            if (flags & kFar) [[unlikely]]
+                far[n_far++] = q;  // no call here: the loop keeps its pointers in registers
+#if defined(__SSE2__)
+            // max_of(min_of(φ, hi), lo) on registers: a scalar load clears the upper lanes.
+            const __m128 below = _mm_min_ss(_mm_load_ss(value + r.hi[s]), _mm_load_ss(phi + q));
+            _mm_store_ss(phi + q, _mm_max_ss(_mm_load_ss(value + r.lo[s]), below));
+#else
+            phi[q] = max_of(min_of(phi[q], value[r.hi[s]]), value[r.lo[s]]);
+#endif
+            status[q] = static_cast<std::int8_t>(r.after[s]);
+            next[n_reached] = q;
+            n_reached += flags & kClaimed;
+        };
+        // A source off the lattice's faces (almost every one) visits its six neighbours
+        // without a test per neighbour; the same visits in the same order.
+        const Vec3i c = decoder.coord(i);
+        if (static_cast<std::uint32_t>(c.x - 1) < core.x && static_cast<std::uint32_t>(c.y - 1) < core.y &&
+            static_cast<std::uint32_t>(c.z - 1) < core.z) [[likely]] {
+            visit(i - 1);
+            visit(i + 1);
+            visit(i - sy);
+            visit(i + sy);
+            visit(i - sz);
+            visit(i + sz);
+        } else {
+            for_each_neighbor6(lat, decoder, i, visit);
+        }
     }
-    std::uint32_t mid = 0;
-    for (std::size_t seen = 0; mid + 1 < static_cast<std::uint32_t>(planes); ++mid) {
-        seen += count[mid];
-        if (2 * seen >= n) break;
-    }
-    // Three outputs, each written at every source and advanced only for its own: no branch on
-    // the plane (the sources are only roughly in lattice order).
-    points.resize(3 * n);
-    PointIndex* const out[3] = {points.data(), points.data() + n, points.data() + 2 * n};
-    std::size_t used[3] = {0, 0, 0};
-    for (std::size_t m = 0; m < n; ++m) {
-        const std::uint32_t z = z_of[m];
-        const std::size_t below = z + 2 <= mid ? 1 : 0, above = z >= mid + 2 ? 1 : 0;
-        out[0][used[0]] = sources[m];
-        out[1][used[1]] = sources[m];
-        out[2][used[2]] = sources[m];
-        used[0] += below;
-        used[1] += above;
-        used[2] += 1 - below - above;
-    }
-    return {{out[0], used[0]}, {out[1], used[1]}, {out[2], used[2]}};
+    return std::pair{n_reached, n_far};
 }
 
 }  // namespace
@@ -235,51 +283,25 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
     const IndexDecoder decoder = decoder_;
     for (int k = 1; k <= layers_; ++k) {
         // Claim (the first changed point in order claims, as the region's order needs): only the
-        // statuses are read here; a claimed point's old φ is read in the parallel pass. Without a
-        // branch on a neighbour's status: every neighbour's status is rewritten through the
-        // level's table and recorded, and the count moves on only for a claim. The claims go to
-        // `out` in blocks of changed points through `buffer`, so the buffer stays small.
+        // statuses are read here; a claimed point's old φ is read in the parallel pass. Many
+        // sources claim as two tasks and a seam (plane_split.hpp): the part above the plane into
+        // its own list, which joins the region before the seam claims.
         const std::size_t first_new = region.size();
-        const auto claim = [&, rules = &claim_rules(k, layers_), status_ptr = status, lat_copy = lat, decoder_copy = decoder](
-                               std::span<const PointIndex> sources, std::vector<RegionPoint>& buffer, std::vector<RegionPoint>& out) {
-            // Locals, not the closure's members: a store through std::int8_t may alias the closure
-            // (when it is not inlined), which would reload them after every status store.
-            std::int8_t* const status = status_ptr;
-            const Lattice lat = lat_copy;
-            const IndexDecoder decoder = decoder_copy;
-            const ClaimRules& rule = *rules;
-            constexpr std::size_t kClaimBlock = 4096;
-            buffer.resize(6 * kClaimBlock);
-            RegionPoint* const claims = buffer.data();
-            for (std::size_t b = 0; b < sources.size(); b += kClaimBlock) {
-                std::size_t n_claims = 0;
-                for (std::size_t n = b; n < std::min(sources.size(), b + kClaimBlock); ++n) {
-                    const PointIndex p = sources[n];
-                    const std::int8_t* const r = rule[status[p] > 0 ? 1 : 0].data();  // the change's side (kPendPos > 0)
-                    for_each_neighbor6(lat, decoder, p, [&](PointIndex q) __attribute__((always_inline)) {
-                        const std::int8_t s = status[q];
-                        const std::int8_t after = r[static_cast<std::uint8_t>(s)];
-                        status[q] = after;
-                        claims[n_claims] = {q, s, 0.0f};
-                        n_claims += after != s ? 1 : 0;
-                    });
-                }
-                out.insert(out.end(), claims, claims + n_claims);
-            }
-        };
-        if (changed.size() < kSplitClaimsMin) {
-            claim(changed, claims_.v, region);
+        const ClaimRules& rule = claim_rules(k, layers_);
+        if (changed.size() < detail::kPlaneSplitMin) {
+            claim_from(std::span<const PointIndex>(changed), rule, status, lat, decoder, claims_[0].v, region);
         } else {
-            // Many sources: the two sides of a plane claim at once, then the seam between them
-            // (split_sources). Same claims as in source order; their order in the region is the
-            // split's, on any thread count.
-            const SplitSources split = split_sources(changed, decoder, lat.dims().z, split_z_.v, split_points_.v);
-            std::vector<RegionPoint>& above = claims_above_.v;
-            above.clear();
-            tbb::parallel_invoke([&] { claim(split.below, claims_.v, region); },
-                                 [&] { claim(split.above, claims_other_.v, above); });
-            region.insert(region.end(), above.begin(), above.end());
-            claim(split.seam, claims_.v, region);
+            split_.split(changed, decoder, lat.dims().z);
+            std::vector<RegionPoint>& above = claims_[1].v;
+            split_.run([&](std::span<const PointIndex> sources, int part) {
+                if (part == detail::PlaneSplit::kAbove) {
+                    above.clear();
+                    claim_from(sources, rule, status, lat, decoder, claims_[2].v, above);
+                    return;
+                }
+                if (part == detail::PlaneSplit::kSeam) region.insert(region.end(), above.begin(), above.end());
+                claim_from(sources, rule, status, lat, decoder, claims_[0].v, region);
+            });
         }
         for (std::size_t r = first_new; r < region.size(); ++r) pending.push_back(r);
         if (pending.empty()) break;
@@ -356,12 +378,6 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
     std::int8_t* const status = status_.values().data();
     const Lattice lat = lattice();
     const IndexDecoder decoder = decoder_;
-    constexpr float inf = std::numeric_limits<float>::infinity();
-    // x - 1 < core.x (unsigned) iff 1 <= x <= dims.x - 2; a dimension below 3 has no such points.
-    const auto core_extent = [](int d) { return d >= 3 ? static_cast<std::uint32_t>(d - 2) : 0u; };
-    const struct {
-        std::uint32_t x, y, z;
-    } core{core_extent(lat.dims().x), core_extent(lat.dims().y), core_extent(lat.dims().z)};
     std::vector<std::vector<PointIndex>>& levels = level_claims_.v;
     if (keep_levels) {
         levels.resize(2 * static_cast<std::size_t>(layers_));
@@ -371,90 +387,32 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
         // Grown geometrically: a growing front must not refill them every step.
         if (reached.size() < 6 * n_from) reached.resize(std::max(6 * n_from, 2 * reached.size()));
         if (far_claims.size() < 6 * n_from) far_claims.resize(std::max(6 * n_from, 2 * far_claims.size()));
-        const SweepRules rules = sweep_rules(k, far_out, far_in);
-        // The visits of `sources` in order, claims to `next` and far points to `far` (each room
-        // for six per source); returns how many of each.
-        const auto sweep = [&, phi_ptr = phi, status_ptr = status, lat_copy = lat, decoder_copy = decoder, core_copy = core](
-                               std::span<const PointIndex> sources, PointIndex* next, PointIndex* far) {
-            // Locals, not the closure's members: a store through std::int8_t may alias the closure
-            // (when it is not inlined), which would reload them after every status store.
-            float* const phi = phi_ptr;
-            std::int8_t* const status = status_ptr;
-            const SweepRules& rule = rules;
-            const Lattice lat = lat_copy;
-            const IndexDecoder decoder = decoder_copy;
-            const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
-            const auto core = core_copy;
-            std::size_t n_reached = 0, n_far = 0;
-            float value[4] = {-inf, inf, 0.0f, 0.0f};  // SweepValue order; the offers per source
-            for (std::size_t f = 0; f < sources.size(); ++f) {
-                const PointIndex i = sources[f];
-                // The sources run roughly in lattice order, so a source's +z neighbour is usually the
-                // first touch of its line: fetch it for a source a few ahead (a hint; no effect on bits).
-                if (f + detail::kAhead < sources.size()) {
-                    const PointIndex ahead = sources[f + detail::kAhead] + sz;
-                    __builtin_prefetch(status + ahead, 1);
-                    __builtin_prefetch(phi + ahead, 1);
-                }
-                const float v = phi[i];
-                value[kOfferUp] = v + 1.0f;
-                value[kOfferDown] = v - 1.0f;
-                const SweepRule& r = rule[status[i] < 0 ? 1 : 0];  // the source's side
-                const auto visit = [&](PointIndex q) __attribute__((always_inline)) {
-                    const auto s = static_cast<std::uint8_t>(status[q]);
-                    const std::uint8_t flags = r.flags[s];
-                    if (flags & kFar) [[unlikely]]
-                        far[n_far++] = q;  // no call here: the loop keeps its pointers in registers
-#if defined(__SSE2__)
-                    // max_of(min_of(φ, hi), lo) on registers: a scalar load clears the upper lanes.
-                    const __m128 below = _mm_min_ss(_mm_load_ss(value + r.hi[s]), _mm_load_ss(phi + q));
-                    _mm_store_ss(phi + q, _mm_max_ss(_mm_load_ss(value + r.lo[s]), below));
-#else
-                    phi[q] = max_of(min_of(phi[q], value[r.hi[s]]), value[r.lo[s]]);
-#endif
-                    status[q] = static_cast<std::int8_t>(r.after[s]);
-                    next[n_reached] = q;
-                    n_reached += flags & kClaimed;
-                };
-                // A source off the lattice's faces (almost every one) visits its six neighbours
-                // without a test per neighbour; the same visits in the same order.
-                const Vec3i c = decoder.coord(i);
-                if (static_cast<std::uint32_t>(c.x - 1) < core.x && static_cast<std::uint32_t>(c.y - 1) < core.y &&
-                    static_cast<std::uint32_t>(c.z - 1) < core.z) [[likely]] {
-                    visit(i - 1);
-                    visit(i + 1);
-                    visit(i - sy);
-                    visit(i + sy);
-                    visit(i - sz);
-                    visit(i + sz);
-                } else {
-                    for_each_neighbor6(lat, decoder, i, visit);
-                }
-            }
-            return std::pair{n_reached, n_far};
-        };
+        const SweepRules rule = sweep_rules(k, far_out, far_in);
         PointIndex* const next = reached.data();
         PointIndex* const far = far_claims.data();
         const std::span<const PointIndex> sources(from.data(), n_from);
-        std::size_t n_reached = 0, n_far = 0;
-        if (n_from < kSplitClaimsMin) {
-            std::tie(n_reached, n_far) = sweep(sources, next, far);
+        std::pair<std::size_t, std::size_t> got{0, 0};
+        if (n_from < detail::kPlaneSplitMin) {
+            got = sweep_from(sources, rule, phi, status, lat, decoder, next, far);
         } else {
-            // Many sources: the two sides of a plane at once, then the seam (split_sources); the
-            // claims of each part are moved up behind those of the part before.
-            const SplitSources split = split_sources(sources, decoder, lat.dims().z, split_z_.v, split_points_.v);
-            const std::size_t room[3] = {0, 6 * split.below.size(), 6 * (split.below.size() + split.above.size())};
-            std::pair<std::size_t, std::size_t> got[3];
-            tbb::parallel_invoke([&] { got[0] = sweep(split.below, next, far); },
-                                 [&] { got[1] = sweep(split.above, next + room[1], far + room[1]); });
-            got[2] = sweep(split.seam, next + room[2], far + room[2]);
+            // Many sources: two tasks and a seam (plane_split.hpp), each part writing its claims
+            // and far points at its own offset, moved up behind the parts before it after.
+            split_.split(sources, decoder, lat.dims().z);
+            const std::size_t room[3] = {0, 6 * split_.part(detail::PlaneSplit::kBelow).size(),
+                                         6 * (n_from - split_.part(detail::PlaneSplit::kSeam).size())};
+            std::pair<std::size_t, std::size_t> part_got[3];
+            split_.run([&](std::span<const PointIndex> part_sources, int part) {
+                const std::size_t at = room[part];
+                part_got[part] = sweep_from(part_sources, rule, phi, status, lat, decoder, next + at, far + at);
+            });
             for (int part = 0; part < 3; ++part) {
-                if (room[part] != n_reached) std::copy_n(next + room[part], got[part].first, next + n_reached);
-                if (room[part] != n_far) std::copy_n(far + room[part], got[part].second, far + n_far);
-                n_reached += got[part].first;
-                n_far += got[part].second;
+                if (room[part] != got.first) std::copy_n(next + room[part], part_got[part].first, next + got.first);
+                if (room[part] != got.second) std::copy_n(far + room[part], part_got[part].second, far + got.second);
+                got.first += part_got[part].first;
+                got.second += part_got[part].second;
             }
         }
+        const auto [n_reached, n_far] = got;  // claims, far points claimed
         // The far points claimed join the region in the order reached; each was far (φ = its
         // status, the invariant) on the side of the layer it took.
         for (std::size_t n = 0; n < n_far; ++n) {

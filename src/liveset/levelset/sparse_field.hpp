@@ -27,6 +27,7 @@
 #include "liveset/grid/grid.hpp"
 #include "liveset/grid/index_decoder.hpp"
 #include "liveset/levelset/activity.hpp"
+#include "liveset/levelset/plane_split.hpp"
 #include "liveset/levelset/speed.hpp"
 
 namespace liveset {
@@ -260,10 +261,8 @@ private:
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
     Scratch<PointIndex> sweep_far_;                // sweep_whole_band's far points claimed in one level
     Scratch<std::vector<PointIndex>> level_claims_;  // its claims per level and side (2(k-1): outside, +1: inside)
-    Scratch<RegionPoint> claims_, claims_other_;   // relayer_changes' claim buffers (one per side of a split)
-    Scratch<RegionPoint> claims_above_;            // the claims above a split's plane, until they join the region
-    Scratch<std::uint32_t> split_z_;               // a split's source planes
-    Scratch<PointIndex> split_points_;             // a split's three source sets
+    Scratch<RegionPoint> claims_[3];               // relayer_changes' claims per part of a plane split (the first: all)
+    detail::PlaneSplit split_;                     // a large level's sources split for two tasks (plane_split.hpp)
     Scratch<PointIndex> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
     Scratch<PointIndex> sort_scratch_;             // sort_lists' radix sort
 };
