@@ -23,8 +23,8 @@
 
 namespace liveset::detail {
 
-// A level of fewer sources runs as one ordered loop: the split's two passes over the sources and
-// the task switch cost more than half of the loop there.
+// A level of fewer sources runs as one ordered loop (the split costs two more passes over the
+// sources and a task switch; 16 384 is a round choice, not a tuned one).
 inline constexpr std::size_t kPlaneSplitMin = 16384;
 
 class PlaneSplit {
@@ -44,11 +44,11 @@ public:
     void split(std::span<const PointIndex> sources, const IndexDecoder& decoder, int planes);
     std::span<const PointIndex> part(Part p) const { return {points_.data() + static_cast<std::size_t>(p) * size_, used_[p]}; }
 
-    // run(sources of a part, part) for the parts below and above as two tasks, then the seam.
-    template <class Run>
-    void run(const Run& run) const {
-        tbb::parallel_invoke([&] { run(part(kBelow), kBelow); }, [&] { run(part(kAbove), kAbove); });
-        run(part(kSeam), kSeam);
+    // f(sources of a part, part) for the parts below and above as two tasks, then the seam.
+    template <class F>
+    void run(const F& f) const {
+        tbb::parallel_invoke([&] { f(part(kBelow), kBelow); }, [&] { f(part(kAbove), kAbove); });
+        f(part(kSeam), kSeam);
     }
 
 private:

@@ -261,7 +261,10 @@ private:
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
     Scratch<PointIndex> sweep_far_;                // sweep_whole_band's far points claimed in one level
     Scratch<std::vector<PointIndex>> level_claims_;  // its claims per level and side (2(k-1): outside, +1: inside)
-    Scratch<RegionPoint> claims_[3];               // relayer_changes' claims per part of a plane split (the first: all)
+    // relayer_changes' claims: [0] the blocks of an ordered loop (the whole level, or the parts
+    // below and the seam of a split), [1] the part above's claims until they join the region,
+    // [2] its blocks.
+    Scratch<RegionPoint> claims_[3];
     detail::PlaneSplit split_;                     // a large level's sources split for two tasks (plane_split.hpp)
     Scratch<PointIndex> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
     Scratch<PointIndex> sort_scratch_;             // sort_lists' radix sort
