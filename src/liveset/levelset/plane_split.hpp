@@ -31,14 +31,6 @@ class PlaneSplit {
 public:
     enum Part : int { kBelow = 0, kAbove = 1, kSeam = 2 };
 
-    // Working memory, kept between levels and steps; a copy starts empty.
-    PlaneSplit() = default;
-    PlaneSplit(const PlaneSplit&) {}
-    PlaneSplit& operator=(const PlaneSplit&) { return *this; }
-    PlaneSplit(PlaneSplit&&) noexcept = default;
-    PlaneSplit& operator=(PlaneSplit&&) noexcept = default;
-    ~PlaneSplit() = default;
-
     // Splits `sources` (each a point of a lattice of `planes` z planes); the spans stay valid
     // until the next split.
     void split(std::span<const PointIndex> sources, const IndexDecoder& decoder, int planes);

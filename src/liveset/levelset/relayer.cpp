@@ -291,9 +291,9 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         if (changed.size() < detail::kPlaneSplitMin) {
             claim_from(std::span<const PointIndex>(changed), rule, status, lat, decoder, claims_[0].v, region);
         } else {
-            split_.split(changed, decoder, lat.dims().z);
+            split_.v.split(changed, decoder, lat.dims().z);
             std::vector<RegionPoint>& above = claims_[1].v;
-            split_.run([&](std::span<const PointIndex> sources, int part) {
+            split_.v.run([&](std::span<const PointIndex> sources, int part) {
                 if (part == detail::PlaneSplit::kAbove) {
                     above.clear();
                     claim_from(sources, rule, status, lat, decoder, claims_[2].v, above);
@@ -397,11 +397,11 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
         } else {
             // Many sources: two tasks and a seam (plane_split.hpp), each part writing its claims
             // and far points at its own offset, moved up behind the parts before it after.
-            split_.split(sources, decoder, lat.dims().z);
-            const std::size_t room[3] = {0, 6 * split_.part(detail::PlaneSplit::kBelow).size(),
-                                         6 * (n_from - split_.part(detail::PlaneSplit::kSeam).size())};
+            split_.v.split(sources, decoder, lat.dims().z);
+            const std::size_t room[3] = {0, 6 * split_.v.part(detail::PlaneSplit::kBelow).size(),
+                                         6 * (n_from - split_.v.part(detail::PlaneSplit::kSeam).size())};
             std::pair<std::size_t, std::size_t> part_got[3];
-            split_.run([&](std::span<const PointIndex> part_sources, int part) {
+            split_.v.run([&](std::span<const PointIndex> part_sources, int part) {
                 const std::size_t at = room[part];
                 part_got[part] = sweep_from(part_sources, rule, phi, status, lat, decoder, next + at, far + at);
             });

@@ -248,15 +248,17 @@ private:
     // Working memory of one update, kept so that a global step does not allocate (and fault in)
     // band-sized buffers every time; not part of the state, so a copy of the field starts empty.
     template <class T>
-    struct Scratch {
-        std::vector<T> v;
-        Scratch() = default;
-        Scratch(const Scratch&) {}
-        Scratch& operator=(const Scratch&) { return *this; }
-        Scratch(Scratch&&) noexcept = default;
-        Scratch& operator=(Scratch&&) noexcept = default;
-        ~Scratch() = default;
+    struct Kept {
+        T v;
+        Kept() = default;
+        Kept(const Kept&) {}
+        Kept& operator=(const Kept&) { return *this; }
+        Kept(Kept&&) noexcept = default;
+        Kept& operator=(Kept&&) noexcept = default;
+        ~Kept() = default;
     };
+    template <class T>
+    using Scratch = Kept<std::vector<T>>;
     Scratch<RegionPoint> region_;                  // repair_band's region
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
     Scratch<PointIndex> sweep_far_;                // sweep_whole_band's far points claimed in one level
@@ -265,7 +267,7 @@ private:
     // below and the seam of a split), [1] the part above's claims until they join the region,
     // [2] its blocks.
     Scratch<RegionPoint> claims_[3];
-    detail::PlaneSplit split_;                     // a large level's sources split for two tasks (plane_split.hpp)
+    Kept<detail::PlaneSplit> split_;               // a large level's sources split for two tasks (plane_split.hpp)
     Scratch<PointIndex> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
     Scratch<PointIndex> sort_scratch_;             // sort_lists' radix sort
 };
