@@ -24,7 +24,9 @@ inline constexpr std::int8_t kPendPos = 100;   // to be re-layered, outside sign
 inline constexpr std::int8_t kPendNeg = -100;  // to be re-layered, inside sign
 inline constexpr std::int8_t kPendZero = 101;  // on the new zero layer
 inline constexpr std::size_t kParallelMin = 4096;  // below this, loops run serially
-inline constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;  // the list slot of a point not in the band
+// The list slot of a point not in the band (after a relist, a point that left it may keep a stale
+// slot until the slots are next written; nothing reads a slot outside the band).
+inline constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;
 // How far ahead a loop over scattered band points prefetches the lattice entries it will touch:
 // a hint only (no effect on any result); 0.92-0.95x the whole-band step's time at 10 000-60 000
 // front points on the 2-core VM (docs/BENCHMARKS.md, session 36).

@@ -226,8 +226,8 @@ std::pair<std::size_t, std::size_t> sweep_from(std::span<const PointIndex> sourc
         const auto visit = [&](PointIndex q) __attribute__((always_inline)) {
             const auto s = static_cast<std::uint8_t>(status[q]);
             const std::uint8_t flags = r.flags[s];
-            if (flags & kFar) [[unlikely]]
-                far[n_far++] = q;  // no call here: the loop keeps its pointers in registers
+            far[n_far] = q;  // a store and a count, no branch (far claims are unpredictable)
+            n_far += flags >> 1;
 #if defined(__SSE2__)
             // max_of(min_of(φ, hi), lo) on registers: a scalar load clears the upper lanes.
             const __m128 below = _mm_min_ss(_mm_load_ss(value + r.hi[s]), _mm_load_ss(phi + q));
@@ -463,6 +463,7 @@ void SparseField::sweep_layers(std::span<const RegionPoint> region) {
 // list walks only its own; a list's operations touch only its own points' slots, so each list is
 // one task once there are many moves; the lists come out the same on any thread count.
 void SparseField::move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves) {
+    ensure_slots();  // list_add and list_remove use them
     const int lists = 2 * layers_ + 1;
     const auto list_of = [&](int layer) { return layer >= -layers_ && layer <= layers_ ? layer + layers_ : -1; };
     // begin[l] .. begin[l + 1]: list l's points; counted one slot up, then summed.
@@ -510,7 +511,6 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool rebu
         std::size_t n_moved = 0;
     };
     const bool record_moves = !rebuilding_lists;
-    std::uint32_t* const slot = slot_.values().data();
     const float far = static_cast<float>(layers_ + 1);
     const std::int8_t far_out = far_outside(), far_in = far_inside();
     float* const phi = phi_.values().data();  // raw: see sweep_whole_band
@@ -544,7 +544,6 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool rebu
                 v = s == far_out ? far : -far;
                 status[i] = s;
                 phi[i] = v;
-                if (!record_moves) slot[i] = kNoSlot;  // (a move takes it from its old list by its slot)
             }
             const std::size_t layer_changed = s != r.old_status ? 1 : 0;
             if (record_moves) moved[n_moved] = {n, s};

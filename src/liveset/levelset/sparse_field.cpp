@@ -8,6 +8,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -122,6 +123,7 @@ void SparseField::evaluate_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo
     activity_.reset();  // a new front: everything awake again
     for (auto& l : lists_) l.clear();
     slot_.fill(kNoSlot);
+    slots_stale_ = false;
     // Copied, not moved: φ keeps its storage (the viewer's crash handler reads it in place).
     // Outside the box the function is at least the far value, which the clamp makes exactly far.
     if (!(n == lattice().dims())) phi_.fill(far);
@@ -286,8 +288,15 @@ void SparseField::sort_lists(bool zero_only) {
     for (auto& list : lists_) {
         if (zero_only && &list != &lists_[static_cast<std::size_t>(layers_)]) continue;
         sort_indices(list, scratch);
-        write_slots(list, slot_.values().data());
+        if (!slots_stale_) write_slots(list, slot_.values().data());  // else ensure_slots writes them all
     }
+}
+
+void SparseField::ensure_slots() {
+    if (!slots_stale_) return;
+    std::uint32_t* const slot = slot_.values().data();
+    detail::for_each_list(2 * layers_ + 1, band_size() >= detail::kParallelMin, [&](std::size_t l) { write_slots(lists_[l], slot); });
+    slots_stale_ = false;
 }
 
 StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
@@ -378,64 +387,42 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
     return changed;
 }
 
-ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
-    const std::size_t n = edits.size();
-    if (n == 0) return {{}, std::vector<PointIndex>{}};
+namespace {
 
-    // 1. New zero-layer values (all Δ were computed from the old state, so this is Jacobi).
-    std::vector<float> old_phi(n);
-    parallel_range(n, [&](std::size_t k) {
-        old_phi[k] = phi_[edits[k].point];
-        phi_[edits[k].point] = old_phi[k] + edits[k].delta;
-    });
-
-    // 2. Classify: +1 leaves outwards, -1 inwards, 0 stays. A point whose neighbour leaves the
-    //    other way stays, clamped to ±0.5, so the front never jumps over a lattice edge.
-    std::vector<std::int8_t> move(n, 0);
-    parallel_range(n, [&](std::size_t k) {
+// Step 2 of the repair for edits [b, e) (see move_zero_layer): +1 leaves outwards, -1 inwards,
+// +2 / -2 would leave but is blocked, 0 stays. Reads only; the locals as in relayer.cpp's loops
+// (a store through std::int8_t may alias anything, so captured pointers would be reloaded).
+void classify_moves(const ZeroLayerEdit* edits, std::size_t b, std::size_t e, const float* phi, const std::int8_t* status,
+                    const Lattice& lattice, const IndexDecoder& index_decoder, std::int8_t* move) {
+    const Lattice lat = lattice;
+    const IndexDecoder decoder = index_decoder;
+    for (std::size_t k = b; k < e; ++k) {
         const PointIndex i = edits[k].point;
-        const float v = phi_[i];
-        if (std::abs(v) <= 0.5f) return;
+        const float v = phi[i];
+        if (std::abs(v) <= 0.5f) {  // (a branch: computing every point's neighbours was slower)
+            move[k] = 0;
+            continue;
+        }
         const bool up = v > 0.5f;
         // Without a branch per neighbour (a moving band's statuses and values are unpredictable):
         // a zero-layer neighbour beyond -0.5 (leaving inwards) blocks an outward move, and back.
         // On the other side's values, x > 0.5 is -x < -0.5 bit for bit.
         const float flip = up ? 1.0f : -1.0f;
         unsigned blocked = 0;
-        for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
-            blocked |= static_cast<unsigned>(status_[q] == 0) & static_cast<unsigned>(flip * phi_[q] < -0.5f);
+        for_each_neighbor6(lat, decoder, i, [&](PointIndex q) {
+            blocked |= static_cast<unsigned>(status[q] == 0) & static_cast<unsigned>(flip * phi[q] < -0.5f);
         });
         move[k] = blocked != 0 ? static_cast<std::int8_t>(up ? 2 : -2) : static_cast<std::int8_t>(up ? 1 : -1);
-    });
-    for (std::size_t k = 0; k < n; ++k)
-        if (std::abs(move[k]) == 2) {
-            phi_[edits[k].point] = move[k] > 0 ? 0.5f : -0.5f;
-            move[k] = 0;
-        }
+    }
+}
 
-    // 3. The front passes to the neighbours on the other side: an L∓1 neighbour of a leaving point
-    //    enters the zero layer with the value implied by the old zero layer's new values.
+}  // namespace
+
+ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
+    if (edits.empty()) return {{}, std::vector<PointIndex>{}};
     std::vector<RegionPoint>& region = region_.v;
     region.clear();
-    for (std::size_t k = 0; k < n; ++k) {
-        if (move[k] == 0) continue;
-        const std::int8_t from = move[k] > 0 ? std::int8_t{-1} : std::int8_t{1};
-        for_each_neighbor6(lattice(), decoder_, edits[k].point, [&](PointIndex q) {
-            if (status_[q] != from) return;
-            // Over its zero-layer neighbours (not those entering it in this loop), φ + 1 or φ − 1.
-            const float w = detail::layer_value(phi_, status_, q, decoder_.coord(q), from > 0, [](std::int8_t s) { return s == 0; });
-            region.push_back({q, status_[q], phi_[q]});
-            status_[q] = kPendZero;
-            phi_[q] = w;
-        });
-    }
-    for (std::size_t k = 0; k < n; ++k) {
-        const PointIndex i = edits[k].point;
-        // A point that keeps its layer and its bits changes nothing: not a seed of the region.
-        if (move[k] == 0 && std::bit_cast<std::uint32_t>(phi_[i]) == std::bit_cast<std::uint32_t>(old_phi[k])) continue;
-        region.push_back({i, 0, old_phi[k]});
-        status_[i] = move[k] > 0 ? kPendPos : (move[k] < 0 ? kPendNeg : kPendZero);
-    }
+    move_zero_layer(edits, region);
 
     // 4-5. Outer layers from the new zero layer: a local update re-layers outwards from the
     //    changed points only (relayer_changes, relayer.cpp); a global one the whole band,
@@ -466,6 +453,78 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
     return finish(region);
 }
 
+// Steps 1-3 (sparse_field.hpp). The loops run over raw pointers and write the region through a
+// buffer sized first, without a branch on what a point does (unpredictable in a moving front):
+// each writes its entry and counts it or not.
+void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vector<RegionPoint>& region) {
+    const std::size_t n = edits.size();
+    float* const phi = phi_.values().data();
+    std::int8_t* const status = status_.values().data();
+    const Lattice lat = lattice();
+    const IndexDecoder decoder = decoder_;
+    if (old_phi_.v.size() < n) old_phi_.v.resize(n);  // kept between updates, never shrunk
+    if (move_.v.size() < n) move_.v.resize(n);
+    if (movers_.v.size() < n) movers_.v.resize(n);
+    float* const old_phi = old_phi_.v.data();
+    std::int8_t* const move = move_.v.data();
+    std::uint32_t* const movers = movers_.v.data();
+
+    // 1. New zero-layer values (all Δ were computed from the old state, so this is Jacobi).
+    parallel_range(n, [=](std::size_t k) {
+        old_phi[k] = phi[edits[k].point];
+        phi[edits[k].point] = old_phi[k] + edits[k].delta;
+    });
+    // 2. Classify (reads only). A point whose neighbour leaves the other way stays, clamped to
+    //    ±0.5, so the front never jumps over a lattice edge.
+    detail::for_chunks(n, [&](std::size_t b, std::size_t e) { classify_moves(edits.data(), b, e, phi, status, lat, decoder, move); });
+    std::size_t n_movers = 0;
+    for (std::size_t k = 0; k < n; ++k) {
+        const std::int8_t m = move[k];
+        if (m == 2 || m == -2) [[unlikely]] {
+            phi[edits[k].point] = m > 0 ? 0.5f : -0.5f;
+            move[k] = 0;
+        }
+        movers[n_movers] = static_cast<std::uint32_t>(k);
+        n_movers += move[k] != 0 ? 1 : 0;
+    }
+
+    // 3. The front passes to the neighbours on the other side: an L∓1 neighbour of a leaving point
+    //    enters the zero layer (marked at once, so it enters once) with the value implied by the
+    //    zero layer's new values: over its zero-layer neighbours (not those entering it here, whose
+    //    status is no longer 0, so the order of entering changes no value), φ + 1 or φ − 1.
+    region.resize(6 * n_movers + n);
+    RegionPoint* const out = region.data();
+    std::size_t n_out = 0;
+    for (std::size_t m = 0; m < n_movers; ++m) {
+        const std::size_t k = movers[m];
+        const std::int8_t from = move[k] > 0 ? std::int8_t{-1} : std::int8_t{1};
+        for_each_neighbor6(lat, decoder, edits[k].point, [&](PointIndex q) __attribute__((always_inline)) {
+            const std::int8_t s = status[q];
+            const bool enters = s == from;
+            out[n_out] = {q, s, phi[q]};
+            status[q] = enters ? detail::kPendZero : s;
+            n_out += enters ? 1 : 0;
+        });
+    }
+    const auto is_zero = [](std::int8_t s) { return s == 0; };
+    for (std::size_t r = 0; r < n_out; ++r) {
+        const PointIndex q = out[r].point;
+        phi[q] = detail::layer_value(phi_, status_, q, decoder.coord(q), out[r].old_status > 0, is_zero);
+    }
+    // Then the edited points: a point that keeps its layer and its bits changes nothing and is no
+    // seed of the region; the others are marked pending on their side (status 0 before).
+    constexpr std::int8_t pending[3] = {kPendNeg, kPendZero, kPendPos};
+    for (std::size_t k = 0; k < n; ++k) {
+        const PointIndex i = edits[k].point;
+        const std::int8_t m = move[k];
+        const bool seed = m != 0 || std::bit_cast<std::uint32_t>(phi[i]) != std::bit_cast<std::uint32_t>(old_phi[k]);
+        out[n_out] = {i, 0, old_phi[k]};
+        status[i] = seed ? pending[m + 1] : std::int8_t{0};
+        n_out += seed ? 1 : 0;
+    }
+    region.resize(n_out);
+}
+
 void SparseField::relist(std::vector<PointIndex>& zero) {
     std::vector<std::vector<PointIndex>>& levels = level_claims_.v;
     for (int k = 1; k <= layers_; ++k) {
@@ -474,8 +533,9 @@ void SparseField::relist(std::vector<PointIndex>& zero) {
     }
     lists_[static_cast<std::size_t>(layers_)].swap(zero);
     zero_reordered_ = 0;  // the zero layer came sorted
-    std::uint32_t* const slot = slot_.values().data();
-    detail::for_each_list(2 * layers_ + 1, band_size() >= detail::kParallelMin, [&](std::size_t l) { write_slots(lists_[l], slot); });
+    // The slots are written when next needed (ensure_slots): a growing front rebuilds its lists
+    // step after step and needs none of them.
+    slots_stale_ = true;
 }
 
 ChangedPoints SparseField::restore(std::span<const PointState> states) {
@@ -486,6 +546,7 @@ ChangedPoints SparseField::restore(std::span<const PointState> states) {
             throw std::invalid_argument("restored status at " + point_text(lattice(), s.point) + " is out of range");
         if (!std::isfinite(s.phi)) throw std::invalid_argument("restored value at " + point_text(lattice(), s.point) + " is not finite");
     }
+    ensure_slots();  // list_add and list_remove use them
     ChangedPoints changed;
     changed.sign_changes.emplace();
     for (const PointState& s : states) {
@@ -530,31 +591,49 @@ void SparseField::collect_ball(PointIndex seed, std::vector<RegionPoint>& region
 
 std::vector<PointIndex> SparseField::collect_band(std::vector<RegionPoint>& region) {
     // Room for the band and as many far points reached as the outermost lists hold (so the
-    // region grows without copying itself on most steps).
-    region.reserve(region.size() + band_size() + layer(-layers_).size() + layer(layers_).size());
-    std::vector<PointIndex> zero;  // the new zero layer: every band point now pending on it
-    zero.reserve(layer(0).size() + layer(0).size() / 4);
-    // Marking changes statuses, never the lists, so iterating the lists here is safe. A point
-    // enters the new zero layer only from L0 or L±1, and every list point is visited once.
+    // region grows without copying itself on most steps); written through a buffer sized first.
+    const std::size_t marked = region.size();
+    region.reserve(marked + band_size() + layer(-layers_).size() + layer(layers_).size());
+    region.resize(marked + band_size());
+    // The new zero layer: every band point now pending on it. A point enters it only from L0 or
+    // L±1 (marked kPendZero by move_zero_layer, or a zero-layer point it left unchanged).
+    std::vector<PointIndex> zero(layer(-1).size() + layer(0).size() + layer(1).size());
+    // Marking changes statuses, never the lists, so iterating the lists here is safe; every list
+    // point is visited once. Without a branch on its status (a moving front's are unpredictable):
+    // each point writes its region entry and its zero-layer entry and counts each or not, and
+    // its status goes through a table (a temporary status, already marked, stays as it is).
+    static const std::array<std::int8_t, 256> mark = [] {
+        std::array<std::int8_t, 256> t{};
+        for (int b = 0; b < 256; ++b) {
+            const auto st = static_cast<std::int8_t>(b);
+            t[static_cast<std::size_t>(b)] = is_temp(st) ? st : detail::pending_of(st);
+        }
+        return t;
+    }();
     const float* const phi = phi_.values().data();  // raw: a status store could alias the members
     std::int8_t* const status = status_.values().data();
-    for (const auto& list : lists_)
-        for (std::size_t n = 0; n < list.size(); ++n) {
-            if (n + detail::kAhead < list.size()) {  // a list's points are scattered: fetch ahead
-                __builtin_prefetch(status + list[n + detail::kAhead], 1);
-                __builtin_prefetch(phi + list[n + detail::kAhead], 0);
+    RegionPoint* const out = region.data();
+    PointIndex* const z = zero.data();
+    std::size_t n_out = marked, n_zero = 0;
+    for (const auto& list : lists_) {
+        const PointIndex* const points = list.data();
+        const std::size_t size = list.size();
+        for (std::size_t n = 0; n < size; ++n) {
+            if (n + detail::kAhead < size) {  // a list's points are scattered: fetch ahead
+                __builtin_prefetch(status + points[n + detail::kAhead], 1);
+                __builtin_prefetch(phi + points[n + detail::kAhead], 0);
             }
-            const PointIndex i = list[n];
+            const PointIndex i = points[n];
             const std::int8_t s = status[i];
-            if (s == kPendZero) {  // already marked: a zero-layer point of this update (step 3)
-                zero.push_back(i);
-                continue;
-            }
-            if (is_temp(s)) continue;
-            region.push_back({i, s, phi[i]});
-            status[i] = detail::pending_of(s);
-            if (s == 0) zero.push_back(i);
+            out[n_out] = {i, s, phi[i]};
+            n_out += is_temp(s) ? 0 : 1;
+            z[n_zero] = i;
+            n_zero += (s == 0) | (s == kPendZero) ? 1 : 0;
+            status[i] = mark[static_cast<std::uint8_t>(s)];
         }
+    }
+    region.resize(n_out);
+    zero.resize(n_zero);
     return zero;
 }
 

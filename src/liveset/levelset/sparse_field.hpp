@@ -187,6 +187,8 @@ public:
 
 private:
     struct RegionPoint {
+        RegionPoint() {}  // left unset: a buffer of them is sized first and each entry written once
+        RegionPoint(PointIndex i, std::int8_t status, float phi) : point(i), old_status(status), old_phi(phi) {}
         PointIndex point;
         std::int8_t old_status;
         float old_phi;
@@ -199,6 +201,9 @@ private:
     StepResult step_incremental(const Speed& speed, const StepOptions& options);  // incremental_step.cpp
     ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);  // timed repair_band
     ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope);
+    // The repair's first steps: the zero layer's new values, the front handed over to the
+    // neighbours entering it, and the changed points marked pending, into the (empty) region.
+    void move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vector<RegionPoint>& region);
     // Re-layers level by level from the pending points in `region` (the zero layer's changes),
     // re-evaluating only what a change at the level below can reach; appends what it marks.
     void relayer_changes(std::vector<RegionPoint>& region);  // relayer.cpp, as the sweeps and finish
@@ -218,13 +223,14 @@ private:
         std::int8_t layer;           // the new status
     };
     // The points that changed layer are moved between the lists, unless `rebuilding_lists` (the
-    // caller then rebuilds them: relist): no move is recorded, and a point that leaves the band
-    // loses its slot here. `layer_changes`: where to count those points.
+    // caller then rebuilds them: relist): no move is recorded. `layer_changes`: where to count those points.
     ChangedPoints finish(std::span<const RegionPoint> region, bool rebuilding_lists = false,
                          std::size_t* layer_changes = nullptr);
-    // The lists from the new zero layer (in lattice order) and the levels' claims, and every
-    // list point's slot.
+    // The lists from the new zero layer (in lattice order) and the levels' claims; every list
+    // point's slot is written when next needed (ensure_slots).
     void relist(std::vector<PointIndex>& zero);
+    // Writes every list point's slot if relist left them stale (before list_add / list_remove).
+    void ensure_slots();
     void move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves);
     void sort_lists(bool zero_only = false);  // each (or the zero) layer list in ascending point order
     void list_add(PointIndex i, int layer);
@@ -233,7 +239,8 @@ private:
     int layers_;
     Grid<float> phi_;
     Grid<std::int8_t> status_;
-    Grid<std::uint32_t> slot_;                 // position of a band point in its layer list
+    Grid<std::uint32_t> slot_;                 // position of a band point in its layer list (unread elsewhere)
+    bool slots_stale_ = false;                  // relist left slot_ to be written (ensure_slots)
     std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
     int steps_since_sort_ = 0;
@@ -260,6 +267,9 @@ private:
     template <class T>
     using Scratch = Kept<std::vector<T>>;
     Scratch<RegionPoint> region_;                  // repair_band's region
+    Scratch<float> old_phi_;                       // move_zero_layer's values before the edits
+    Scratch<std::int8_t> move_;                    // its moves, one per edit
+    Scratch<std::uint32_t> movers_;                // its edits that leave the zero layer
     Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
     Scratch<PointIndex> sweep_far_;                // sweep_whole_band's far points claimed in one level
     Scratch<std::vector<PointIndex>> level_claims_;  // its claims per level and side (2(k-1): outside, +1: inside)
