@@ -389,21 +389,37 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
 
 namespace {
 
-// Step 2 of the repair for edits [b, e) (see move_zero_layer): +1 leaves outwards, -1 inwards,
-// +2 / -2 would leave but is blocked, 0 stays. Reads only; the locals as in relayer.cpp's loops
-// (a store through std::int8_t may alias anything, so captured pointers would be reloaded).
-void classify_moves(const ZeroLayerEdit* edits, std::size_t b, std::size_t e, const float* phi, const std::int8_t* status,
-                    const Lattice& lattice, const IndexDecoder& index_decoder, std::int8_t* move) {
-    const Lattice lat = lattice;
-    const IndexDecoder decoder = index_decoder;
+// Step 1 of the repair for edits [b, e) (see move_zero_layer): the new values, the old ones kept,
+// every move 0, and the edits whose new value leaves [-0.5, 0.5] listed in order from leaving[b];
+// returns how many. A store and a count each, no branch (whether a point leaves is unpredictable).
+// Locals and parameters only: a store through std::int8_t may alias anything, so values read
+// through a closure would be reloaded after every store.
+std::size_t move_values(const ZeroLayerEdit* edits, std::size_t b, std::size_t e, float* phi, float* old_phi,
+                        std::int8_t* move, std::uint32_t* leaving) {
+    std::size_t n = b;
     for (std::size_t k = b; k < e; ++k) {
         const PointIndex i = edits[k].point;
         const float v = phi[i];
-        if (std::abs(v) <= 0.5f) {  // (a branch: computing every point's neighbours was slower)
-            move[k] = 0;
-            continue;
-        }
-        const bool up = v > 0.5f;
+        const float moved = v + edits[k].delta;
+        old_phi[k] = v;
+        phi[i] = moved;
+        move[k] = 0;
+        leaving[n] = static_cast<std::uint32_t>(k);
+        n += std::abs(moved) > 0.5f ? 1 : 0;
+    }
+    return n - b;
+}
+
+// Step 2 for the leaving edits `leaving` (see move_zero_layer): +1 leaves outwards, -1 inwards,
+// +2 / -2 would leave but is blocked. Reads only, after every value of step 1 is written.
+void classify_moves(const ZeroLayerEdit* edits, std::span<const std::uint32_t> leaving, const float* phi,
+                    const std::int8_t* status, const Lattice& lattice, const IndexDecoder& index_decoder,
+                    std::int8_t* move) {
+    const Lattice lat = lattice;
+    const IndexDecoder decoder = index_decoder;
+    for (const std::uint32_t k : leaving) {
+        const PointIndex i = edits[k].point;
+        const bool up = phi[i] > 0.5f;
         // Without a branch per neighbour (a moving band's statuses and values are unpredictable):
         // a zero-layer neighbour beyond -0.5 (leaving inwards) blocks an outward move, and back.
         // On the other side's values, x > 0.5 is -x < -0.5 bit for bit.
@@ -469,24 +485,32 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     std::int8_t* const move = move_.v.data();
     std::uint32_t* const movers = movers_.v.data();
 
-    // 1. New zero-layer values (all Δ were computed from the old state, so this is Jacobi).
-    parallel_range(n, [=](std::size_t k) {
-        old_phi[k] = phi[edits[k].point];
-        phi[edits[k].point] = old_phi[k] + edits[k].delta;
+    // 1. New zero-layer values (all Δ were computed from the old state, so this is Jacobi), and
+    //    each chunk's leaving edits (movers_ holds them at the chunk's offset until step 2 is done).
+    std::vector<std::size_t> n_leaving((n + detail::kChunk - 1) / detail::kChunk);
+    detail::for_chunks(n, [&](std::size_t b, std::size_t e) {
+        n_leaving[b / detail::kChunk] = move_values(edits.data(), b, e, phi, old_phi, move, movers);
     });
-    // 2. Classify (reads only). A point whose neighbour leaves the other way stays, clamped to
-    //    ±0.5, so the front never jumps over a lattice edge.
-    detail::for_chunks(n, [&](std::size_t b, std::size_t e) { classify_moves(edits.data(), b, e, phi, status, lat, decoder, move); });
+    // 2. Classify the leaving edits (reads only). A point whose neighbour leaves the other way
+    //    stays, clamped to ±0.5, so the front never jumps over a lattice edge.
+    detail::for_chunks(n, [&](std::size_t b, std::size_t) {
+        classify_moves(edits.data(), std::span<const std::uint32_t>(movers + b, n_leaving[b / detail::kChunk]), phi, status,
+                       lat, decoder, move);
+    });
+    // The movers, in edit order: each chunk's leaving edits but the blocked ones (compacted in
+    // place: a mover is written at or before where it was read).
     std::size_t n_movers = 0;
-    for (std::size_t k = 0; k < n; ++k) {
-        const std::int8_t m = move[k];
-        if (m == 2 || m == -2) [[unlikely]] {
-            phi[edits[k].point] = m > 0 ? 0.5f : -0.5f;
-            move[k] = 0;
+    for (std::size_t c = 0; c < n_leaving.size(); ++c)
+        for (std::size_t j = 0; j < n_leaving[c]; ++j) {
+            const std::uint32_t k = movers[c * detail::kChunk + j];
+            const std::int8_t m = move[k];
+            if (m == 2 || m == -2) [[unlikely]] {
+                phi[edits[k].point] = m > 0 ? 0.5f : -0.5f;
+                move[k] = 0;
+            }
+            movers[n_movers] = k;
+            n_movers += move[k] != 0 ? 1 : 0;
         }
-        movers[n_movers] = static_cast<std::uint32_t>(k);
-        n_movers += move[k] != 0 ? 1 : 0;
-    }
 
     // 3. The front passes to the neighbours on the other side: an L∓1 neighbour of a leaving point
     //    enters the zero layer (marked at once, so it enters once) with the value implied by the
