@@ -78,9 +78,34 @@ struct Stencil1 {
     return _mm_and_ps(_mm_cmpgt_ps(len, _mm_set1_ps(1e-6f)), _mm_div_ps(ga, len));
 }
 
+// upwind_gradient_norm()'s arithmetic (sampling.hpp) in four lanes, each with its own speed's
+// sign: per axis the larger square of the one-sided differences pointing upwind, summed from 0 in
+// x, y, z order, then the square root. SSE's min and max may give another zero's sign than
+// min_of and max_of, but only squares of them are used, so every lane has the scalar bits.
+[[gnu::always_inline]] inline __m128 upwind_gradient_norm4(__m128 speed, __m128 c, __m128 xm, __m128 xp, __m128 ym, __m128 yp,
+                                                           __m128 zm, __m128 zp) {
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 rising = _mm_cmpgt_ps(speed, zero);  // φ increases: the scalar form's speed > 0
+    const auto pick = [rising](__m128 if_rising, __m128 otherwise) {
+        return _mm_or_ps(_mm_and_ps(rising, if_rising), _mm_andnot_ps(rising, otherwise));
+    };
+    const auto axis = [&](__m128 minus, __m128 plus) {
+        const __m128 dm = _mm_sub_ps(c, minus), dp = _mm_sub_ps(plus, c);
+        const __m128 a1 = pick(_mm_min_ps(dm, zero), _mm_max_ps(dm, zero));
+        const __m128 a2 = pick(_mm_max_ps(dp, zero), _mm_min_ps(dp, zero));
+        return _mm_max_ps(_mm_mul_ps(a1, a1), _mm_mul_ps(a2, a2));
+    };
+    const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_add_ps(zero, axis(xm, xp)), axis(ym, yp)), axis(zm, zp));
+    return _mm_sqrt_ps(sum);
+}
+
+// With `speed` (four lanes' speeds), also each lane's upwind |∇φ| into `upwind`.
 template <class Stencil>
-[[gnu::always_inline]] inline void curvature_and_gradient4(const Stencil& st, std::ptrdiff_t sy, std::ptrdiff_t sz, float kappa[4], float gradient_norm[4]) {
+[[gnu::always_inline]] inline void curvature_and_gradient4(const Stencil& st, std::ptrdiff_t sy, std::ptrdiff_t sz, float kappa[4],
+                                                           float gradient_norm[4], const float* speed = nullptr,
+                                                           float* upwind = nullptr) {
     const __m128 c = st.at(0), xp = st.at(1), xm = st.at(-1), yp = st.at(sy), ym = st.at(-sy), zp = st.at(sz), zm = st.at(-sz);
+    if (speed != nullptr) _mm_storeu_ps(upwind, upwind_gradient_norm4(_mm_loadu_ps(speed), c, xm, xp, ym, yp, zm, zp));
     const __m128 xpyp = st.at(1 + sy), xpym = st.at(1 - sy), xmyp = st.at(-1 + sy), xmym = st.at(-1 - sy);
     const __m128 xpzp = st.at(1 + sz), xpzm = st.at(1 - sz), xmzp = st.at(-1 + sz), xmzm = st.at(-1 - sz);
     const __m128 ypzp = st.at(sy + sz), ypzm = st.at(sy - sz), ymzp = st.at(-sy + sz), ymzm = st.at(-sy - sz);
@@ -139,8 +164,12 @@ float mean_curvature(const Grid<float>& phi, Vec3i p) {
     return k;
 }
 
-void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIndex> points, std::span<CurvatureAndGradient> out) {
-    if (out.size() != points.size()) throw std::invalid_argument("mean_curvature_and_gradient: output size differs from the points'");
+namespace {
+
+// The batch loop of both forms below; `speed` and `upwind` empty for mean_curvature_and_gradient.
+void batch_stencils(const Grid<float>& phi, std::span<const PointIndex> points, std::span<const float> speed,
+                    std::span<CurvatureAndGradient> out, std::span<float> upwind) {
+    const bool with_upwind = !upwind.empty();
     const Lattice& l = phi.lattice();
     const IndexDecoder decoder(l);
     [[maybe_unused]] const Vec3i d = l.dims();  // the interior test of the SSE2 batch
@@ -148,12 +177,15 @@ void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIn
     const auto sy = static_cast<std::ptrdiff_t>(l.stride_y()), sz = static_cast<std::ptrdiff_t>(l.stride_z());
     Stencil4 st{phi.values().data(), {}};
     std::size_t slot[4];  // where each filled lane's result goes
+    float lane_speed[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     int filled = 0;
     const auto flush = [&] {
         for (int k = filled; k < 4; ++k) st.i[k] = st.i[0];  // a partial batch repeats its first point
-        float kappa[4], gradient_norm[4];
-        curvature_and_gradient4(st, sy, sz, kappa, gradient_norm);
+        float kappa[4], gradient_norm[4], lane_upwind[4];
+        curvature_and_gradient4(st, sy, sz, kappa, gradient_norm, with_upwind ? lane_speed : nullptr, lane_upwind);
         for (int k = 0; k < filled; ++k) out[slot[k]] = {kappa[k], gradient_norm[k]};
+        if (with_upwind)
+            for (int k = 0; k < filled; ++k) upwind[slot[k]] = lane_upwind[k];
         filled = 0;
     };
 #endif
@@ -162,16 +194,33 @@ void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIn
 #if defined(__SSE2__)
         if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x <= d.x - 2 && p.y <= d.y - 2 && p.z <= d.z - 2) {
             st.i[filled] = static_cast<std::ptrdiff_t>(points[n]);
+            if (with_upwind) lane_speed[filled] = speed[n];
             slot[filled++] = n;
             if (filled == 4) flush();
             continue;
         }
 #endif
         out[n] = {mean_curvature(phi, p), norm(central_gradient(phi, p))};
+        if (with_upwind) upwind[n] = upwind_gradient_norm(phi, p, speed[n]);
     }
 #if defined(__SSE2__)
     if (filled > 0) flush();
 #endif
+}
+
+}  // namespace
+
+void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIndex> points, std::span<CurvatureAndGradient> out) {
+    if (out.size() != points.size()) throw std::invalid_argument("mean_curvature_and_gradient: output size differs from the points'");
+    batch_stencils(phi, points, {}, out, {});
+}
+
+void curvature_gradient_and_upwind(const Grid<float>& phi, std::span<const PointIndex> points, std::span<const float> speed,
+                                   std::span<CurvatureAndGradient> out, std::span<float> upwind) {
+    if (out.size() != points.size() || speed.size() != points.size() || upwind.size() != points.size())
+        throw std::invalid_argument("curvature_gradient_and_upwind: sizes differ from the points'");
+    if (points.empty()) return;
+    batch_stencils(phi, points, speed, out, upwind);
 }
 
 double rate_of(SpeedSample s, const Grid<float>& phi, Vec3i p) {

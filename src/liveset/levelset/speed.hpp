@@ -56,6 +56,10 @@ struct CurvatureAndGradient {
     float gradient_norm;
 };
 void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIndex> points, std::span<CurvatureAndGradient> out);
+// The same, and at each point upwind_gradient_norm(phi, p, speed[k]) (sampling.hpp) into `upwind`
+// (all four spans of the same size): the same bits as the single calls, from the same loads.
+void curvature_gradient_and_upwind(const Grid<float>& phi, std::span<const PointIndex> points, std::span<const float> speed,
+                                   std::span<CurvatureAndGradient> out, std::span<float> upwind);
 
 // Speed::rate's formula for a sample `s` taken at p.
 double rate_of(SpeedSample s, const Grid<float>& phi, Vec3i p);

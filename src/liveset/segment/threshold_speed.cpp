@@ -65,10 +65,9 @@ SpeedSample ThresholdSpeed::at(const Grid<float>& phi, Vec3i p) const {
 // rate_of(at(phi, p), phi, p) at each point, the curvature and the central |∇φ| batched.
 void ThresholdSpeed::rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const {
     if (out.size() != points.size()) throw std::invalid_argument("Speed::rates: output size differs from the points'");
-    const IndexDecoder decoder(phi.lattice());
     const float weight = curvature_weight();
     std::array<CurvatureAndGradient, 256> batch;
-    std::array<float, 256> propagation;
+    std::array<float, 256> propagation, upwind;
     std::array<bool, 256> curved;
     for (std::size_t b = 0; b < points.size(); b += batch.size()) {
         const std::size_t m = std::min(batch.size(), points.size() - b);
@@ -78,12 +77,12 @@ void ThresholdSpeed::rates(const Grid<float>& phi, std::span<const PointIndex> p
             propagation[k] = propagation_[points[b + k]];
             curved[k] = roi_ == nullptr || (*roi_)[points[b + k]] != 0;
         }
-        mean_curvature_and_gradient(phi, points.subspan(b, m), std::span(batch).first(m));
+        // The curvature, the central and the upwind |∇φ| from one set of loads per point.
+        curvature_gradient_and_upwind(phi, points.subspan(b, m), std::span(propagation).first(m), std::span(batch).first(m),
+                                      std::span(upwind).first(m));
         for (std::size_t k = 0; k < m; ++k) {
-            const PointIndex i = points[b + k];
             double r = 0.0;
-            if (propagation[k] != 0.0f)
-                r += static_cast<double>(propagation[k]) * upwind_gradient_norm(phi, decoder.coord(i), propagation[k]);
+            if (propagation[k] != 0.0f) r += static_cast<double>(propagation[k]) * upwind[k];
             const float curvature = curved[k] ? weight * batch[k].kappa : 0.0f;
             if (curvature != 0.0f) r += static_cast<double>(curvature) * batch[k].gradient_norm;
             out[b + k] = r;
