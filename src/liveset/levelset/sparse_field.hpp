@@ -223,7 +223,8 @@ private:
         std::int8_t layer;           // the new status
     };
     // The points that changed layer are moved between the lists, unless `rebuilding_lists` (the
-    // caller then rebuilds them: relist): no move is recorded. `layer_changes`: where to count those points.
+    // caller then rebuilds them: relist): no move is recorded. `layer_changes`: where to count
+    // those points.
     ChangedPoints finish(std::span<const RegionPoint> region, bool rebuilding_lists = false,
                          std::size_t* layer_changes = nullptr);
     // The lists from the new zero layer (in lattice order) and the levels' claims; every list
@@ -239,7 +240,7 @@ private:
     int layers_;
     Grid<float> phi_;
     Grid<std::int8_t> status_;
-    Grid<std::uint32_t> slot_;                 // position of a band point in its layer list (unread elsewhere)
+    Grid<std::uint32_t> slot_;                 // position of a band point in its layer list, unless stale:
     bool slots_stale_ = false;                  // relist left slot_ to be written (ensure_slots)
     std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
