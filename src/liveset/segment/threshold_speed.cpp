@@ -10,9 +10,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "liveset/grid/index_decoder.hpp"
-#include "liveset/grid/sampling.hpp"
-
 namespace liveset {
 
 void validate(const ThresholdParams& p) {
@@ -62,7 +59,7 @@ SpeedSample ThresholdSpeed::at(const Grid<float>& phi, Vec3i p) const {
     return {propagation_[i], curvature_weight() * mean_curvature(phi, p)};
 }
 
-// rate_of(at(phi, p), phi, p) at each point, the curvature and the central |∇φ| batched.
+// rate_of(at(phi, p), phi, p) at each point, the curvature, the central and the upwind |∇φ| batched.
 void ThresholdSpeed::rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const {
     if (out.size() != points.size()) throw std::invalid_argument("Speed::rates: output size differs from the points'");
     const float weight = curvature_weight();
