@@ -1,7 +1,7 @@
 // Internals shared by the sparse field's update code (sparse_field.cpp, relayer.cpp,
-// incremental_step.cpp): the temporary status codes of one update, 6-neighbour iteration, the
-// serial-below-a-size parallel loop and its ordered form (outputs joined in a fixed order). Not
-// part of the public API.
+// incremental_step.cpp, local_edits.cpp, unite.cpp): the temporary status codes of one update,
+// 6-neighbour iteration, the serial-below-a-size parallel loop and its ordered form (outputs joined
+// in a fixed order), a point's text for error messages. Not part of the public API.
 #pragma once
 
 #include <tbb/blocked_range.h>
@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <sstream>
+#include <string>
 #include <vector>
 
 #include "liveset/grid/index_decoder.hpp"
@@ -31,6 +33,14 @@ inline constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;
 // a hint only (no effect on any result); 0.92-0.95x the whole-band step's time at 10 000-60 000
 // front points on the 2-core VM (docs/BENCHMARKS.md, session 36).
 inline constexpr std::size_t kAhead = 16;
+
+// "(x,y,z)": a lattice point in an error message.
+inline std::string point_text(const Lattice& lat, PointIndex i) {
+    const Vec3i c = lat.coord(i);
+    std::ostringstream os;
+    os << '(' << c.x << ',' << c.y << ',' << c.z << ')';
+    return os.str();
+}
 
 inline bool is_temp(std::int8_t s) { return s >= kPendPos || s <= kPendNeg; }
 // The pending code a band point of status s takes when an update marks it.

@@ -1,5 +1,6 @@
-// SparseField implementation: initialisation, the global step, local edits, undo, and the shared
-// order-independent band repair up to the re-layering (relayer.cpp; scheme in sparse_field.hpp).
+// SparseField implementation: initialisation, the global step and the shared order-independent
+// band repair up to the re-layering (relayer.cpp; local edits and undo in local_edits.cpp; the
+// scheme in sparse_field.hpp).
 #include "liveset/levelset/sparse_field.hpp"
 
 #include <tbb/blocked_range.h>
@@ -13,7 +14,6 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <span>
 #include <string>
@@ -34,6 +34,7 @@ using detail::kNoSlot;
 using detail::kPendPos;
 using detail::kPendZero;
 using detail::parallel_range;
+using detail::point_text;
 
 // Each point's position in its layer list, into the slot lattice (prefetched: the points are
 // scattered over it).
@@ -42,13 +43,6 @@ void write_slots(std::span<const PointIndex> list, std::uint32_t* slot) {
         if (k + detail::kAhead < list.size()) __builtin_prefetch(slot + list[k + detail::kAhead], 1);
         slot[list[k]] = static_cast<std::uint32_t>(k);
     }
-}
-
-std::string point_text(const Lattice& lat, PointIndex i) {
-    const Vec3i c = lat.coord(i);
-    std::ostringstream os;
-    os << '(' << c.x << ',' << c.y << ',' << c.z << ')';
-    return os.str();
 }
 
 }  // namespace
@@ -334,50 +328,6 @@ StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& op
 }
 
 // ---------------------------------------------------------------------------------------------
-// Local edits
-
-ChangedPoints SparseField::apply_edits(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
-    std::vector<ZeroLayerEdit> merged(edits.begin(), edits.end());
-    std::sort(merged.begin(), merged.end(), [](const auto& a, const auto& b) { return a.point < b.point; });
-    std::size_t out = 0;
-    for (std::size_t n = 0; n < merged.size(); ++n) {
-        const ZeroLayerEdit& e = merged[n];
-        if (e.point >= phi_.size()) throw std::invalid_argument("edit outside the lattice");
-        if (!std::isfinite(e.delta))
-            throw std::invalid_argument("edit at " + point_text(lattice(), e.point) + " has a non-finite change");
-        if (status_[e.point] != 0)
-            throw std::invalid_argument("edit at " + point_text(lattice(), e.point) + " is not on the zero layer");
-        if (out > 0 && merged[out - 1].point == e.point)
-            merged[out - 1].delta += e.delta;
-        else
-            merged[out++] = e;
-    }
-    merged.resize(out);
-    for (auto& e : merged) e.delta = std::clamp(e.delta, -0.5f, 0.5f);
-    ChangedPoints changed = commit(merged, scope);
-    activity_.wake_near(changed.points, lattice(), steps_);  // an edit wakes the front around it
-    return changed;
-}
-
-ChangedPoints SparseField::apply_in_box(Vec3i lo, Vec3i hi, const std::function<float(Vec3i, float)>& delta) {
-    const Vec3i d = lattice().dims();
-    for (int a = 0; a < 3; ++a) {
-        lo[a] = std::max(lo[a], 0);
-        hi[a] = std::min(hi[a], d[a] - 1);
-    }
-    std::vector<ZeroLayerEdit> edits;
-    for (int z = lo.z; z <= hi.z; ++z)
-        for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x) {
-                const PointIndex i = lattice().index({x, y, z});
-                if (status_[i] != 0) continue;
-                const float dv = delta({x, y, z}, phi_[i]);
-                if (dv != 0.0f) edits.push_back({i, dv});
-            }
-    return apply_edits(edits, RepairScope::kLocal);
-}
-
-// ---------------------------------------------------------------------------------------------
 // The shared repair
 
 ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
@@ -560,36 +510,6 @@ void SparseField::relist(std::vector<PointIndex>& zero) {
     // The slots are written when next needed (ensure_slots): a growing front rebuilds its lists
     // step after step and needs none of them.
     slots_stale_ = true;
-}
-
-ChangedPoints SparseField::restore(std::span<const PointState> states) {
-    const auto start = std::chrono::steady_clock::now();
-    for (const PointState& s : states) {
-        if (s.point >= phi_.size()) throw std::invalid_argument("restored point outside the lattice");
-        if (s.status < far_inside() || s.status > far_outside())
-            throw std::invalid_argument("restored status at " + point_text(lattice(), s.point) + " is out of range");
-        if (!std::isfinite(s.phi)) throw std::invalid_argument("restored value at " + point_text(lattice(), s.point) + " is not finite");
-    }
-    ensure_slots();  // list_add and list_remove use them
-    ChangedPoints changed;
-    changed.sign_changes.emplace();
-    for (const PointState& s : states) {
-        const PointIndex i = s.point;
-        const std::int8_t old = status_[i];
-        const bool value_changed = std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(s.phi);
-        if (old == s.status && !value_changed) continue;
-        if (old != s.status) {
-            if (old >= -layers_ && old <= layers_) list_remove(i, old);
-            if (s.status >= -layers_ && s.status <= layers_) list_add(i, s.status);
-            status_[i] = s.status;
-        }
-        if ((phi_[i] < 0.0f) != (s.phi < 0.0f)) changed.sign_changes->push_back(i);
-        phi_[i] = s.phi;
-        changed.points.push_back(i);
-    }
-    activity_.wake_near(changed.points, lattice(), steps_);  // so does an undo
-    last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    return changed;
 }
 
 [[gnu::always_inline]] inline void SparseField::mark_pending(PointIndex i, std::vector<RegionPoint>& region) {
