@@ -4,18 +4,22 @@
 # mask, the box flow against ITK's, Figure 3, whole-volume meshing against VTK's Flying Edges, and
 # the swarm's step times; the load average and the time between stages. Needs `bash scripts/setup.sh
 # --peers` (./build and ./build-peer). Prints everything on stdout; logs and outputs go to OUT.
-# Usage: scripts/issue16_checks.sh OUT [--itk-only]      (about 15 minutes on a 2-core VM)
+# Usage: scripts/issue16_checks.sh OUT [--itk-only]      (about 10 minutes on a 2-core VM)
 set -euo pipefail
-[ $# -ge 1 ] || { echo "usage: scripts/issue16_checks.sh OUT [--itk-only]" >&2; exit 2; }
-out=$1
+usage="usage: scripts/issue16_checks.sh OUT [--itk-only]"
+[ $# -ge 1 ] && [ $# -le 2 ] || { echo "$usage" >&2; exit 2; }
 itk_only=0
-[ "${2:-}" = "--itk-only" ] && itk_only=1
+if [ $# -eq 2 ]; then
+  [ "$2" = "--itk-only" ] || { echo "issue16_checks: unknown option $2 ($usage)" >&2; exit 2; }
+  itk_only=1
+fi
+mkdir -p "$1"
+out=$(cd "$1" && pwd)  # OUT as given from the caller's folder, before moving to the repository
 cd "$(dirname "$0")/.."
 for bin in build/liveset build/bench/mesh_file_bench build-peer/bench/peers/itk_threshold_levelset \
            build-peer/bench/peers/itk_box_flow build-peer/bench/peers/vtk_flying_edges; do
   [ -x "$bin" ] || { echo "issue16_checks: $bin is missing (run bash scripts/setup.sh --peers)" >&2; exit 1; }
 done
-mkdir -p "$out"
 B=data/brainweb
 S8=(--seed 35,83,113 --seed 35,125,38 --seed 44,164,92 --seed 71,74,53 --seed 122,149,47 --seed 140,86,74 --seed 38,71,26 --seed 83,23,71)
 segment=(segment "$B/t1.mha" "${S8[@]}" --roi "$B/brain_mask.nii.gz" --mu-raw 94 --epsilon-raw 22 --quiet)
