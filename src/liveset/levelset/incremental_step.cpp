@@ -79,7 +79,7 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
     detail::join_parts(parts, &Part::edits, edits);
     // Local and global re-layering give the same bits (sparse_field.hpp); when most of a small
     // front moves, most of the band changes and the whole-band push sweep is the cheaper one.
-    const bool dense = !edits.empty() && zero.size() <= options.dense_front_max && 4 * edits.size() >= 3 * zero.size();
+    const bool dense = !edits.empty() && zero.size() <= options.dense_front_max && 5 * edits.size() >= 3 * zero.size();
     result.whole_band = dense;
     result.changed = repair_band(edits, dense ? RepairScope::kGlobal : RepairScope::kLocal);
     last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -74,14 +74,15 @@ struct StepOptions {
     // wakes it. 0 (the default) never sleeps: kIncremental is then the full-band step bit for bit.
     // `liveset segment` uses 20 (sleeping_step(), segmentation.hpp). At most 1 000 000.
     int sleep_after = 0;
-    // kIncremental only: when at least 3/4 of a zero layer of at most this many points moves in a
+    // kIncremental only: when at least 3/5 of a zero layer of at most this many points moves in a
     // step, the band is re-layered whole (the push sweep, its lists rebuilt from the sweep's
     // levels) instead of outwards from the changes: the same bits (local ≡ global), and cheaper
-    // there (docs/BENCHMARKS.md, session 36: 0.70-0.77x the propagation's time at 30 000-120 000
-    // front points growing everywhere, on one thread and on two; but on BrainWeb's 2-thread run
-    // the fronts of 60 000-150 000 points, where sleeping starts, were slower whole, so 60 000;
-    // session 25 had set 30 000). 0: always propagate. At most 1 000 000 000.
-    std::size_t dense_front_max = 60'000;
+    // there. docs/BENCHMARKS.md, session 42: on BrainWeb the fronts of 60 000-100 000 points, 70-78 %
+    // of them moving, took 0.68-0.73x the time whole on one thread, 0.89x on two; no size or
+    // fraction beyond these paid (a half moving, or no cap: up to 1.65x slower from 100 000 points
+    // on two threads, where sleeping stretches leave fewer points moving). Sessions 25 and 36 had set
+    // 30 000 and 60 000 with 3/4. 0: always propagate. At most 1 000 000 000.
+    std::size_t dense_front_max = 150'000;
     // A step over a band of fewer points runs on the calling thread alone (bitwise the same
     // result): its loops are too short to pay for waking another thread, which costs tens of
     // microseconds per parallel loop on a virtual machine (docs/BENCHMARKS.md, session 31: on the
