@@ -192,6 +192,52 @@ void claim_from(std::span<const PointIndex> sources, const ClaimRules& rule, std
     }
 }
 
+// The decide pass of one level of change propagation over pending[b, e) (region indices): each
+// point's side and its value by Whitaker's rule (layer_value.hpp) from a frozen state, ±inf if no
+// neighbour is in the inner layer; a point claimed at this level (index from first_new) records its
+// old φ first. Without a branch on the side (region order mixes them unpredictably): the inside
+// rule max(φ(q) − 1) is taken as −min(−φ(q) + 1), the same bits (rounding commutes with negation,
+// and −min_of(−a, −b) is max_of(a, b), ties included). What it reads on every point is held in
+// locals (see claim_from).
+template <class Record>
+void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::size_t first_new, Record* region,
+                 const float* phi, const std::int8_t* status, const Lattice& lattice, const IndexDecoder& index_decoder,
+                 const InnerStatuses& inner, float* value, std::uint8_t* outside) {
+    const Lattice lat = lattice;
+    const IndexDecoder decoder = index_decoder;
+    const Vec3i d = lat.dims();
+    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    const float step[2] = {inf, 1.0f};  // a neighbour not in the inner layer offers +inf: never the min
+    for (std::size_t m = b; m < e; ++m) {
+        const std::size_t r = pending[m];
+        const PointIndex i = region[r].point;
+        if (r >= first_new) region[r].old_phi = phi[i];
+        const std::uint8_t out = status[i] == kPendPos ? 1 : 0;
+        const float sign = out != 0 ? 1.0f : -1.0f;
+        const std::uint8_t* const is_inner = out != 0 ? inner.outside.data() : inner.inside.data();
+        float best = inf;
+        const auto offer = [&](PointIndex q) __attribute__((always_inline)) {
+            best = min_of(best, sign * phi[q] + step[is_inner[static_cast<std::uint8_t>(status[q])]]);
+        };
+        const Vec3i c = decoder.coord(i);
+        if (static_cast<std::uint32_t>(c.x - 1) < static_cast<std::uint32_t>(d.x - 2) &&
+            static_cast<std::uint32_t>(c.y - 1) < static_cast<std::uint32_t>(d.y - 2) &&
+            static_cast<std::uint32_t>(c.z - 1) < static_cast<std::uint32_t>(d.z - 2)) [[likely]] {
+            offer(i - 1);
+            offer(i + 1);
+            offer(i - sy);
+            offer(i + sy);
+            offer(i - sz);
+            offer(i + sz);
+        } else {
+            for_each_neighbor6(lat, decoder, i, offer);
+        }
+        outside[m] = out;
+        value[m] = sign * best;
+    }
+}
+
 // One level of the push sweep from `sources`, in order (see sweep_whole_band): claims to `next` and
 // far points claimed to `far` (room for six per source); returns how many of each (as a pair: a
 // two-field struct here made GCC 12's loop take 8 % more instructions). What it reads on every
@@ -309,11 +355,9 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         value.resize(pending.size());
         outside.resize(pending.size());
         const InnerStatuses inner(k);
-        parallel_range(pending.size(), [&](std::size_t m) {
-            RegionPoint& rp = region[pending[m]];
-            if (pending[m] >= first_new) rp.old_phi = phi_[rp.point];
-            outside[m] = status_[rp.point] == kPendPos;
-            value[m] = inner_layer_value(phi_, status_, decoder, rp.point, outside[m] != 0, inner);
+        detail::for_chunks(pending.size(), [&](std::size_t b, std::size_t e) {
+            decide_from(pending.data(), b, e, first_new, region.data(), phi, status, lat, decoder, inner, value.data(),
+                        outside.data());
         });
         // ... then write, each chunk its own points; the lists join in chunk order. Without a
         // branch on whether a point settled (unpredictable; a mispredicted branch also stalls the
