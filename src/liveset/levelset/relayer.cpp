@@ -203,10 +203,7 @@ template <class Record>
 void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::size_t first_new, Record* region,
                  const float* phi, const std::int8_t* status, const Lattice& lattice, const IndexDecoder& index_decoder,
                  const InnerStatuses& inner, float* value, std::uint8_t* outside) {
-    const Lattice lat = lattice;
-    const IndexDecoder decoder = index_decoder;
-    const Vec3i d = lat.dims();
-    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    const detail::Neighbors6 around(lattice, index_decoder);
     constexpr float inf = std::numeric_limits<float>::infinity();
     const float step[2] = {inf, 1.0f};  // a neighbour not in the inner layer offers +inf: never the min
     for (std::size_t m = b; m < e; ++m) {
@@ -220,19 +217,7 @@ void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::
         const auto offer = [&](PointIndex q) __attribute__((always_inline)) {
             best = min_of(best, sign * phi[q] + step[is_inner[static_cast<std::uint8_t>(status[q])]]);
         };
-        const Vec3i c = decoder.coord(i);
-        if (static_cast<std::uint32_t>(c.x - 1) < static_cast<std::uint32_t>(d.x - 2) &&
-            static_cast<std::uint32_t>(c.y - 1) < static_cast<std::uint32_t>(d.y - 2) &&
-            static_cast<std::uint32_t>(c.z - 1) < static_cast<std::uint32_t>(d.z - 2)) [[likely]] {
-            offer(i - 1);
-            offer(i + 1);
-            offer(i - sy);
-            offer(i + sy);
-            offer(i - sz);
-            offer(i + sz);
-        } else {
-            for_each_neighbor6(lat, decoder, i, offer);
-        }
+        around.visit(i, offer);
         outside[m] = out;
         value[m] = sign * best;
     }
@@ -245,15 +230,9 @@ void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::
 std::pair<std::size_t, std::size_t> sweep_from(std::span<const PointIndex> sources, const SweepRules& rule, float* phi,
                                                std::int8_t* status, const Lattice& lattice,
                                                const IndexDecoder& index_decoder, PointIndex* next, PointIndex* far) {
-    const Lattice lat = lattice;
-    const IndexDecoder decoder = index_decoder;
+    const detail::Neighbors6 around(lattice, index_decoder);
     constexpr float inf = std::numeric_limits<float>::infinity();
-    // x - 1 < core.x (unsigned) iff 1 <= x <= dims.x - 2; a dimension below 3 has no such points.
-    const auto core_extent = [](int d) { return d >= 3 ? static_cast<std::uint32_t>(d - 2) : 0u; };
-    const struct {
-        std::uint32_t x, y, z;
-    } core{core_extent(lat.dims().x), core_extent(lat.dims().y), core_extent(lat.dims().z)};
-    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    const auto sz = static_cast<PointIndex>(lattice.stride_z());
     std::size_t n_reached = 0, n_far = 0;
     float value[4] = {-inf, inf, 0.0f, 0.0f};  // SweepValue order; the offers per source
     for (std::size_t f = 0; f < sources.size(); ++f) {
@@ -285,20 +264,7 @@ std::pair<std::size_t, std::size_t> sweep_from(std::span<const PointIndex> sourc
             next[n_reached] = q;
             n_reached += flags & kClaimed;
         };
-        // A source off the lattice's faces (almost every one) visits its six neighbours
-        // without a test per neighbour; the same visits in the same order.
-        const Vec3i c = decoder.coord(i);
-        if (static_cast<std::uint32_t>(c.x - 1) < core.x && static_cast<std::uint32_t>(c.y - 1) < core.y &&
-            static_cast<std::uint32_t>(c.z - 1) < core.z) [[likely]] {
-            visit(i - 1);
-            visit(i + 1);
-            visit(i - sy);
-            visit(i + sy);
-            visit(i - sz);
-            visit(i + sz);
-        } else {
-            for_each_neighbor6(lat, decoder, i, visit);
-        }
+        around.visit(i, visit);  // a source off the lattice's faces (almost every one): no test per neighbour
     }
     return std::pair{n_reached, n_far};
 }
