@@ -79,9 +79,9 @@ struct StepOptions {
     // levels) instead of outwards from the changes: the same bits (local ≡ global), and cheaper
     // there. docs/BENCHMARKS.md, session 42: on BrainWeb the fronts of 60 000-100 000 points, 70-78 %
     // of them moving, took 0.68-0.73x the time whole on one thread, 0.89x on two; no size or
-    // fraction beyond these paid (a half moving, or no cap: up to 1.65x slower from 100 000 points
-    // on two threads, where sleeping stretches leave fewer points moving). Sessions 25 and 36 had set
-    // 30 000 and 60 000 with 3/4. 0: always propagate. At most 1 000 000 000.
+    // fraction beyond these paid (from 100 000 points on two threads, where sleeping stretches leave
+    // fewer points moving: no cap up to 1.18x slower, 1/2 up to 1.17x, 11/20 up to 1.65x). Sessions
+    // 25 and 36 had set 30 000 and 60 000 with 3/4. 0: always propagate. At most 1 000 000 000.
     std::size_t dense_front_max = 150'000;
     // A step over a band of fewer points runs on the calling thread alone (bitwise the same
     // result): its loops are too short to pay for waking another thread, which costs tens of
