@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "liveset/levelset/band_detail.hpp"
-#include "liveset/levelset/layer_value.hpp"
+#include "liveset/grid/float_min_max.hpp"
 #include "liveset/levelset/sparse_field.hpp"
 
 namespace liveset {
@@ -149,16 +149,21 @@ struct InnerStatuses {
     }
 };
 
-// Whitaker's layer rule at a pending point of level k (layer_value.hpp), inlined into the loops.
-[[gnu::always_inline]] inline float inner_layer_value(const Grid<float>& phi, const Grid<std::int8_t>& status,
-                                                      const IndexDecoder& decoder, PointIndex i, bool outside,
-                                                      const InnerStatuses& inner) {
-    const Vec3i c = decoder.coord(i);
-    const auto from = [](const std::array<std::uint8_t, 256>& t) {
-        return [&t](std::int8_t s) { return t[static_cast<std::uint8_t>(s)] != 0; };
-    };
-    return outside ? detail::layer_value_side<true>(phi, status, i, c, from(inner.outside))
-                   : detail::layer_value_side<false>(phi, status, i, c, from(inner.inside));
+// Whitaker's layer rule at a pending point of level k (layer_value.hpp), ±inf if no neighbour is in
+// the inner layer, without a branch on the point's side (a band mixes them unpredictably): the
+// inside rule max(φ(q) − 1) is taken as −min(−φ(q) + 1), the same bits (rounding commutes with
+// negation, and −min_of(−a, −b) is max_of(a, b), ties included).
+[[gnu::always_inline]] inline float pull_value(const detail::Neighbors6& around, const float* phi, const std::int8_t* status,
+                                               PointIndex i, bool outside, const InnerStatuses& inner) {
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    const float step[2] = {inf, 1.0f};  // a neighbour not in the inner layer offers +inf: never the min
+    const float sign = outside ? 1.0f : -1.0f;
+    const std::uint8_t* const is_inner = outside ? inner.outside.data() : inner.inside.data();
+    float best = inf;
+    around.visit(i, [&](PointIndex q) __attribute__((always_inline)) {
+        best = min_of(best, sign * phi[q] + step[is_inner[static_cast<std::uint8_t>(status[q])]]);
+    });
+    return sign * best;
 }
 
 // The claims of `sources` at one level, in order (see relayer_changes), appended to `out` through
@@ -193,33 +198,21 @@ void claim_from(std::span<const PointIndex> sources, const ClaimRules& rule, std
 }
 
 // The decide pass of one level of change propagation over pending[b, e) (region indices): each
-// point's side and its value by Whitaker's rule (layer_value.hpp) from a frozen state, ±inf if no
-// neighbour is in the inner layer; a point claimed at this level (index from first_new) records its
-// old φ first. Without a branch on the side (region order mixes them unpredictably): the inside
-// rule max(φ(q) − 1) is taken as −min(−φ(q) + 1), the same bits (rounding commutes with negation,
-// and −min_of(−a, −b) is max_of(a, b), ties included). What it reads on every point is held in
-// locals (see claim_from).
+// point's side and its value by pull_value from a frozen state; a point claimed at this level (index
+// from first_new) records its old φ first. What it reads on every point is held in locals (see
+// claim_from).
 template <class Record>
 void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::size_t first_new, Record* region,
                  const float* phi, const std::int8_t* status, const Lattice& lattice, const IndexDecoder& index_decoder,
                  const InnerStatuses& inner, float* value, std::uint8_t* outside) {
     const detail::Neighbors6 around(lattice, index_decoder);
-    constexpr float inf = std::numeric_limits<float>::infinity();
-    const float step[2] = {inf, 1.0f};  // a neighbour not in the inner layer offers +inf: never the min
     for (std::size_t m = b; m < e; ++m) {
         const std::size_t r = pending[m];
         const PointIndex i = region[r].point;
         if (r >= first_new) region[r].old_phi = phi[i];
-        const std::uint8_t out = status[i] == kPendPos ? 1 : 0;
-        const float sign = out != 0 ? 1.0f : -1.0f;
-        const std::uint8_t* const is_inner = out != 0 ? inner.outside.data() : inner.inside.data();
-        float best = inf;
-        const auto offer = [&](PointIndex q) __attribute__((always_inline)) {
-            best = min_of(best, sign * phi[q] + step[is_inner[static_cast<std::uint8_t>(status[q])]]);
-        };
-        around.visit(i, offer);
-        outside[m] = out;
-        value[m] = sign * best;
+        const bool out = status[i] == kPendPos;
+        outside[m] = out ? 1 : 0;
+        value[m] = pull_value(around, phi, status, i, out, inner);
     }
 }
 
@@ -365,7 +358,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
 // then) offers φ ± 1 to its neighbours on its side that are pending or far, which keep the min
 // (outside) or max (inside). A point is in layer k iff some neighbour is in layer k-1 (the zero
 // layer for k = 1), and min/max are exact and order-free, so this gives the pull rule's bits
-// (inner_layer_value, the invariant checker) while visiting the 6 neighbours of each source
+// (pull_value, the invariant checker) while visiting the 6 neighbours of each source
 // instead of those of every pending point at every level (the pull re-asked the points of outer
 // layers at each level). A far point reached joins the region then (its record: far, ±(N+1));
 // one not reached stays as it is, so no ring of far points around the band is collected first.
@@ -449,10 +442,12 @@ void SparseField::sweep_layers(std::span<const RegionPoint> region) {
         value.assign(pending.size(), 0.0f);
         // Decide (reads only), then write: Jacobi within a layer, so any thread order agrees.
         const InnerStatuses inner(k);
+        const detail::Neighbors6 around(lattice(), decoder_);
+        const float* const phi = phi_.values().data();
+        const std::int8_t* const status = status_.values().data();
         parallel_range(pending.size(), [&](std::size_t m) {
             const PointIndex i = pending[m];
-            const bool outside = status_[i] == kPendPos;
-            value[m] = inner_layer_value(phi_, status_, decoder_, i, outside, inner);
+            value[m] = pull_value(around, phi, status, i, status[i] == kPendPos, inner);
         });
         next.clear();
         for (std::size_t m = 0; m < pending.size(); ++m) {
