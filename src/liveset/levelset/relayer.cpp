@@ -41,13 +41,17 @@ bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std
 // one clamp of the old value to [lo, hi], which gives std::min's and std::max's bits; lo and hi are
 // picked from the source's four values {-inf, +inf, offer up, offer down} by index.
 enum SweepValue : std::uint8_t { kMinusInf, kPlusInf, kOfferUp, kOfferDown };
-// Flags: claimed (joins the next level) and far (joins the region first).
-constexpr std::uint8_t kClaimed = 1, kFar = 2;
+// A far point claimed at level k holds ±(k + kFarMark) until the level is done (settle_claims
+// then gives it ±k and its region record): no layer, far or temporary status (|s| <= 9 or >= 100),
+// so the claim needs no store of its own in the sweep's loop, which visits six neighbours per source.
+constexpr std::int8_t kFarMark = 50;
+static_assert(SparseField::kMaxLayers + 1 < kFarMark && kFarMark + SparseField::kMaxLayers < kPendPos);
 
 // One side's rules at level k, a table per field (one byte load each, no unpacking): by status as
-// a byte, the status after, the indices of lo and hi, and the flags.
+// a byte, the status after, the indices of lo and hi, and whether it is claimed (1: joins the next
+// level).
 struct SweepRule {
-    std::array<std::uint8_t, 256> after, lo, hi, flags;
+    std::array<std::uint8_t, 256> after, lo, hi, claimed;
 };
 // rules[side] at level k; side 0 for an outside source, 1 for an inside one (level 1's zero layer
 // offers both ways).
@@ -63,49 +67,31 @@ SweepRules sweep_rules(int k, std::int8_t far_out, std::int8_t far_in) {
             r.after[b] = static_cast<std::uint8_t>(s);
             r.lo[b] = kMinusInf;
             r.hi[b] = kPlusInf;
-            r.flags[b] = 0;
+            r.claimed[b] = 0;
         }
-    const auto set = [&](int side, std::int8_t s, std::int8_t after, SweepValue lo, SweepValue hi, std::uint8_t flags) {
+    const auto set = [&](int side, std::int8_t s, std::int8_t after, SweepValue lo, SweepValue hi, std::uint8_t claimed) {
         SweepRule& r = rules[static_cast<std::size_t>(side)];
         r.after[at(s)] = at(after);
         r.lo[at(s)] = lo;
         r.hi[at(s)] = hi;
-        r.flags[at(s)] = flags;
+        r.claimed[at(s)] = claimed;
     };
+    const auto up_far = static_cast<std::int8_t>(k + kFarMark), down_far = static_cast<std::int8_t>(-k - kFarMark);
     for (int side = 0; side < 2; ++side) {
         if (side == 0 || k == 1) {
-            set(side, up, up, kMinusInf, kOfferUp, 0);                   // min
-            set(side, kPendPos, up, kOfferUp, kOfferUp, kClaimed);       // claim
-            set(side, far_out, up, kOfferUp, kOfferUp, kClaimed | kFar);  // claim a far point
+            set(side, up, up, kMinusInf, kOfferUp, 0);              // min
+            set(side, up_far, up_far, kMinusInf, kOfferUp, 0);      // min (a far point claimed here)
+            set(side, kPendPos, up, kOfferUp, kOfferUp, 1);         // claim
+            set(side, far_out, up_far, kOfferUp, kOfferUp, 1);      // claim a far point
         }
         if (side == 1 || k == 1) {
             set(side, down, down, kOfferDown, kPlusInf, 0);  // max
-            set(side, kPendNeg, down, kOfferDown, kOfferDown, kClaimed);
-            set(side, far_in, down, kOfferDown, kOfferDown, kClaimed | kFar);
+            set(side, down_far, down_far, kOfferDown, kPlusInf, 0);
+            set(side, kPendNeg, down, kOfferDown, kOfferDown, 1);
+            set(side, far_in, down_far, kOfferDown, kOfferDown, 1);
         }
     }
     return rules;
-}
-
-// A level's claims into the lists of its two sides (a claimed status is ±k: its sign bit is the
-// side), in the order claimed: a store to each list and a count from the sign bit, since a branch
-// on the side (unpredictable) cost a quarter of the sweep's time.
-void split_by_side(std::span<const PointIndex> claims, const std::int8_t* status, std::vector<PointIndex>& up,
-                   std::vector<PointIndex>& down) {
-    up.resize(claims.size());
-    down.resize(claims.size());
-    PointIndex* const u = up.data();
-    PointIndex* const d = down.data();
-    std::size_t n_up = 0, n_down = 0;
-    for (const PointIndex q : claims) {
-        const std::size_t inside = static_cast<std::uint8_t>(status[q]) >> 7;
-        u[n_up] = q;
-        d[n_down] = q;
-        n_up += inside ^ 1u;
-        n_down += inside;
-    }
-    up.resize(n_up);
-    down.resize(n_down);
 }
 
 // What a change's neighbour of each status becomes when level k's claim reaches it: its pending
@@ -216,17 +202,15 @@ void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::
     }
 }
 
-// One level of the push sweep from `sources`, in order (see sweep_whole_band): claims to `next` and
-// far points claimed to `far` (room for six per source); returns how many of each (as a pair: a
-// two-field struct here made GCC 12's loop take 8 % more instructions). What it reads on every
-// visit is held in locals (see claim_from).
-std::pair<std::size_t, std::size_t> sweep_from(std::span<const PointIndex> sources, const SweepRules& rule, float* phi,
-                                               std::int8_t* status, const Lattice& lattice,
-                                               const IndexDecoder& index_decoder, PointIndex* next, PointIndex* far) {
+// One level of the push sweep from `sources`, in order (see sweep_whole_band): claims to `next`
+// (room for six per source), a far point claimed with its far mark; returns how many. What it
+// reads on every visit is held in locals (see claim_from).
+std::size_t sweep_from(std::span<const PointIndex> sources, const SweepRules& rule, float* phi, std::int8_t* status,
+                       const Lattice& lattice, const IndexDecoder& index_decoder, PointIndex* next) {
     const detail::Neighbors6 around(lattice, index_decoder);
     constexpr float inf = std::numeric_limits<float>::infinity();
     const auto sz = static_cast<PointIndex>(lattice.stride_z());
-    std::size_t n_reached = 0, n_far = 0;
+    std::size_t n_reached = 0;
     float value[4] = {-inf, inf, 0.0f, 0.0f};  // SweepValue order; the offers per source
     for (std::size_t f = 0; f < sources.size(); ++f) {
         const PointIndex i = sources[f];
@@ -243,9 +227,6 @@ std::pair<std::size_t, std::size_t> sweep_from(std::span<const PointIndex> sourc
         const SweepRule& r = rule[status[i] < 0 ? 1 : 0];  // the source's side
         const auto visit = [&](PointIndex q) __attribute__((always_inline)) {
             const auto s = static_cast<std::uint8_t>(status[q]);
-            const std::uint8_t flags = r.flags[s];
-            far[n_far] = q;  // a store and a count, no branch (far claims are unpredictable)
-            n_far += flags >> 1;
 #if defined(__SSE2__)
             // max_of(min_of(φ, hi), lo) on registers: a scalar load clears the upper lanes.
             const __m128 below = _mm_min_ss(_mm_load_ss(value + r.hi[s]), _mm_load_ss(phi + q));
@@ -254,12 +235,96 @@ std::pair<std::size_t, std::size_t> sweep_from(std::span<const PointIndex> sourc
             phi[q] = max_of(min_of(phi[q], value[r.hi[s]]), value[r.lo[s]]);
 #endif
             status[q] = static_cast<std::int8_t>(r.after[s]);
-            next[n_reached] = q;
-            n_reached += flags & kClaimed;
+            next[n_reached] = q;  // a store and a count, no branch (claims are unpredictable)
+            n_reached += r.claimed[s];
         };
         around.visit(i, visit);  // a source off the lattice's faces (almost every one): no test per neighbour
     }
-    return std::pair{n_reached, n_far};
+    return n_reached;
+}
+
+// After a level of the push sweep, over its claims in the order claimed (the order reached): a far
+// point claimed takes its layer ±k and joins the region with its record (far, ±(N+1); φ was its
+// status, the invariant). With `up` and `down`, every claim also goes to the list of its side (the
+// sign bit of ±k), a store to each list and a count, since a branch on the side (unpredictable)
+// cost a quarter of the sweep's time.
+template <class Region, class List>
+void settle_claims(std::span<const PointIndex> claims, std::int8_t* status, std::int8_t far_out, Region& region,
+                   List* up, List* down) {
+    const bool split = up != nullptr;
+    if (split) {
+        up->resize(claims.size());
+        down->resize(claims.size());
+    }
+    PointIndex* const u = split ? up->data() : nullptr;
+    PointIndex* const d = split ? down->data() : nullptr;
+    std::size_t n_up = 0, n_down = 0;
+    const auto settle = [&](PointIndex q) __attribute__((always_inline)) {
+        std::int8_t s = status[q];
+        if (s > kFarMark || s < -kFarMark) {
+            const auto was = static_cast<std::int8_t>(s > 0 ? far_out : -far_out);
+            region.push_back({q, was, static_cast<float>(was)});
+            s = static_cast<std::int8_t>(s > 0 ? s - kFarMark : s + kFarMark);
+            status[q] = s;
+        }
+        return s;
+    };
+    if (!split) {
+        for (const PointIndex q : claims) settle(q);
+        return;
+    }
+    for (const PointIndex q : claims) {
+        const std::size_t inside = static_cast<std::uint8_t>(settle(q)) >> 7;
+        u[n_up] = q;
+        d[n_down] = q;
+        n_up += inside ^ 1u;
+        n_down += inside;
+    }
+    up->resize(n_up);
+    down->resize(n_down);
+}
+
+// finish's pass over region[b, e): each point settled (a pending one is far: it left the band),
+// its index stored and counted if its layer or φ's bits changed, the move recorded (kMoves) if its
+// layer did, the point kept in `signs` if its sign did; returns how many changed and how many moved.
+// A free function so that every pointer it reads is a local: a status store, through a char type,
+// would make a closure's members reload on every point. Counts without branching on a change
+// (unpredictable).
+template <bool kMoves, class Record, class Move>
+std::pair<std::size_t, std::size_t> settle_region(const Record* points, std::size_t b, std::size_t e, float* phi,
+                                                  std::int8_t* status, std::int8_t far_out, PointIndex* changed,
+                                                  Move* moved, std::vector<PointIndex>& signs) {
+    const float far = static_cast<float>(far_out);
+    const auto far_in = static_cast<std::int8_t>(-far_out);
+    std::size_t n_changed = 0, n_moved = 0;
+    for (std::size_t n = b; n < e; ++n) {
+        if (n + detail::kAhead < e) {  // the region's points are scattered: fetch ahead
+            __builtin_prefetch(status + points[n + detail::kAhead].point, 1);
+            __builtin_prefetch(phi + points[n + detail::kAhead].point, 0);
+        }
+        const Record r = points[n];
+        const PointIndex i = r.point;
+        std::int8_t s = status[i];
+        float v = phi[i];
+        // Only a pending status is written: the sweeps left every other one final, and a store
+        // to a line another chunk's points share would make the cores fight over it.
+        if (s == kPendZero) {
+            s = 0;
+            status[i] = s;
+        } else if (s == kPendPos || s == kPendNeg) {  // left the band
+            s = s == kPendPos ? far_out : far_in;
+            v = s == far_out ? far : -far;
+            status[i] = s;
+            phi[i] = v;
+        }
+        const std::size_t layer_changed = s != r.old_status ? 1 : 0;
+        if constexpr (kMoves) moved[n_moved] = {n, s};
+        n_moved += layer_changed;
+        changed[n_changed] = i;
+        n_changed += layer_changed | (same_bits(v, r.old_phi) ? 0u : 1u);
+        if ((v < 0.0f) != (r.old_phi < 0.0f)) signs.push_back(i);
+    }
+    return {n_changed, n_moved};
 }
 
 }  // namespace
@@ -293,7 +358,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         // its own list, which joins the region before the seam claims.
         const std::size_t first_new = region.size();
         const ClaimRules& rule = claim_rules(k, layers_);
-        if (changed.size() < detail::kPlaneSplitMin) {
+        if (!split_levels_ || changed.size() < detail::kPlaneSplitMin) {
             claim_from(std::span<const PointIndex>(changed), rule, status, lat, decoder, claims_[0].v, region);
         } else {
             split_.v.split(changed, decoder, lat.dims().z);
@@ -369,9 +434,8 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
     // A point takes its layer and the first offer when first reached; later offers of the same
     // level still count. The level lists are kept between steps (never shrunk), sized to the most
     // a level can reach (6 per source) so that a claim is a store and a count.
-    std::vector<PointIndex>& from = sweep_from_.v;
-    std::vector<PointIndex>& reached = sweep_next_.v;
-    std::vector<PointIndex>& far_claims = sweep_far_.v;
+    PointList& from = sweep_from_.v;
+    PointList& reached = sweep_next_.v;
     if (from.size() < zero.size()) from.resize(zero.size());
     std::copy(zero.begin(), zero.end(), from.begin());
     std::size_t n_from = zero.size();
@@ -381,7 +445,7 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
     std::int8_t* const status = status_.values().data();
     const Lattice lat = lattice();
     const IndexDecoder decoder = decoder_;
-    std::vector<std::vector<PointIndex>>& levels = level_claims_.v;
+    std::vector<PointList>& levels = level_claims_.v;
     if (keep_levels) {
         levels.resize(2 * static_cast<std::size_t>(layers_));
         for (auto& l : levels) l.clear();  // a level the sweep does not reach claims nothing
@@ -389,42 +453,30 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
     for (int k = 1; k <= layers_ && n_from > 0; ++k) {
         // Grown geometrically: a growing front must not refill them every step.
         if (reached.size() < 6 * n_from) reached.resize(std::max(6 * n_from, 2 * reached.size()));
-        if (far_claims.size() < 6 * n_from) far_claims.resize(std::max(6 * n_from, 2 * far_claims.size()));
         const SweepRules rule = sweep_rules(k, far_out, far_in);
         PointIndex* const next = reached.data();
-        PointIndex* const far = far_claims.data();
         const std::span<const PointIndex> sources(from.data(), n_from);
-        std::pair<std::size_t, std::size_t> got{0, 0};
-        if (n_from < detail::kPlaneSplitMin) {
-            got = sweep_from(sources, rule, phi, status, lat, decoder, next, far);
+        std::size_t n_reached = 0;
+        if (!split_levels_ || n_from < detail::kPlaneSplitMin) {
+            n_reached = sweep_from(sources, rule, phi, status, lat, decoder, next);
         } else {
             // Many sources: two tasks and a seam (plane_split.hpp), each part writing its claims
-            // and far points at its own offset, moved up behind the parts before it after.
+            // at its own offset, moved up behind the parts before it after.
             split_.v.split(sources, decoder, lat.dims().z);
             const std::size_t room[3] = {0, 6 * split_.v.part(detail::PlaneSplit::kBelow).size(),
                                          6 * (n_from - split_.v.part(detail::PlaneSplit::kSeam).size())};
-            std::pair<std::size_t, std::size_t> part_got[3];
+            std::size_t part_reached[3];
             split_.v.run([&](std::span<const PointIndex> part_sources, int part) {
-                const std::size_t at = room[part];
-                part_got[part] = sweep_from(part_sources, rule, phi, status, lat, decoder, next + at, far + at);
+                part_reached[part] = sweep_from(part_sources, rule, phi, status, lat, decoder, next + room[part]);
             });
             for (int part = 0; part < 3; ++part) {
-                if (room[part] != got.first) std::copy_n(next + room[part], part_got[part].first, next + got.first);
-                if (room[part] != got.second) std::copy_n(far + room[part], part_got[part].second, far + got.second);
-                got.first += part_got[part].first;
-                got.second += part_got[part].second;
+                if (room[part] != n_reached) std::copy_n(next + room[part], part_reached[part], next + n_reached);
+                n_reached += part_reached[part];
             }
         }
-        const auto [n_reached, n_far] = got;  // claims, far points claimed
-        // The far points claimed join the region in the order reached; each was far (φ = its
-        // status, the invariant) on the side of the layer it took.
-        for (std::size_t n = 0; n < n_far; ++n) {
-            const std::int8_t was = status[far[n]] > 0 ? far_out : far_in;
-            region.push_back({far[n], was, static_cast<float>(was)});
-        }
-        if (keep_levels)
-            split_by_side(std::span(next, n_reached), status, levels[2 * static_cast<std::size_t>(k - 1)],
-                          levels[2 * static_cast<std::size_t>(k - 1) + 1]);
+        PointList* const up = keep_levels ? &levels[2 * static_cast<std::size_t>(k - 1)] : nullptr;
+        PointList* const down = keep_levels ? &levels[2 * static_cast<std::size_t>(k - 1) + 1] : nullptr;
+        settle_claims(std::span<const PointIndex>(next, n_reached), status, far_out, region, up, down);
         from.swap(reached);
         n_from = n_reached;
     }
@@ -482,8 +534,8 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
         out_begin[static_cast<std::size_t>(l) + 1] += out_begin[static_cast<std::size_t>(l)];
         in_begin[static_cast<std::size_t>(l) + 1] += in_begin[static_cast<std::size_t>(l)];
     }
-    std::vector<PointIndex>& out = moved_out_.v;
-    std::vector<PointIndex>& in = moved_in_.v;
+    PointList& out = moved_out_.v;
+    PointList& in = moved_in_.v;
     out.resize(out_begin[static_cast<std::size_t>(lists)]);
     in.resize(in_begin[static_cast<std::size_t>(lists)]);
     {
@@ -516,47 +568,16 @@ ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool rebu
         std::size_t n_moved = 0;
     };
     const bool record_moves = !rebuilding_lists;
-    const float far = static_cast<float>(layers_ + 1);
-    const std::int8_t far_out = far_outside(), far_in = far_inside();
+    const std::int8_t far_out = far_outside();
     float* const phi = phi_.values().data();  // raw: see sweep_whole_band
     std::int8_t* const status = status_.values().data();
     const RegionPoint* const points = region.data();
-    // The loop reads every pointer from locals copied by value (a status store, through a char
-    // type, would otherwise make it reload them from the closure on every point) and counts
-    // without branching on a change (unpredictable).
     auto parts = detail::ordered_chunks<Part>(region.size(), [=](std::size_t b, std::size_t e, Part& out) {
         out.changed.resize(e - b);                   // most region points change: a store and a count each
         if (record_moves) out.moved.resize(e - b);  // and many move (unpredictably): the same
-        PointIndex* const changed = out.changed.data();
-        ListMove* const moved = out.moved.data();
-        std::size_t n_changed = 0, n_moved = 0;
-        for (std::size_t n = b; n < e; ++n) {
-            if (n + detail::kAhead < e) {  // the region's points are scattered: fetch ahead
-                __builtin_prefetch(status + points[n + detail::kAhead].point, 1);
-                __builtin_prefetch(phi + points[n + detail::kAhead].point, 0);
-            }
-            const RegionPoint r = points[n];
-            const PointIndex i = r.point;
-            std::int8_t s = status[i];
-            float v = phi[i];
-            // Only a pending status is written: the sweeps left every other one final, and a
-            // store to a line another chunk's points share would make the cores fight over it.
-            if (s == kPendZero) {
-                s = 0;
-                status[i] = s;
-            } else if (s == kPendPos || s == kPendNeg) {  // left the band
-                s = s == kPendPos ? far_out : far_in;
-                v = s == far_out ? far : -far;
-                status[i] = s;
-                phi[i] = v;
-            }
-            const std::size_t layer_changed = s != r.old_status ? 1 : 0;
-            if (record_moves) moved[n_moved] = {n, s};
-            n_moved += layer_changed;
-            changed[n_changed] = i;
-            n_changed += layer_changed | (same_bits(v, r.old_phi) ? 0u : 1u);
-            if ((v < 0.0f) != (r.old_phi < 0.0f)) out.signs.push_back(i);
-        }
+        const auto [n_changed, n_moved] =
+            record_moves ? settle_region<true>(points, b, e, phi, status, far_out, out.changed.data(), out.moved.data(), out.signs)
+                         : settle_region<false>(points, b, e, phi, status, far_out, out.changed.data(), out.moved.data(), out.signs);
         out.changed.resize(n_changed);
         if (record_moves) out.moved.resize(n_moved);
         out.n_moved = n_moved;

@@ -266,7 +266,8 @@ namespace {
 
 // Ascending order by LSD radix sort on bytes, skipping the bytes no index uses: a layer list of
 // n points sorts in a few linear passes (std::sort was 8 % of a BrainWeb segmentation).
-void sort_indices(std::vector<PointIndex>& v, std::vector<PointIndex>& scratch) {
+template <class List>
+void sort_indices(List& v, List& scratch) {
     if (v.size() < 256) {
         std::sort(v.begin(), v.end());
         return;
@@ -278,7 +279,7 @@ void sort_indices(std::vector<PointIndex>& v, std::vector<PointIndex>& scratch) 
 
 void SparseField::sort_lists(bool zero_only) {
     zero_reordered_ = 0;
-    std::vector<PointIndex>& scratch = sort_scratch_.v;  // kept: a list-sized buffer is not faulted in every sort
+    auto& scratch = sort_scratch_.v;  // kept: a list-sized buffer is not faulted in every sort
     for (auto& list : lists_) {
         if (zero_only && &list != &lists_[static_cast<std::size_t>(layers_)]) continue;
         sort_indices(list, scratch);
@@ -303,6 +304,11 @@ StepResult SparseField::step(const Speed& speed, const StepOptions& options) {
     if (band_size() < options.parallel_band_min) {
         // One slot, one arena per calling thread: fields stepped on other threads never wait for it.
         thread_local tbb::task_arena alone(1);
+        struct NoSplit {  // no level split for two tasks in this step, whatever it throws
+            bool& split;
+            explicit NoSplit(bool& s) : split(s) { split = false; }
+            ~NoSplit() { split = true; }
+        } no_split(split_levels_);
         alone.execute(run);
     } else {
         run();
@@ -406,7 +412,7 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         // A rebuilding repair puts the new zero layer in lattice order first: the zero list then,
         // and the sweep's first sources, run forwards through memory (the sort is needed for the
         // zero list anyway; before the sweep it gains at most a few per cent, session 37).
-        std::vector<PointIndex> zero = collect_band(region);
+        PointList zero = collect_band(region);
         const bool rebuild = relist_next_;
         if (rebuild) sort_indices(zero, sort_scratch_.v);
         sweep_whole_band(region, zero, /*keep_levels=*/rebuild);
@@ -499,8 +505,8 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     region.resize(n_out);
 }
 
-void SparseField::relist(std::vector<PointIndex>& zero) {
-    std::vector<std::vector<PointIndex>>& levels = level_claims_.v;
+void SparseField::relist(PointList& zero) {
+    std::vector<PointList>& levels = level_claims_.v;
     for (int k = 1; k <= layers_; ++k) {
         lists_[static_cast<std::size_t>(layers_ + k)].swap(levels[2 * static_cast<std::size_t>(k - 1)]);
         lists_[static_cast<std::size_t>(layers_ - k)].swap(levels[2 * static_cast<std::size_t>(k - 1) + 1]);
@@ -533,7 +539,7 @@ void SparseField::collect_ball(PointIndex seed, std::vector<RegionPoint>& region
     }
 }
 
-std::vector<PointIndex> SparseField::collect_band(std::vector<RegionPoint>& region) {
+SparseField::PointList SparseField::collect_band(std::vector<RegionPoint>& region) {
     // Room for the band and as many far points reached as the outermost lists hold (so the
     // region grows without copying itself on most steps); written through a buffer sized first.
     const std::size_t marked = region.size();
@@ -541,16 +547,20 @@ std::vector<PointIndex> SparseField::collect_band(std::vector<RegionPoint>& regi
     region.resize(marked + band_size());
     // The new zero layer: every band point now pending on it. A point enters it only from L0 or
     // L±1 (marked kPendZero by move_zero_layer, or a zero-layer point it left unchanged).
-    std::vector<PointIndex> zero(layer(-1).size() + layer(0).size() + layer(1).size());
+    PointList zero(layer(-1).size() + layer(0).size() + layer(1).size());
     // Marking changes statuses, never the lists, so iterating the lists here is safe; every list
     // point is visited once. Without a branch on its status (a moving front's are unpredictable):
-    // each point writes its region entry and its zero-layer entry and counts each or not, and
-    // its status goes through a table (a temporary status, already marked, stays as it is).
-    static const std::array<std::int8_t, 256> mark = [] {
-        std::array<std::int8_t, 256> t{};
+    // each point writes its region entry and its zero-layer entry and counts each or not, all three
+    // from one table entry by its status: the low byte the status it takes (a temporary status,
+    // already marked, stays as it is), bit 8 whether it joins the region (not yet marked), bit 9
+    // whether it is on the new zero layer.
+    static const std::array<std::uint16_t, 256> mark = [] {
+        std::array<std::uint16_t, 256> t{};
         for (int b = 0; b < 256; ++b) {
             const auto st = static_cast<std::int8_t>(b);
-            t[static_cast<std::size_t>(b)] = is_temp(st) ? st : detail::pending_of(st);
+            const auto after = static_cast<std::uint8_t>(is_temp(st) ? st : detail::pending_of(st));
+            const unsigned joins = is_temp(st) ? 0u : 1u, zero = st == 0 || st == kPendZero ? 1u : 0u;
+            t[static_cast<std::size_t>(b)] = static_cast<std::uint16_t>(after | joins << 8 | zero << 9);
         }
         return t;
     }();
@@ -569,11 +579,12 @@ std::vector<PointIndex> SparseField::collect_band(std::vector<RegionPoint>& regi
             }
             const PointIndex i = points[n];
             const std::int8_t s = status[i];
+            const unsigned m = mark[static_cast<std::uint8_t>(s)];
             out[n_out] = {i, s, phi[i]};
-            n_out += is_temp(s) ? 0 : 1;
+            n_out += (m >> 8) & 1u;
             z[n_zero] = i;
-            n_zero += (s == 0) | (s == kPendZero) ? 1 : 0;
-            status[i] = mark[static_cast<std::uint8_t>(s)];
+            n_zero += m >> 9;
+            status[i] = static_cast<std::int8_t>(m & 0xFFu);
         }
     }
     region.resize(n_out);

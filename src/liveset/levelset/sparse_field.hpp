@@ -26,6 +26,7 @@
 
 #include "liveset/grid/grid.hpp"
 #include "liveset/grid/index_decoder.hpp"
+#include "liveset/grid/uninit_allocator.hpp"
 #include "liveset/levelset/activity.hpp"
 #include "liveset/levelset/plane_split.hpp"
 #include "liveset/levelset/speed.hpp"
@@ -187,6 +188,8 @@ public:
     double last_update_ms() const { return last_update_ms_; }
 
 private:
+    // A layer list or a level's claims: sized first, then written entry by entry (no zero fill).
+    using PointList = UninitVector<PointIndex>;
     struct RegionPoint {
         RegionPoint() {}  // left unset: a buffer of them is sized first and each entry written once
         RegionPoint(PointIndex i, std::int8_t status, float phi) : point(i), old_status(status), old_phi(phi) {}
@@ -210,7 +213,7 @@ private:
     void relayer_changes(std::vector<RegionPoint>& region);  // relayer.cpp, as the sweeps and finish
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     // Marks the whole band pending (appending what it marks); returns the new zero layer.
-    std::vector<PointIndex> collect_band(std::vector<RegionPoint>& region);
+    PointList collect_band(std::vector<RegionPoint>& region);
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
     void sweep_layers(std::span<const RegionPoint> region);       // any region (pull)
     // The whole band (push, same bits) from the new zero layer `zero`; appends the
@@ -230,7 +233,7 @@ private:
                          std::size_t* layer_changes = nullptr);
     // The lists from the new zero layer (in lattice order) and the levels' claims; every list
     // point's slot is written when next needed (ensure_slots).
-    void relist(std::vector<PointIndex>& zero);
+    void relist(PointList& zero);
     // Writes every list point's slot if relist left them stale (before list_add / list_remove).
     void ensure_slots();
     void move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves);
@@ -243,9 +246,14 @@ private:
     Grid<std::int8_t> status_;
     Grid<std::uint32_t> slot_;                 // position of a band point in its layer list, unless stale:
     bool slots_stale_ = false;                  // relist left slot_ to be written (ensure_slots)
-    std::vector<std::vector<PointIndex>> lists_;  // index k + N holds layer k
+    std::vector<PointList> lists_;  // index k + N holds layer k
     std::vector<Vec3i> ball_;                  // offsets within Manhattan distance N
     int steps_since_sort_ = 0;
+    // Whether a large level's sources are split for two tasks (plane_split.hpp): not in a step
+    // whose band is below StepOptions::parallel_band_min, which runs on the calling thread alone
+    // (the split is then two passes over the sources for nothing). Decided by the band's size, so
+    // the claims' order, the lists and X are the same on any thread count.
+    bool split_levels_ = true;
     // Whether the next whole-band repair rebuilds its lists (relist) rather than moving points
     // between them: set by the last one's share of points that changed layer (repair_band).
     bool relist_next_ = true;
@@ -272,16 +280,15 @@ private:
     Scratch<float> old_phi_;                       // move_zero_layer's values before the edits
     Scratch<std::int8_t> move_;                    // its moves, one per edit
     Scratch<std::uint32_t> movers_;                // its edits that leave the zero layer
-    Scratch<PointIndex> sweep_from_, sweep_next_;  // sweep_whole_band's levels
-    Scratch<PointIndex> sweep_far_;                // sweep_whole_band's far points claimed in one level
-    Scratch<std::vector<PointIndex>> level_claims_;  // its claims per level and side (2(k-1): outside, +1: inside)
+    Kept<PointList> sweep_from_, sweep_next_;  // sweep_whole_band's levels
+    Scratch<PointList> level_claims_;  // its claims per level and side (2(k-1): outside, +1: inside)
     // relayer_changes' claims: [0] the blocks of an ordered loop (the whole level, or the parts
     // below and the seam of a split), [1] the part above's claims until they join the region,
     // [2] its blocks.
     Scratch<RegionPoint> claims_[3];
     Kept<detail::PlaneSplit> split_;               // a large level's sources split for two tasks (plane_split.hpp)
-    Scratch<PointIndex> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
-    Scratch<PointIndex> sort_scratch_;             // sort_lists' radix sort
+    Kept<PointList> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
+    Kept<PointList> sort_scratch_;             // sort_lists' radix sort
 };
 
 }  // namespace liveset
