@@ -89,7 +89,10 @@ struct StepOptions {
     // microseconds per parallel loop on a virtual machine (docs/BENCHMARKS.md, session 31: on the
     // 2-core VM two threads were 1.3-1.6x slower than one below 30 000 front points; session 35:
     // with today's passes they break even at about 90 000 band points, 20 000 on BrainWeb's
-    // front). 0: always use the threads there are. At most 1 000 000 000.
+    // front). Such a step also splits no level for two tasks (session 43), so the order of the
+    // lists and of X follows this option as it follows dense_front_max (the same φ, statuses and X
+    // as a set; the same order on any thread count). 0: always use the threads there are. At most
+    // 1 000 000 000.
     std::size_t parallel_band_min = 100'000;
 };
 
