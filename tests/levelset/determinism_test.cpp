@@ -4,7 +4,6 @@
 
 #include <tbb/task_arena.h>
 
-#include <algorithm>
 #include <atomic>
 #include <random>
 #include <span>
@@ -103,10 +102,6 @@ TEST(Determinism, ChangePropagationOnOneAndTwoThreadsGivesTheSameOrder) {
 // same bits, for both step modes. Below it no level is split for two tasks, so the order of the
 // lists and of X follows the option (as it follows dense_front_max), and is the same on one thread.
 TEST(Determinism, SmallBandStepsOnTheCallingThreadAloneWithTheSameBits) {
-    const auto sorted = [](std::vector<PointIndex> v) {
-        std::sort(v.begin(), v.end());
-        return v;
-    };
     for (StepMode m : {StepMode::kFullBand, StepMode::kIncremental}) {
         tbb::task_arena arena(2), one(1);
         SparseField alone = make_box_field({}), shared = alone, alone_one = alone;

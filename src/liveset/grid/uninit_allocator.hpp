@@ -6,7 +6,6 @@
 #include <memory>
 #include <new>
 #include <type_traits>
-#include <utility>
 #include <vector>
 
 namespace liveset {
@@ -20,14 +19,11 @@ struct UninitAllocator : std::allocator<T> {
     template <class U>
     explicit UninitAllocator(const UninitAllocator<U>&) noexcept {}
 
-    // No arguments: default-initialised (left unset); otherwise constructed as usual.
+    // No arguments: default-initialised (left unset). With arguments std::allocator_traits finds no
+    // construct here and constructs as usual (std::construct_at).
     template <class U>
     void construct(U* p) noexcept {
         ::new (static_cast<void*>(p)) U;
-    }
-    template <class U, class... Args>
-    void construct(U* p, Args&&... args) {
-        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
     }
     template <class U>
     bool operator==(const UninitAllocator<U>&) const noexcept {

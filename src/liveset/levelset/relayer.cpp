@@ -358,7 +358,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
         // its own list, which joins the region before the seam claims.
         const std::size_t first_new = region.size();
         const ClaimRules& rule = claim_rules(k, layers_);
-        if (!split_levels_ || changed.size() < detail::kPlaneSplitMin) {
+        if (!splits(changed.size())) {
             claim_from(std::span<const PointIndex>(changed), rule, status, lat, decoder, claims_[0].v, region);
         } else {
             split_.v.split(changed, decoder, lat.dims().z);
@@ -457,7 +457,7 @@ void SparseField::sweep_whole_band(std::vector<RegionPoint>& region, std::span<c
         PointIndex* const next = reached.data();
         const std::span<const PointIndex> sources(from.data(), n_from);
         std::size_t n_reached = 0;
-        if (!split_levels_ || n_from < detail::kPlaneSplitMin) {
+        if (!splits(n_from)) {
             n_reached = sweep_from(sources, rule, phi, status, lat, decoder, next);
         } else {
             // Many sources: two tasks and a seam (plane_split.hpp), each part writing its claims

@@ -257,6 +257,9 @@ private:
     // (the split is then two passes over the sources for nothing). Decided by the band's size, so
     // the claims' order, the lists and X are the same on any thread count.
     bool split_levels_ = true;
+    // Whether a level of this many sources is split (plane_split.hpp's threshold, in a step that may
+    // use two threads).
+    bool splits(std::size_t sources) const { return split_levels_ && sources >= detail::kPlaneSplitMin; }
     // Whether the next whole-band repair rebuilds its lists (relist) rather than moving points
     // between them: set by the last one's share of points that changed layer (repair_band).
     bool relist_next_ = true;
