@@ -4,9 +4,14 @@
 # mask, the box flow against ITK's, Figure 3, whole-volume meshing against VTK's Flying Edges, and
 # the swarm's step times; the load average and the time between stages. Needs `bash scripts/setup.sh
 # --peers` (./build and ./build-peer). Prints everything on stdout; logs and outputs go to OUT.
-# Usage: scripts/issue16_checks.sh OUT [--itk-only]      (about 10 minutes on a 2-core VM)
+# ITK's filter keeps as many layers on each side as the image has dimensions (3) unless told;
+# liveset keeps 2. ITK_LAYERS=2 runs ITK with liveset's band (the same segmentation, ~25-35 % less
+# work per iteration: docs/BENCHMARKS.md, session 44); unset or 0, ITK's default.
+# Usage: [ITK_LAYERS=N] scripts/issue16_checks.sh OUT [--itk-only]      (about 10 minutes on a 2-core VM)
 set -euo pipefail
-usage="usage: scripts/issue16_checks.sh OUT [--itk-only]"
+usage="usage: [ITK_LAYERS=N] scripts/issue16_checks.sh OUT [--itk-only]"
+itk_layers=${ITK_LAYERS:-0}
+[[ "$itk_layers" =~ ^[0-8]$ ]] || { echo "issue16_checks: ITK_LAYERS must be 0-8 (0: ITK's default), got '$itk_layers'" >&2; exit 2; }
 [ $# -ge 1 ] && [ $# -le 2 ] || { echo "$usage" >&2; exit 2; }
 itk_only=0
 if [ $# -eq 2 ]; then
@@ -27,12 +32,14 @@ load() { echo "-- load $(cut -d' ' -f1-3 /proc/loadavg), $(date -u +%H:%M:%S) UT
 summary() { /usr/bin/python3 -c 'import json, sys; d = json.load(sys.stdin); print({k: v for k, v in d.items() if not isinstance(v, (list, dict))})'; }
 
 load
+echo "ITK's layers on each side: $([ "$itk_layers" = 0 ] && echo "its default (3)" || echo "$itk_layers") (liveset: 2)"
 for threads in 1 2; do
   pin=()
   [ "$threads" = 1 ] && pin=(taskset -c 0)
   for round in 1 2 3; do
     ./build-peer/bench/peers/itk_threshold_levelset --image "$B/t1.mha" --mask "$B/brain_mask.nii.gz" \
-      --labels "$B/labels_crisp.nii.gz" "${S8[@]}" --iterations 600 --threads "$threads" --log "$out/itk${threads}_$round.jsonl" >/dev/null
+      --labels "$B/labels_crisp.nii.gz" "${S8[@]}" --iterations 600 --threads "$threads" --layers "$itk_layers" \
+      --log "$out/itk${threads}_$round.jsonl" >/dev/null
     start=$(date +%s.%N)
     "${pin[@]}" ./build/liveset --threads "$threads" "${segment[@]}" --out-mask "$out/mask${threads}_$round.nii.gz" \
       --log "$out/ls${threads}_$round.jsonl"

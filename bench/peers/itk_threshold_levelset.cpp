@@ -85,6 +85,7 @@ struct Args {
     double rms = 0.001;
     unsigned threads = 1;
     int label = 2;
+    unsigned layers = 0;  // the sparse field's layers on each side; 0: the filter's default (the image dimension)
     std::string init = "sdf";  // sdf: exact distance to the seed spheres; maurer: SignedMaurer of the balls
     std::vector<unsigned> checkpoints;
 };
@@ -93,7 +94,7 @@ struct Args {
     std::cerr << "itk_threshold_levelset: " << msg << "\n"
               << "usage: itk_threshold_levelset --image T1 --mask BRAIN_MASK --labels LABELS --seed I,J,K[:R] ...\n"
                  "  [--seed-radius 2] [--lower 72] [--upper 116] [--alpha 0.1] [--propagation W] [--curvature W]\n"
-                 "  [--naive-weights] [--iterations 1000] [--rms 0.001] [--threads 1] [--label 2]\n"
+                 "  [--naive-weights] [--iterations 1000] [--rms 0.001] [--threads 1] [--label 2] [--layers N]\n"
                  "  [--init sdf|maurer] [--checkpoints 50,200,...] [--out-mask FILE] [--log FILE.jsonl]\n";
     std::exit(2);
 }
@@ -148,6 +149,7 @@ Args parse(int argc, char** argv) {
         else if (k == "--rms") a.rms = to_double(val());
         else if (k == "--threads") a.threads = static_cast<unsigned>(to_double(val()));
         else if (k == "--label") a.label = static_cast<int>(to_double(val()));
+        else if (k == "--layers") a.layers = static_cast<unsigned>(to_double(val()));
         else if (k == "--init") a.init = val();
         else if (k == "--checkpoints") {
             for (double x : split_numbers(val())) a.checkpoints.push_back(static_cast<unsigned>(x));
@@ -159,6 +161,7 @@ Args parse(int argc, char** argv) {
     if (!(a.upper > a.lower)) usage("--upper must exceed --lower");
     if (!(a.alpha >= 0 && a.alpha < 1)) usage("--alpha must be in [0, 1)");
     if (a.threads < 1) usage("--threads must be >= 1");
+    if (a.layers > 8) usage("--layers must be at most 8 (0: the filter's default)");
     if (a.iterations < 1) usage("--iterations must be >= 1");
     if (a.init != "sdf" && a.init != "maurer") usage("--init must be sdf or maurer");
     for (const auto& t : seed_text) {
@@ -320,6 +323,7 @@ int main(int argc, char** argv) try {
     filter->SetMaximumRMSError(a.rms);
     filter->SetNumberOfIterations(a.iterations);
     filter->SetNumberOfWorkUnits(a.threads);
+    if (a.layers > 0) filter->SetNumberOfLayers(a.layers);  // else ImageDimension (3), the segmentation filters' default
 
     // Iteration observer: a timestamp per IterationEvent; at checkpoints, the Dice of the current
     // output (the sparse field updates the output buffer in place; its sign is valid everywhere).
@@ -430,6 +434,7 @@ int main(int argc, char** argv) try {
     std::printf("\"total_s\":%.3f,\"setup_s\":%.3f,\"iterate_s\":%.3f,", total_s, setup_s, iterate_s);
     std::printf("\"dice\":%.4f,\"segmented_voxels\":%llu,\"truth_voxels\":%llu,", o.dice,
                 static_cast<unsigned long long>(o.segmented), static_cast<unsigned long long>(o.truth));
+    std::printf("\"layers\":%u,", filter->GetNumberOfLayers());
     std::printf("\"threads\":%u,\"lower\":%g,\"upper\":%g,\"alpha\":%g,\"curvature_scaling\":%g,\"propagation_scaling\":%g,",
                 a.threads, a.lower, a.upper, a.alpha, static_cast<double>(filter->GetCurvatureScaling()),
                 static_cast<double>(filter->GetPropagationScaling()));

@@ -278,3 +278,41 @@ TEST(Activity, TheRowScanAgreesWithThePointTest) {
     EXPECT_GT(sleeping_seen, 1000);  // the test saw both answers, many times
     EXPECT_GT(awake_seen, 1000);
 }
+
+// wake_near wakes exactly the blocks within one block (each axis) of a woken point's block, on the
+// lattice's faces and edges too, whatever the order and repeats of the points (a run along x shares
+// its blocks): brute force over every point of a lattice of odd dimensions.
+TEST(Activity, WakeNearWakesTheBlocksAroundEachPoint) {
+    const Lattice l({13, 10, 9});
+    const Vec3i d = l.dims();
+    constexpr std::uint64_t kSpeed = 1;
+    std::mt19937 rng(11);
+    std::uniform_int_distribution<PointIndex> any(0, static_cast<PointIndex>(l.size() - 1));
+    FrontActivity a;
+    a.begin_step(l, kSpeed, 1);
+    for (std::int64_t t = 2; t <= 30; ++t) {
+        a.begin_step(l, kSpeed, t);
+        std::vector<PointIndex> woken;
+        const int n = static_cast<int>(t % 5);
+        for (int k = 0; k < n; ++k) {
+            const PointIndex p = any(rng);
+            woken.push_back(p);
+            if (k % 2 == 0 && l.coord(p).x + 1 < d.x) woken.push_back(p + 1);  // a run along x
+        }
+        if (t == 7) woken.push_back(l.index({0, 0, 0}));                      // corners of the lattice
+        if (t == 8) woken.push_back(l.index({d.x - 1, d.y - 1, d.z - 1}));
+        a.wake_near(woken, l, t);
+        for (int z = 0; z < d.z; ++z)
+            for (int y = 0; y < d.y; ++y)
+                for (int x = 0; x < d.x; ++x) {
+                    bool want = false;  // no speed change since step 1: only wakes count
+                    for (const PointIndex q : woken) {
+                        const Vec3i c = l.coord(q);
+                        want = want || (std::abs((c.x >> 1) - (x >> 1)) <= 1 && std::abs((c.y >> 1) - (y >> 1)) <= 1 &&
+                                        std::abs((c.z >> 1) - (z >> 1)) <= 1);
+                    }
+                    // With a window of 0 steps, awake at t iff woken at t.
+                    ASSERT_EQ(a.awake({x, y, z}, t, 0), want) << "step " << t << " point " << x << "," << y << "," << z;
+                }
+    }
+}

@@ -109,13 +109,25 @@ void FrontActivity::wake_near(std::span<const PointIndex> points, const Lattice&
     const auto bx = static_cast<int>(blocks_x_), by = static_cast<int>(blocks_y_), bz = static_cast<int>(blocks_z_);
     rebase(now);
     const std::int32_t at = offset_of(now, base_);
+    const IndexDecoder decoder(lattice);  // no division per point (a step's sign changes: half its front)
+    std::int32_t* const stamp = stamp_.data();
+    const std::size_t sy = blocks_x_, sz = blocks_x_ * blocks_y_;
+    std::size_t last = std::numeric_limits<std::size_t>::max();
     for (PointIndex i : points) {
-        const Vec3i p = lattice.coord(i);
+        const Vec3i p = decoder.coord(i);
         const Vec3i b{p.x >> 1, p.y >> 1, p.z >> 1};
+        const std::size_t block = static_cast<std::size_t>(b.x) + sy * static_cast<std::size_t>(b.y) + sz * static_cast<std::size_t>(b.z);
+        if (block == last) continue;  // its 27 blocks already hold `at` (points come in runs along x)
+        last = block;
+        if (b.x > 0 && b.y > 0 && b.z > 0 && b.x < bx - 1 && b.y < by - 1 && b.z < bz - 1) {
+            for (std::size_t z = block - sz - sy - 1; z <= block + sz - sy - 1; z += sz)
+                for (std::size_t row = z; row <= z + 2 * sy; row += sy) stamp[row] = stamp[row + 1] = stamp[row + 2] = at;
+            continue;
+        }
         for (int z = std::max(b.z - 1, 0); z <= std::min(b.z + 1, bz - 1); ++z)
             for (int y = std::max(b.y - 1, 0); y <= std::min(b.y + 1, by - 1); ++y)
                 for (int x = std::max(b.x - 1, 0); x <= std::min(b.x + 1, bx - 1); ++x)
-                    stamp_[static_cast<std::size_t>(x) + blocks_x_ * (static_cast<std::size_t>(y) + blocks_y_ * static_cast<std::size_t>(z))] = at;
+                    stamp[static_cast<std::size_t>(x) + sy * static_cast<std::size_t>(y) + sz * static_cast<std::size_t>(z)] = at;
     }
 }
 
