@@ -5,8 +5,8 @@
 # the swarm's step times; the load average and the time between stages. Needs `bash scripts/setup.sh
 # --peers` (./build and ./build-peer). Prints everything on stdout; logs and outputs go to OUT.
 # ITK's filter keeps as many layers on each side as the image has dimensions (3) unless told;
-# liveset keeps 2. ITK_LAYERS=2 runs ITK with liveset's band (the same segmentation, ~25-35 % less
-# work per iteration: docs/BENCHMARKS.md, session 44); unset or 0, ITK's default.
+# liveset keeps 2. ITK_LAYERS=2 runs ITK with liveset's band (the same segmentation, 0.66-0.91x the
+# time per iteration: docs/BENCHMARKS.md, session 44); unset or 0, ITK's default.
 # Usage: [ITK_LAYERS=N] scripts/issue16_checks.sh OUT [--itk-only]      (about 10 minutes on a 2-core VM)
 set -euo pipefail
 usage="usage: [ITK_LAYERS=N] scripts/issue16_checks.sh OUT [--itk-only]"
