@@ -4,9 +4,10 @@
 # mask, the box flow against ITK's, Figure 3, whole-volume meshing against VTK's Flying Edges, and
 # the swarm's step times; the load average and the time between stages. Needs `bash scripts/setup.sh
 # --peers` (./build and ./build-peer). Prints everything on stdout; logs and outputs go to OUT.
-# ITK's filter keeps as many layers on each side as the image has dimensions (3) unless told;
-# liveset keeps 2. ITK_LAYERS=2 runs ITK with liveset's band (the same segmentation, 0.66-0.91x the
-# time per iteration: docs/BENCHMARKS.md, session 44); unset or 0, ITK's default.
+# ITK's filters keep as many layers on each side as the image has dimensions (3) unless told;
+# liveset keeps 2. ITK_LAYERS=2 runs ITK (threshold level set and box flow) with liveset's band
+# (the same segmentation, 0.66-0.91x the time per iteration: docs/BENCHMARKS.md, session 44);
+# unset or 0, ITK's default.
 # Usage: [ITK_LAYERS=N] scripts/issue16_checks.sh OUT [--itk-only]      (about 10 minutes on a 2-core VM)
 set -euo pipefail
 usage="usage: [ITK_LAYERS=N] scripts/issue16_checks.sh OUT [--itk-only]"
@@ -55,7 +56,7 @@ md5sum "$out"/mask?_?.nii.gz | cut -c1-8 | sort | uniq -c
 
 echo "box flow, 1 thread (ITK, then liveset), 3 rounds:"
 for round in 1 2 3; do
-  taskset -c 0 ./build-peer/bench/peers/itk_box_flow --threads 1 | tail -1
+  taskset -c 0 ./build-peer/bench/peers/itk_box_flow --threads 1 --layers "$itk_layers" | tail -1
   taskset -c 0 ./build/liveset --threads 1 flow --check-every 0 --json | summary
 done
 load

@@ -61,16 +61,18 @@ struct Ctx {
 
 int main(int argc, char** argv) {
     int lattice = 100, box = 50, threads = 1, max_iterations = 20000;
+    int layers = 0;  // the sparse field's layers on each side; 0: the filter's default (the image dimension, 3)
     for (int i = 1; i < argc; ++i) {
         const std::string k = argv[i];
         if (i + 1 >= argc) {
-            std::cerr << "usage: itk_box_flow [--lattice 100] [--box 50] [--threads 1] [--max-iterations 20000]\n";
+            std::cerr << "usage: itk_box_flow [--lattice 100] [--box 50] [--threads 1] [--max-iterations 20000] [--layers N]\n";
             return 2;
         }
         if (k == "--lattice") lattice = int_arg(k, argv[++i], 4, 1024);
         else if (k == "--box") box = int_arg(k, argv[++i], 1, 1022);
         else if (k == "--threads") threads = int_arg(k, argv[++i], 1, 256);
         else if (k == "--max-iterations") max_iterations = int_arg(k, argv[++i], 1, 10'000'000);
+        else if (k == "--layers") layers = int_arg(k, argv[++i], 0, 8);
         else {
             std::cerr << "itk_box_flow: unknown option " << k << "\n";
             return 2;
@@ -115,6 +117,7 @@ int main(int argc, char** argv) {
     filter->SetMaximumRMSError(0.0);
     filter->SetNumberOfIterations(static_cast<itk::IdentifierType>(max_iterations));
     filter->SetNumberOfWorkUnits(static_cast<itk::ThreadIdType>(threads));
+    if (layers > 0) filter->SetNumberOfLayers(static_cast<unsigned>(layers));  // else ImageDimension (3)
 
     Ctx ctx{filter.GetPointer(), {}};
     ctx.stamps.reserve(static_cast<std::size_t>(max_iterations) + 1);
@@ -135,9 +138,9 @@ int main(int argc, char** argv) {
         ms.push_back(std::chrono::duration<double, std::milli>(ctx.stamps[i] - ctx.stamps[i - 1]).count());
     std::sort(ms.begin(), ms.end());
     const double median = ms.empty() ? 0.0 : ms[ms.size() / 2];
-    std::printf("{\"peer\":\"itk_box_flow\",\"lattice\":%d,\"box\":%d,\"threads\":%d,\"iterations\":%lu,\"vanished\":%s,"
+    std::printf("{\"peer\":\"itk_box_flow\",\"lattice\":%d,\"box\":%d,\"layers\":%u,\"threads\":%d,\"iterations\":%lu,\"vanished\":%s,"
                 "\"ms_per_iteration_median\":%.4f,\"total_s\":%.4f}\n",
-                lattice, box, threads, static_cast<unsigned long>(filter->GetElapsedIterations()),
+                lattice, box, filter->GetNumberOfLayers(), threads, static_cast<unsigned long>(filter->GetElapsedIterations()),
                 filter->ActiveLayerSize() == 0 ? "true" : "false", median, total_s);
     return 0;
 }
