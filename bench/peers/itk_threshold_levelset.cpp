@@ -123,6 +123,14 @@ double to_double(const std::string& s) {
     return v[0];
 }
 
+// A whole number in [lo, hi] (checked before the conversion, which is undefined out of range).
+long to_whole(const std::string& name, const std::string& s, long lo, long hi) {
+    const double x = to_double(s);
+    if (!(x >= static_cast<double>(lo) && x <= static_cast<double>(hi)) || x != std::floor(x))
+        usage(name + " must be a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got '" + s + "'");
+    return static_cast<long>(x);
+}
+
 Args parse(int argc, char** argv) {
     Args a;
     std::vector<std::string> seed_text;
@@ -145,14 +153,17 @@ Args parse(int argc, char** argv) {
         else if (k == "--propagation") a.propagation = to_double(val());
         else if (k == "--curvature") a.curvature = to_double(val());
         else if (k == "--naive-weights") a.naive_weights = true;
-        else if (k == "--iterations") a.iterations = static_cast<unsigned>(to_double(val()));
+        else if (k == "--iterations") a.iterations = static_cast<unsigned>(to_whole(k, val(), 1, 10'000'000));
         else if (k == "--rms") a.rms = to_double(val());
-        else if (k == "--threads") a.threads = static_cast<unsigned>(to_double(val()));
-        else if (k == "--label") a.label = static_cast<int>(to_double(val()));
-        else if (k == "--layers") a.layers = static_cast<unsigned>(to_double(val()));
+        else if (k == "--threads") a.threads = static_cast<unsigned>(to_whole(k, val(), 1, 256));
+        else if (k == "--label") a.label = static_cast<int>(to_whole(k, val(), 0, 255));
+        else if (k == "--layers") a.layers = static_cast<unsigned>(to_whole(k, val(), 0, 8));  // 0: the filter's default
         else if (k == "--init") a.init = val();
         else if (k == "--checkpoints") {
-            for (double x : split_numbers(val())) a.checkpoints.push_back(static_cast<unsigned>(x));
+            for (double x : split_numbers(val())) {
+                if (!(x >= 1 && x <= 1e7) || x != std::floor(x)) usage("--checkpoints must be whole iteration numbers");
+                a.checkpoints.push_back(static_cast<unsigned>(x));
+            }
         } else if (k == "-h" || k == "--help") usage("help");
         else usage("unknown argument " + k);
     }
@@ -160,9 +171,6 @@ Args parse(int argc, char** argv) {
     if (seed_text.empty()) usage("at least one --seed is required");
     if (!(a.upper > a.lower)) usage("--upper must exceed --lower");
     if (!(a.alpha >= 0 && a.alpha < 1)) usage("--alpha must be in [0, 1)");
-    if (a.threads < 1) usage("--threads must be >= 1");
-    if (a.layers > 8) usage("--layers must be at most 8 (0: the filter's default)");
-    if (a.iterations < 1) usage("--iterations must be >= 1");
     if (a.init != "sdf" && a.init != "maurer") usage("--init must be sdf or maurer");
     for (const auto& t : seed_text) {
         const auto colon = t.find(':');
