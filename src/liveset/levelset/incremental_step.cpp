@@ -1,6 +1,7 @@
 // The incremental global step: the same Δφ as the full-band step, applied only where it moves a
 // zero-layer value and re-layered only around those points; with sleeping on, only at the awake
-// zero-layer points (see sparse_field.hpp and activity.hpp).
+// zero-layer points (see sparse_field.hpp and activity.hpp); when most of a small front moves,
+// the whole band (repair_dense).
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -78,12 +79,32 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
     std::vector<ZeroLayerEdit> edits;
     detail::join_parts(parts, &Part::edits, edits);
     // Local and global re-layering give the same bits (sparse_field.hpp); when most of a small
-    // front moves, most of the band changes and the whole-band push sweep is the cheaper one.
+    // front moves, most of the band changes and a whole-band repair is the cheaper one
+    // (repair_dense: the push sweep, or changes of layer and a value pass when few points change
+    // layer).
     const bool dense = !edits.empty() && zero.size() <= options.dense_front_max && 5 * edits.size() >= 3 * zero.size();
     result.whole_band = dense;
-    result.changed = repair_band(edits, dense ? RepairScope::kGlobal : RepairScope::kLocal);
+    result.value_pass = dense && pass_next_;  // repair_dense's choice
+    result.changed = dense ? repair_dense(edits) : repair_band(edits, RepairScope::kLocal);
     last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return result;
+}
+
+// A dense step's repair (sparse_field.hpp): the same bits either way.
+ChangedPoints SparseField::repair_dense(std::span<const ZeroLayerEdit> edits) {
+    if (!pass_next_ || edits.empty()) return repair_band(edits, RepairScope::kGlobal);
+    std::vector<RegionPoint>& region = region_.v;
+    region.clear();
+    move_zero_layer(edits, region);
+    std::vector<PointIndex> pulled;  // X: the value pass's points, then the region's
+    pulled.reserve(band_size() + region.size());
+    relayer_changes(region, &pulled);
+    std::size_t layer_changes = 0;
+    ChangedPoints changed = finish(region, false, &layer_changes);
+    pass_next_ = 10 * layer_changes < band_size();
+    pulled.insert(pulled.end(), changed.points.begin(), changed.points.end());  // the pass changes no sign
+    changed.points.swap(pulled);
+    return changed;
 }
 
 }  // namespace liveset

@@ -1,7 +1,7 @@
-// Re-layering a repair region and settling it (see sparse_field.hpp for the scheme): the outer
-// layers from the new zero layer (the pull for any region, the push for the whole band, change
-// propagation for a local update), then the final statuses, X, the sign changes and the list moves
-// (or, after a whole-band sweep, the lists rebuilt from its levels: relist, sparse_field.cpp).
+// Re-layering a repair region (see sparse_field.hpp for the scheme): the outer layers from the new
+// zero layer (the pull for any region, the push for the whole band, change propagation for a local
+// update, or changes of layer only with a value pass over the lists for a dense one); settling it
+// (finish) is in settle.cpp.
 #include <tbb/parallel_for.h>
 
 #if defined(__SSE2__)
@@ -202,6 +202,43 @@ void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::
     }
 }
 
+// The dense repair's value pass at level k over list[b, e) of layer ±k (kOutside: +k): a point
+// still on that layer (no change of layer reached it, so it keeps its layer, and so do its
+// neighbours) takes its value from the inner level; it is recorded with its value (a store and a
+// count, whether it changed being unpredictable) if its bits change, to be written after the pass.
+// Whitaker's rule over the inner neighbours only, without reading their statuses: neighbouring
+// layers differ by at most one, so the point's neighbours are in layers k-1, k and k+1 of its side
+// (the zero layer for k = 1), whose values lie in [k-1.5, k-0.5], [k-0.5, k+0.5] and [k+0.5, k+1.5]
+// (far: N+1); so the min over all six is the min over the inner ones (a tie is the same value),
+// and min(φ) + 1 is min(φ + 1) bit for bit (rounding is monotonic). Inside, the same with max and
+// −1. Reads only; every pointer and the neighbour offsets are locals (see claim_from).
+template <bool kOutside>
+std::size_t pull_list(const PointIndex* list, std::size_t b, std::size_t e, std::int8_t layer, const float* phi,
+                      const std::int8_t* status, const detail::Neighbors6& neighbors, PointIndex* changed, float* values) {
+    const detail::Neighbors6 around = neighbors;
+    std::size_t n_changed = 0;
+    for (std::size_t n = b; n < e; ++n) {
+        if (n + detail::kAhead < e) __builtin_prefetch(phi + list[n + detail::kAhead], 0);
+        const PointIndex i = list[n];
+        if (status[i] != layer) continue;  // claimed by a change of layer (pending), or moved at a level below
+#if defined(__SSE2__)
+        __m128 best = _mm_set_ss(kOutside ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity());
+        around.visit(i, [&](PointIndex q) __attribute__((always_inline)) {
+            best = kOutside ? _mm_min_ss(best, _mm_load_ss(phi + q)) : _mm_max_ss(best, _mm_load_ss(phi + q));
+        });
+        const float v = _mm_cvtss_f32(best) + (kOutside ? 1.0f : -1.0f);
+#else
+        float best = kOutside ? std::numeric_limits<float>::infinity() : -std::numeric_limits<float>::infinity();
+        around.visit(i, [&](PointIndex q) { best = kOutside ? min_of(best, phi[q]) : max_of(best, phi[q]); });
+        const float v = best + (kOutside ? 1.0f : -1.0f);
+#endif
+        changed[n_changed] = i;
+        values[n_changed] = v;
+        n_changed += same_bits(v, phi[i]) ? 0 : 1;
+    }
+    return n_changed;
+}
+
 // One level of the push sweep from `sources`, in order (see sweep_whole_band): claims to `next`
 // (room for six per source), a far point claimed with its far mark; returns how many. What it
 // reads on every visit is held in locals (see claim_from).
@@ -284,60 +321,58 @@ void settle_claims(std::span<const PointIndex> claims, std::int8_t* status, std:
     down->resize(n_down);
 }
 
-// finish's pass over region[b, e): each point settled (a pending one is far: it left the band),
-// its index stored and counted if its layer or φ's bits changed, the move recorded (kMoves) if its
-// layer did, the point kept in `signs` if its sign did; returns how many changed and how many moved.
-// A free function so that every pointer it reads is a local: a status store, through a char type,
-// would make a closure's members reload on every point. Counts without branching on a change
-// (unpredictable).
-template <bool kMoves, class Record, class Move>
-std::pair<std::size_t, std::size_t> settle_region(const Record* points, std::size_t b, std::size_t e, float* phi,
-                                                  std::int8_t* status, std::int8_t far_out, PointIndex* changed,
-                                                  Move* moved, std::vector<PointIndex>& signs) {
-    const float far = static_cast<float>(far_out);
-    const auto far_in = static_cast<std::int8_t>(-far_out);
-    std::size_t n_changed = 0, n_moved = 0;
-    for (std::size_t n = b; n < e; ++n) {
-        if (n + detail::kAhead < e) {  // the region's points are scattered: fetch ahead
-            __builtin_prefetch(status + points[n + detail::kAhead].point, 1);
-            __builtin_prefetch(phi + points[n + detail::kAhead].point, 0);
-        }
-        const Record r = points[n];
-        const PointIndex i = r.point;
-        std::int8_t s = status[i];
-        float v = phi[i];
-        // Only a pending status is written: the sweeps left every other one final, and a store
-        // to a line another chunk's points share would make the cores fight over it.
-        if (s == kPendZero) {
-            s = 0;
-            status[i] = s;
-        } else if (s == kPendPos || s == kPendNeg) {  // left the band
-            s = s == kPendPos ? far_out : far_in;
-            v = s == far_out ? far : -far;
-            status[i] = s;
-            phi[i] = v;
-        }
-        const std::size_t layer_changed = s != r.old_status ? 1 : 0;
-        if constexpr (kMoves) moved[n_moved] = {n, s};
-        n_moved += layer_changed;
-        changed[n_changed] = i;
-        n_changed += layer_changed | (same_bits(v, r.old_phi) ? 0u : 1u);
-        if ((v < 0.0f) != (r.old_phi < 0.0f)) signs.push_back(i);
-    }
-    return {n_changed, n_moved};
-}
-
 }  // namespace
+
+// The dense form's value pass at level k: pull_list over the lists of layers +k and -k (reads
+// only, in chunks on two threads), then the values written; the points whose value changed are
+// appended to `pulled` in list order (the chunks joined in order).
+void SparseField::pass_values(int k, std::vector<PointIndex>& pulled) {
+    struct Part {
+        std::size_t at = 0, n = 0;  // the chunk's changed points: pulled[at, at + n), pass_value_[at, ...)
+    };
+    float* const phi = phi_.values().data();
+    const std::int8_t* const status = status_.values().data();
+    const detail::Neighbors6 around(lattice(), decoder_);
+    std::vector<float>& values = pass_value_.v;
+    for (const auto layer : {static_cast<std::int8_t>(k), static_cast<std::int8_t>(-k)}) {
+        const PointList& list = lists_[static_cast<std::size_t>(layers_ + layer)];
+        const std::size_t at = pulled.size();
+        pulled.resize(at + list.size());  // room for every point (reserved by repair_dense)
+        if (values.size() < at + list.size()) values.resize(std::max(at + list.size(), 2 * values.size()));
+        auto parts = detail::ordered_chunks<Part>(list.size(), [&](std::size_t b, std::size_t e, Part& out) {
+            out.at = at + b;
+            out.n = layer > 0 ? pull_list<true>(list.data(), b, e, layer, phi, status, around, pulled.data() + out.at, values.data() + out.at)
+                              : pull_list<false>(list.data(), b, e, layer, phi, status, around, pulled.data() + out.at, values.data() + out.at);
+        });
+        std::size_t end = at;  // each chunk's points moved up behind the ones before, then written
+        for (const Part& p : parts) {
+            for (std::size_t n = 0; n < p.n; ++n) {
+                phi[pulled[p.at + n]] = values[p.at + n];
+                pulled[end + n] = pulled[p.at + n];
+            }
+            end += p.n;
+        }
+        pulled.resize(end);
+    }
+}
 
 // Level k re-evaluates the points still pending from level k-1 plus every neighbour, not yet final,
 // of a point that changed at level k-1 (entered or left layer ±(k-1), or took a new value there).
 // Exact: a point's layer and value depend only on its neighbours one level further in, so a point
 // none of whose neighbours changed keeps both (the state before the update is the layers' fixed
 // point); a point whose layer is below k is final by then (it depends on levels below k-1 only).
-void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
-    std::vector<PointIndex> changed;  // the points that changed at the level below; level 0: every seed
+// The dense form (`pulled`): a point's layer depends only on the layers of its neighbours one level
+// further in, so only a change of layer needs propagating; a point no change of layer reaches keeps
+// its layer, and its value is Whitaker's rule over its neighbours, which the value pass gives it
+// (pull_list). Level 1's changes of layer are the points that left or entered the zero layer.
+void SparseField::relayer_changes(std::vector<RegionPoint>& region, std::vector<PointIndex>* pulled) {
+    const bool dense = pulled != nullptr;
+    // The points that changed at the level below; level 0: every seed (dense: those that left or
+    // entered the zero layer).
+    std::vector<PointIndex> changed;
     changed.reserve(region.size());
-    for (const RegionPoint& r : region) changed.push_back(r.point);
+    for (const RegionPoint& r : region)
+        if (!dense || status_[r.point] != kPendZero || r.old_status != 0) changed.push_back(r.point);
     std::vector<std::size_t> pending;
     for (std::size_t r = 0; r < region.size(); ++r)
         if (status_[region[r].point] == kPendPos || status_[region[r].point] == kPendNeg) pending.push_back(r);
@@ -374,7 +409,7 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
             });
         }
         for (std::size_t r = first_new; r < region.size(); ++r) pending.push_back(r);
-        if (pending.empty()) break;
+        if (pending.empty() && !dense) break;
         // Decide (reads only; Jacobi within a level, so any thread order agrees) ...
         value.resize(pending.size());
         outside.resize(pending.size());
@@ -383,6 +418,9 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
             decide_from(pending.data(), b, e, first_new, region.data(), phi, status, lat, decoder, inner, value.data(),
                         outside.data());
         });
+        // (dense: the points that keep layer ±k take their values from level k-1, in place; the
+        // decide pass has read what it needs, and no pending point's value is read by the pass) ...
+        if (dense) pass_values(k, *pulled);
         // ... then write, each chunk its own points; the lists join in chunk order. Without a
         // branch on whether a point settled (unpredictable; a mispredicted branch also stalls the
         // next points' loads): every point's status and value are stored (a point that stays
@@ -407,7 +445,9 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region) {
                 next[n_next] = r;
                 n_next += stays ? 1 : 0;
                 changed_here[n_changed] = p;
-                n_changed += (stays ? std::abs(rp.old_status) == k : (layer != rp.old_status || !same_bits(v, rp.old_phi))) ? 1 : 0;
+                // Dense: only a change of layer reaches the next level (values come by the pass).
+                n_changed += (stays ? std::abs(rp.old_status) == k
+                                    : (layer != rp.old_status || (!dense && !same_bits(v, rp.old_phi)))) ? 1 : 0;
             }
             out.next.resize(n_next);
             out.changed.resize(n_changed);
@@ -513,88 +553,6 @@ void SparseField::sweep_layers(std::span<const RegionPoint> region) {
         }
         pending.swap(next);
     }
-}
-
-// Moves the points whose layer changed between the lists: every removal, then every addition, each
-// in region order. The moves are first bucketed by list (a stable counting sort), so that each
-// list walks only its own; a list's operations touch only its own points' slots, so each list is
-// one task once there are many moves; the lists come out the same on any thread count.
-void SparseField::move_between_lists(std::span<const RegionPoint> region, std::span<const ListMove> moves) {
-    ensure_slots();  // list_add and list_remove use them
-    const int lists = 2 * layers_ + 1;
-    const auto list_of = [&](int layer) { return layer >= -layers_ && layer <= layers_ ? layer + layers_ : -1; };
-    // begin[l] .. begin[l + 1]: list l's points; counted one slot up, then summed.
-    std::array<std::size_t, 2 * kMaxLayers + 2> out_begin{}, in_begin{};
-    for (const ListMove& m : moves) {
-        const int from = list_of(region[m.region_index].old_status), to = list_of(m.layer);
-        if (from >= 0) ++out_begin[static_cast<std::size_t>(from) + 1];
-        if (to >= 0) ++in_begin[static_cast<std::size_t>(to) + 1];
-    }
-    for (int l = 0; l < lists; ++l) {
-        out_begin[static_cast<std::size_t>(l) + 1] += out_begin[static_cast<std::size_t>(l)];
-        in_begin[static_cast<std::size_t>(l) + 1] += in_begin[static_cast<std::size_t>(l)];
-    }
-    PointList& out = moved_out_.v;
-    PointList& in = moved_in_.v;
-    out.resize(out_begin[static_cast<std::size_t>(lists)]);
-    in.resize(in_begin[static_cast<std::size_t>(lists)]);
-    {
-        auto out_at = out_begin, in_at = in_begin;
-        for (const ListMove& m : moves) {
-            const RegionPoint& r = region[m.region_index];
-            const int from = list_of(r.old_status), to = list_of(m.layer);
-            if (from >= 0) out[out_at[static_cast<std::size_t>(from)]++] = r.point;
-            if (to >= 0) in[in_at[static_cast<std::size_t>(to)]++] = r.point;
-        }
-    }
-    const bool parallel = moves.size() >= detail::kParallelMin;
-    // A point leaves its old list before it enters its new one (both touch its slot).
-    detail::for_each_list(lists, parallel, [&](std::size_t l) {
-        for (std::size_t n = out_begin[l]; n < out_begin[l + 1]; ++n) list_remove(out[n], static_cast<int>(l) - layers_);
-    });
-    detail::for_each_list(lists, parallel, [&](std::size_t l) {
-        for (std::size_t n = in_begin[l]; n < in_begin[l + 1]; ++n) list_add(in[n], static_cast<int>(l) - layers_);
-    });
-}
-
-// Settles every region point (a pending one is far), in parallel over fixed chunks; then moves the
-// points whose layer changed between the lists (move_between_lists), unless the caller rebuilds
-// them (relist). The change report and the sign changes come in the region's order, whatever the
-// thread count.
-ChangedPoints SparseField::finish(std::span<const RegionPoint> region, bool rebuilding_lists, std::size_t* layer_changes) {
-    struct Part {
-        std::vector<PointIndex> changed, signs;
-        std::vector<ListMove> moved;  // the points whose layer changed (when the lists are moved)
-        std::size_t n_moved = 0;
-    };
-    const bool record_moves = !rebuilding_lists;
-    const std::int8_t far_out = far_outside();
-    float* const phi = phi_.values().data();  // raw: see sweep_whole_band
-    std::int8_t* const status = status_.values().data();
-    const RegionPoint* const points = region.data();
-    auto parts = detail::ordered_chunks<Part>(region.size(), [=](std::size_t b, std::size_t e, Part& out) {
-        out.changed.resize(e - b);                   // most region points change: a store and a count each
-        if (record_moves) out.moved.resize(e - b);  // and many move (unpredictably): the same
-        const auto [n_changed, n_moved] =
-            record_moves ? settle_region<true>(points, b, e, phi, status, far_out, out.changed.data(), out.moved.data(), out.signs)
-                         : settle_region<false>(points, b, e, phi, status, far_out, out.changed.data(), out.moved.data(), out.signs);
-        out.changed.resize(n_changed);
-        if (record_moves) out.moved.resize(n_moved);
-        out.n_moved = n_moved;
-    });
-    if (layer_changes != nullptr) {
-        *layer_changes = 0;
-        for (const Part& p : parts) *layer_changes += p.n_moved;
-    }
-    if (record_moves) {
-        std::vector<ListMove> moved;
-        detail::join_parts(parts, &Part::moved, moved);
-        move_between_lists(region, moved);
-    }
-    ChangedPoints changed;
-    detail::join_parts(parts, &Part::changed, changed.points);
-    detail::join_parts(parts, &Part::signs, changed.sign_changes.emplace());
-    return changed;
 }
 
 }  // namespace liveset

@@ -66,8 +66,11 @@ enum class StepMode {
 struct StepOptions {
     float cfl = 0.5f;        // largest |Δφ| of one step (at most 0.5, the sparse-field step bound)
     float max_dt = 1.0e9f;   // optional cap on the time step
-    // The full-band reference by default: the fastest exact step when most of the front moves
-    // every step (a curvature flow, a growing segmentation); kIncremental costs what moves.
+    // The full-band reference by default; kIncremental gives its bits and costs what moves, or
+    // when most of the front moves, the whole band as the cheaper of two exact repairs (the
+    // reference's push sweep where many points change layer, a growing segmentation; changes of
+    // layer and one value pass over the lists where few do, a curvature flow: 0.75-0.85x the
+    // sweep's time per step on the box, docs/BENCHMARKS.md, session 45).
     StepMode mode = StepMode::kFullBand;
     // Sleeping (needs kIncremental; docs/ARCHITECTURE.md, "Activity"): a stretch of front where no
     // point changed sign within 2-3 points for `sleep_after` steps sleeps - its zero-layer points
@@ -111,6 +114,7 @@ struct StepResult {
     std::size_t zero_layer = 0;    // zero-layer size before the step
     std::size_t awake = 0;         // zero-layer points evaluated (all of them unless sleeping)
     bool whole_band = false;       // the repair re-layered the whole band (kFullBand; a dense kIncremental step)
+    bool value_pass = false;       // ... by changes of layer and a value pass (a dense step, few points changing layer)
     ChangedPoints changed;         // points whose φ or status changed, and those whose sign changed
 };
 
@@ -213,7 +217,16 @@ private:
     void move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vector<RegionPoint>& region);
     // Re-layers level by level from the pending points in `region` (the zero layer's changes),
     // re-evaluating only what a change at the level below can reach; appends what it marks.
-    void relayer_changes(std::vector<RegionPoint>& region);  // relayer.cpp, as the sweeps and finish
+    // `pulled` (the dense form): only changes of layer propagate; every other point of each layer
+    // takes its value from the level inside it (pass_values), and those whose value changed are
+    // appended to `pulled`.
+    void relayer_changes(std::vector<RegionPoint>& region, std::vector<PointIndex>* pulled = nullptr);  // relayer.cpp
+    void pass_values(int k, std::vector<PointIndex>& pulled);
+    // The repair of a step where most of the zero layer moved (step_incremental): the whole band
+    // either way, with the same bits; by the dense form of relayer_changes when the last whole-band
+    // repair changed the layer of under a tenth of the band (pass_next_), else as repair_band's
+    // global repair (the push sweep).
+    ChangedPoints repair_dense(std::span<const ZeroLayerEdit> edits);
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     // Marks the whole band pending (appending what it marks); returns the new zero layer.
     PointList collect_band(std::vector<RegionPoint>& region);
@@ -263,6 +276,12 @@ private:
     // Whether the next whole-band repair rebuilds its lists (relist) rather than moving points
     // between them: set by the last one's share of points that changed layer (repair_band).
     bool relist_next_ = true;
+    // Whether the next dense repair propagates only changes of layer and passes over the lists for
+    // the values (repair_dense): set by the last whole-band repair's share of the band that changed
+    // layer. A front growing from seeds changes 10-30 % of its band per step (BrainWeb), where
+    // the push sweep costs 0.7-0.9x the dense form; the box under curvature flow 0-10 %, where the
+    // dense form costs 0.75-0.85x the sweep (docs/BENCHMARKS.md, session 45).
+    bool pass_next_ = false;
     std::size_t zero_reordered_ = 0;  // zero-layer list insertions and removals since its last sort
     double last_update_ms_ = 0.0;
     std::int64_t steps_ = 0;                    // global steps taken (the activity's clock)
@@ -295,6 +314,7 @@ private:
     Kept<detail::PlaneSplit> split_;               // a large level's sources split for two tasks (plane_split.hpp)
     Kept<PointList> moved_out_, moved_in_;     // move_between_lists' points, bucketed by list
     Kept<PointList> sort_scratch_;             // sort_lists' radix sort
+    Scratch<float> pass_value_;                    // pass_values' new values
 };
 
 }  // namespace liveset
