@@ -203,8 +203,8 @@ void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::
 }
 
 // The dense repair's value pass at level k over list[b, e) of layer ±k (kOutside: +k): a point
-// still on that layer (no change of layer reached it, so it keeps its layer, and so do its
-// neighbours) takes its value from the inner level; it is recorded with its value (a store and a
+// still on that layer (no change of layer at level k-1 reached it, so it keeps its layer and its
+// inner neighbours) takes its value from the inner level; it is recorded with its value (a store and a
 // count, whether it changed being unpredictable) if its bits change, to be written after the pass.
 // Whitaker's rule over the inner neighbours only, without reading their statuses: neighbouring
 // layers differ by at most one, so the point's neighbours are in layers k-1, k and k+1 of its side
@@ -418,8 +418,8 @@ void SparseField::relayer_changes(std::vector<RegionPoint>& region, std::vector<
             decide_from(pending.data(), b, e, first_new, region.data(), phi, status, lat, decoder, inner, value.data(),
                         outside.data());
         });
-        // (dense: the points that keep layer ±k take their values from level k-1, in place; the
-        // decide pass has read what it needs, and no pending point's value is read by the pass) ...
+        // (dense: the points that keep layer ±k take their values from level k-1: read, then
+        // written; no pending point's decision reads them) ...
         if (dense) pass_values(k, *pulled);
         // ... then write, each chunk its own points; the lists join in chunk order. Without a
         // branch on whether a point settled (unpredictable; a mispredicted branch also stalls the
