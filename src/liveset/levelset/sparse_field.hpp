@@ -279,7 +279,7 @@ private:
     // Whether the next dense repair propagates only changes of layer and passes over the lists for
     // the values (repair_dense): set by the last whole-band repair's share of the band that changed
     // layer. A front growing from seeds changes 10-30 % of its band per step (BrainWeb), where
-    // the push sweep costs 0.7-0.9x the dense form; the box under curvature flow 0-10 %, where the
+    // the push sweep costs 0.65-0.9x the dense form; the box under curvature flow 0-10 %, where the
     // dense form costs 0.75-0.85x the sweep (docs/BENCHMARKS.md, session 45).
     bool pass_next_ = false;
     std::size_t zero_reordered_ = 0;  // zero-layer list insertions and removals since its last sort
