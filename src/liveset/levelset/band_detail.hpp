@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <sstream>
@@ -41,6 +42,9 @@ inline std::string point_text(const Lattice& lat, PointIndex i) {
     os << '(' << c.x << ',' << c.y << ',' << c.z << ')';
     return os.str();
 }
+
+// Whether two floats have the same bits (a change report counts a value whose bits changed).
+inline bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
 
 inline bool is_temp(std::int8_t s) { return s >= kPendPos || s <= kPendNeg; }
 // The pending code a band point of status s takes when an update marks it.

@@ -101,7 +101,7 @@ ChangedPoints SparseField::repair_dense(std::span<const ZeroLayerEdit> edits) {
     relayer_changes(region, &pulled);
     std::size_t layer_changes = 0;
     ChangedPoints changed = finish(region, false, &layer_changes);
-    pass_next_ = 10 * layer_changes < band_size();
+    pass_next_ = few_layer_changes(layer_changes);
     pulled.insert(pulled.end(), changed.points.begin(), changed.points.end());  // the pass changes no sign
     changed.points.swap(pulled);
     return changed;

@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -31,9 +30,8 @@ using detail::kNoSlot;
 using detail::kPendNeg;
 using detail::kPendPos;
 using detail::kPendZero;
+using detail::same_bits;
 using detail::parallel_range;
-
-bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
 
 // What a neighbour's status makes of an offer in the push sweep, looked up instead of branched on
 // (a band neighbour's status is unpredictable): keep it; keep the min (the same layer, outside) or

@@ -1,7 +1,6 @@
 // Settling a repair region (see sparse_field.hpp for the scheme): each point's final status, X and
 // the sign changes (finish), and the moves of the points whose layer changed between the lists.
 #include <array>
-#include <bit>
 #include <cstdint>
 #include <span>
 #include <utility>
@@ -17,8 +16,7 @@ namespace {
 using detail::kPendNeg;
 using detail::kPendPos;
 using detail::kPendZero;
-
-bool same_bits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
+using detail::same_bits;
 
 // finish's pass over region[b, e): each point settled (a pending one is far: it left the band),
 // its index stored and counted if its layer or φ's bits changed, the move recorded (kMoves) if its
@@ -62,7 +60,6 @@ std::pair<std::size_t, std::size_t> settle_region(const Record* points, std::siz
     }
     return {n_changed, n_moved};
 }
-
 
 }  // namespace
 

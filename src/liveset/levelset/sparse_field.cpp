@@ -420,7 +420,7 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         ChangedPoints changed = finish(region, rebuild, &layer_changes);
         if (rebuild) relist(zero);
         relist_next_ = 8 * layer_changes >= region.size();
-        pass_next_ = 10 * layer_changes < band_size();
+        pass_next_ = few_layer_changes(layer_changes);
         return changed;
     }
     return finish(region);

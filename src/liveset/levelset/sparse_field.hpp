@@ -282,6 +282,7 @@ private:
     // the push sweep costs 0.65-0.9x the dense form; the box under curvature flow 0-10 %, where the
     // dense form costs 0.75-0.85x the sweep (docs/BENCHMARKS.md, session 45).
     bool pass_next_ = false;
+    bool few_layer_changes(std::size_t layer_changes) const { return 10 * layer_changes < band_size(); }  // pass_next_'s rule
     std::size_t zero_reordered_ = 0;  // zero-layer list insertions and removals since its last sort
     double last_update_ms_ = 0.0;
     std::int64_t steps_ = 0;                    // global steps taken (the activity's clock)
