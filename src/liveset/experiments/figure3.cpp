@@ -3,9 +3,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <set>
 #include <span>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "liveset/levelset/curvature_flow.hpp"
 #include "liveset/mesh/fragment_mesher.hpp"
@@ -31,20 +35,90 @@ void naive_scan(Column& c, const Grid<float>& phi) {
     c.scan.polygonise_box(phi, {0, 0, 0}, {d.x - 1, d.y - 1, d.z - 1}, c.scan_mesh);
 }
 
-void verify(int step, const Grid<float>& phi, std::span<const PointIndex> zero_layer, const std::vector<Column>& cols) {
+void verify(int step, const Grid<float>& phi, std::span<const PointIndex> zero_layer, const Column& c) {
     const Mesh ref = marching_cubes_band(phi, zero_layer);
-    const auto ref_tris = canonical_triangles(ref);
-    for (const Column& c : cols) {
-        const Mesh m = c.out.naive ? c.scan_mesh : c.mesher.merged();
-        std::string at = "figure 3 check failed at step ";  // appended: gcc 12's -Wrestrict misfires on "…" + string
-        at += std::to_string(step) + ": " + c.out.name + " mesh ";
-        if (m.triangle_count() != ref.triangle_count())
-            throw std::runtime_error(at + "has " + std::to_string(m.triangle_count()) + " triangles, marching_cubes_band has " +
-                                     std::to_string(ref.triangle_count()));
-        if (canonical_triangles(m) != ref_tris)
-            throw std::runtime_error(at + "differs from marching_cubes_band (" + std::to_string(m.triangle_count()) +
-                                     " triangles each)");
+    const Mesh m = c.out.naive ? c.scan_mesh : c.mesher.merged();
+    std::string at = "figure 3 check failed at step ";  // appended: gcc 12's -Wrestrict misfires on "…" + string
+    at += std::to_string(step) + ": " + c.out.name + " mesh ";
+    if (m.triangle_count() != ref.triangle_count())
+        throw std::runtime_error(at + "has " + std::to_string(m.triangle_count()) + " triangles, marching_cubes_band has " +
+                                 std::to_string(ref.triangle_count()));
+    if (canonical_triangles(m) != canonical_triangles(ref))
+        throw std::runtime_error(at + "differs from marching_cubes_band (" + std::to_string(m.triangle_count()) +
+                                 " triangles each)");
+}
+
+// FNV-1a over a step's X and its sign changes: every column's flow must hand its mesher the same.
+std::uint64_t fingerprint(std::span<const PointIndex> changed, std::span<const PointIndex> signs) {
+    std::uint64_t h = 1469598103934665603ull;
+    const auto mix = [&](std::uint64_t v) { h = (h ^ v) * 1099511628211ull; };
+    for (const PointIndex x : changed) mix(x);
+    mix(~std::uint64_t{0});
+    for (const PointIndex x : signs) mix(x);
+    return h;
+}
+
+// One column: its own flow of the box from the start, re-meshed after every step by this column
+// alone (as a session re-meshes with its one mesher), so no other column's meshes share its caches.
+// The flow is deterministic: every column's flow must give the X of the first (`steps_x`, filled
+// by the first column, checked by the others).
+Figure3Column run_column(const Figure3Options& a, const BoxFlowOptions& box, const std::string& name, bool naive, int size,
+                         std::vector<std::uint64_t>& steps_x, Figure3Result& r) {
+    using clock = std::chrono::steady_clock;
+    SparseField field = make_box_field(box);
+    Column c{Figure3Column{}, FragmentMesher(field.lattice(), size), CellPolygoniser{}, Mesh{}};
+    c.out.name = name;
+    c.out.naive = naive;
+    if (naive) naive_scan(c, field.phi());
+    else c.mesher.full_rebuild(field.phi(), field.zero_layer());
+    c.out.fragments = naive ? 1 : c.mesher.fragment_count();
+    c.out.cumulative.reserve(static_cast<std::size_t>(a.steps));
+    verify(0, field.phi(), field.zero_layer(), c);
+    const bool first = steps_x.empty();
+    const auto cells = static_cast<std::size_t>(a.lattice - 1);
+    int checks = 1;
+    const auto mesh_step = [&](int step, std::span<const PointIndex> changed, std::span<const PointIndex> signs) {
+        const std::uint64_t x = fingerprint(changed, signs);
+        const auto k = static_cast<std::size_t>(step - 1);
+        if (first) {
+            steps_x.push_back(x);
+            r.changed_sum += changed.size();
+        } else if (k >= steps_x.size() || steps_x[k] != x) {
+            throw std::runtime_error("figure 3: column " + name + " saw a different X at step " + std::to_string(step) +
+                                     " than the first column (the flow must be deterministic)");
+        }
+        std::size_t rebuilt = 1;
+        const auto t0 = clock::now();
+        if (naive) naive_scan(c, field.phi());
+        else rebuilt = c.mesher.update(field.phi(), changed, signs).size();
+        const auto t1 = clock::now();
+        c.out.total_s += std::chrono::duration<double>(t1 - t0).count();
+        c.out.cumulative.push_back(c.out.total_s);
+        c.out.rebuilt_sum += rebuilt;
+        c.out.rebuilt_max = std::max(c.out.rebuilt_max, rebuilt);
+        c.out.cells_sum += naive ? cells * cells * cells : c.mesher.last_stats().cells_visited;
+        if (!naive) c.out.vertices_only_sum += c.mesher.last_stats().vertices_only;
+        if ((a.verify_every > 0 && step % a.verify_every == 0) || step == a.steps) {
+            verify(step, field.phi(), field.zero_layer(), c);
+            ++checks;
+        }
+    };
+    const FlowHook hook = [&](const SparseField&, const StepResult& s, const FlowStepRecord& rec) {
+        mesh_step(rec.step, s.changed.points, s.changed.sign_changes.value());
+        return true;
+    };
+    // The driver's time step stays at 1/6 (the parabolic bound before session 15; the box vanishes
+    // after step 1410), so the columns stay comparable with earlier runs: at the level set's own
+    // bound of 1/4 it vanishes after 941 steps, which would only add idle steps to every column.
+    const BoxFlowReport rep = run_curvature_flow(field, a.steps, {.cfl = box.cfl, .max_dt = 1.0f / 6.0f}, hook);
+    const int flow_steps = static_cast<int>(rep.steps.size());
+    for (int s = flow_steps + 1; s <= a.steps; ++s) mesh_step(s, {}, {});
+    if (first) {
+        r.flow_steps = flow_steps;
+        for (const FlowStepRecord& rec : rep.steps) r.level_set_s += rec.ms / 1000.0;
+        r.checks = checks;
     }
+    return std::move(c.out);
 }
 
 }  // namespace
@@ -71,71 +145,16 @@ Figure3Result run_figure3(const Figure3Options& a) {
     box.lattice = a.lattice;
     box.box = a.box;
     box.max_steps = a.steps;
-    SparseField field = make_box_field(box);
-    const Lattice& lattice = field.lattice();
     const int cells = a.lattice - 1;
-
-    std::vector<Column> cols;
-    const auto add = [&](std::string name, bool naive, int size) {
-        Figure3Column out;
-        out.name = std::move(name);
-        out.naive = naive;
-        cols.push_back(Column{std::move(out), FragmentMesher(lattice, size), CellPolygoniser{}, Mesh{}});
-    };
     const auto name = [](int n, const char* suffix) {
         std::string x = "x";  // appended: gcc 12's -Wrestrict misfires on "x" + std::to_string(n)
         x += std::to_string(n);
         return x + suffix;
     };
-    for (int s : a.sizes) add(name(s, ""), s >= cells, std::min(s, cells));
-    add(name(a.lattice, "_band"), false, cells);
-    for (Column& c : cols) {
-        if (c.out.naive) naive_scan(c, field.phi());
-        else c.mesher.full_rebuild(field.phi(), field.zero_layer());
-        c.out.fragments = c.out.naive ? 1 : c.mesher.fragment_count();
-        c.out.cumulative.reserve(static_cast<std::size_t>(a.steps));
-    }
-    verify(0, field.phi(), field.zero_layer(), cols);
-
-    using clock = std::chrono::steady_clock;
     Figure3Result r;
-    r.checks = 1;
-    // Each column gets the step's X and its sign changes (ChangedPoints), as a session does.
-    const auto mesh_step = [&](int step, std::span<const PointIndex> changed, std::span<const PointIndex> signs) {
-        const Grid<float>& phi = field.phi();
-        r.changed_sum += changed.size();
-        const std::size_t n = cols.size();
-        for (std::size_t k = 0; k < n; ++k) {  // rotate the order so no size always runs first
-            Column& c = cols[(k + static_cast<std::size_t>(step)) % n];
-            std::size_t rebuilt = 1;
-            const auto t0 = clock::now();
-            if (c.out.naive) naive_scan(c, phi);
-            else rebuilt = c.mesher.update(phi, changed, signs).size();
-            const auto t1 = clock::now();
-            c.out.total_s += std::chrono::duration<double>(t1 - t0).count();
-            c.out.cumulative.push_back(c.out.total_s);
-            c.out.rebuilt_sum += rebuilt;
-            c.out.rebuilt_max = std::max(c.out.rebuilt_max, rebuilt);
-            c.out.cells_sum += c.out.naive ? static_cast<std::size_t>(cells) * cells * cells : c.mesher.last_stats().cells_visited;
-            if (!c.out.naive) c.out.vertices_only_sum += c.mesher.last_stats().vertices_only;
-        }
-        if ((a.verify_every > 0 && step % a.verify_every == 0) || step == a.steps) {
-            verify(step, phi, field.zero_layer(), cols);
-            ++r.checks;
-        }
-    };
-    const FlowHook hook = [&](const SparseField&, const StepResult& s, const FlowStepRecord& rec) {
-        mesh_step(rec.step, s.changed.points, s.changed.sign_changes.value());
-        return true;
-    };
-    // The driver's time step stays at 1/6 (the parabolic bound before session 15; the box vanishes
-    // after step 1410), so the columns stay comparable with earlier runs: at the level set's own
-    // bound of 1/4 it vanishes after 941 steps, which would only add idle steps to every column.
-    const BoxFlowReport rep = run_curvature_flow(field, a.steps, {.cfl = box.cfl, .max_dt = 1.0f / 6.0f}, hook);
-    r.flow_steps = static_cast<int>(rep.steps.size());
-    for (int s = r.flow_steps + 1; s <= a.steps; ++s) mesh_step(s, {}, {});
-    for (const FlowStepRecord& rec : rep.steps) r.level_set_s += rec.ms / 1000.0;
-    for (Column& c : cols) r.columns.push_back(std::move(c.out));
+    std::vector<std::uint64_t> steps_x;  // each step's X, as the first column's flow gave it
+    for (int s : a.sizes) r.columns.push_back(run_column(a, box, name(s, ""), s >= cells, std::min(s, cells), steps_x, r));
+    r.columns.push_back(run_column(a, box, name(a.lattice, "_band"), false, cells, steps_x, r));
     return r;
 }
 
