@@ -35,6 +35,28 @@ inline constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;
 // front points on the 2-core VM (docs/BENCHMARKS.md, session 36).
 inline constexpr std::size_t kAhead = 16;
 
+// Fetches the lattice lines a point's six-neighbour stencil touches (its own, which holds its x
+// neighbours, and those ±y and ±z) in φ and in the statuses (either skipped when null): a hint
+// for a loop over scattered points, issued kAhead points ahead (no effect on any result); indices
+// clamped to the lattice, so no pointer leaves it. docs/BENCHMARKS.md, session 46.
+[[gnu::always_inline]] inline void prefetch_stencil(const float* phi, const std::int8_t* status, PointIndex i, PointIndex sy,
+                                                    PointIndex sz, PointIndex last) {
+    const PointIndex at[5] = {i, i >= sy ? i - sy : 0, std::min(i + sy, last), i >= sz ? i - sz : 0, std::min(i + sz, last)};
+    for (const PointIndex a : at) {
+        if (phi != nullptr) __builtin_prefetch(phi + a, 0);
+        if (status != nullptr) __builtin_prefetch(status + a, 0);
+    }
+}
+
+// Room for n elements in a buffer kept between steps (cleared, then resized): its capacity at
+// least doubles when it grows, so a growing front does not reallocate it every step (a cleared
+// vector resized past its capacity gets exactly n, and fresh memory is faulted in page by page;
+// on the VM clearing such pages took 0.3-5 % of a BrainWeb run, docs/BENCHMARKS.md, session 46).
+template <class Vector>
+void reserve_growing(Vector& v, std::size_t n) {
+    if (v.capacity() < n) v.reserve(std::max(n, 2 * v.capacity()));
+}
+
 // "(x,y,z)": a lattice point in an error message.
 inline std::string point_text(const Lattice& lat, PointIndex i) {
     const Vec3i c = lat.coord(i);

@@ -97,11 +97,24 @@ void SparseField::move_between_lists(std::span<const RegionPoint> region, std::s
     }
     const bool parallel = moves.size() >= detail::kParallelMin;
     // A point leaves its old list before it enters its new one (both touch its slot).
+    // The points are scattered: each loop fetches the slots it will touch a few points ahead (a
+    // removal also rewrites the slot of its list's last point, and the lists shrink from the back).
+    const std::uint32_t* const slot = slot_.values().data();
     detail::for_each_list(lists, parallel, [&](std::size_t l) {
-        for (std::size_t n = out_begin[l]; n < out_begin[l + 1]; ++n) list_remove(out[n], static_cast<int>(l) - layers_);
+        const PointList& list = lists_[l];
+        const std::size_t end = out_begin[l + 1];
+        for (std::size_t n = out_begin[l]; n < end; ++n) {
+            if (n + detail::kAhead < end) __builtin_prefetch(slot + out[n + detail::kAhead], 1);
+            if (list.size() > detail::kAhead) __builtin_prefetch(slot + list[list.size() - 1 - detail::kAhead], 1);
+            list_remove(out[n], static_cast<int>(l) - layers_);
+        }
     });
     detail::for_each_list(lists, parallel, [&](std::size_t l) {
-        for (std::size_t n = in_begin[l]; n < in_begin[l + 1]; ++n) list_add(in[n], static_cast<int>(l) - layers_);
+        const std::size_t end = in_begin[l + 1];
+        for (std::size_t n = in_begin[l]; n < end; ++n) {
+            if (n + detail::kAhead < end) __builtin_prefetch(slot + in[n + detail::kAhead], 1);
+            list_add(in[n], static_cast<int>(l) - layers_);
+        }
     });
 }
 

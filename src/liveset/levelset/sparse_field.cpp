@@ -373,7 +373,11 @@ void classify_moves(const ZeroLayerEdit* edits, std::span<const std::uint32_t> l
                     std::int8_t* move) {
     const Lattice lat = lattice;
     const IndexDecoder decoder = index_decoder;
-    for (const std::uint32_t k : leaving) {
+    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    const auto last = static_cast<PointIndex>(lat.size() - 1);
+    for (std::size_t j = 0; j < leaving.size(); ++j) {
+        if (j + detail::kAhead < leaving.size()) detail::prefetch_stencil(phi, status, edits[leaving[j + detail::kAhead]].point, sy, sz, last);
+        const std::uint32_t k = leaving[j];
         const PointIndex i = edits[k].point;
         const bool up = phi[i] > 0.5f;
         // Without a branch per neighbour (a moving band's statuses and values are unpredictable):
@@ -412,7 +416,7 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
         // A rebuilding repair puts the new zero layer in lattice order first: the zero list then,
         // and the sweep's first sources, run forwards through memory (the sort is needed for the
         // zero list anyway; before the sweep it gains at most a few per cent, session 37).
-        PointList zero = collect_band(region);
+        PointList& zero = collect_band(region);
         const bool rebuild = relist_next_;
         if (rebuild) sort_indices(zero, sort_scratch_.v);
         sweep_whole_band(region, zero, /*keep_levels=*/rebuild);
@@ -473,10 +477,14 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     //    enters the zero layer (marked at once, so it enters once) with the value implied by the
     //    zero layer's new values: over its zero-layer neighbours (not those entering it here, whose
     //    status is no longer 0, so the order of entering changes no value), φ + 1 or φ − 1.
+    detail::reserve_growing(region, 6 * n_movers + n);
     region.resize(6 * n_movers + n);
     RegionPoint* const out = region.data();
     std::size_t n_out = 0;
+    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
+    const auto last = static_cast<PointIndex>(lat.size() - 1);
     for (std::size_t m = 0; m < n_movers; ++m) {
+        if (m + detail::kAhead < n_movers) detail::prefetch_stencil(phi, status, edits[movers[m + detail::kAhead]].point, sy, sz, last);
         const std::size_t k = movers[m];
         const std::int8_t from = move[k] > 0 ? std::int8_t{-1} : std::int8_t{1};
         for_each_neighbor6(lat, decoder, edits[k].point, [&](PointIndex q) __attribute__((always_inline)) {
@@ -489,6 +497,7 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     }
     const auto is_zero = [](std::int8_t s) { return s == 0; };
     for (std::size_t r = 0; r < n_out; ++r) {
+        if (r + detail::kAhead < n_out) detail::prefetch_stencil(phi, status, out[r + detail::kAhead].point, sy, sz, last);
         const PointIndex q = out[r].point;
         phi[q] = detail::layer_value(phi_, status_, q, decoder.coord(q), out[r].old_status > 0, is_zero);
     }
@@ -540,15 +549,17 @@ void SparseField::collect_ball(PointIndex seed, std::vector<RegionPoint>& region
     }
 }
 
-SparseField::PointList SparseField::collect_band(std::vector<RegionPoint>& region) {
+SparseField::PointList& SparseField::collect_band(std::vector<RegionPoint>& region) {
     // Room for the band and as many far points reached as the outermost lists hold (so the
     // region grows without copying itself on most steps); written through a buffer sized first.
     const std::size_t marked = region.size();
-    region.reserve(marked + band_size() + layer(-layers_).size() + layer(layers_).size());
+    detail::reserve_growing(region, marked + band_size() + layer(-layers_).size() + layer(layers_).size());
     region.resize(marked + band_size());
     // The new zero layer: every band point now pending on it. A point enters it only from L0 or
     // L±1 (marked kPendZero by move_zero_layer, or a zero-layer point it left unchanged).
-    PointList zero(layer(-1).size() + layer(0).size() + layer(1).size());
+    PointList& zero = zero_next_.v;  // kept: after a relist it holds the old zero list's memory
+    detail::reserve_growing(zero, layer(-1).size() + layer(0).size() + layer(1).size());
+    zero.resize(layer(-1).size() + layer(0).size() + layer(1).size());
     // Marking changes statuses, never the lists, so iterating the lists here is safe; every list
     // point is visited once. Without a branch on its status (a moving front's are unpredictable):
     // each point writes its region entry and its zero-layer entry and counts each or not, all three

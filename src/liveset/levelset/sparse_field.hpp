@@ -228,8 +228,9 @@ private:
     // global repair (the push sweep).
     ChangedPoints repair_dense(std::span<const ZeroLayerEdit> edits);
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
-    // Marks the whole band pending (appending what it marks); returns the new zero layer.
-    PointList collect_band(std::vector<RegionPoint>& region);
+    // Marks the whole band pending (appending what it marks); returns the new zero layer (held in
+    // zero_next_, whose memory a relist swaps with the old zero list's, so none is allocated per step).
+    PointList& collect_band(std::vector<RegionPoint>& region);
     void mark_pending(PointIndex i, std::vector<RegionPoint>& region);
     void sweep_layers(std::span<const RegionPoint> region);       // any region (pull)
     // The whole band (push, same bits) from the new zero layer `zero`; appends the
@@ -307,6 +308,7 @@ private:
     Scratch<std::int8_t> move_;                    // its moves, one per edit
     Scratch<std::uint32_t> movers_;                // its edits that leave the zero layer
     Kept<PointList> sweep_from_, sweep_next_;  // sweep_whole_band's levels
+    Kept<PointList> zero_next_;                // collect_band's new zero layer (relist swaps it in)
     Scratch<PointList> level_claims_;  // its claims per level and side (2(k-1): outside, +1: inside)
     // relayer_changes' claims: [0] the blocks of an ordered loop (the whole level, or the parts
     // below and the seam of a split), [1] the part above's claims until they join the region,

@@ -188,8 +188,22 @@ void batch_stencils(const Grid<float>& phi, std::span<const PointIndex> points, 
             for (int k = 0; k < filled; ++k) upwind[slot[k]] = lane_upwind[k];
         filled = 0;
     };
+    // The points are scattered once stretches of front sleep, and a stencil spans nine lattice
+    // lines (its own and those ±y, ±z and ±y±z): fetched 8 points (some 1 500 instructions) ahead,
+    // a hint with no effect on any result; indices clamped to the lattice.
+    constexpr std::size_t kAhead = 8;
+    const float* const values = phi.values().data();
+    const auto last = static_cast<std::ptrdiff_t>(l.size() - 1);
+    const auto prefetch = [&](std::ptrdiff_t i) {
+        for (const std::ptrdiff_t z : {-sz, std::ptrdiff_t{0}, sz})
+            for (const std::ptrdiff_t y : {-sy, std::ptrdiff_t{0}, sy})
+                __builtin_prefetch(values + std::clamp(i + y + z, std::ptrdiff_t{0}, last), 0);
+    };
 #endif
     for (std::size_t n = 0; n < points.size(); ++n) {
+#if defined(__SSE2__)
+        if (n + kAhead < points.size()) prefetch(static_cast<std::ptrdiff_t>(points[n + kAhead]));
+#endif
         const Vec3i p = decoder.coord(points[n]);
 #if defined(__SSE2__)
         if (p.x >= 1 && p.y >= 1 && p.z >= 1 && p.x <= d.x - 2 && p.y <= d.y - 2 && p.z <= d.z - 2) {
