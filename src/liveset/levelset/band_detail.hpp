@@ -35,19 +35,6 @@ inline constexpr std::uint32_t kNoSlot = 0xFFFF'FFFFu;
 // front points on the 2-core VM (docs/BENCHMARKS.md, session 36).
 inline constexpr std::size_t kAhead = 16;
 
-// Fetches the lattice lines a point's six-neighbour stencil touches (its own, which holds its x
-// neighbours, and those ±y and ±z) in φ and in the statuses (either skipped when null): a hint
-// for a loop over scattered points, issued kAhead points ahead (no effect on any result); indices
-// clamped to the lattice, so no pointer leaves it. docs/BENCHMARKS.md, session 46.
-[[gnu::always_inline]] inline void prefetch_stencil(const float* phi, const std::int8_t* status, PointIndex i, PointIndex sy,
-                                                    PointIndex sz, PointIndex last) {
-    const PointIndex at[5] = {i, i >= sy ? i - sy : 0, std::min(i + sy, last), i >= sz ? i - sz : 0, std::min(i + sz, last)};
-    for (const PointIndex a : at) {
-        if (phi != nullptr) __builtin_prefetch(phi + a, 0);
-        if (status != nullptr) __builtin_prefetch(status + a, 0);
-    }
-}
-
 // Room for n elements in a buffer kept between steps (cleared, then resized): its capacity at
 // least doubles when it grows, so a growing front does not reallocate it every step (a cleared
 // vector resized past its capacity gets exactly n, and fresh memory is faulted in page by page;
@@ -97,6 +84,7 @@ public:
           decoder_(decoder),
           sy_(static_cast<PointIndex>(lattice.stride_y())),
           sz_(static_cast<PointIndex>(lattice.stride_z())),
+          last_(static_cast<PointIndex>(lattice.size() - 1)),
           core_x_(core_extent(lattice.dims().x)),
           core_y_(core_extent(lattice.dims().y)),
           core_z_(core_extent(lattice.dims().z)) {}
@@ -117,12 +105,25 @@ public:
         }
     }
 
+    // Fetches the lattice lines a point's six neighbours lie on (its own, which holds its x
+    // neighbours, and those ±y and ±z) in φ and in the statuses (either skipped when null): a hint
+    // for a loop over scattered points, issued kAhead points ahead (no effect on any result);
+    // indices clamped to the lattice, so no pointer leaves it. docs/BENCHMARKS.md, session 46.
+    [[gnu::always_inline]] void prefetch(const float* phi, const std::int8_t* status, PointIndex i) const {
+        const PointIndex at[5] = {i, i >= sy_ ? i - sy_ : 0, std::min(i + sy_, last_), i >= sz_ ? i - sz_ : 0,
+                                  std::min(i + sz_, last_)};
+        for (const PointIndex a : at) {
+            if (phi != nullptr) __builtin_prefetch(phi + a, 0);
+            if (status != nullptr) __builtin_prefetch(status + a, 0);
+        }
+    }
+
 private:
     // x - 1 < core (unsigned) iff 1 <= x <= dims - 2; a dimension below 3 has no such points.
     static std::uint32_t core_extent(int d) { return d >= 3 ? static_cast<std::uint32_t>(d - 2) : 0u; }
     Lattice lat_;
     IndexDecoder decoder_;
-    PointIndex sy_, sz_;
+    PointIndex sy_, sz_, last_;
     std::uint32_t core_x_, core_y_, core_z_;
 };
 

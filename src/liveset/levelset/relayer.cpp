@@ -161,15 +161,14 @@ void claim_from(std::span<const PointIndex> sources, const ClaimRules& rule, std
                 const IndexDecoder& index_decoder, std::vector<Record>& buffer, std::vector<Record>& out) {
     const Lattice lat = lattice;  // locals (see above)
     const IndexDecoder decoder = index_decoder;
-    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
-    const auto last = static_cast<PointIndex>(lat.size() - 1);
+    const detail::Neighbors6 around(lat, decoder);  // its prefetch only
     constexpr std::size_t kClaimBlock = 4096;
     buffer.resize(6 * kClaimBlock);
     Record* const claims = buffer.data();
     for (std::size_t b = 0; b < sources.size(); b += kClaimBlock) {
         std::size_t n_claims = 0;
         for (std::size_t n = b; n < std::min(sources.size(), b + kClaimBlock); ++n) {
-            if (n + detail::kAhead < sources.size()) detail::prefetch_stencil(nullptr, status, sources[n + detail::kAhead], sy, sz, last);
+            if (n + detail::kAhead < sources.size()) around.prefetch(nullptr, status, sources[n + detail::kAhead]);
             const PointIndex p = sources[n];
             const std::int8_t* const r = rule[status[p] > 0 ? 1 : 0].data();  // the change's side (kPendPos > 0)
             for_each_neighbor6(lat, decoder, p, [&](PointIndex q) __attribute__((always_inline)) {
@@ -193,11 +192,9 @@ void decide_from(const std::size_t* pending, std::size_t b, std::size_t e, std::
                  const float* phi, const std::int8_t* status, const Lattice& lattice, const IndexDecoder& index_decoder,
                  const InnerStatuses& inner, float* value, std::uint8_t* outside) {
     const detail::Neighbors6 around(lattice, index_decoder);
-    const auto sy = static_cast<PointIndex>(lattice.stride_y()), sz = static_cast<PointIndex>(lattice.stride_z());
-    const auto last = static_cast<PointIndex>(lattice.size() - 1);
     for (std::size_t m = b; m < e; ++m) {
         // The pending points are scattered (claim order), and each reads its neighbours' lines.
-        if (m + detail::kAhead < e) detail::prefetch_stencil(phi, status, region[pending[m + detail::kAhead]].point, sy, sz, last);
+        if (m + detail::kAhead < e) around.prefetch(phi, status, region[pending[m + detail::kAhead]].point);
         const std::size_t r = pending[m];
         const PointIndex i = region[r].point;
         if (r >= first_new) region[r].old_phi = phi[i];

@@ -373,10 +373,9 @@ void classify_moves(const ZeroLayerEdit* edits, std::span<const std::uint32_t> l
                     std::int8_t* move) {
     const Lattice lat = lattice;
     const IndexDecoder decoder = index_decoder;
-    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
-    const auto last = static_cast<PointIndex>(lat.size() - 1);
+    const detail::Neighbors6 around(lat, decoder);  // its prefetch only
     for (std::size_t j = 0; j < leaving.size(); ++j) {
-        if (j + detail::kAhead < leaving.size()) detail::prefetch_stencil(phi, status, edits[leaving[j + detail::kAhead]].point, sy, sz, last);
+        if (j + detail::kAhead < leaving.size()) around.prefetch(phi, status, edits[leaving[j + detail::kAhead]].point);
         const std::uint32_t k = leaving[j];
         const PointIndex i = edits[k].point;
         const bool up = phi[i] > 0.5f;
@@ -481,10 +480,9 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     region.resize(6 * n_movers + n);
     RegionPoint* const out = region.data();
     std::size_t n_out = 0;
-    const auto sy = static_cast<PointIndex>(lat.stride_y()), sz = static_cast<PointIndex>(lat.stride_z());
-    const auto last = static_cast<PointIndex>(lat.size() - 1);
+    const detail::Neighbors6 around(lat, decoder);  // its prefetch only
     for (std::size_t m = 0; m < n_movers; ++m) {
-        if (m + detail::kAhead < n_movers) detail::prefetch_stencil(phi, status, edits[movers[m + detail::kAhead]].point, sy, sz, last);
+        if (m + detail::kAhead < n_movers) around.prefetch(phi, status, edits[movers[m + detail::kAhead]].point);
         const std::size_t k = movers[m];
         const std::int8_t from = move[k] > 0 ? std::int8_t{-1} : std::int8_t{1};
         for_each_neighbor6(lat, decoder, edits[k].point, [&](PointIndex q) __attribute__((always_inline)) {
@@ -497,7 +495,7 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     }
     const auto is_zero = [](std::int8_t s) { return s == 0; };
     for (std::size_t r = 0; r < n_out; ++r) {
-        if (r + detail::kAhead < n_out) detail::prefetch_stencil(phi, status, out[r + detail::kAhead].point, sy, sz, last);
+        if (r + detail::kAhead < n_out) around.prefetch(phi, status, out[r + detail::kAhead].point);
         const PointIndex q = out[r].point;
         phi[q] = detail::layer_value(phi_, status_, q, decoder.coord(q), out[r].old_status > 0, is_zero);
     }
