@@ -16,7 +16,7 @@ Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& refere
     // mask fractions; non-zero is inside, whatever the type (README, "ROI").
     const Grid<float> raw = read_image(path);
     try {
-        require_same_geometry(raw.lattice(), reference, option);
+        require_same_geometry(raw.lattice(), reference, option, "mask", "image");
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{} {} does not overlay the image: {}", option, path, e.what()));
     }

@@ -244,3 +244,26 @@ TEST(TissueModel, TooManyClassesFallBackToFewerWithAWarning) {
     EXPECT_EQ(w.seed_class, 0);
     EXPECT_NEAR(w.upper, (97 + 131) / 2.0, 1.5);
 }
+
+// A bright class holding 2 % of the region (a bias field can split white matter so, session 47):
+// a warning that points at bias correction; the usual T1 mixture (its thinnest class above the
+// darkest: 25 %) and a thin darkest class (little CSF in a tight mask) give none.
+TEST(TissueModel, AThinBrightClassIsWarnedAbout) {
+    const auto warnings_for = [](const std::vector<TrueClass>& classes) {
+        const std::vector<float> v = sample(classes, 0.2, 80000, 12);
+        Grid<float> image(Lattice({static_cast<int>(v.size()), 1, 1}));
+        for (std::size_t i = 0; i < v.size(); ++i) image[static_cast<PointIndex>(i)] = v[i];
+        std::vector<std::string> warnings;
+        const std::optional<TissueModel> m = fit_window_model(image, Grid<std::uint8_t>(image.lattice(), 1), {}, warnings);
+        EXPECT_TRUE(m.has_value() && m->usable());
+        std::string thin;
+        for (const std::string& w : warnings)
+            if (w.find("holds only") != std::string::npos) thin += w;
+        return thin;
+    };
+    const std::string bright = warnings_for({{48, 10, 0.35}, {97, 8, 0.43}, {150, 5, 0.02}});
+    EXPECT_NE(bright.find("WM class"), std::string::npos) << bright;
+    EXPECT_NE(bright.find("--bias-correct"), std::string::npos) << bright;
+    EXPECT_EQ(warnings_for(kT1), "");
+    EXPECT_EQ(warnings_for({{48, 10, 0.025}, {97, 8, 0.45}, {131, 6, 0.325}}), "");
+}

@@ -27,14 +27,16 @@ std::string describe_placement(const Lattice& lat) {
 
 }  // namespace
 
-void require_same_geometry(const Lattice& mask, const Lattice& truth, std::string_view caller) {
+void require_same_geometry(const Lattice& mask, const Lattice& truth, std::string_view caller, std::string_view mask_name,
+                           std::string_view truth_name) {
+    const std::string head = std::string(caller) + ": " + std::string(mask_name);
     if (!(mask.dims() == truth.dims())) {
-        throw std::invalid_argument(std::string(caller) + ": mask dims " + describe_dims(mask.dims()) +
-                                    " differ from truth dims " + describe_dims(truth.dims()));
+        throw std::invalid_argument(head + " dims " + describe_dims(mask.dims()) + " differ from " + std::string(truth_name) +
+                                    " dims " + describe_dims(truth.dims()));
     }
     if (!mask.same_geometry(truth, kEvalGeometryTolerance)) {
-        throw std::invalid_argument(std::string(caller) + ": mask geometry [" + describe_placement(mask) +
-                                    "] differs from truth geometry [" + describe_placement(truth) + "]");
+        throw std::invalid_argument(head + " geometry [" + describe_placement(mask) + "] differs from " +
+                                    std::string(truth_name) + " geometry [" + describe_placement(truth) + "]");
     }
 }
 

@@ -15,9 +15,11 @@ namespace liveset {
 // cosines agree within this absolute tolerance (mm for spacing/origin).
 inline constexpr double kEvalGeometryTolerance = 1e-4;
 
-// Throws std::invalid_argument with a one-line message naming `caller` when the dims of the two
-// lattices differ, or when their spacing/origin/direction differ by more than kEvalGeometryTolerance.
-void require_same_geometry(const Lattice& mask, const Lattice& truth, std::string_view caller);
+// Throws std::invalid_argument with a one-line message naming `caller` and the two lattices (as
+// `mask_name` and `truth_name`: "mask ... differ from truth ..." unless told) when their dims differ,
+// or when their spacing/origin/direction differ by more than kEvalGeometryTolerance.
+void require_same_geometry(const Lattice& mask, const Lattice& truth, std::string_view caller,
+                           std::string_view mask_name = "mask", std::string_view truth_name = "truth");
 
 struct OverlapMetrics {
     double dice = 0;               // 2|M∩T| / (|M|+|T|); 1.0 when both masks are empty

@@ -12,16 +12,21 @@
 
 namespace liveset {
 
-// N4's parameters. The defaults are the literature's (Tustison et al. 2010; ANTs' brain
-// pipelines: 4 levels x 50 iterations, B-spline mesh elements of ~200 mm, Wiener noise 0.01,
-// deconvolution FWHM 0.15, 200 histogram bins, shrink factor 4 for 1 mm data), not tuned to a scan.
+// N4's parameters. Standard settings, not tuned to a scan: ITK's own N4 default convergence
+// (1e-3), 3D Slicer's N4ITK default of 3 fitting levels, and the literature's B-spline mesh elements
+// of ~200 mm, Wiener noise 0.01, deconvolution FWHM 0.15 and 200 histogram bins (Tustison et al.
+// 2010), on a 6 mm grid. Until session 47 they were ANTs' 4 levels x 50 iterations, convergence
+// 1e-6 (never reached: every run did all 200 iterations) on a 4 mm grid: 10-15x the time, and on
+// BrainWeb and its variants a field that left the tissue classes wider (docs/BENCHMARKS.md, session 47).
 struct BiasCorrectionOptions {
     // Target voxel size of the shrunk grid N4 runs on: the shrink factor along an axis is
-    // round(shrink_mm / spacing), at least 1 (4 for 1 mm voxels, 1 for voxels of 4 mm or more).
-    double shrink_mm = 4.0;
-    int levels = 4;              // fitting levels; the B-spline mesh doubles at each
+    // round(shrink_mm / spacing), at least 1 (6 for 1 mm voxels, 1 for voxels of 6 mm or more).
+    // The field is smooth (the third level's mesh elements are ~45 mm on a head), so a 6 mm grid
+    // still samples each of them 7-8 times a side.
+    double shrink_mm = 6.0;
+    int levels = 3;              // fitting levels; the B-spline mesh doubles at each
     int iterations = 50;         // maximum iterations per level
-    double convergence = 1e-6;   // stop a level when the field's change (N4's CV measure) falls below
+    double convergence = 1e-3;   // stop a level when the field's change (N4's CV measure) falls below
     // Length of one B-spline mesh element at the first level: an axis spanning L mm gets
     // ceil(L / spline_distance_mm) elements (at least 1), i.e. that many + 3 control points (cubic).
     double spline_distance_mm = 200.0;
