@@ -17,7 +17,7 @@ namespace liveset {
 // of ~200 mm, Wiener noise 0.01, deconvolution FWHM 0.15 and 200 histogram bins (Tustison et al.
 // 2010), on a 6 mm grid. Until session 47 they were ANTs' 4 levels x 50 iterations, convergence
 // 1e-6 (never reached: every run did all 200 iterations) on a 4 mm grid: 10-15x the time, and on
-// BrainWeb and its variants a field that left the tissue classes wider (docs/BENCHMARKS.md, session 47).
+// BrainWeb a field that left the tissue classes wider (docs/BENCHMARKS.md, session 47).
 struct BiasCorrectionOptions {
     // Target voxel size of the shrunk grid N4 runs on: the shrink factor along an axis is
     // round(shrink_mm / spacing), at least 1 (6 for 1 mm voxels, 1 for voxels of 6 mm or more).
