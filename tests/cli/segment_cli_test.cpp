@@ -86,8 +86,8 @@ fs::path big_noise_image() {
     return img;
 }
 
-// 160^3 voxels of 2 mm: three intensity classes in 20 mm blocks with noise, under a strong smooth
-// field (about -45 % .. +65 %). N4 needs tens of iterations on its 54^3 samples (seconds each
+// 160^3 voxels of 2 mm: three intensity classes in 40 mm blocks with noise, under a strong smooth
+// field (about -50 % .. +65 %). N4 needs tens of iterations on its 54^3 samples (seconds each
 // level, 15-20 s in all on the 2-core VM), so a Ctrl-C 1.5 s in lands inside it.
 fs::path biased_blocks_image() {
     static const fs::path img = [] {
@@ -245,7 +245,7 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
     write_image(g, flat.string());
     Grid<std::uint8_t> small(Lattice({16, 16, 16}), 1);
     write_label_image(small, (work_dir() / "small_mask.nii.gz").string());
-    Grid<std::uint8_t> corner(read_image(img).lattice(), 0);  // one voxel, between N4's samples (every 4th)
+    Grid<std::uint8_t> corner(read_image(img).lattice(), 0);  // one voxel, between N4's samples (every 6th)
     corner({1, 1, 1}) = 1;
     write_label_image(corner, (work_dir() / "corner_mask.nii.gz").string());
     const fs::path corrected = work_dir() / "never_corrected.nii.gz";

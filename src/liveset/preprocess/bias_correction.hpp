@@ -16,13 +16,13 @@ namespace liveset {
 // (1e-3), 3D Slicer's N4ITK default of 3 fitting levels, and the literature's B-spline mesh elements
 // of ~200 mm, Wiener noise 0.01, deconvolution FWHM 0.15 and 200 histogram bins (Tustison et al.
 // 2010), on a 6 mm grid. Until session 47 they were ANTs' 4 levels x 50 iterations, convergence
-// 1e-6 (never reached: every run did all 200 iterations) on a 4 mm grid: 10-15x the time, and on
+// 1e-6 (never reached: every run did all 200 iterations) on a 4 mm grid: 9-16x the time, and on
 // BrainWeb a field that left the tissue classes wider (docs/BENCHMARKS.md, session 47).
 struct BiasCorrectionOptions {
     // Target voxel size of the shrunk grid N4 runs on: the shrink factor along an axis is
     // round(shrink_mm / spacing), at least 1 (6 for 1 mm voxels, 1 for voxels of 6 mm or more).
-    // The field is smooth (the third level's mesh elements are ~45 mm on a head), so a 6 mm grid
-    // still samples each of them 7-8 times a side.
+    // The field is smooth (the third level's mesh elements are 27-45 mm on a head), so a 6 mm grid
+    // still samples each of them 4-8 times a side.
     double shrink_mm = 6.0;
     int levels = 3;              // fitting levels; the B-spline mesh doubles at each
     int iterations = 50;         // maximum iterations per level

@@ -49,21 +49,24 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
 
 namespace {
 
-// A pure class above the darkest one (GM, WM in a T1 brain) holding under 3 % of the region: no
-// brain region is like that, but a bias field can split a tissue into a thin bright class and the
+// In a three-class (CSF, GM, WM) model, GM or WM holding under 3 % of the region: no whole-brain
+// region measured is like that, but a bias field can split a tissue into a thin bright class and the
 // rest (BrainWeb under a +-20 % ramp along z: WM 1.1 %, Dice 0.86; 0.936 after N4). Every BrainWeb
-// variant and ROI measured keeps each of them at 14 % or more (docs/BENCHMARKS.md, session 47). The
-// darkest class is left out: a tight brain mask leaves next to no CSF.
+// variant and whole-brain ROI measured keeps each of them at 14 % or more (docs/BENCHMARKS.md,
+// session 47). The darkest class is left out (a tight brain mask leaves next to no CSF), and so are
+// other class counts (a fourth class may be a small lesion population).
 void thin_class_warnings(const TissueModel& m, std::vector<std::string>& warnings) {
     constexpr double kThinClass = 0.03;
+    if (m.classes.size() != 3) return;
     for (std::size_t k = 1; k < m.classes.size(); ++k) {
         const TissueClass& c = m.classes[k];
         if (c.weight >= kThinClass) continue;
         std::ostringstream os;
+        os.precision(4);  // the mean as window_warnings prints means; the share rounded down, so never "3.0 %"
+        os << "tissue model: its " << tissue_class_name(m, static_cast<int>(k)) << " class (mean " << c.mean << ") holds only ";
         os.precision(1);
-        os << std::fixed << "tissue model: its " << tissue_class_name(m, static_cast<int>(k)) << " class (mean " << c.mean
-           << ") holds only " << 100.0 * c.weight
-           << " % of the region: shading (a bias field) may have split a tissue; correct it first (--bias-correct) or give the window";
+        os << std::fixed << std::floor(1000.0 * c.weight) / 10.0
+           << " % of the region: a bias field may have split a tissue (if the scan is shaded and not yet corrected: --bias-correct)";
         warnings.push_back(os.str());
     }
 }
@@ -87,7 +90,8 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
         }
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
         // (On BrainWeb only its shaded variants fail the partial-volume fit: say so.)
-        if (!m.note.empty()) warnings.push_back("tissue model: " + m.note + "; shading (a bias field) can do this: try --bias-correct");
+        if (!m.note.empty())
+            warnings.push_back("tissue model: " + m.note + " (a bias field can do this: if the scan is shaded and not yet corrected, --bias-correct)");
         if (m.usable() && !m.converged)
             warnings.push_back("tissue model: EM stopped at its limit of " + std::to_string(options.max_iterations) +
                                " iterations before converging (the class means still drift slowly)");
