@@ -49,6 +49,9 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
 
 namespace {
 
+// What both shading warnings (below and in fit_window_model) advise.
+constexpr const char* kShadingHint = "if the scan is shaded and not yet corrected: --bias-correct";
+
 // In a three-class (CSF, GM, WM) model, GM or WM holding under 3 % of the region: no whole-brain
 // region measured is like that, but a bias field can split a tissue into a thin bright class and the
 // rest (BrainWeb under a +-20 % ramp along z: WM 1.1 %, Dice 0.86; 0.936 after N4). Every BrainWeb
@@ -66,7 +69,7 @@ void thin_class_warnings(const TissueModel& m, std::vector<std::string>& warning
         os << "tissue model: its " << tissue_class_name(m, static_cast<int>(k)) << " class (mean " << c.mean << ") holds only ";
         os.precision(1);
         os << std::fixed << std::floor(1000.0 * c.weight) / 10.0
-           << " % of the region: a bias field may have split a tissue (if the scan is shaded and not yet corrected: --bias-correct)";
+           << " % of the region: a bias field may have split a tissue (" << kShadingHint << ")";
         warnings.push_back(os.str());
     }
 }
@@ -91,7 +94,7 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
         // (On BrainWeb only its shaded variants fail the partial-volume fit: say so.)
         if (!m.note.empty())
-            warnings.push_back("tissue model: " + m.note + " (a bias field can do this: if the scan is shaded and not yet corrected, --bias-correct)");
+            warnings.push_back("tissue model: " + m.note + " (a bias field can do this; " + kShadingHint + ")");
         if (m.usable() && !m.converged)
             warnings.push_back("tissue model: EM stopped at its limit of " + std::to_string(options.max_iterations) +
                                " iterations before converging (the class means still drift slowly)");
