@@ -69,9 +69,11 @@ struct BiasCorrectionReport {
 //  - Every voxel is divided by the field (a smooth positive function), outside the mask too: zeros
 //    stay zero, negative voxels stay negative, no NaN. An image that is constant in the mask is
 //    returned unchanged (field 1).
-//  - Deterministic whatever the thread count: the fit runs single-threaded (ITK's scattered-data
-//    B-spline fit sums per-thread partial lattices, so its rounding depends on the thread count);
-//    the full-resolution evaluation uses up to TBB's allowed parallelism (per-voxel, exact).
+//  - Deterministic whatever the thread count, and within TBB's allowed parallelism (--threads):
+//    ITK's filters inside N4 run a fixed number of work units as TBB tasks (ITK's scattered-data
+//    B-spline fit sums one partial lattice per work unit, so a count that followed the threads
+//    would change its rounding); the full-resolution field (bspline_field.hpp) and the division are
+//    per voxel.
 //  - `interrupt` (e.g. Ctrl-C) is polled at every N4 iteration; when it turns true N4 stops and the
 //    input comes back unchanged with report->interrupted set.
 // Throws std::invalid_argument (one line) on bad options, an empty image or an axis of < 2 voxels,
