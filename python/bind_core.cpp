@@ -71,7 +71,7 @@ struct SegmentArgs {
     std::string window_from = "model";
     int classes = 3, iterations = 2000;
     double n = 4.0, alpha = 0.1;
-    bool bias_correct = false;
+    std::optional<bool> bias_correct;  // unset: on, skipped with a warning where it cannot run (as the CLI's default)
 };
 
 // The request `liveset segment` builds from its options (cmd_segment.cpp), on an image in memory.
@@ -86,6 +86,11 @@ SegmentRequest request_for(const SegmentArgs& a, const Lattice& lattice, bool ne
     return req;
 }
 
+// The bias correction a binding's option asks for: unset (the default) as the CLI's default.
+cli::BiasCorrection bias_mode(const std::optional<bool>& bias_correct) {
+    return !bias_correct ? cli::BiasCorrection::kDefault : *bias_correct ? cli::BiasCorrection::kRequired : cli::BiasCorrection::kOff;
+}
+
 pyb::dict segment(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a, const pyb::object& progress) {
     Grid<float> image = grid_from_array(values, lattice);
     SegmentRequest req = request_for(a, lattice);
@@ -94,14 +99,15 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     if (!a.init_mask.is_none()) init = mask_from_array(a.init_mask.cast<pyb::array>(), lattice);
     Interrupt interrupt;
     interrupt.callback = progress;
-    std::optional<Grid<std::uint8_t>> fit_region;
-    std::optional<BiasCorrectionReport> bias;
+    const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
+    const cli::BiasCorrection mode = bias_mode(a.bias_correct);
+    cli::PreparedImage prepared;
     std::optional<SegmentOutcome> out;
     {
         pyb::gil_scoped_release nogil;
-        if (!roi) fit_region = cli::try_auto_brain_mask(image);
-        const Grid<std::uint8_t>* fit = roi ? &roi->mask : fit_region ? &*fit_region : nullptr;
-        if (a.bias_correct) image = correct_bias(image, fit, {}, &bias.emplace(), &interrupt.flag());
+        prepared = cli::prepare_image(image, roi_mask, mode, &interrupt.flag());
+        const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
+        const std::optional<BiasCorrectionReport>& bias = prepared.bias;
         if (roi) req.roi = &roi->mask;
         if (init) req.initial_mask = &*init;
         req.model_region = fit;
@@ -117,30 +123,26 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     if (interrupt.raised()) interrupt.rethrow();
     if (!out || out->result.reason == StopReason::kInterrupted) throw pyb::error_already_set();  // a pending KeyboardInterrupt
     nlohmann::json j = cli::segmentation_report(*out, lattice);
-    if (bias) {
-        j["bias_correction"] = cli::bias_correction_report(*bias);
-        j["bias_correction"]["mask"] = roi ? "roi" : fit_region ? "auto brain mask" : "otsu";
-    }
+    cli::add_bias_report(j, prepared, roi_mask);
     if (roi) j["roi"] = cli::roi_report(*roi);
     pyb::dict r;
     r["phi"] = array_from_grid(Grid<float>(out->field->phi()));
     r["mask"] = array_from_grid(std::move(out->mask));
     r["report"] = j.dump();
     if (roi && pyb::isinstance<pyb::str>(a.roi)) r["roi"] = array_from_grid(Grid<std::uint8_t>(roi->mask));
-    if (bias) r["corrected"] = array_from_grid(std::move(image));
+    if (prepared.bias) r["corrected"] = array_from_grid(std::move(image));
     return r;
 }
 
 // The tissue model fitted where segment() fits it, and the window the seeds would get.
 std::string tissue_model(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a) {
-    const Grid<float> image = grid_from_array(values, lattice);
+    Grid<float> image = grid_from_array(values, lattice);
     SegmentRequest req = request_for(a, lattice, false);
     const std::optional<cli::Roi> roi = roi_of(a.roi, image);
     pyb::gil_scoped_release nogil;
-    std::optional<Grid<std::uint8_t>> fit_region;
-    if (!roi) fit_region = cli::try_auto_brain_mask(image);
-    const Grid<std::uint8_t>* fit = roi ? &roi->mask : fit_region ? &*fit_region : nullptr;
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
+    const cli::PreparedImage prepared = cli::prepare_image(image, roi_mask, bias_mode(a.bias_correct));  // as segment
+    const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
     const IntensityScale scale = robust_scale(image, roi_mask, req.scale);
     std::vector<std::string> warnings;
     const Grid<std::uint8_t> region = model_region(image, fit, roi_mask, a.classes);
@@ -158,6 +160,7 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
         j["tissue_model"] = cli::tissue_model_report(*model, nullptr);
     }
     j["warnings"] = warnings;
+    cli::add_bias_report(j, prepared, roi_mask);
     return j.dump();
 }
 
@@ -306,7 +309,7 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
         else if (k == "iterations") a.iterations = value.cast<int>();
         else if (k == "n") a.n = value.cast<double>();
         else if (k == "alpha") a.alpha = value.cast<double>();
-        else if (k == "bias_correct") a.bias_correct = value.cast<bool>();
+        else if (k == "bias_correct") a.bias_correct = value.cast<std::optional<bool>>();
         else throw std::invalid_argument("unknown segment option '" + k + "'");
     }
     if (a.classes < 2 || a.classes > 6) throw UsageError("classes must be in 2..6");

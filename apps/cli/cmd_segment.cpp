@@ -34,7 +34,8 @@ struct SegmentArgs : ThresholdArgs {
     int iterations = 2000;
     std::string out_mask, out_phi, out_mesh, out_roi, log;
     bool json = false, quiet = false;
-    bool bias_correct = false;  // N4 before everything else (the corrected image replaces the input)
+    bool bias_correct = true;   // N4 before everything else (the corrected image replaces the input)
+    bool bias_given = false;    // --bias-correct given: a failure is an error, not a skipped step
     std::string out_corrected;
 };
 
@@ -46,7 +47,7 @@ void check_segment_args(const SegmentArgs& a) {
     if (!a.log.empty()) check_output_path(a.log, OutputKind::kText, "--log");
     if (!a.out_roi.empty()) check_output_path(a.out_roi, OutputKind::kImage, "--out-roi");
     if (!a.out_roi.empty() && a.roi.empty()) throw UsageError("--out-roi needs --roi (a mask or auto)");
-    if (!a.out_corrected.empty() && !a.bias_correct) throw UsageError("--out-corrected needs --bias-correct");
+    if (!a.out_corrected.empty() && !a.bias_correct) throw UsageError("--out-corrected needs the bias correction (drop --no-bias-correct)");
     if (!a.out_corrected.empty()) check_output_path(a.out_corrected, OutputKind::kImage, "--out-corrected");
     check_threshold_args(a);
     if (a.seeds.empty() && a.seeds_mm.empty() && a.init_mask.empty())
@@ -67,12 +68,9 @@ SegmentRequest segment_request(const SegmentArgs& a, const Lattice& lattice, con
 
 // The report: the segmentation's, the bias correction's, the ROI and what was written.
 nlohmann::json segment_report(const SegmentArgs& a, const SegmentOutcome& o, const Lattice& lattice, const std::optional<Roi>& roi,
-                              const std::optional<BiasCorrectionReport>& bias, bool auto_fit_region, std::size_t triangles) {
+                              const PreparedImage& prepared, std::size_t triangles) {
     nlohmann::json j = segmentation_report(o, lattice);
-    if (bias) {
-        j["bias_correction"] = bias_correction_report(*bias);
-        j["bias_correction"]["mask"] = roi ? "roi" : auto_fit_region ? "auto brain mask" : "otsu";
-    }
+    add_bias_report(j, prepared, roi ? &roi->mask : nullptr);
     j["image"] = a.image;
     j["outputs"] = {{"mask", a.out_mask}};
     if (roi) j["roi"] = roi_report(*roi);
@@ -95,19 +93,18 @@ int run_segment(const SegmentArgs& a, int threads) {
     std::optional<Grid<std::uint8_t>> init;
     const std::optional<Roi> roi = load_roi(a.roi, image);
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
-    // Without an ROI, the automatic brain mask (when the image is a head) is where N4 and the
-    // tissue model are fitted: scalp fat and muscle would pull both off the brain.
-    std::optional<Grid<std::uint8_t>> fit_region;
-    if (!roi) fit_region = try_auto_brain_mask(image);
-    const Grid<std::uint8_t>* fit = roi ? &roi->mask : fit_region ? &*fit_region : nullptr;
-    std::optional<BiasCorrectionReport> bias;
-    if (a.bias_correct) {  // fitted inside `fit` (Otsu's foreground when there is none)
-        image = correct_bias(image, fit, {}, &bias.emplace(), &interrupt.flag());
-        if (bias->interrupted) {
-            if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
-            return 130;
-        }
+    // N4 first, on by default; asked for (or its image to be written), a failure is an error.
+    const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
+    const BiasCorrection mode = !a.bias_correct ? BiasCorrection::kOff
+                                : a.bias_given || !a.out_corrected.empty() ? BiasCorrection::kRequired
+                                                                             : BiasCorrection::kDefault;
+    const PreparedImage prepared = prepare_image(image, roi_mask, mode, &interrupt.flag());
+    if (prepared.bias && prepared.bias->interrupted) {
+        if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
+        return 130;
     }
+    if (!prepared.bias_skipped.empty() && !a.quiet) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
+    const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
 
     const SegmentRequest req = segment_request(a, image.lattice(), roi, init, fit);
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
@@ -127,7 +124,7 @@ int run_segment(const SegmentArgs& a, int threads) {
         write_mesh(a.out_mesh, mesh.view(), image.lattice());
     }
 
-    const nlohmann::json j = segment_report(a, o, image.lattice(), roi, bias, fit_region.has_value(), triangles);
+    const nlohmann::json j = segment_report(a, o, image.lattice(), roi, prepared, triangles);
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
@@ -202,11 +199,12 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--out-mesh", sa.out_mesh, "output surface mesh (.ply/.obj/.stl, LPS mm)");
     seg->add_option("--out-roi", sa.out_roi, "write the region of interest used (e.g. the --roi auto brain mask, uint8 0/1)");
     seg->add_option("--log", sa.log, "write one JSON line per iteration to this file");
-    seg->add_flag("--bias-correct,!--no-bias-correct", sa.bias_correct, "correct the intensity non-uniformity first (N4, fitted inside --roi, else the automatic brain mask, else Otsu's foreground); recommended, see the README")->capture_default_str();
-    seg->add_option("--out-corrected", sa.out_corrected, "write the bias-corrected image (float) here (needs --bias-correct)");
+    auto* bias = seg->add_flag("--bias-correct,!--no-bias-correct", sa.bias_correct, "correct the intensity non-uniformity first (N4, fitted inside --roi, else the automatic brain mask, else Otsu's foreground). Default: on, skipped with a warning where it cannot run (asked for: an error)");
+    seg->add_option("--out-corrected", sa.out_corrected, "write the bias-corrected image (float) here");
     seg->add_flag("--json", sa.json, "print the report as one JSON object on stdout");
     seg->add_flag("--quiet,-q", sa.quiet, "no progress line and no report");
-    seg->callback([&threads] {
+    seg->callback([&threads, bias] {
+        sa.bias_given = bias->count() > 0 && sa.bias_correct;
         const int rc = run_segment(sa, threads);
         if (rc != 0) std::exit(rc);
     });

@@ -48,6 +48,49 @@ std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image) 
     }
 }
 
+PreparedImage prepare_image(Grid<float>& image, const Grid<std::uint8_t>* roi, BiasCorrection mode,
+                            const std::atomic<bool>* interrupt) {
+    PreparedImage out;
+    if (roi == nullptr) out.fit_region = try_auto_brain_mask(image);
+    if (mode == BiasCorrection::kOff) return out;
+    if (mode == BiasCorrection::kDefault) {
+        // N4 models a multiplicative field on magnitude data. Negative values in the fit region (an
+        // offset, a z-scored image) are outside that model: the default leaves such an image alone.
+        const Grid<std::uint8_t>* fit = out.fit(roi);
+        std::size_t negative = 0, total = 0;
+        for (std::size_t i = 0; i < image.size(); ++i) {
+            const auto p = static_cast<PointIndex>(i);
+            if (fit != nullptr && (*fit)[p] == 0) continue;
+            ++total;
+            negative += image[p] < 0.0f;
+        }
+        if (negative * 100 > total) {
+            out.bias_skipped = fmt::format("bias correction skipped: {:.0f} % of the voxels it would fit are negative (an offset or a z-scored "
+                                           "image?), outside N4's multiplicative model; segmenting the uncorrected image (--bias-correct forces it)",
+                                           100.0 * static_cast<double>(negative) / static_cast<double>(total));
+            return out;
+        }
+    }
+    BiasCorrectionReport report;
+    try {
+        image = correct_bias(image, out.fit(roi), {}, &report, interrupt);
+    } catch (const std::invalid_argument& e) {
+        if (mode == BiasCorrection::kRequired) throw;
+        out.bias_skipped = std::string(e.what()) + "; segmenting the uncorrected image";
+        return out;
+    }
+    out.bias = std::move(report);
+    return out;
+}
+
+void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi) {
+    if (prepared.bias) {
+        report["bias_correction"] = bias_correction_report(*prepared.bias);
+        report["bias_correction"]["mask"] = prepared.fit_name(roi);
+    }
+    if (!prepared.bias_skipped.empty()) report["warnings"].push_back(prepared.bias_skipped);
+}
+
 nlohmann::json roi_report(const Roi& roi) {
     const Vec3d s = roi.mask.lattice().spacing();
     std::size_t voxels = 0;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <atomic>
 #include <optional>
 #include <string>
 
@@ -38,6 +39,34 @@ std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image);
 nlohmann::json roi_report(const Roi& roi);
 // One line: "  roi          auto brain mask: N voxels, V ml (...)".
 void print_roi_summary(const nlohmann::json& roi);
+
+// Whether N4 runs before a segmentation (segment, view, the Python module): on by default, where a
+// failure (an image too small for its grid, a mask that leaves no sample) skips it with a warning;
+// required when asked for (or when the corrected image is to be written), where it is an error.
+enum class BiasCorrection { kOff, kDefault, kRequired };
+
+// An image made ready for the tissue model and the speed: corrected in place, and the region both
+// are fitted in.
+struct PreparedImage {
+    // Without an ROI, the automatic brain mask (when the image is a head): scalp fat and muscle
+    // would pull N4's field and the tissue model off the brain.
+    std::optional<Grid<std::uint8_t>> fit_region;
+    std::optional<BiasCorrectionReport> bias;  // N4's report when it ran
+    std::string bias_skipped;                  // why the default correction did not run (a warning)
+    // The region N4 and the tissue model are fitted in: the ROI, else fit_region, else none (N4
+    // then takes Otsu's foreground).
+    const Grid<std::uint8_t>* fit(const Grid<std::uint8_t>* roi) const { return roi ? roi : fit_region ? &*fit_region : nullptr; }
+    // "roi", "auto brain mask" or "otsu": where N4 was fitted (the report's bias_correction.mask).
+    std::string fit_name(const Grid<std::uint8_t>* roi) const { return roi ? "roi" : fit_region ? "auto brain mask" : "otsu"; }
+};
+// N4 (BiasCorrectionOptions' defaults) on `image` per `mode`, fitted inside the ROI, else the
+// automatic brain mask, else Otsu's foreground. `interrupt`: Ctrl-C (the report then says
+// interrupted and the image is unchanged). Throws std::invalid_argument (kRequired) as correct_bias.
+PreparedImage prepare_image(Grid<float>& image, const Grid<std::uint8_t>* roi, BiasCorrection mode,
+                            const std::atomic<bool>* interrupt = nullptr);
+// The report's "bias_correction" object (bias_correction_report and where it was fitted), or, when
+// the default correction was skipped, its warning appended to the report's "warnings".
+void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi);
 
 // True when every voxel is exactly 0 or 1 (a mask stored as a float image).
 bool is_binary_mask(const Grid<float>& image);

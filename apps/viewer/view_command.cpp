@@ -36,6 +36,9 @@ struct ViewArgs : ThresholdArgs {
     double autosave_every = 120.0;
     std::string recovery_dir;
     std::string window_from = "model";  // µ, ε from the seeds: the tissue model or the seeds' statistics
+    bool bias_correct = true;           // N4 first, as `segment` (a continued workspace: as it was saved)
+    bool bias_given = false;            // --bias-correct or --no-bias-correct on the command line
+    bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
 };
 
 void parse_size(const std::string& text, int& w, int& h) {
@@ -53,10 +56,20 @@ void parse_size(const std::string& text, int& w, int& h) {
     if (w < 320 || h < 240 || w > 8192 || h > 8192) throw UsageError(fmt::format("--size {}: from 320x240 to 8192x8192", text));
 }
 
-std::unique_ptr<Session> load_session(const ViewArgs& a) {
+std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> roi;
     if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
+    // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for.
+    const BiasCorrection mode = !a.bias_correct ? BiasCorrection::kOff : a.bias_given ? BiasCorrection::kRequired : BiasCorrection::kDefault;
+    PreparedImage prepared;
+    try {
+        prepared = prepare_image(image, roi ? &*roi : nullptr, mode);
+    } catch (const std::invalid_argument& e) {
+        throw UsageError(fmt::format("{}: {}", a.image, e.what()));
+    }
+    if (!prepared.bias_skipped.empty()) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
+    a.image_corrected = prepared.bias.has_value();
     SessionOptions so;
     so.fragment_size = a.fragment_size;
     so.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
@@ -105,8 +118,13 @@ std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
         viewer::Workspace ws = viewer::read_workspace(a.workspace);
         if (a.image.empty() && !std::filesystem::exists(ws.image))
             throw std::runtime_error(fmt::format("workspace {}: its image {} is gone", a.workspace, ws.image));
+        if (a.bias_given && a.bias_correct != ws.bias_corrected)
+            throw std::runtime_error(fmt::format("workspace {} was saved {} bias correction; drop {}", a.workspace,
+                                                 ws.bias_corrected ? "with" : "without", a.bias_correct ? "--bias-correct" : "--no-bias-correct"));
         if (a.image.empty()) a.image = ws.image;
         if (a.roi.empty()) a.roi = ws.roi;
+        if (!a.bias_given) a.bias_correct = ws.bias_corrected;  // its image as it was: corrected again, or not
+        a.bias_given = a.bias_correct;  // a saved correction that cannot run is an error, not a new image
         return ws;
     } catch (const std::runtime_error& e) {
         fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
@@ -174,6 +192,8 @@ int run_view(ViewArgs& a, int threads) {
     config.session.segmentation.step = step_options(a);
     config.image_path = a.image;
     config.roi_path = a.roi;
+    config.bias_correct = a.bias_correct;
+    config.image_corrected = a.image_corrected;
     config.params_note = note;
     config.workspace_path = a.workspace;
     if (ws) config.workspace_view = ws->view;
@@ -243,6 +263,7 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave");
     v->add_option("--seed", va.seeds, "seed I,J,K[:R] (voxels); repeatable");
     v->add_option("--window-from", va.window_from, "estimate the window from the tissue model (the seeds pick the class) or from the seeds' statistics, as `segment`")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
+    auto* bias = v->add_flag("--bias-correct,!--no-bias-correct", va.bias_correct, "correct the intensity non-uniformity first (N4), as `segment`. Default: on, skipped with a warning where it cannot run (asked for: an error); a continued workspace keeps its own setting");
     v->add_option("--seeds", va.seeds_file, "seed file: one I,J,K[:R] per line (the --seed format; the panel saves them)");
     v->add_option("--workspace", va.workspace, "continue a saved workspace (image, ROI, phi, seeds, parameters, swarm, camera); the panel saves it");
     add_threshold_options(*v, va);  // as `liveset segment`: --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
@@ -270,9 +291,10 @@ void add_view_command(CLI::App& app, const int& threads) {
                   "headless runs autosave only when it is given)");
     v->add_flag("--no-autosave", va.no_autosave, "no autosave, no recovery offer");
     v->add_flag("--recover", va.recover, "restore the image's recovery file (unsaved work of an earlier run) without asking");
-    v->callback([&threads, v] {
+    v->callback([&threads, v, bias] {
         va.n_given = v->count("--n") > 0;
         va.alpha_given = v->count("--alpha") > 0;
+        va.bias_given = bias->count() > 0;
         const int rc = run_view(va, threads);
         if (rc != 0) std::exit(rc);
     });

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "image_commands.hpp"
 #include "imgui_bridge.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/render/png_writer.hpp"
@@ -356,15 +357,19 @@ bool Viewer::fail(const std::string& what) {
 bool Viewer::open_image(const std::string& path) {
     try {
         Grid<float> image = read_image(path);
+        const cli::PreparedImage prepared =
+            cli::prepare_image(image, nullptr, config_.bias_correct ? cli::BiasCorrection::kDefault : cli::BiasCorrection::kOff);
         auto session = std::make_unique<Session>(std::move(image), config_.session);
         halt_run();
         autosave_->at_exit();  // the previous image's unsaved work
         report_autosave();
         session_ = std::move(session);
         image_path_ = path;
+        config_.roi_path.clear();  // an image opened here has no ROI
+        config_.image_corrected = prepared.bias.has_value();
         image_name_ = std::filesystem::path(path).filename().string();
         attach_session();
-        message_ = "opened " + path;
+        message_ = "opened " + path + (prepared.bias_skipped.empty() ? "" : " (" + prepared.bias_skipped + ")");
         message_is_error_ = false;
         log_.add("open", {{"path", path}});
         return true;

@@ -85,6 +85,11 @@ struct ViewerConfig {
     std::string image_path;  // the session's image as given (the key of its recovery file)
     AutosaveConfig autosave;  // recovery files (dir empty: none)
     std::string roi_path;     // the session's ROI as given (saved in workspaces)
+    // N4 first for images opened from the panel (as `view` and `segment` by default; skipped with a
+    // message where it cannot run), and whether the session's image is N4-corrected (saved in
+    // workspaces: a continued workspace corrects its image again, or not).
+    bool bias_correct = true;
+    bool image_corrected = false;
     std::string params_note;  // where the start parameters came from (panel and stderr)
     std::string workspace_path;                   // the panel's workspace file (--workspace)
     std::optional<WorkspaceView> workspace_view;  // camera, cursor, ... of the workspace continued

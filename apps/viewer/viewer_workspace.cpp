@@ -73,7 +73,7 @@ bool Viewer::save_workspace(const std::string& path, bool overwrite) {
     view.camera = camera_.pose();
     view.cursor = cursor_;
     try {
-        viewer::save_workspace(path, *session_, image_path_, config_.roi_path, view);
+        viewer::save_workspace(path, *session_, image_path_, config_.roi_path, config_.image_corrected, view);
     } catch (const std::exception& e) {
         return fail(e.what());
     }

@@ -162,6 +162,10 @@ Workspace parse_workspace(const json& j) {
     Workspace ws;
     ws.image = field(j, "image").get<std::string>();
     ws.roi = field(j, "roi").get<std::string>();
+    if (j.contains("bias_corrected")) {
+        if (!j["bias_corrected"].is_boolean()) throw std::runtime_error("field 'bias_corrected' is not true or false");
+        ws.bias_corrected = j["bias_corrected"].get<bool>();
+    }
     const json& g = field(j, "geometry");
     const auto d = numbers(g, "dims", 3), dir = numbers(g, "direction", 9);
     Mat3d direction{};
@@ -208,7 +212,7 @@ std::uint64_t image_checksum(const Grid<float>& image) {
 fs::path workspace_state_path(const fs::path& workspace) { return fs::path(workspace.string() + ".state"); }
 
 void save_workspace(const fs::path& path, const Session& session, const std::string& image, const std::string& roi,
-                    const WorkspaceView& view) {
+                    bool bias_corrected, const WorkspaceView& view) {
     const SessionMarks& m = session.marks();
     const auto now = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
     const std::vector<std::uint8_t> state =
@@ -219,6 +223,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
     json j{{"liveset_workspace", kWorkspaceVersion},
            {"image", image.empty() ? std::string() : fs::absolute(image).string()},
            {"roi", roi.empty() ? std::string() : fs::absolute(roi).string()},
+           {"bias_corrected", bias_corrected},
            {"geometry", {{"dims", {l.dims().x, l.dims().y, l.dims().z}}, {"spacing", vec(l.spacing())}, {"origin", vec(l.origin())},
                          {"direction", l.direction()}}},
            {"image_fnv", image_checksum(session.image())},

@@ -52,7 +52,8 @@ def _seed_text(seed) -> str:
 class Segmentation:
     """What ``segment`` returns: ``mask`` (uint8 0/1, φ < 0 within the ROI), ``phi`` (float32,
     < 0 inside), ``report`` (the dict ``liveset segment --json`` prints: iterations, stop, window,
-    tissue model, volume, ...), ``roi`` when one was used, ``corrected`` with bias_correct."""
+    tissue model, volume, ...), ``roi`` when one was used, ``corrected`` when N4 ran (the default:
+    the image the segmentation saw)."""
     mask: Image
     phi: Image
     report: dict
@@ -64,7 +65,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
             roi=None, init_mask=None, mu: Optional[float] = None, epsilon: Optional[float] = None,
             mu_raw: Optional[float] = None, epsilon_raw: Optional[float] = None,
             window_from: str = "model", classes: int = 3, n: float = 4.0, alpha: float = 0.1,
-            iterations: int = 2000, bias_correct: bool = False,
+            iterations: int = 2000, bias_correct: Optional[bool] = None,
             progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
     """Threshold level-set segmentation from seeds (paper Eq. 2-3), exactly as ``liveset segment``
     with the same options (the same image and options give the same mask, bit for bit).
@@ -76,7 +77,10 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
         may not leave. init_mask: start from this region instead of seeds.
     mu/epsilon: the window in normalised units, or mu_raw/epsilon_raw in the image's own; by
         default the tissue model's window for the seeds' class (``window_from="seeds"``: their
-        statistics). n, alpha, iterations, classes, bias_correct: as the CLI.
+        statistics). n, alpha, iterations, classes: as the CLI. bias_correct: None (the default)
+        runs N4 first as ``liveset segment`` does, skipped with a report warning where it cannot run
+        (an image too small for its grid); True requires it (ValueError where it cannot run); False
+        turns it off.
     progress: called with a dict (iteration, zero_layer, band, awake, changed, flips, inside, dt, ms)
         after every step; an exception it raises stops the run and propagates.
 
@@ -86,7 +90,8 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
     kw = dict(seeds=[_seed_text(s) for s in seeds], seeds_mm=[_seed_text(s) for s in seeds_mm],
               seed_radius=float(seed_radius), mu=mu, epsilon=epsilon, mu_raw=mu_raw,
               epsilon_raw=epsilon_raw, window_from=window_from, classes=int(classes), n=float(n),
-              alpha=float(alpha), iterations=int(iterations), bias_correct=bool(bias_correct))
+              alpha=float(alpha), iterations=int(iterations),
+              bias_correct=None if bias_correct is None else bool(bias_correct))
     kw["roi"] = _mask_arg(roi, img, "roi", allow_auto=True)
     kw["init_mask"] = _mask_arg(init_mask, img, "init_mask")
     r = _liveset._segment(img.array, img.geometry, progress, **kw)
@@ -115,15 +120,19 @@ def _mask_arg(mask, img: Image, what: str, allow_auto: bool = False):
 
 
 def tissue_model(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius: float = 2.0,
-                 roi=None, classes: int = 3, window_from: str = "model") -> dict:
+                 roi=None, classes: int = 3, window_from: str = "model",
+                 bias_correct: Optional[bool] = None) -> dict:
     """The tissue model (CSF/GM/WM mixture with partial volume) fitted where ``segment`` fits it,
-    and, with seeds, the threshold window ``segment`` would use: a dict with ``intensity_scale``,
-    ``tissue_model`` (classes: name, mean, sigma, weight; seed_class), ``window`` (mu, epsilon
-    normalised; mu_raw, epsilon_raw, lower_raw, upper_raw; source) and ``warnings``."""
+    on the image ``segment`` fits it on (bias-corrected as there: ``bias_correct`` as in
+    ``segment``), and, with seeds, the threshold window ``segment`` would use: a dict with
+    ``intensity_scale``, ``tissue_model`` (classes: name, mean, sigma, weight; seed_class),
+    ``window`` (mu, epsilon normalised; mu_raw, epsilon_raw, lower_raw, upper_raw; source),
+    ``warnings`` and, when N4 ran, ``bias_correction``."""
     img = as_image(image)
     kw = dict(seeds=[_seed_text(s) for s in seeds], seeds_mm=[_seed_text(s) for s in seeds_mm],
               seed_radius=float(seed_radius), classes=int(classes), window_from=window_from,
-              roi=_mask_arg(roi, img, "roi", allow_auto=True))
+              roi=_mask_arg(roi, img, "roi", allow_auto=True),
+              bias_correct=None if bias_correct is None else bool(bias_correct))
     return json.loads(_liveset._tissue_model(img.array, img.geometry, **kw))
 
 

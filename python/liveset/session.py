@@ -22,7 +22,9 @@ class Session:
     >>> s.undo(); m = s.mask()
 
     Coordinates are voxel indices (i, j, k). Runs release the GIL and stop on Ctrl-C between
-    steps (KeyboardInterrupt; the steps taken so far stay and can be undone)."""
+    steps (KeyboardInterrupt; the steps taken so far stay and can be undone). The image is taken as
+    given: for the bias-corrected one that ``segment`` and ``liveset view`` work on by default, pass
+    ``segment(...).corrected``."""
 
     def __init__(self, image, roi=None, *, n: float = 4.0, alpha: float = 0.1, layers: int = 2,
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,

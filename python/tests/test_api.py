@@ -82,6 +82,26 @@ def test_segment_equals_cli_bitwise(phantom, cli_segmentation):
     assert means == sorted(means)
 
 
+def test_bias_correction_is_the_default_and_false_turns_it_off(phantom, cli_segmentation):
+    """N4 first by default (as ``liveset segment``, whose report the fixture holds), off with
+    bias_correct=False; the default skips it with a warning where N4's model does not apply
+    (negative intensities), where bias_correct=True refuses with a ValueError."""
+    img = liveset.Image.from_nibabel(nib.load(phantom["image"]))
+    on = liveset.segment(img, phantom["seeds"], iterations=20)
+    off = liveset.segment(img, phantom["seeds"], iterations=20, bias_correct=False)
+    assert "bias_correction" in on.report and on.corrected is not None
+    assert on.report["bias_correction"]["field_min"] == pytest.approx(cli_segmentation["report"]["bias_correction"]["field_min"], abs=0)
+    assert "bias_correction" not in off.report and off.corrected is None
+    assert liveset.tissue_model(img, phantom["seeds"])["bias_correction"]["mask"] == on.report["bias_correction"]["mask"]
+    shifted = liveset.Image.from_nibabel(nib.Nifti1Image(np.asarray(nib.load(phantom["image"]).dataobj, dtype=np.float32) - 5000.0,
+                                                         nib.load(phantom["image"]).affine))
+    skipped = liveset.segment(shifted, phantom["seeds"], iterations=20)
+    assert "bias_correction" not in skipped.report
+    assert any("negative" in w for w in skipped.report["warnings"]), skipped.report["warnings"]
+    with pytest.raises(ValueError, match="bias correction"):
+        liveset.segment(shifted, phantom["seeds"], iterations=20, bias_correct=True)
+
+
 def test_evaluate_matches_brute_force_and_cli(phantom, cli_segmentation):
     mask, truth = liveset.read(cli_segmentation["mask"], labels=True), liveset.read(phantom["truth"], labels=True)
     ev = liveset.evaluate(mask, truth)

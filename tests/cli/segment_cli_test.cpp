@@ -279,7 +279,10 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
         {"segment " + img + " --seed 32,32,32 --mu nan" + o, ""},
         // ("the image", not eval's "truth": the message names what the mask must overlay)
         {"segment " + img + " --seed 32,32,32 --roi " + (work_dir() / "small_mask.nii.gz").string() + o, "differ from image dims"},
-        {"segment " + img + " --seed 32,32,32 --out-corrected " + corrected.string() + o, "needs --bias-correct"},
+        {"segment " + img + " --seed 32,32,32 --no-bias-correct --out-corrected " + corrected.string() + o, "needs the bias correction"},
+        // Writing the corrected image asks for the correction: where N4 cannot run it is an error.
+        {"segment " + img + " --seed 32,32,32 --out-corrected " + corrected.string() + " --roi " +
+             (work_dir() / "corner_mask.nii.gz").string() + o, "no voxel on the shrunk grid"},
         {"segment " + img + " --seed 32,32,32 --bias-correct --out-corrected " + corrected.string() + " --roi " +
              (work_dir() / "corner_mask.nii.gz").string() + o, "no voxel on the shrunk grid"},
         {"segment " + img + " --seed 32,32,32 --bias-correct --out-corrected /no/such/dir/c.nii.gz" + o, "does not exist"},
@@ -342,6 +345,54 @@ TEST(SegmentCli, BiasCorrectSegmentsTheCorrectedImageAndWritesIt) {
     const IntensityScale scale = robust_scale(expected);
     EXPECT_DOUBLE_EQ(j["intensity_scale"]["low"].get<double>(), scale.low);
     EXPECT_DOUBLE_EQ(j["intensity_scale"]["high"].get<double>(), scale.high);
+}
+
+// N4 runs by default (`--no-bias-correct` turns it off, the same mask as before the default
+// changed); where it cannot run and nobody asked for it, the segmentation goes on uncorrected with a
+// warning: a region holding no sample of N4's grid, or an image whose fit region is negative (an
+// offset: outside N4's multiplicative model).
+TEST(SegmentCli, BiasCorrectionIsTheDefaultAndSkipsWithAWarningWhereItCannotRun) {
+    const PhantomFiles& ph = phantom64();
+    const std::string img = (ph.dir / "t1.nii.gz").string();
+    const fs::path mask = work_dir() / "default_bc.nii.gz";
+    const auto run_json = [&](const std::string& args) {
+        const Result r = run_cli("segment " + args + " --iterations 20 --json --out-mask " + mask.string());
+        EXPECT_EQ(r.rc, 0) << args << ": " << r.err;
+        return r.rc == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object();
+    };
+    const auto warned = [](const nlohmann::json& j, const std::string& phrase) {
+        for (const auto& w : j["warnings"])
+            if (w.get<std::string>().find(phrase) != std::string::npos) return true;
+        return false;
+    };
+    const nlohmann::json on = run_json(img + ph.seeds), off = run_json(img + ph.seeds + " --no-bias-correct");
+    EXPECT_TRUE(on.contains("bias_correction"));
+    EXPECT_FALSE(off.contains("bias_correction"));
+    EXPECT_NE(on["intensity_scale"]["high"], off["intensity_scale"]["high"]);  // the corrected image was segmented
+
+    // A region between N4's samples (every 6th voxel of the phantom's 1 mm grid): voxels 1..4.
+    Grid<std::uint8_t> block(read_image(img).lattice(), 0);
+    for (int z = 1; z <= 4; ++z)
+        for (int y = 1; y <= 4; ++y)
+            for (int x = 1; x <= 4; ++x) block({x, y, z}) = 1;
+    const fs::path block_path = work_dir() / "block_roi.nii.gz";
+    write_label_image(block, block_path.string());
+    const nlohmann::json skipped = run_json(img + " --seed 2,2,2:1 --roi " + block_path.string());
+    EXPECT_FALSE(skipped.contains("bias_correction"));
+    EXPECT_TRUE(warned(skipped, "no voxel on the shrunk grid")) << skipped["warnings"];
+    EXPECT_TRUE(warned(skipped, "segmenting the uncorrected image")) << skipped["warnings"];
+
+    // The phantom shifted below zero: the default leaves it alone, and segments it as the
+    // uncorrected phantom (the same mask: the model and the speed see intensities, not their sign).
+    Grid<float> shifted = read_image(img);
+    for (float& v : shifted.values()) v -= 5000.0f;
+    const fs::path shifted_path = work_dir() / "shifted.nii.gz";
+    write_image(shifted, shifted_path.string());
+    const nlohmann::json negative = run_json(shifted_path.string() + ph.seeds);
+    EXPECT_FALSE(negative.contains("bias_correction"));
+    EXPECT_TRUE(warned(negative, "negative")) << negative["warnings"];
+    EXPECT_EQ(negative["voxels"], off["voxels"]);
+    EXPECT_EQ(negative["iterations"], off["iterations"]);
 }
 
 TEST(SegmentCli, DemoWritesItsOutputsAndAJsonReport) {

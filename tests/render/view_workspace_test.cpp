@@ -93,15 +93,45 @@ TEST(ViewCommand, AWorkspaceContinuesBitForBit) {
     EXPECT_EQ(viewer::read_workspace(w).marks.iterations, 45);
 }
 
+// The viewer segments the image `liveset segment` does: N4-corrected by default (the workspace
+// records it and holds the checksum of the corrected image `segment --out-corrected` writes), raw
+// with --no-bias-correct; a workspace saved with N4 refuses --no-bias-correct in one line.
+TEST(ViewCommand, TheViewerCorrectsTheBiasAsSegmentDoes) {
+    const Fixture& f = fixture();
+    const std::string w_on = (f.dir / "bias_on.json").string(), w_off = (f.dir / "bias_off.json").string();
+    const std::string corrected = (f.dir / "bias_corrected.nii.gz").string(), mask = (f.dir / "bias_mask.nii.gz").string();
+    CliResult r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
+                                      script("bias_on.json", R"([{"save_workspace": ")" + w_on + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    r = run_cli(fmt::format("view {} --no-bias-correct --seeds {} --headless --script {}", f.image, f.seeds,
+                            script("bias_off.json", R"([{"save_workspace": ")" + w_off + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    r = run_cli(fmt::format("segment {} --seed {},{},{} --iterations 1 --quiet --out-mask {} --out-corrected {}", f.image, f.ph.seeds[0].x,
+                            f.ph.seeds[0].y, f.ph.seeds[0].z, mask, corrected));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const viewer::Workspace on = viewer::read_workspace(w_on), off = viewer::read_workspace(w_off);
+    EXPECT_TRUE(on.bias_corrected);
+    EXPECT_FALSE(off.bias_corrected);
+    EXPECT_EQ(on.image_checksum, viewer::image_checksum(read_image(corrected)));
+    EXPECT_EQ(off.image_checksum, viewer::image_checksum(read_image(f.image)));
+    EXPECT_NE(on.image_checksum, off.image_checksum);
+
+    r = run_cli(fmt::format("view --workspace {} --no-bias-correct --headless --script {}", w_on, script("bias_none.json", "[]")));
+    EXPECT_NE(r.rc, 0);
+    EXPECT_NE(r.err.find("was saved with bias correction; drop --no-bias-correct"), std::string::npos) << r.err;
+}
+
 // A φ loaded alone: µ, ε from the tissue model's window of the class most of its inside falls in,
-// said on stderr; with --workspace, the workspace's; with --mu-raw/--epsilon-raw, those.
+// said on stderr; with --workspace, the workspace's; with --mu-raw/--epsilon-raw, those. (Without
+// N4: the reference below is the library's window on the raw image.)
 TEST(ViewCommand, APhiLoadedAloneSaysWhereItsParametersCameFrom) {
     const Fixture& f = fixture();
     const std::string phi = (f.dir / "alone_phi.nii.gz").string(), w = (f.dir / "alone.json").string();
-    CliResult r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
+    CliResult r = run_cli(fmt::format("view {} --no-bias-correct --seeds {} --headless --script {}", f.image, f.seeds,
                                       script("d.json", R"([{"segment": 40}, {"save_phi": ")" + phi + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
-    r = run_cli(fmt::format("view {} --phi {} --headless --script {}", f.image, phi, script("e.json", R"([{"undo": 1}, {"save_workspace": ")" + w + R"("}])")));
+    r = run_cli(fmt::format("view {} --no-bias-correct --phi {} --headless --script {}", f.image, phi,
+                            script("e.json", R"([{"undo": 1}, {"save_workspace": ")" + w + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_NE(r.err.find("µ, ε from the tissue model"), std::string::npos) << r.err;
     // The same window computed here from the library: the class of the φ's inside.
@@ -122,7 +152,7 @@ TEST(ViewCommand, APhiLoadedAloneSaysWhereItsParametersCameFrom) {
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_NE(r.err.find("µ, ε, n, α from the workspace"), std::string::npos) << r.err;
 
-    r = run_cli(fmt::format("view {} --phi {} --mu-raw 500 --epsilon-raw 120 --alpha 0.2 --headless --script {}", f.image, phi,
+    r = run_cli(fmt::format("view {} --no-bias-correct --phi {} --mu-raw 500 --epsilon-raw 120 --alpha 0.2 --headless --script {}", f.image, phi,
                             script("g.json", R"([{"save_workspace": ")" + w + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_NE(r.err.find("µ, ε from the command line"), std::string::npos) << r.err;

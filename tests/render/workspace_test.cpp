@@ -113,12 +113,13 @@ std::string error_of(const std::function<void()>& f) {
 TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     const auto original = worked_session();
     const fs::path w = work_dir() / "roundtrip.json";
-    viewer::save_workspace(w, *original, "t1.nii.gz", "", a_view());
+    viewer::save_workspace(w, *original, "t1.nii.gz", "", true, a_view());
     ASSERT_TRUE(fs::exists(viewer::workspace_state_path(w)));
 
     const Workspace ws = viewer::read_workspace(w);
     EXPECT_EQ(ws.image, fs::absolute("t1.nii.gz").string());
     EXPECT_TRUE(ws.roi.empty());
+    EXPECT_TRUE(ws.bias_corrected);
     EXPECT_TRUE(ws.lattice.same_geometry(original->lattice(), 0.0));
     EXPECT_TRUE(same_bits(ws.phi, original->field().phi()));
     EXPECT_TRUE(same_status(ws.status, original->field().status()));
@@ -176,7 +177,7 @@ TEST(WorkspaceFile, BadWorkspacesAreRefusedWithOneClearLine) {
     const fs::path dir = work_dir() / "bad";
     fs::create_directories(dir);
     const fs::path good = dir / "good.json";
-    viewer::save_workspace(good, *s, "t1.nii.gz", "", a_view());
+    viewer::save_workspace(good, *s, "t1.nii.gz", "", false, a_view());
     const std::string json_text = testing_slurp(good);
     const auto copy_as = [&](const std::string& name, const std::string& text) {
         const fs::path p = dir / name;
@@ -217,7 +218,7 @@ TEST(WorkspaceFile, BadWorkspacesAreRefusedWithOneClearLine) {
     const fs::path other = dir / "other_save.json";
     s->segment_step();
     s->end_action();
-    viewer::save_workspace(other, *s, "t1.nii.gz", "", a_view());
+    viewer::save_workspace(other, *s, "t1.nii.gz", "", false, a_view());
     fs::copy_file(viewer::workspace_state_path(other), viewer::workspace_state_path(copy_as("mixed.json", json_text)),
                   fs::copy_options::overwrite_existing);
     expect_line(read(dir / "mixed.json"), "belongs to another save");
