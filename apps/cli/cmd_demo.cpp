@@ -1,5 +1,5 @@
-// `liveset demo`, the README's main job: phantom -> segment (seeds, default parameters; the bias
-// leaves holes) -> mesh -> eval -> swarm repair with targets placed at the holes (as a user would
+// `liveset demo`, the README's main job: phantom -> segment (seeds, default parameters but no N4:
+// the phantom's bias leaves the holes the demo repairs) -> mesh -> eval -> swarm repair with targets placed at the holes (as a user would
 // click them, one after another) -> eval again, with a report (Dice and holes before and after,
 // timings) and every output written to a folder.
 #include <fmt/core.h>

@@ -125,7 +125,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     for (std::uint8_t& v : truth.values()) v = v == 2;  // grey matter
     const Grid<std::uint8_t> roi = load_mask_like((data / "brain_mask.nii.gz").string(), t1.lattice(), "brain mask");
 
-    // As `liveset segment --bias-correct` does: N4 inside the brain mask first.
+    // As `liveset segment` does by default: N4 inside the brain mask first.
     BiasCorrectionReport bias;
     const InterruptGuard interrupt;
     t1 = correct_bias(t1, &roi, {}, &bias, &interrupt.flag());

@@ -93,7 +93,7 @@ void add_holes_command(CLI::App& app, const int& threads) {
     static HolesArgs ha;
     auto* h = app.add_subcommand("holes", "candidate holes of a segmented sheet without ground truth, largest first, with --target sites");
     h->add_option("input", ha.input, "phi (<0 inside) or 0/1 mask of the segmented sheet")->required();
-    h->add_option("--image", ha.image, "the image the segmentation came from (the --out-corrected image when it was segmented with --bias-correct)")->required();
+    h->add_option("--image", ha.image, "the image the segmentation came from: segment's --out-corrected image (segment corrects the bias by default), or the input with --no-bias-correct")->required();
     h->add_option("--roi", ha.roi, "region of interest (outside it counts as the outside tissue)");
     h->add_option("--min-voxels", ha.min_voxels, "smallest candidate listed")->check(CLI::Range(std::size_t{1}, std::size_t{1} << 40))->capture_default_str();
     h->add_option("--min-sheet-share", ha.min_sheet_share, "leave out candidates with a smaller share of voxels touching the segmentation")->check(CLI::Range(0.0, 1.0))->capture_default_str();

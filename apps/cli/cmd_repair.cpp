@@ -316,7 +316,7 @@ void add_repair_command(CLI::App& app, const int& threads) {
     static RepairArgs ra;
     auto* r = app.add_subcommand("repair", "agent-swarm repair of a segmentation around target points (paper section 4)");
     r->add_option("input", ra.input, "phi (<0 inside) or 0/1 mask to repair")->required();
-    r->add_option("--image", ra.image, "the image the segmentation came from (the --out-corrected image when it was segmented with --bias-correct)")->required();
+    r->add_option("--image", ra.image, "the image the segmentation came from: segment's --out-corrected image (segment corrects the bias by default), or the input with --no-bias-correct")->required();
     r->add_option("--target", ra.targets, "target voxel I,J,K[@STEP] (from step STEP on; default 0); repeatable");
     r->add_option("--target-mm", ra.targets_mm, "target X,Y,Z[@STEP] in physical LPS mm; repeatable");
     r->add_option("--find-holes", ra.find_holes, "no targets needed: the truth-free hole finder's N largest holes (as `liveset holes` lists them, >= --min-hole voxels, 12 voxels apart) are repaired one round each with the sheet rule, the brush sized to the hole and the band sampled around it, as `liveset demo --brain --repair` does (p 0.3 unless --p is given)")

@@ -48,36 +48,51 @@ std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image) 
     }
 }
 
+namespace {
+
+// The share of the voxels N4 would fit (the region, else Otsu's foreground, as correct_bias) that
+// are negative.
+double negative_share(const Grid<float>& image, const Grid<std::uint8_t>* region) {
+    const std::optional<Grid<std::uint8_t>> otsu = region ? std::nullopt : std::optional(otsu_foreground(image));
+    const Grid<std::uint8_t>& fit = region ? *region : *otsu;
+    std::size_t negative = 0, total = 0;
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if (fit[p] == 0) continue;
+        ++total;
+        negative += image[p] < 0.0f;
+    }
+    return total > 0 ? static_cast<double>(negative) / static_cast<double>(total) : 0.0;
+}
+
+}  // namespace
+
 PreparedImage prepare_image(Grid<float>& image, const Grid<std::uint8_t>* roi, BiasCorrection mode,
                             const std::atomic<bool>* interrupt) {
     PreparedImage out;
     if (roi == nullptr) out.fit_region = try_auto_brain_mask(image);
     if (mode == BiasCorrection::kOff) return out;
-    if (mode == BiasCorrection::kDefault) {
-        // N4 models a multiplicative field on magnitude data. Negative values in the fit region (an
-        // offset, a z-scored image) are outside that model: the default leaves such an image alone.
-        const Grid<std::uint8_t>* fit = out.fit(roi);
-        std::size_t negative = 0, total = 0;
-        for (std::size_t i = 0; i < image.size(); ++i) {
-            const auto p = static_cast<PointIndex>(i);
-            if (fit != nullptr && (*fit)[p] == 0) continue;
-            ++total;
-            negative += image[p] < 0.0f;
-        }
-        if (negative * 100 > total) {
-            out.bias_skipped = fmt::format("bias correction skipped: {:.0f} % of the voxels it would fit are negative (an offset or a z-scored "
-                                           "image?), outside N4's multiplicative model; segmenting the uncorrected image (--bias-correct forces it)",
-                                           100.0 * static_cast<double>(negative) / static_cast<double>(total));
-            return out;
-        }
-    }
+    const auto skip = [&](const std::string& why) {
+        out.bias_skipped = "bias correction skipped: " + why + "; the uncorrected image is used";
+        return out;
+    };
     BiasCorrectionReport report;
     try {
+        if (mode == BiasCorrection::kDefault) {
+            // N4 models a multiplicative field on magnitude data. Negative values where it would fit
+            // (an offset, a z-scored image) are outside that model: the default leaves such an image alone.
+            const double negative = negative_share(image, out.fit(roi));
+            if (negative > 0.01)
+                return skip(fmt::format("{:.1f} % of the voxels it would fit are negative (an offset or a z-scored image?), outside N4's "
+                                        "multiplicative model", 100.0 * negative));
+        }
         image = correct_bias(image, out.fit(roi), {}, &report, interrupt);
-    } catch (const std::invalid_argument& e) {
+    } catch (const std::invalid_argument& e) {  // the input N4 cannot take
         if (mode == BiasCorrection::kRequired) throw;
-        out.bias_skipped = std::string(e.what()) + "; segmenting the uncorrected image";
-        return out;
+        return skip(e.what());
+    } catch (const std::runtime_error& e) {  // N4 itself failed
+        if (mode == BiasCorrection::kRequired) throw;
+        return skip(e.what());
     }
     out.bias = std::move(report);
     return out;

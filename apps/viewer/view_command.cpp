@@ -36,8 +36,9 @@ struct ViewArgs : ThresholdArgs {
     double autosave_every = 120.0;
     std::string recovery_dir;
     std::string window_from = "model";  // µ, ε from the seeds: the tissue model or the seeds' statistics
-    bool bias_correct = true;           // N4 first, as `segment` (a continued workspace: as it was saved)
+    bool bias_correct = true;           // N4 first, as `segment` (also for images opened from the panel)
     bool bias_given = false;            // --bias-correct or --no-bias-correct on the command line
+    std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
 };
 
@@ -60,8 +61,12 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> roi;
     if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
-    // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for.
-    const BiasCorrection mode = !a.bias_correct ? BiasCorrection::kOff : a.bias_given ? BiasCorrection::kRequired : BiasCorrection::kDefault;
+    // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for (or a
+    // continued workspace's image was corrected: then it must be again).
+    const bool correct = a.workspace_bias.value_or(a.bias_correct);
+    const BiasCorrection mode = !correct ? BiasCorrection::kOff
+                                : a.bias_given || a.workspace_bias ? BiasCorrection::kRequired
+                                                                   : BiasCorrection::kDefault;
     PreparedImage prepared;
     try {
         prepared = prepare_image(image, roi ? &*roi : nullptr, mode);
@@ -123,8 +128,7 @@ std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
                                                  ws.bias_corrected ? "with" : "without", a.bias_correct ? "--bias-correct" : "--no-bias-correct"));
         if (a.image.empty()) a.image = ws.image;
         if (a.roi.empty()) a.roi = ws.roi;
-        if (!a.bias_given) a.bias_correct = ws.bias_corrected;  // its image as it was: corrected again, or not
-        a.bias_given = a.bias_correct;  // a saved correction that cannot run is an error, not a new image
+        a.workspace_bias = ws.bias_corrected;
         return ws;
     } catch (const std::runtime_error& e) {
         fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
@@ -143,6 +147,7 @@ std::unique_ptr<Session> open_session(ViewArgs& a, std::optional<viewer::Workspa
         } catch (const std::exception& e) {
             fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
             ws.reset();
+            a.workspace_bias.reset();  // the command line's setting again
             s = load_session(a);
         }
     }

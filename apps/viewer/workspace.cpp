@@ -291,7 +291,7 @@ void check_workspace_image(const Workspace& ws, const fs::path& path, const Grid
         throw std::runtime_error(fmt::format("workspace {} was saved for another image: {} there, {} here (size, spacing, origin or direction)",
                                              path.string(), ws.lattice.describe(), image.lattice().describe()));
     if (image_checksum(image) != ws.image_checksum)
-        throw std::runtime_error(fmt::format("workspace {} was saved for another image: same geometry, other voxel values", path.string()));
+        throw std::runtime_error(fmt::format("workspace {} was saved for another image: same geometry, other voxel values (or another N4 correction of it)", path.string()));
 }
 
 void apply_workspace(Session& session, const Workspace& ws) {

@@ -176,7 +176,8 @@ def find_holes(mask, image, roi=None, sheet_band=None, min_voxels: int = 10, min
     that look like the sheet's tissue where the tissue it encloses meets the outside.
 
     ``mask`` the segmentation (non-zero inside) or a φ image (< 0 inside is not assumed: pass a
-    mask), ``image`` the raw image on the same grid, ``roi`` optional. ``sheet_band=(lower, upper)``
+    mask), ``image`` the image the segmentation came from on the same grid (``segment(...).corrected``
+    when N4 ran, the default), ``roi`` optional. ``sheet_band=(lower, upper)``
     in raw intensities; by default the tissue model's band of the sheet's class. Returns
     ``{"sheet_band", "band_from", "holes": [{"voxels", "rim", "sheet", "target": [i, j, k],
     "centroid"}, ...] (largest first), "warnings"}``; a ``target`` is what ``repair`` and

@@ -380,7 +380,7 @@ TEST(SegmentCli, BiasCorrectionIsTheDefaultAndSkipsWithAWarningWhereItCannotRun)
     const nlohmann::json skipped = run_json(img + " --seed 2,2,2:1 --roi " + block_path.string());
     EXPECT_FALSE(skipped.contains("bias_correction"));
     EXPECT_TRUE(warned(skipped, "no voxel on the shrunk grid")) << skipped["warnings"];
-    EXPECT_TRUE(warned(skipped, "segmenting the uncorrected image")) << skipped["warnings"];
+    EXPECT_TRUE(warned(skipped, "the uncorrected image is used")) << skipped["warnings"];
 
     // The phantom shifted below zero: the default leaves it alone, and segments it as the
     // uncorrected phantom (the same mask: the model and the speed see intensities, not their sign).

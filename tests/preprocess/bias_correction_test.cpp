@@ -453,17 +453,42 @@ TEST(BiasCorrection, TheStorageOrderOfTheAxesDoesNotChangeTheResult) {
 }
 
 // The same data with its voxel size as NIfTI stores it (float) and as MINC does (double, after
-// normalising direction cosines): 6e-8 apart. N4 is told the size rounded to 6 significant digits,
-// so both get the same bits (unrounded, its fit turned the difference into fields 0.3 % apart).
+// normalising direction cosines): a few ulps apart. N4 works in index units and millimetres only
+// pick whole numbers (with a margin at rounding boundaries), so both get the same bits (before, its
+// fit turned 6e-8 into fields 0.3 % apart). Sizes: this box's, 250 mm / 256 (a half-way case for
+// rounding to 6 digits), and 4/3 mm (6 mm / 1.3333 = 4.5: the shrink factor's boundary).
 TEST(BiasCorrection, AVoxelSizeOffByRoundingGivesTheSameResult) {
     const Phantom ph = make_phantom(kBox);
     const Grid<float> input = multiply(ph.image, smooth_field(kBox, log_test_field));
-    const Lattice nudged(kBox.dims(), {2.0 * (1 + 6e-8), 2.0 * (1 - 4e-8), static_cast<double>(3.0f) * (1 - 5e-8)});
-    Grid<float> moved(nudged);
-    Grid<std::uint8_t> moved_head(nudged);
-    std::copy(input.values().begin(), input.values().end(), moved.values().begin());
-    std::copy(ph.head.values().begin(), ph.head.values().end(), moved_head.values().begin());
-    const Grid<float> a = correct_bias(input, &ph.head, small_grid());
-    const Grid<float> b = correct_bias(moved, &moved_head, small_grid());
-    for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[static_cast<PointIndex>(i)], b[static_cast<PointIndex>(i)]) << i;
+    const auto with_spacing = [&](Vec3d spacing) {
+        const Lattice l(kBox.dims(), spacing);
+        Grid<float> image(l);
+        Grid<std::uint8_t> head(l);
+        std::copy(input.values().begin(), input.values().end(), image.values().begin());
+        std::copy(ph.head.values().begin(), ph.head.values().end(), head.values().begin());
+        BiasCorrectionOptions o = small_grid();
+        o.shrink_mm = 6.0;
+        BiasCorrectionReport rep;
+        Grid<float> out = correct_bias(image, &head, o, &rep);
+        return std::pair(std::move(out), rep.shrink_factors);
+    };
+    const std::vector<Vec3d> sizes = {{2.0, 2.0, 3.0}, {0.9765625, 0.9765625, 1.2}, {4.0 / 3.0, 4.0 / 3.0, 1.5}};
+    for (const Vec3d& s : sizes) {
+        const Vec3d as_float{double(float(s.x)), double(float(s.y)), double(float(s.z))};
+        const Vec3d nudged{s.x * (1 + 6e-8), s.y * (1 - 4e-8), s.z * (1 - 5e-8)};
+        const auto [a, fa] = with_spacing(as_float);
+        const auto [b, fb] = with_spacing(nudged);
+        ASSERT_EQ(fa, fb) << s;
+        for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[static_cast<PointIndex>(i)], b[static_cast<PointIndex>(i)]) << s << " voxel " << i;
+    }
+}
+
+// The first correction registers the threader that runs ITK's work units as TBB tasks: from then
+// on every ITK filter gets it, with its fixed count of work units.
+TEST(BiasCorrection, ItksFiltersRunTheirWorkUnitsAsTbbTasks) {
+    const Phantom ph = make_phantom(kBox);
+    correct_bias(ph.image, &ph.head, small_grid());
+    const auto threader = itk::MultiThreaderBase::New();
+    EXPECT_STREQ(threader->GetNameOfClass(), "TbbWorkUnits");
+    EXPECT_EQ(threader->GetNumberOfWorkUnits(), 8u);
 }

@@ -263,7 +263,7 @@ TEST(TissueModel, AThinBrightClassIsWarnedAbout) {
     };
     const std::string bright = warnings_for({{48, 10, 0.35}, {97, 8, 0.43}, {150, 5, 0.02}});
     EXPECT_NE(bright.find("WM class"), std::string::npos) << bright;
-    EXPECT_NE(bright.find("--bias-correct"), std::string::npos) << bright;
+    EXPECT_NE(bright.find("bias-corrected"), std::string::npos) << bright;
     EXPECT_EQ(warnings_for(kT1), "");
     EXPECT_EQ(warnings_for({{48, 10, 0.025}, {97, 8, 0.45}, {131, 6, 0.325}}), "");
 }

@@ -13,6 +13,7 @@
 #include <itkVersion.h>
 #include <itkN4BiasFieldCorrectionImageFilter.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
@@ -85,18 +86,16 @@ Grid<std::uint8_t> fit_mask(const Grid<float>& image, const Grid<std::uint8_t>* 
     return fit;
 }
 
-// The voxel size N4 is told (and the shrink factors are computed from): the image's rounded to 6
-// significant digits. The same data as NIfTI (spacing in float: 1.2000000477 mm) and as MINC (in
-// double: 1.1999999552 mm once its direction cosines are normalised) must get the same field, and
-// N4's 50-iteration fit turned a 6e-8 difference into fields 0.3 % apart (a phantom and its
-// nii2mnc copy: masks a few voxels apart).
-Vec3d n4_spacing(Vec3d spacing) {
-    for (int a = 0; a < 3; ++a) {
-        const double scale = std::pow(10.0, 5.0 - std::floor(std::log10(spacing[a])));
-        spacing[a] = std::round(spacing[a] * scale) / scale;
-    }
-    return spacing;
-}
+// The voxel size's last bits must not reach N4: the same data as NIfTI (spacing in float:
+// 1.2000000477 mm) and as MINC (in double: 1.1999999552 mm once its direction cosines are
+// normalised) must get the same field, and N4's fit turned that 6e-8 into fields 0.3 % apart (a
+// phantom and its nii2mnc copy: masks a few voxels apart). So N4 works in index units (its
+// B-spline's parametric coordinates are then ratios of sample indices, exact), and millimetres only
+// pick whole numbers - the shrink factors and the control points - with this margin, so that a
+// ratio within it of a rounding boundary (6 mm / 1.3333 mm = 4.5) goes the same way for both.
+constexpr double kMmMargin = 1e-6;
+// Unit spacing: what N4 and the field's evaluation are told.
+constexpr Vec3d kIndexUnits{1.0, 1.0, 1.0};
 
 // The shrunk grid: along each axis samples 0, f, 2f, ... up to the first one at or past the last
 // voxel (n_s = ceil((n-1)/f) + 1), so its span (n_s-1)·f covers the image's n-1 exactly or with a
@@ -112,7 +111,7 @@ ShrinkPlan plan_shrink(Vec3i dims, Vec3d spacing, double shrink_mm) {
     ShrinkPlan plan;
     for (int a = 0; a < 3; ++a) {
         const int n = dims[a];
-        const int f = std::clamp(static_cast<int>(std::lround(shrink_mm / spacing[a])), 1, n - 1);
+        const int f = std::clamp(static_cast<int>(std::floor(shrink_mm / spacing[a] + 0.5 - kMmMargin)), 1, n - 1);
         plan.factors[a] = f;
         plan.dims[a] = (n - 1 + f - 1) / f + 1;
         plan.span[a] = (plan.dims[a] - 1) * f + 1;
@@ -123,14 +122,11 @@ ShrinkPlan plan_shrink(Vec3i dims, Vec3d spacing, double shrink_mm) {
 // The shrunk grid filled with value(p) at each sample's full-resolution voxel p = j·f (the
 // padding samples past the image's end stay 0).
 template <class Image, class Value>
-typename Image::Pointer shrunk_image(const Vec3i& n, const ShrinkPlan& plan, Vec3d spacing_mm, const Value& value) {
+typename Image::Pointer shrunk_image(const Vec3i& n, const ShrinkPlan& plan, const Value& value) {
     auto out = Image::New();
     typename Image::SizeType size;
     for (int a = 0; a < 3; ++a) size[a] = static_cast<itk::SizeValueType>(plan.dims[a]);
-    out->SetRegions(size);
-    typename Image::SpacingType spacing;
-    for (int a = 0; a < 3; ++a) spacing[a] = spacing_mm[a];
-    out->SetSpacing(spacing);  // origin 0, identity direction: N4 fits in this parametric space anyway
+    out->SetRegions(size);  // unit spacing, origin 0, identity direction: index units (kMmMargin)
     out->Allocate(true);
     auto* dst = out->GetBufferPointer();
     std::size_t k = 0;
@@ -161,9 +157,9 @@ float fit_median(const Grid<float>& full, const Grid<std::uint8_t>& fit, Vec3i c
     return v[static_cast<std::size_t>(count / 2)];
 }
 
-// ITK's work split onto TBB (ItkOnTbb below): every work unit of a filter runs as a TBB task, so
-// ITK honours --threads (TBB's allowed parallelism) as liveset's own loops do, and a filter gets a
-// fixed number of work units whatever the machine. ITK's own pool threader cannot do either: it
+// ITK's work split onto TBB (use_tbb_work_units below): every work unit of a filter runs as a TBB
+// task, so ITK honours --threads (TBB's allowed parallelism) as liveset's own loops do, and a
+// filter gets a fixed number of work units whatever the machine. ITK's own pool threader cannot do either: it
 // runs each work unit on a pool thread (as many as the machine's cores), and a filter's default
 // count of work units follows its thread count (1 thread: 1, 2: 8).
 class TbbWorkUnits : public itk::MultiThreaderBase {
@@ -186,13 +182,15 @@ public:
     void SingleMethodExecute() override {
         const itk::ThreadIdType n = this->GetNumberOfWorkUnits();
         std::vector<WorkUnitInfo> units(n);
-        tbb::parallel_for(itk::ThreadIdType{0}, n, [&](itk::ThreadIdType i) {
-            units[i].WorkUnitID = i;
-            units[i].NumberOfWorkUnits = n;
-            units[i].UserData = data_;
-            units[i].ThreadFunction = method_;
-            units[i].ThreadExitCode = WorkUnitInfo::ThreadExitCodeEnum::SUCCESS;
-            method_(&units[i]);
+        tbb::this_task_arena::isolate([&] {  // a caller inside a TBB task waits for these units only
+            tbb::parallel_for(itk::ThreadIdType{0}, n, [&](itk::ThreadIdType i) {
+                units[i].WorkUnitID = i;
+                units[i].NumberOfWorkUnits = n;
+                units[i].UserData = data_;
+                units[i].ThreadFunction = method_;
+                units[i].ThreadExitCode = WorkUnitInfo::ThreadExitCodeEnum::SUCCESS;
+                method_(&units[i]);
+            });
         });
     }
 
@@ -224,23 +222,13 @@ protected:
     }
 };
 
-// While alive, every ITK filter created gets the TbbWorkUnits threader (N4 creates its filters
-// inside): registered for the guard's lifetime only, one guard at a time.
-class ItkOnTbb {
-public:
-    ItkOnTbb() : lock_(mutex()), factory_(TbbWorkUnitsFactory::New()) { itk::ObjectFactoryBase::RegisterFactory(factory_); }
-    ~ItkOnTbb() { itk::ObjectFactoryBase::UnRegisterFactory(factory_); }
-    ItkOnTbb(const ItkOnTbb&) = delete;
-    ItkOnTbb& operator=(const ItkOnTbb&) = delete;
-
-private:
-    static std::mutex& mutex() {
-        static std::mutex m;
-        return m;
-    }
-    std::lock_guard<std::mutex> lock_;
-    TbbWorkUnitsFactory::Pointer factory_;
-};
+// From the first bias correction on, every ITK filter the process creates gets the TbbWorkUnits
+// threader (N4 creates its filters inside). Registered once and never removed: ITK's factory list
+// has no lock, and other threads (Python's, Dask's) may create ITK objects at any time.
+void use_tbb_work_units() {
+    static std::once_flag once;
+    std::call_once(once, [] { itk::ObjectFactoryBase::RegisterFactory(TbbWorkUnitsFactory::New()); });
+}
 
 // True when the fit voxels of the shrunk grid all hold the same value (N4's histogram would have
 // zero width: nothing to correct).
@@ -271,7 +259,7 @@ ControlLattice::ConstPointer run_n4(const FloatImage::Pointer& image, const Mask
     N4Filter::ArrayType control_points;
     for (int a = 0; a < 3; ++a) {
         const double span_mm = (plan.dims[a] - 1) * plan.factors[a] * spacing[a];
-        const int mesh = std::max(1, static_cast<int>(std::ceil(span_mm / o.spline_distance_mm - 1e-9)));
+        const int mesh = std::max(1, static_cast<int>(std::ceil(span_mm / o.spline_distance_mm - kMmMargin)));
         control_points[a] = static_cast<unsigned>(mesh + 3);
         report.control_points[a] = mesh + 3;
     }
@@ -303,7 +291,7 @@ Grid<float> full_resolution_log_field(const ControlLattice::ConstPointer& lattic
     std::vector<float> control(lattice->GetLargestPossibleRegion().GetNumberOfPixels());
     const auto* points = lattice->GetBufferPointer();
     for (std::size_t i = 0; i < control.size(); ++i) control[i] = points[i][0];
-    return evaluate_cubic_bspline(control, dims, plan.span, n4_spacing(grid.spacing()), grid);
+    return evaluate_cubic_bspline(control, dims, plan.span, kIndexUnits, grid);
 }
 
 // image / exp(log field - mean log field over the fit mask); the field's range in the mask.
@@ -368,15 +356,14 @@ Grid<float> correct_bias(const Grid<float>& image, const Grid<std::uint8_t>* mas
     check_inputs(image, mask);
     BiasCorrectionReport report;
     const Grid<std::uint8_t> fit = fit_mask(image, mask, report);
-    const Vec3d s = n4_spacing(image.lattice().spacing());
+    const Vec3d s = image.lattice().spacing();
     const ShrinkPlan plan = plan_shrink(image.dims(), s, options.shrink_mm);
     report.shrink_factors = plan.factors;
     report.shrunk_dims = plan.dims;
-    const Vec3d shrunk_spacing{s.x * plan.factors.x, s.y * plan.factors.y, s.z * plan.factors.z};
-    const auto small = shrunk_image<FloatImage>(image.dims(), plan, shrunk_spacing, [&](Vec3i p) {
+    const auto small = shrunk_image<FloatImage>(image.dims(), plan, [&](Vec3i p) {
         return options.denoise && fit(p) != 0 ? fit_median(image, fit, p) : image(p);
     });
-    const auto small_mask = shrunk_image<MaskImage>(image.dims(), plan, shrunk_spacing, [&](Vec3i p) { return fit(p); });
+    const auto small_mask = shrunk_image<MaskImage>(image.dims(), plan, [&](Vec3i p) { return fit(p); });
     const unsigned char* m = small_mask->GetBufferPointer();
     if (std::none_of(m, m + small_mask->GetBufferedRegion().GetNumberOfPixels(), [](unsigned char v) { return v != 0; }))
         fail("the mask leaves no voxel on the shrunk grid (" + dims_text(plan.dims) + "); lower shrink_mm");
@@ -387,7 +374,7 @@ Grid<float> correct_bias(const Grid<float>& image, const Grid<std::uint8_t>* mas
         corrected = image;
     } else {
         const auto n4_start = Clock::now();
-        const ItkOnTbb on_tbb;
+        use_tbb_work_units();
         ControlLattice::ConstPointer lattice;
         try {
             lattice = run_n4(small, small_mask, plan, s, options, report, interrupt);

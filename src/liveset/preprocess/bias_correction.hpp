@@ -73,7 +73,11 @@ struct BiasCorrectionReport {
 //    ITK's filters inside N4 run a fixed number of work units as TBB tasks (ITK's scattered-data
 //    B-spline fit sums one partial lattice per work unit, so a count that followed the threads
 //    would change its rounding); the full-resolution field (bspline_field.hpp) and the division are
-//    per voxel.
+//    per voxel. The first call registers, for the rest of the process, the ITK object factory that
+//    gives every ITK filter created after it that threader.
+//  - N4 works in index units; millimetres only pick the shrink factors and the control points
+//    (with a margin at rounding boundaries), so the same data stored with a voxel size a few ulps
+//    apart (NIfTI's float, MINC's double) gets the same bits.
 //  - `interrupt` (e.g. Ctrl-C) is polled at every N4 iteration; when it turns true N4 stops and the
 //    input comes back unchanged with report->interrupted set.
 // Throws std::invalid_argument (one line) on bad options, an empty image or an axis of < 2 voxels,

@@ -50,7 +50,7 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
 namespace {
 
 // What both shading warnings (below and in fit_window_model) advise.
-constexpr const char* kShadingHint = "if the scan is shaded and was not corrected (--no-bias-correct, or N4 skipped): --bias-correct";
+constexpr const char* kShadingHint = "if the scan is shaded: check that it was bias-corrected (the default; not with --no-bias-correct)";
 
 // In a three-class (CSF, GM, WM) model, GM or WM holding under 3 % of the region: no whole-brain
 // region measured is like that, but a bias field can split a tissue into a thin bright class and the
