@@ -159,9 +159,9 @@ float fit_median(const Grid<float>& full, const Grid<std::uint8_t>& fit, Vec3i c
 
 // ITK's work split onto TBB (use_tbb_work_units below): every work unit of a filter runs as a TBB
 // task, so ITK honours --threads (TBB's allowed parallelism) as liveset's own loops do, and a
-// filter gets a fixed number of work units whatever the machine. ITK's own pool threader cannot do either: it
-// runs each work unit on a pool thread (as many as the machine's cores), and a filter's default
-// count of work units follows its thread count (1 thread: 1, 2: 8).
+// filter gets a fixed number of work units whatever the machine. ITK's own pool threader cannot
+// do either: it runs each work unit on a pool thread (as many as the machine's cores), and a
+// filter's default count of work units follows its thread count (1 thread: 1, 2: 8).
 class TbbWorkUnits : public itk::MultiThreaderBase {
 public:
     using Self = TbbWorkUnits;
