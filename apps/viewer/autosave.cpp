@@ -44,7 +44,7 @@ std::filesystem::path default_recovery_dir() {
     return {};
 }
 
-void Autosave::attach(Session* session, const std::string& image_path) {
+void Autosave::attach(Session* session, const std::string& image_path, bool corrected) {
     crash_.reset();
     offer_.reset();
     session_ = nullptr;
@@ -60,7 +60,7 @@ void Autosave::attach(Session* session, const std::string& image_path) {
         session_ = nullptr;
         return;
     }
-    file_ = recovery_path(config_.dir, image_);
+    file_ = recovery_path(config_.dir, image_, corrected ? "n4" : "");
     clean_revision_ = written_revision_ = session_->revision();
     tracked_revision_ = ~std::uint64_t{0};
     last_write_ = std::chrono::steady_clock::now();

@@ -35,10 +35,11 @@ public:
 
     bool enabled() const { return !config_.dir.empty(); }
     // A new session on `image_path` (the path as given; call at_exit() before the previous session
-    // goes). Looks for its recovery file: a readable one
-    // matching the image becomes the pending offer (restored at once with `recover`); a damaged or
-    // mismatching one is reported in message() and will be replaced by this run's autosaves.
-    void attach(Session* session, const std::string& image_path);
+    // goes), `corrected`: on its N4-corrected copy (a recovery file of its own). Looks for its
+    // recovery file: a readable one matching the image becomes the pending offer (restored at once
+    // with `recover`); a damaged or mismatching one is reported in message() and will be replaced by
+    // this run's autosaves.
+    void attach(Session* session, const std::string& image_path, bool corrected = false);
 
     // The pending offer: a recovery file awaiting the user's choice (autosave waits meanwhile).
     bool offer_pending() const { return offer_.has_value(); }

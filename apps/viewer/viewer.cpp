@@ -58,7 +58,7 @@ Viewer::~Viewer() {
 }
 
 void Viewer::attach_session() {
-    autosave_->attach(session_.get(), image_path_);
+    autosave_->attach(session_.get(), image_path_, config_.image_corrected);
     show_session();
     // What was loaded is on disk; restored unsaved work is not (it lives in the recovery file).
     saved_revision_ = session_ && !autosave_->restored() ? session_->revision() : ~std::uint64_t{0};

@@ -97,6 +97,14 @@ TEST(Autosave, UnsavedWorkIsKeptAtExitRestoredWithRecoverAndGoneOnceSaved) {
     ASSERT_EQ(ignored.rc, 0) << ignored.err;
     EXPECT_NE(ignored.err.find("--recover restores it"), std::string::npos) << ignored.err;
     EXPECT_EQ(recovery_files(rec).size(), 1u);
+    // The work was on the N4-corrected image (the default): a session on the raw image has a
+    // recovery file of its own and is not offered this one.
+    EXPECT_EQ(files[0], recovery_path(rec, f.image, "n4"));
+    const CliResult raw = run_cli(view(f, rec, script(f.dir, "idle.json", R"([{"layout": "four"}])"), "--no-bias-correct --recover"));
+    ASSERT_EQ(raw.rc, 0) << raw.err;
+    EXPECT_EQ(raw.err.find("restored unsaved work"), std::string::npos) << raw.err;
+    EXPECT_EQ(raw.err.find("--recover restores it"), std::string::npos) << raw.err;
+    EXPECT_EQ(recovery_files(rec).size(), 1u);
 
     // --recover: the same surface as before the exit; saving the mask then removes the file.
     const fs::path mask = f.dir / "restored_mask.nii.gz";
@@ -170,7 +178,7 @@ TEST(Autosave, ADamagedRecoveryFileIsReportedAndReplaced) {
     const fs::path rec = f.dir / "rec3";
     fs::remove_all(rec);
     fs::create_directories(rec);
-    const fs::path file = recovery_path(rec, f.image);
+    const fs::path file = recovery_path(rec, f.image, "n4");  // the viewer's default: N4 first
     std::ofstream(file) << "LSRECOV1 but nothing after it";
     const CliResult r = run_cli(view(f, rec, script(f.dir, "short.json", "[" + f.seeds + R"({"segment": 5}])")));
     ASSERT_EQ(r.rc, 0) << r.err;

@@ -83,7 +83,7 @@ TEST(WindowSmoke, DragClickKeysAndAButtonUnderXvfb) {
     EXPECT_DOUBLE_EQ(exit["camera"]["pitch"].get<double>(), 20.0);
     ASSERT_TRUE(exit.contains("target"));
     // The swarm's edits were never saved: they wait in a recovery file for the next start.
-    const fs::path kept = recovery_path(dir / "recovery", image);
+    const fs::path kept = recovery_path(dir / "recovery", image, "n4");  // the viewer's default: N4 first
     ASSERT_TRUE(fs::exists(kept)) << driver_out;
     EXPECT_EQ(read_recovery(kept).signal, 0);
     fs::remove_all(dir);
@@ -108,7 +108,7 @@ TEST(WindowSmoke, TheRestoreDialogRestoresUnsavedWorkUnderXvfb) {
     const std::string work = std::string(LIVESET_CLI_PATH) + " view " + image + " --headless --recovery-dir " + recovery.string() +
                              " --script " + (dir / "work.json").string() + " > " + (dir / "work.out").string() + " 2>&1";
     ASSERT_EQ(std::system(work.c_str()), 0);
-    ASSERT_TRUE(fs::exists(recovery_path(recovery, image)));
+    ASSERT_TRUE(fs::exists(recovery_path(recovery, image, "n4")));  // the viewer's default: N4 first
 
     const std::string cmd = "cd " + dir.string() + " && timeout 300 xvfb-run -a -s '-screen 0 1280x720x24' bash " +
                             std::string(LIVESET_SOURCE_DIR) + "/tests/render/window_recovery.sh " + LIVESET_CLI_PATH + " " + image +
@@ -132,7 +132,7 @@ TEST(WindowSmoke, TheRestoreDialogRestoresUnsavedWorkUnderXvfb) {
     EXPECT_EQ((*exit)["seeds"], ph.seeds.size()) << "the restored seeds";
     EXPECT_EQ((*exit)["iterations"], 30);
     // Still unsaved after the restore: the file is kept for the next start.
-    EXPECT_EQ(read_recovery(recovery_path(recovery, image)).marks.iterations, 30);
+    EXPECT_EQ(read_recovery(recovery_path(recovery, image, "n4")).marks.iterations, 30);
     fs::remove_all(dir);
 }
 

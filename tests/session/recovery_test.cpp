@@ -133,6 +133,8 @@ TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {
     EXPECT_EQ(path.parent_path(), dir);
     EXPECT_EQ(path.extension(), ".lsrecovery");
     EXPECT_NE(recovery_path(dir, "/other/t1.nii.gz"), path) << "two images with one file name share a recovery file";
+    EXPECT_NE(recovery_path(dir, s.image, "n4"), path) << "an image and its bias-corrected copy share a recovery file";
+    EXPECT_EQ(recovery_path(dir, s.image, "n4").parent_path(), path.parent_path());
     write_recovery(path, s);
     expect_same(s, read_recovery(path));
     EXPECT_FALSE(fs::exists(path.string() + ".part"));

@@ -106,7 +106,7 @@ private:
 
 }  // namespace
 
-std::filesystem::path recovery_path(const std::filesystem::path& dir, const std::string& image) {
+std::filesystem::path recovery_path(const std::filesystem::path& dir, const std::string& image, const std::string& variant) {
     std::error_code ec;
     std::filesystem::path full = std::filesystem::weakly_canonical(std::filesystem::absolute(image, ec), ec);
     if (ec) full = std::filesystem::path(image).lexically_normal();
@@ -117,7 +117,7 @@ std::filesystem::path recovery_path(const std::filesystem::path& dir, const std:
     if (name.empty()) name = "image";
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.h));
-    return dir / (name + "-" + hex + ".lsrecovery");
+    return dir / (name + "-" + hex + (variant.empty() ? "" : "-" + variant) + ".lsrecovery");
 }
 
 std::vector<std::uint8_t> encode_recovery(const RecoveryView& state) {

@@ -48,8 +48,10 @@ struct RecoveryView {
     const Grid<std::int8_t>& status;
 };
 
-// The recovery file for `image` in `dir`: "<file name>-<hash of the absolute path>.lsrecovery".
-std::filesystem::path recovery_path(const std::filesystem::path& dir, const std::string& image);
+// The recovery file for `image` in `dir`: "<file name>-<hash of the absolute path>.lsrecovery", or
+// "...-<variant>.lsrecovery" for a variant of the image (e.g. "n4": its bias-corrected copy, so that
+// a session on it and one on the raw image never restore each other's work).
+std::filesystem::path recovery_path(const std::filesystem::path& dir, const std::string& image, const std::string& variant = {});
 
 // The serialised file (what write_recovery writes).
 std::vector<std::uint8_t> encode_recovery(const RecoveryView& state);
