@@ -88,7 +88,7 @@ SegmentRequest request_for(const SegmentArgs& a, const Lattice& lattice, bool ne
 
 // The bias correction a binding's option asks for: unset (the default) as the CLI's default.
 cli::BiasCorrection bias_mode(const std::optional<bool>& bias_correct) {
-    return !bias_correct ? cli::BiasCorrection::kDefault : *bias_correct ? cli::BiasCorrection::kRequired : cli::BiasCorrection::kOff;
+    return cli::bias_mode(bias_correct.value_or(true), bias_correct.has_value());
 }
 
 pyb::dict segment(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a, const pyb::object& progress) {
@@ -107,7 +107,6 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
         pyb::gil_scoped_release nogil;
         prepared = cli::prepare_image(image, roi_mask, mode, &interrupt.flag());
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
-        const std::optional<BiasCorrectionReport>& bias = prepared.bias;
         if (roi) req.roi = &roi->mask;
         if (init) req.initial_mask = &*init;
         req.model_region = fit;
@@ -118,7 +117,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
                                  pyb::arg("inside") = p.inside, pyb::arg("dt") = p.dt, pyb::arg("ms") = p.ms);
             });
         };
-        if (!bias || !bias->interrupted) out.emplace(segment_image(image, req, hook, &interrupt.flag()));
+        if (!prepared.bias || !prepared.bias->interrupted) out.emplace(segment_image(image, req, hook, &interrupt.flag()));
     }
     if (interrupt.raised()) interrupt.rethrow();
     if (!out || out->result.reason == StopReason::kInterrupted) throw pyb::error_already_set();  // a pending KeyboardInterrupt

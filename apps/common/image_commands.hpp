@@ -44,6 +44,10 @@ void print_roi_summary(const nlohmann::json& roi);
 // failure (an image too small for its grid, a mask that leaves no sample) skips it with a warning;
 // required when asked for (or when the corrected image is to be written), where it is an error.
 enum class BiasCorrection { kOff, kDefault, kRequired };
+// The mode of a front end's setting: off unless `correct`, required when `asked` for.
+inline BiasCorrection bias_mode(bool correct, bool asked) {
+    return !correct ? BiasCorrection::kOff : asked ? BiasCorrection::kRequired : BiasCorrection::kDefault;
+}
 
 // An image made ready for the tissue model and the speed: corrected in place, and the region both
 // are fitted in.

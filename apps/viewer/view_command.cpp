@@ -63,10 +63,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
     // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for (or a
     // continued workspace's image was corrected: then it must be again).
-    const bool correct = a.workspace_bias.value_or(a.bias_correct);
-    const BiasCorrection mode = !correct ? BiasCorrection::kOff
-                                : a.bias_given || a.workspace_bias ? BiasCorrection::kRequired
-                                                                   : BiasCorrection::kDefault;
+    const BiasCorrection mode = bias_mode(a.workspace_bias.value_or(a.bias_correct), a.bias_given || a.workspace_bias);
     PreparedImage prepared;
     try {
         prepared = prepare_image(image, roi ? &*roi : nullptr, mode);

@@ -358,7 +358,7 @@ bool Viewer::open_image(const std::string& path) {
     try {
         Grid<float> image = read_image(path);
         const cli::PreparedImage prepared =
-            cli::prepare_image(image, nullptr, config_.bias_correct ? cli::BiasCorrection::kDefault : cli::BiasCorrection::kOff);
+            cli::prepare_image(image, nullptr, cli::bias_mode(config_.bias_correct, false));
         auto session = std::make_unique<Session>(std::move(image), config_.session);
         halt_run();
         autosave_->at_exit();  // the previous image's unsaved work

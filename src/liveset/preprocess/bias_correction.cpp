@@ -35,7 +35,6 @@ using FloatImage = itk::Image<float, 3>;
 using MaskImage = itk::Image<unsigned char, 3>;
 using N4Filter = itk::N4BiasFieldCorrectionImageFilter<FloatImage, MaskImage, FloatImage>;
 using ControlLattice = N4Filter::BiasFieldControlPointLatticeType;
-using FieldImage = N4Filter::ScalarImageType;
 using Clock = std::chrono::steady_clock;
 
 [[noreturn]] void fail(const std::string& what) { throw std::invalid_argument("bias correction: " + what); }
