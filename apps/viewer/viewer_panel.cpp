@@ -124,7 +124,7 @@ void Viewer::draw_segmentation_section() {
     help_marker("steepness of the threshold speed at the window's edge (Eq. 3)");
     if (ImGui::SliderFloat("alpha", &alpha, 0.0f, 0.95f, "%.2f")) ui_params_.alpha = alpha, edited = true;
     done |= ImGui::IsItemDeactivatedAfterEdit();
-    help_marker("curvature weight (Eq. 2): smoother fronts that leak less");
+    help_marker("curvature weight (Eq. 2; the curvature is per mm): smoother fronts that leak less");
     if (edited && apply_params(ui_params_, ui_auto_window_)) {
         params_note_.clear();  // the user's own values from now on
         const ThresholdParams& p = session_->params();

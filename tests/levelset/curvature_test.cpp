@@ -1,4 +1,5 @@
-// Mean curvature by difference of normals against analytic shapes: sphere 2/r, cylinder 1/r, plane 0.
+// Mean curvature by difference of normals against analytic shapes: sphere 2/r, cylinder 1/r, plane 0,
+// in 1/mm on anisotropic lattices too.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -39,6 +40,27 @@ TEST(Curvature, SphereIsTwoOverR) {
     }
 }
 
+// κ is per millimetre: a sphere of radius r mm sampled on grids of other voxel sizes, anisotropic
+// ones included, gives 2/r (the index-unit curvature gave 2/r only at 1 mm, and on a 1 x 1 x 2 mm
+// grid a value that depends on the direction: the sphere is an ellipsoid in index space).
+TEST(Curvature, SphereIsTwoOverRInMillimetresOnAnyGrid) {
+    for (const Vec3d h : {Vec3d{2, 2, 2}, Vec3d{0.8, 0.8, 0.8}, Vec3d{1, 1, 2}, Vec3d{0.9375, 0.9375, 1.2}, Vec3d{1.5, 1, 0.7}}) {
+        const Vec3i dims{int(std::ceil(60.0 / h.x)), int(std::ceil(60.0 / h.y)), int(std::ceil(60.0 / h.z))};
+        Grid<float> g(Lattice(dims, h));
+        const Vec3d c{30.3, 29.6, 30.1};  // mm
+        const double r = 18.0;
+        for (int z = 0; z < dims.z; ++z)
+            for (int y = 0; y < dims.y; ++y)
+                for (int x = 0; x < dims.x; ++x) g({x, y, z}) = static_cast<float>(norm(Vec3d{x * h.x, y * h.y, z * h.z} - c) - r);
+        for (Vec3d dir : {Vec3d{1, 0, 0}, Vec3d{0, 1, 0}, Vec3d{0, 0, 1}, Vec3d{1, 1, 0}, Vec3d{1, 1, 1}, Vec3d{-1, 2, 0.5}}) {
+            const Vec3d p = c + dir / norm(dir) * r;  // mm
+            const Vec3i q{int(std::lround(p.x / h.x)), int(std::lround(p.y / h.y)), int(std::lround(p.z / h.z))};
+            const double at = norm(Vec3d{q.x * h.x, q.y * h.y, q.z * h.z} - c);  // the level set through q
+            EXPECT_NEAR(mean_curvature(g, q), 2.0 / at, 0.06 * 2.0 / at) << "spacing " << h.x << "x" << h.y << "x" << h.z;
+        }
+    }
+}
+
 TEST(Curvature, CylinderAndPlane) {
     const Grid<float> cyl = sample(40, [](Vec3d p) { return std::hypot(p.x - 19.5, p.y - 19.5) - 8.0; });
     EXPECT_NEAR(mean_curvature(cyl, {27, 20, 20}), 1.0 / std::hypot(7.5, 0.5), 0.05);
@@ -52,7 +74,12 @@ TEST(Curvature, SpeedRejectsBadWeight) {
 }
 
 namespace {
-void check_fast_path_against_reference(const Grid<float>& phi) {
+// The reference multiplies by the inverse voxel sizes (as float, speed.cpp) only when `scaled`: on a
+// 1 mm lattice it is called unscaled, the index-unit formula of before the curvature was per mm, so
+// that 1 mm keeps those bits.
+void check_fast_path_against_reference(const Grid<float>& phi, bool scaled) {
+    const liveset::Vec3d h = phi.lattice().spacing();
+    const float inv[3] = {1.0f / static_cast<float>(h.x), 1.0f / static_cast<float>(h.y), 1.0f / static_cast<float>(h.z)};
     const auto reference = [&](liveset::Vec3i p) {
         float k = 0.0f;
         for (int a = 0; a < 3; ++a) {
@@ -63,13 +90,18 @@ void check_fast_path_against_reference(const Grid<float>& phi) {
                 q[a] += dir;
                 eb[b] = 1;
                 ec[c] = 1;
-                const float ga = static_cast<float>(dir) * (phi.clamped(q) - phi.clamped(p));
-                const float gb = 0.25f * (phi.clamped(p + eb) + phi.clamped(q + eb) - phi.clamped(p - eb) - phi.clamped(q - eb));
-                const float gc = 0.25f * (phi.clamped(p + ec) + phi.clamped(q + ec) - phi.clamped(p - ec) - phi.clamped(q - ec));
+                float ga = static_cast<float>(dir) * (phi.clamped(q) - phi.clamped(p));
+                float gb = 0.25f * (phi.clamped(p + eb) + phi.clamped(q + eb) - phi.clamped(p - eb) - phi.clamped(q - eb));
+                float gc = 0.25f * (phi.clamped(p + ec) + phi.clamped(q + ec) - phi.clamped(p - ec) - phi.clamped(q - ec));
+                if (scaled) {
+                    ga *= inv[a];
+                    gb *= inv[b];
+                    gc *= inv[c];
+                }
                 const float len = std::sqrt(ga * ga + gb * gb + gc * gc);
                 n_dir[dir > 0 ? 0 : 1] = len > 1e-6f ? ga / len : 0.0f;
             }
-            k += n_dir[0] - n_dir[1];
+            k += scaled ? (n_dir[0] - n_dir[1]) * inv[a] : n_dir[0] - n_dir[1];
         }
         return k;
     };
@@ -121,10 +153,13 @@ void check_fast_path_against_reference(const Grid<float>& phi) {
 // reference); mean_curvature's unclamped interior fast path, the batched curvature and central
 // |∇φ|, and CurvatureSpeed's batched rates must agree with it (and rate_of) bit for bit: on random values, and on plateaus with steps of 1e-7 to 1e-5, where half-point normals
 // are exactly 0 or straddle the 1e-6 length below which a normal counts as 0.
+// On a 1 mm lattice against the index-unit formula (unscaled), on others against the per-mm one.
 TEST(Curvature, InteriorFastPathIsBitIdenticalToClampedFormula) {
-    for (const bool plateaus : {false, true}) {
+    for (const bool plateaus : {false, true})
+    for (const liveset::Vec3d h : {liveset::Vec3d{1, 1, 1}, liveset::Vec3d{0.9375, 0.9375, 1.2}, liveset::Vec3d{2, 1, 3}}) {
         SCOPED_TRACE(plateaus ? "plateaus" : "random");
-        const liveset::Lattice lat({9, 8, 7});
+        SCOPED_TRACE(h.z);
+        const liveset::Lattice lat({9, 8, 7}, h);
         liveset::Grid<float> phi(lat);
         std::uint32_t state = 99;
         for (float& v : phi.values()) {
@@ -137,6 +172,6 @@ TEST(Curvature, InteriorFastPathIsBitIdenticalToClampedFormula) {
                 v = 0.5f + steps[(state >> 4) % 8] * (u < 0.5f ? -1.0f : 1.0f);
             }
         }
-        check_fast_path_against_reference(phi);
+        check_fast_path_against_reference(phi, h.z != 1.0);
     }
 }

@@ -232,6 +232,15 @@ std::vector<double> SparseField::zero_rates(const Speed& speed) const {
     return rate;
 }
 
+// h_max / h_min² of the voxel sizes, each rounded to float as the curvature's are (speed.cpp): 1 at
+// 1 mm, and the same for a size stored in float (NIfTI) or in double (MINC).
+double SparseField::parabolic_factor() const {
+    const Vec3d h = phi_.lattice().spacing();
+    const double x = static_cast<float>(h.x), y = static_cast<float>(h.y), z = static_cast<float>(h.z);
+    const double lo = std::min({x, y, z});
+    return std::max({x, y, z}) / (lo * lo);
+}
+
 double SparseField::time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const {
     double max_rate = 0.0;
     for (double r : rate) {
@@ -241,10 +250,11 @@ double SparseField::time_step(std::span<const double> rate, const Speed& speed, 
     double dt = options.max_dt;
     if (max_rate > 0.0) dt = std::min(dt, static_cast<double>(options.cfl) / max_rate);
     // The parabolic bound (docs/ARCHITECTURE.md, "Time step"): the difference-of-normals curvature
-    // linearised about a front with |∇φ| = 1 has eigenvalues of magnitude at most 8 over every
-    // frequency and normal (scripts/parabolic_bound.py; the checkerboard along the front reaches
-    // it), so forward Euler keeps every mode's amplification |1 − 8·w·dt| ≤ 1 up to w·dt = 1/4.
-    if (speed.curvature_weight() > 0.0f) dt = std::min(dt, 1.0 / (4.0 * speed.curvature_weight()));
+    // (per millimetre) linearised about a front with |∇φ| = 1 (in index units) has eigenvalues of
+    // magnitude at most 8·h_max/h_min² over every frequency and normal, h the voxel sizes in mm
+    // (scripts/parabolic_bound.py --spacing; the checkerboard along the front reaches it: 8 at 1 mm),
+    // so forward Euler keeps every mode's amplification |1 − 8·w·f·dt| ≤ 1 up to w·f·dt = 1/4.
+    if (speed.curvature_weight() > 0.0f) dt = std::min(dt, 1.0 / (4.0 * speed.curvature_weight() * parabolic_factor()));
     return dt;
 }
 

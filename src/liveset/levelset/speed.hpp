@@ -35,8 +35,8 @@ public:
     // plus its curvature part times the central |∇φ|, in double (rate_of). A speed may override
     // it with a faster form of exactly these bits (a batched curvature). Thread-safe like at().
     virtual void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const;
-    // Upper bound of the coefficient w in the curvature part w·κ, for the parabolic time-step
-    // bound dt ≤ 1/(4w). Zero when the speed has no curvature part.
+    // Upper bound of the coefficient w in the curvature part w·κ (κ per mm), for the parabolic
+    // time-step bound dt ≤ 1/(4w·h_max/h_min²). Zero when the speed has no curvature part.
     virtual float curvature_weight() const = 0;
 
 private:
@@ -45,8 +45,11 @@ private:
 };
 
 // Mean curvature κ = ∇·(∇φ/|∇φ|) (sum of principal curvatures, 2/r on a sphere) at lattice point p,
-// by the difference-of-normals method: normals at the six half-way points p ± ½e_a from one-sided
-// differences along a and averaged central differences across, then κ = Σ_a (n_a(p+½e_a) − n_a(p−½e_a)).
+// in 1/mm: the derivatives are physical, by the lattice's voxel sizes h, so a sphere of radius r mm
+// gives 2/r on any grid, anisotropic included. By the difference-of-normals method: normals at the
+// six half-way points p ± ½e_a of the gradient from one-sided differences along a and averaged
+// central differences across, each divided by its axis's h, then κ = Σ_a (n_a(p+½e_a) − n_a(p−½e_a))/h_a.
+// On a 1 mm lattice every factor is 1.0f: the index-unit curvature, bit for bit.
 float mean_curvature(const Grid<float>& phi, Vec3i p);
 
 // mean_curvature() and the norm of central_gradient() at each of `points` into `out` (the same
