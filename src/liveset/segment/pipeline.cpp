@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <sstream>
 #include <stdexcept>
 
@@ -37,6 +39,31 @@ void choose_window(const Grid<float>& image, const SegmentRequest& req, SegmentO
         const auto more = window_warnings(*out.model, out.scale.to_raw(p.mu - p.epsilon), out.scale.to_raw(p.mu + p.epsilon));
         out.warnings.insert(out.warnings.end(), more.begin(), more.end());
     }
+}
+
+// A front that converged far short of its tissue (seeds whose class the model gave the window, and
+// a result under kStalledShare of that class's pure voxels in the model's region) is warned
+// about: the mask is then the seeds' neighbourhood, not the tissue, and would otherwise pass
+// silently (docs/BENCHMARKS.md, session 49: a noisy 2 mm scan's grey matter, 1.7 %).
+constexpr double kStalledShare = 0.05;
+
+void warn_if_stalled(SegmentOutcome& out) {
+    if (!out.model || !out.model_window || out.result.reason != StopReason::kConverged) return;
+    const int k = out.model_window->seed_class;
+    if (k < 0 || static_cast<std::size_t>(k) >= out.model->classes.size()) return;
+    const double expected = out.model->classes[static_cast<std::size_t>(k)].weight * static_cast<double>(out.model->voxels);
+    std::size_t inside = 0;
+    for (const std::uint8_t v : out.mask.values()) inside += v != 0;
+    if (expected <= 0.0 || static_cast<double>(inside) >= kStalledShare * expected) return;
+    std::ostringstream os;
+    os.setf(std::ios::fixed);
+    os.precision(1);
+    os << "the segmentation holds " << inside << " voxels, " << 100.0 * static_cast<double>(inside) / expected
+       << " % of the " << static_cast<std::size_t>(std::lround(expected)) << " the tissue model puts in the seeds' class ("
+       << tissue_class_name(*out.model, k)
+       << ") in its region: if the whole tissue was meant, the front stopped early (noise or thin tissue cut it off; "
+          "more seeds, a lower alpha or a wider window may help)";
+    out.warnings.push_back(os.str());
 }
 
 }  // namespace
@@ -78,6 +105,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     }
     out.result = run_segmentation(*out.field, speed, req.loop, hook, interrupt);
     out.mask = inside_mask(out.field->phi(), req.roi);
+    warn_if_stalled(out);
     return out;
 }
 
