@@ -52,6 +52,8 @@ Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const V
 }
 
 Viewer::~Viewer() {
+    cancel_open();
+    if (open_job_.valid()) open_job_.wait();  // N4 stops at its next iteration; the result is dropped
     halt_run();
     autosave_->at_exit();
     report_autosave();
@@ -176,8 +178,8 @@ void Viewer::set_window_size(int width, int height) {
 
 bool Viewer::needs_frame() const {
     if (background_active())  // no session reads
-        return !events_.empty() || redraw_frames_ > 0 || drag_.active || handover_due() || holes_busy();
-    return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active || view3d_coarse_ || stale_ || holes_busy() ||
+        return !events_.empty() || redraw_frames_ > 0 || drag_.active || handover_due() || holes_busy() || opening();
+    return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active || view3d_coarse_ || stale_ || holes_busy() || opening() ||
            (session_ && session_->revision() != seen_revision_);
 }
 
@@ -198,6 +200,7 @@ void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     process_events();  // current_ already holds what scripts or the bench did since the last frame
     advance();
     poll_holes(true);
+    poll_open(true);
     autosave_->tick();
     report_autosave();
     upload();
@@ -352,30 +355,6 @@ bool Viewer::fail(const std::string& what) {
     redraw_frames_ = std::max(redraw_frames_, 1);
     log_.add("error", {{"message", what}});
     return false;
-}
-
-bool Viewer::open_image(const std::string& path) {
-    try {
-        Grid<float> image = read_image(path);
-        const cli::PreparedImage prepared =
-            cli::prepare_image(image, nullptr, cli::bias_mode(config_.bias_correct, false));
-        auto session = std::make_unique<Session>(std::move(image), config_.session);
-        halt_run();
-        autosave_->at_exit();  // the previous image's unsaved work
-        report_autosave();
-        session_ = std::move(session);
-        image_path_ = path;
-        config_.roi_path.clear();  // an image opened here has no ROI
-        config_.image_corrected = prepared.bias.has_value();
-        image_name_ = std::filesystem::path(path).filename().string();
-        attach_session();
-        message_ = "opened " + path + (prepared.bias_skipped.empty() ? "" : " (" + prepared.bias_skipped + ")");
-        message_is_error_ = false;
-        log_.add("open", {{"path", path}});
-        return true;
-    } catch (const std::exception& e) {
-        return fail(e.what());
-    }
 }
 
 bool Viewer::add_seed(Vec3d index, double radius) {

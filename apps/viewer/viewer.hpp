@@ -11,6 +11,8 @@
 #include <array>
 #include <chrono>
 #include <deque>
+#include <future>
+#include <atomic>
 #include <map>
 #include <memory>
 #include <optional>
@@ -163,7 +165,13 @@ public:
     Autosave& autosave() { return *autosave_; }
 
     // --- actions: panel, keys and scripts share them; false + message() on failure ---------
+    // Reads the image and prepares it (N4, as the command line does) on a worker thread, so the
+    // window keeps drawing ("opening... s" and a Cancel button); a later frame swaps the new
+    // session in (viewer_open.cpp). False (nothing started) while another image is opening.
     bool open_image(const std::string& path);
+    bool opening() const { return open_job_.valid(); }
+    // Drops the image being opened (N4 stops at its next iteration); the current session stays.
+    void cancel_open();
     bool add_seed(Vec3d index, double radius);
     bool remove_seed_at(Vec3d index);
     void set_segment_running(bool on);
@@ -216,6 +224,9 @@ public:
     // Starts the truth-free finder on the current segmentation (on a worker thread).
     bool find_holes(const HoleScanOptions& options);
     bool holes_busy() const { return holes_.running(); }
+    // Takes an opened image, waiting up to a frame's pace for it with `wait`, and swaps the new
+    // session in (or reports why it could not be opened; drops it when cancelled).
+    void poll_open(bool wait);
     // Takes a finished scan (waiting a little with `wait`): the list, the markers, the verdicts.
     void poll_holes(bool wait);
     const HoleTool& hole_tool() const { return holes_; }
@@ -382,6 +393,11 @@ private:
     RepairOptions ui_repair_;
     SliceDisplay slices_;
     HoleTool holes_;                       // the hole finder's scan, list and selection
+    struct Opened;                         // an image read and prepared by open_image's worker
+    std::future<std::shared_ptr<Opened>> open_job_;
+    std::shared_ptr<std::atomic<bool>> open_cancel_;  // the running open's interrupt (N4 polls it)
+    std::string open_job_path_;
+    std::chrono::steady_clock::time_point open_started_;
     HoleScanOptions ui_holes_;             // the panel's finder settings
     std::vector<glm::vec3> hole_points_;   // the 3D pane's markers, refreshed per draw
     bool hole_rows_logged_ = false;        // the list's rows were logged for a driving test

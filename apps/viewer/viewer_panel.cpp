@@ -69,7 +69,13 @@ void Viewer::draw_image_section() {
     }
     ImGui::InputText("##open", &open_path_);
     ImGui::SameLine();
-    if (panel_button("Open", "open")) open_image(open_path_);
+    if (!opening()) {
+        if (panel_button("Open", "open")) open_image(open_path_);
+        return;
+    }
+    if (panel_button("Cancel##open", "cancel_open")) cancel_open();
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - open_started_).count();
+    ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "opening... %.1f s (reading, bias correction)", s);
 }
 
 // The mouse tools (crosshair, seed, target) and the seed radius.

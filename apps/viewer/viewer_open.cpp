@@ -1,0 +1,95 @@
+// Opening an image from the panel: read and N4 on a worker thread (the window keeps drawing and
+// can cancel), then the new session swapped in by a frame.
+#include <fmt/core.h>
+
+#include <filesystem>
+#include <utility>
+
+#include "image_commands.hpp"
+#include "liveset/io/image_io.hpp"
+#include "viewer.hpp"
+
+namespace liveset::viewer {
+
+namespace {
+constexpr int kOpenPollMs = 40;  // a frame waits this long for the worker (the window's pace meanwhile)
+}  // namespace
+
+// What the worker hands over: the session on the prepared image, or why there is none.
+struct Viewer::Opened {
+    std::unique_ptr<Session> session;
+    bool corrected = false;    // N4 ran
+    std::string bias_skipped;  // the default correction's warning, when it did not run
+    std::string error;         // the image could not be opened
+};
+
+bool Viewer::open_image(const std::string& path) {
+    if (opening()) return fail("still opening " + open_job_path_ + " (Cancel first)");
+    open_cancel_ = std::make_shared<std::atomic<bool>>(false);
+    const auto cancel = open_cancel_;
+    const cli::BiasCorrection mode = cli::bias_mode(config_.bias_correct, false);
+    const SessionOptions options = config_.session;
+    open_job_ = std::async(std::launch::async, [path, cancel, mode, options] {
+        auto out = std::make_shared<Opened>();
+        try {
+            Grid<float> image = read_image(path);
+            if (cancel->load()) return out;
+            const cli::PreparedImage prepared = cli::prepare_image(image, nullptr, mode, cancel.get());
+            if (cancel->load()) return out;
+            out->corrected = prepared.bias.has_value();
+            out->bias_skipped = prepared.bias_skipped;
+            out->session = std::make_unique<Session>(std::move(image), options);
+        } catch (const std::exception& e) {
+            out->error = e.what();
+        }
+        return out;
+    });
+    open_job_path_ = path;
+    open_started_ = std::chrono::steady_clock::now();
+    message_ = "opening " + path + "...";
+    message_is_error_ = false;
+    log_.add("opening", {{"path", path}});
+    request_redraw();
+    return true;
+}
+
+void Viewer::cancel_open() {
+    if (open_cancel_) open_cancel_->store(true);
+}
+
+void Viewer::poll_open(bool wait) {
+    if (!opening()) return;
+    if (open_job_.wait_for(std::chrono::milliseconds(wait ? kOpenPollMs : 0)) != std::future_status::ready) {
+        request_redraw();  // the "opening..." line counts up
+        return;
+    }
+    const std::shared_ptr<Opened> opened = open_job_.get();
+    const std::string path = std::exchange(open_job_path_, std::string());
+    const bool cancelled = open_cancel_->load();
+    open_cancel_.reset();
+    request_redraw();
+    if (cancelled) {
+        message_ = "opening " + path + " cancelled";
+        message_is_error_ = false;
+        log_.add("open_cancelled", {{"path", path}});
+        return;
+    }
+    if (!opened->error.empty()) {
+        fail(opened->error);
+        return;
+    }
+    halt_run();
+    autosave_->at_exit();  // the previous image's unsaved work
+    report_autosave();
+    session_ = std::move(opened->session);
+    image_path_ = path;
+    config_.roi_path.clear();  // an image opened here has no ROI
+    config_.image_corrected = opened->corrected;
+    image_name_ = std::filesystem::path(path).filename().string();
+    attach_session();
+    message_ = "opened " + path + (opened->bias_skipped.empty() ? "" : " (" + opened->bias_skipped + ")");
+    message_is_error_ = false;
+    log_.add("open", {{"path", path}, {"bias_corrected", opened->corrected}});
+}
+
+}  // namespace liveset::viewer
