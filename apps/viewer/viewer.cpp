@@ -178,7 +178,7 @@ void Viewer::set_window_size(int width, int height) {
 
 bool Viewer::needs_frame() const {
     if (background_active())  // no session reads
-        return !events_.empty() || redraw_frames_ > 0 || drag_.active || handover_due() || holes_busy() || opening();
+        return !events_.empty() || redraw_frames_ > 0 || drag_.active || handover_due() || holes_busy();  // an open: at hand-overs
     return !events_.empty() || redraw_frames_ > 0 || busy() || drag_.active || view3d_coarse_ || stale_ || holes_busy() || opening() ||
            (session_ && session_->revision() != seen_revision_);
 }
@@ -200,7 +200,7 @@ void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     process_events();  // current_ already holds what scripts or the bench did since the last frame
     advance();
     poll_holes(true);
-    poll_open(true);
+    poll_open(!background_active());  // a run's worker waits while a frame holds the hand-over
     autosave_->tick();
     report_autosave();
     upload();

@@ -1,8 +1,11 @@
 // Opening an image from the panel: read and N4 on a worker thread (the window keeps drawing and
-// can cancel), then the new session swapped in by a frame.
+// can cancel), then the new session swapped in by a frame. Cancel stops N4 at its next iteration;
+// reading the file, the brain mask N4 is fitted in and the session's set-up run to their end
+// (seconds at most for a large DICOM series) and their result is dropped.
 #include <fmt/core.h>
 
 #include <filesystem>
+#include <system_error>
 #include <utility>
 
 #include "image_commands.hpp"
@@ -29,9 +32,18 @@ bool Viewer::open_image(const std::string& path) {
     const auto cancel = open_cancel_;
     const cli::BiasCorrection mode = cli::bias_mode(config_.bias_correct, false);
     const SessionOptions options = config_.session;
-    open_job_ = std::async(std::launch::async, [path, cancel, mode, options] {
-        auto out = std::make_shared<Opened>();
+    const auto failed = [](std::string why) noexcept -> std::shared_ptr<Opened> {
         try {
+            auto out = std::make_shared<Opened>();
+            out->error = std::move(why);
+            return out;
+        } catch (...) {
+            return nullptr;  // out of memory: poll_open says so
+        }
+    };
+    const auto work = [path, cancel, mode, options, failed]() -> std::shared_ptr<Opened> {
+        try {
+            auto out = std::make_shared<Opened>();
             Grid<float> image = read_image(path);
             if (cancel->load()) return out;
             const cli::PreparedImage prepared = cli::prepare_image(image, nullptr, mode, cancel.get());
@@ -39,11 +51,19 @@ bool Viewer::open_image(const std::string& path) {
             out->corrected = prepared.bias.has_value();
             out->bias_skipped = prepared.bias_skipped;
             out->session = std::make_unique<Session>(std::move(image), options);
+            return out;
         } catch (const std::exception& e) {
-            out->error = e.what();
+            return failed(e.what());
+        } catch (...) {
+            return failed("cannot open " + path + ": unknown error");
         }
-        return out;
-    });
+    };
+    try {
+        open_job_ = std::async(std::launch::async, work);
+    } catch (const std::system_error& e) {  // no thread to run it on
+        open_cancel_.reset();
+        return fail("cannot open " + path + ": " + e.what());
+    }
     open_job_path_ = path;
     open_started_ = std::chrono::steady_clock::now();
     message_ = "opening " + path + "...";
@@ -63,7 +83,11 @@ void Viewer::poll_open(bool wait) {
         request_redraw();  // the "opening..." line counts up
         return;
     }
-    const std::shared_ptr<Opened> opened = open_job_.get();
+    std::shared_ptr<Opened> opened;  // null: the worker could not even say why (out of memory)
+    try {
+        opened = open_job_.get();
+    } catch (...) {
+    }
     const std::string path = std::exchange(open_job_path_, std::string());
     const bool cancelled = open_cancel_->load();
     open_cancel_.reset();
@@ -74,8 +98,8 @@ void Viewer::poll_open(bool wait) {
         log_.add("open_cancelled", {{"path", path}});
         return;
     }
-    if (!opened->error.empty()) {
-        fail(opened->error);
+    if (!opened || !opened->error.empty()) {
+        fail(opened ? opened->error : "cannot open " + path + ": out of memory");
         return;
     }
     halt_run();

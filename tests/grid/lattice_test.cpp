@@ -38,6 +38,11 @@ TEST(Lattice, RejectsInvalidGeometry) {
     EXPECT_THROW(Lattice({1 << 20, 1 << 20, 1 << 20}), std::invalid_argument);
     EXPECT_THROW(Lattice({4, 4, 4}, {1, 0, 1}), std::invalid_argument);
     EXPECT_THROW(Lattice({4, 4, 4}, {1, NAN, 1}), std::invalid_argument);
+    // Sizes that float cannot hold or invert (the curvature's 1/spacing is a float) are refused;
+    // a micrometre and a metre are not.
+    EXPECT_THROW(Lattice({4, 4, 4}, {1, 1e-46, 1}), std::invalid_argument);
+    EXPECT_THROW(Lattice({4, 4, 4}, {1e300, 1, 1}), std::invalid_argument);
+    EXPECT_NO_THROW(Lattice({4, 4, 4}, {1e-3, 1e3, 1}));
     EXPECT_THROW(Lattice({4, 4, 4}, {1, 1, 1}, {0, INFINITY, 0}), std::invalid_argument);
     EXPECT_THROW(Lattice({4, 4, 4}, {1, 1, 1}, {0, 0, 0}, Mat3d{1, 0, 0, 1, 0, 0, 0, 0, 1}), std::invalid_argument);
 }

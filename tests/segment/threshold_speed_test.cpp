@@ -71,39 +71,43 @@ TEST(ThresholdSpeed, PropagationCurvatureAndRoi) {
 // The batched rates (curvature, central and upwind |∇φ| four stencils at a time) against Speed's
 // formula sample by sample, bit for bit: random φ and image, a ROI with holes, every point (the
 // border's one-sided stencils included), in a scrambled order; and φ on plateaus (values in
-// steps of 0.5), where one-sided differences are exactly ±0 and the upwind picks between zeros.
+// steps of 0.5), where one-sided differences are exactly ±0 and the upwind picks between zeros. On a
+// 1 mm lattice and an anisotropic one (the curvature per mm: the batch's scaled kernel).
 TEST(ThresholdSpeed, BatchedRatesHaveTheBitsOfTheFormula) {
-    const Lattice lat({11, 9, 8});
-    Grid<float> phi(lat), img(lat);
-    Grid<std::uint8_t> roi(lat, 1);
-    std::uint32_t state = 7;
-    const auto next = [&] {
-        state = state * 1664525u + 1013904223u;
-        return static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
-    };
-    for (std::size_t n = 0; n < phi.size(); ++n) {
-        const auto i = static_cast<PointIndex>(n);
-        phi[i] = next() * 4.0f - 2.0f;
-        img[i] = next();
-        if (next() < 0.2f) roi[i] = 0;
-    }
-    Grid<float> plateaus(lat);
-    for (std::size_t n = 0; n < phi.size(); ++n) plateaus[static_cast<PointIndex>(n)] = std::round(next() * 4.0f) * 0.5f - 1.0f;
-    const ThresholdParams params{0.5, 0.2, 2.0, 0.3};
-    std::vector<PointIndex> points(phi.size());
-    for (std::size_t n = 0; n < points.size(); ++n) points[n] = static_cast<PointIndex>((n * 37) % points.size());
-    const Grid<std::uint8_t>* const masks[] = {nullptr, &roi};
-    for (const bool flat : {false, true}) {
-        if (flat) phi = plateaus;
-        for (const Grid<std::uint8_t>* mask : masks) {
-            const ThresholdSpeed speed(img, params, mask);
-            std::vector<double> rates(points.size());
-            speed.rates(phi, points, rates);
-            for (std::size_t n = 0; n < points.size(); ++n) {
-                const Vec3i p = lat.coord(points[n]);
-                const double want = rate_of(speed.at(phi, p), phi, p);
-                ASSERT_EQ(std::bit_cast<std::uint64_t>(rates[n]), std::bit_cast<std::uint64_t>(want))
-                    << (flat ? "plateaus " : "") << p.x << "," << p.y << "," << p.z;
+    for (const Vec3d h : {Vec3d{1, 1, 1}, Vec3d{0.9375, 0.9375, 1.2}}) {
+        SCOPED_TRACE(h.z);
+        const Lattice lat({11, 9, 8}, h);
+        Grid<float> phi(lat), img(lat);
+        Grid<std::uint8_t> roi(lat, 1);
+        std::uint32_t state = 7;
+        const auto next = [&] {
+            state = state * 1664525u + 1013904223u;
+            return static_cast<float>(state >> 8) / static_cast<float>(1u << 24);
+        };
+        for (std::size_t n = 0; n < phi.size(); ++n) {
+            const auto i = static_cast<PointIndex>(n);
+            phi[i] = next() * 4.0f - 2.0f;
+            img[i] = next();
+            if (next() < 0.2f) roi[i] = 0;
+        }
+        Grid<float> plateaus(lat);
+        for (std::size_t n = 0; n < phi.size(); ++n) plateaus[static_cast<PointIndex>(n)] = std::round(next() * 4.0f) * 0.5f - 1.0f;
+        const ThresholdParams params{0.5, 0.2, 2.0, 0.3};
+        std::vector<PointIndex> points(phi.size());
+        for (std::size_t n = 0; n < points.size(); ++n) points[n] = static_cast<PointIndex>((n * 37) % points.size());
+        const Grid<std::uint8_t>* const masks[] = {nullptr, &roi};
+        for (const bool flat : {false, true}) {
+            if (flat) phi = plateaus;
+            for (const Grid<std::uint8_t>* mask : masks) {
+                const ThresholdSpeed speed(img, params, mask);
+                std::vector<double> rates(points.size());
+                speed.rates(phi, points, rates);
+                for (std::size_t n = 0; n < points.size(); ++n) {
+                    const Vec3i p = lat.coord(points[n]);
+                    const double want = rate_of(speed.at(phi, p), phi, p);
+                    ASSERT_EQ(std::bit_cast<std::uint64_t>(rates[n]), std::bit_cast<std::uint64_t>(want))
+                        << (flat ? "plateaus " : "") << p.x << "," << p.y << "," << p.z;
+                }
             }
         }
     }

@@ -53,6 +53,14 @@ Lattice::Lattice(Vec3i dims, Vec3d spacing, Vec3d origin, Mat3d direction)
     for (int a = 0; a < 3; ++a) {
         if (!std::isfinite(spacing[a]) || spacing[a] <= 0)
             throw std::invalid_argument("lattice spacing must be positive and finite");
+        // The level set's curvature works with 1/spacing in float (speed.cpp): a size that float
+        // cannot hold or invert (1e-46, 1e300) is no voxel size in mm anyway.
+        if (spacing[a] < kMinSpacing || spacing[a] > kMaxSpacing) {
+            std::ostringstream os;
+            os << "lattice spacing " << spacing[a] << " is not a voxel size in mm (between " << kMinSpacing << " and "
+               << kMaxSpacing << ")";
+            throw std::invalid_argument(os.str());
+        }
         if (!std::isfinite(origin[a])) throw std::invalid_argument("lattice origin must be finite");
     }
     for (double v : direction)

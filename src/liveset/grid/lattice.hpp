@@ -26,8 +26,10 @@ inline constexpr Mat3d kIdentity3{1, 0, 0, 0, 1, 0, 0, 0, 1};
 class Lattice {
 public:
     Lattice() = default;
+    static constexpr double kMinSpacing = 1e-6, kMaxSpacing = 1e6;  // mm
     // Throws std::invalid_argument on non-positive dimensions, more than kMaxLatticePoints points,
-    // non-positive or non-finite spacing, non-finite origin or a singular direction matrix.
+    // a spacing outside [kMinSpacing, kMaxSpacing] mm (or not finite), a non-finite origin or a
+    // singular direction matrix.
     explicit Lattice(Vec3i dims, Vec3d spacing = {1, 1, 1}, Vec3d origin = {0, 0, 0},
                      Mat3d direction = kIdentity3);
 

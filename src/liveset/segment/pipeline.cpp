@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
@@ -41,28 +42,35 @@ void choose_window(const Grid<float>& image, const SegmentRequest& req, SegmentO
     }
 }
 
-// A front that converged far short of its tissue (seeds whose class the model gave the window, and
-// a result under kStalledShare of that class's pure voxels in the model's region) is warned
-// about: the mask is then the seeds' neighbourhood, not the tissue, and would otherwise pass
-// silently (docs/BENCHMARKS.md, session 49: a noisy 2 mm scan's grey matter, 1.7 %).
+// A front that converged far short of its tissue is warned about: the mask is then the seeds'
+// neighbourhood, not the tissue, and would otherwise pass silently (docs/BENCHMARKS.md, session 49:
+// a noisy 2 mm scan's grey matter, 1.7 %). Both must hold: the result is under kStalledShare of
+// the pure voxels the tissue model gives the seeds' class (the class that set the window) in its
+// region, and under the volume of the seeds' balls grown by kStalledReach voxels - so a small
+// structure segmented on purpose (a nucleus, a lesion: many times its seed balls) is not warned
+// about although its class fills the brain.
 constexpr double kStalledShare = 0.05;
+constexpr double kStalledReach = 4.0;  // voxels
 
-void warn_if_stalled(SegmentOutcome& out) {
-    if (!out.model || !out.model_window || out.result.reason != StopReason::kConverged) return;
+void warn_if_stalled(const std::vector<SeedBall>& seeds, SegmentOutcome& out) {
+    if (seeds.empty() || !out.model || !out.model_window || out.result.reason != StopReason::kConverged) return;
     const int k = out.model_window->seed_class;
     if (k < 0 || static_cast<std::size_t>(k) >= out.model->classes.size()) return;
     const double expected = out.model->classes[static_cast<std::size_t>(k)].weight * static_cast<double>(out.model->voxels);
+    double reach = 0.0;  // the seeds' balls grown by kStalledReach, overlaps counted twice
+    for (const SeedBall& b : seeds) reach += 4.0 / 3.0 * std::numbers::pi * std::pow(b.radius + kStalledReach, 3.0);
     std::size_t inside = 0;
     for (const std::uint8_t v : out.mask.values()) inside += v != 0;
-    if (expected <= 0.0 || static_cast<double>(inside) >= kStalledShare * expected) return;
+    const auto n = static_cast<double>(inside);
+    if (expected <= 0.0 || n >= kStalledShare * expected || n >= reach) return;
     std::ostringstream os;
     os.setf(std::ios::fixed);
     os.precision(1);
-    os << "the segmentation holds " << inside << " voxels, " << 100.0 * static_cast<double>(inside) / expected
-       << " % of the " << static_cast<std::size_t>(std::lround(expected)) << " the tissue model puts in the seeds' class ("
+    os << "the segmentation holds " << inside << " voxels, " << 100.0 * n / expected << " % of the "
+       << static_cast<std::size_t>(std::lround(expected)) << " the tissue model puts in the seeds' class ("
        << tissue_class_name(*out.model, k)
-       << ") in its region: if the whole tissue was meant, the front stopped early (noise or thin tissue cut it off; "
-          "more seeds, a lower alpha or a wider window may help)";
+       << ") in its region, the front hardly past its seeds: if the whole tissue was meant, it stopped early (noise or "
+          "thin tissue cut it off; more seeds, a lower alpha or a wider window may help)";
     out.warnings.push_back(os.str());
 }
 
@@ -105,7 +113,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     }
     out.result = run_segmentation(*out.field, speed, req.loop, hook, interrupt);
     out.mask = inside_mask(out.field->phi(), req.roi);
-    warn_if_stalled(out);
+    warn_if_stalled(req.seeds, out);
     return out;
 }
 
