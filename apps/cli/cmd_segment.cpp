@@ -36,6 +36,7 @@ struct SegmentArgs : ThresholdArgs {
     bool json = false, quiet = false;
     bool bias_correct = true;   // N4 before everything else (the corrected image replaces the input)
     bool bias_given = false;    // --bias-correct given: a failure is an error, not a skipped step
+    bool iterations_given = false;  // --iterations given: stopping there is what was asked
     std::string out_corrected;
 };
 
@@ -122,7 +123,16 @@ int run_segment(const SegmentArgs& a, int threads) {
         write_mesh(a.out_mesh, mesh.view(), image.lattice());
     }
 
-    const nlohmann::json j = segment_report(a, o, image.lattice(), roi, prepared, triangles);
+    nlohmann::json j = segment_report(a, o, image.lattice(), roi, prepared, triangles);
+    // The default limit reached before convergence: the mask is a front still moving (a grid whose
+    // fine voxels keep the time step small, docs/BENCHMARKS.md session 49, or a very large image).
+    if (o.result.reason == StopReason::kIterationLimit && !a.iterations_given) {
+        const std::string w = fmt::format("the front had not converged after {} iterations (the default limit): give --iterations "
+                                          "with a larger number to let it finish",
+                                          o.result.iterations);
+        if (!a.quiet) fmt::print(stderr, "liveset: warning: {}\n", w);
+        j["warnings"].push_back(w);
+    }
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
@@ -197,12 +207,14 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--out-mesh", sa.out_mesh, "output surface mesh (.ply/.obj/.stl, LPS mm)");
     seg->add_option("--out-roi", sa.out_roi, "write the region of interest used (e.g. the --roi auto brain mask, uint8 0/1)");
     seg->add_option("--log", sa.log, "write one JSON line per iteration to this file");
+    auto* iterations = seg->get_option("--iterations");
     auto* bias = seg->add_flag("--bias-correct,!--no-bias-correct", sa.bias_correct, "correct the intensity non-uniformity first (N4, fitted inside --roi, else the automatic brain mask, else Otsu's foreground). Default: on, skipped with a warning where it cannot run (asked for: an error)");
     seg->add_option("--out-corrected", sa.out_corrected, "write the bias-corrected image (float) here");
     seg->add_flag("--json", sa.json, "print the report as one JSON object on stdout");
     seg->add_flag("--quiet,-q", sa.quiet, "no progress line and no report");
-    seg->callback([&threads, bias] {
+    seg->callback([&threads, bias, iterations] {
         sa.bias_given = bias->count() > 0 && sa.bias_correct;
+        sa.iterations_given = iterations->count() > 0;
         const int rc = run_segment(sa, threads);
         if (rc != 0) std::exit(rc);
     });

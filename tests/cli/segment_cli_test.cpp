@@ -502,3 +502,32 @@ TEST(SegmentCli, RepairRunsTheSwarmAndLogsEveryStep) {
         EXPECT_FALSE(fs::exists(work_dir() / "never_repair.nii.gz")) << bad;
     }
 }
+
+// A front still moving when the default iteration limit stops it is warned about (a fine grid
+// keeps the time step small; a user must not take a moving front for a result); with --iterations
+// given, stopping there is what was asked and nothing is said. A bright bar 1 400 voxels long grown
+// from a seed at one end: at most half a voxel per step, so 2 000 steps cannot reach its far end.
+TEST(SegmentCli, TheDefaultIterationLimitReachedBeforeConvergenceIsWarnedAbout) {
+    const fs::path img = work_dir() / "bar.nii.gz", mask = work_dir() / "bar_mask.nii.gz";
+    Grid<float> g(Lattice({1400, 5, 5}), 10.0f);
+    for (int x = 0; x < 1400; ++x)
+        for (int y = 1; y <= 3; ++y)
+            for (int z = 1; z <= 3; ++z) g(Vec3i{x, y, z}) = 100.0f + static_cast<float>((x * 7 + y * 3 + z) % 5);
+    write_image(g, img.string());
+    const std::string cmd = "segment " + img.string() + " --seed 2,2,2:1 --mu-raw 100 --epsilon-raw 40 --no-bias-correct --json --out-mask " +
+                            mask.string();
+    const Result r = run_cli(cmd);
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["stop"], "iteration limit");
+    EXPECT_EQ(j["iterations"], 2000);
+    const std::string w = "the front had not converged after 2000 iterations (the default limit)";
+    EXPECT_NE(r.err.find("liveset: warning: " + w), std::string::npos) << r.err;
+    bool listed = false;
+    for (const auto& s : j["warnings"]) listed = listed || s.get<std::string>().find(w) != std::string::npos;
+    EXPECT_TRUE(listed) << j["warnings"].dump();
+
+    const Result asked = run_cli(cmd + " --iterations 50");
+    ASSERT_EQ(asked.rc, 0) << asked.err;
+    EXPECT_EQ(asked.err.find("had not converged"), std::string::npos) << asked.err;
+}
