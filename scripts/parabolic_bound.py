@@ -4,9 +4,10 @@
 Linearises the difference-of-normals curvature (speed.cpp) about a front phi = n.u with |grad phi| = 1
 in index units u and scans the symbol S(xi, n) over frequencies xi in [-pi, pi]^3 and unit normals n.
 The curvature is the physical one (differences divided by the voxel sizes h, --spacing) and multiplies
-the index-unit |grad phi| = 1, as in a step. Forward Euler is stable while |1 + dt*w*S| <= 1, i.e.
-w*dt <= 2 / max|S|. Prints max|S| (8 at 1 mm: the checkerboard along the front), the bound (1/4 at 1
-mm) and max|S| over 8 * h_max / h_min^2, the factor time_step applies (at most 1 for a safe bound).
+|grad phi| per finest voxel (the physical norm times h_min), as in a step. Forward Euler is stable
+while |1 + dt*w*S| <= 1, i.e. w*dt <= 2 / max|S|. Prints max|S| (8 at 1 mm: the checkerboard along
+the front), the bound (1/4 at 1 mm) and max|S| over 8 / h_min, the factor time_step applies (at most
+1 for a safe bound).
 Needs numpy (/usr/bin/python3 on Debian: python3-numpy).
 
 Usage: scripts/parabolic_bound.py [--freq 33] [--normals 400] [--spacing 1,1,1]
@@ -35,7 +36,8 @@ def symbol(xi, n, h=(1.0, 1.0, 1.0)):
         ng = big_n[0] * g[0] + big_n[1] * g[1] + big_n[2] * g[2]
         half = (g[a] - big_n[a] * ng) / np.linalg.norm(big_g)  # linearised unit-normal component
         total += (1.0 - np.exp(-1j * xi[..., a])) * half / h[a]
-    return total
+    # The curvature multiplies |grad phi| per finest voxel: the physical norm |G| times h_min.
+    return total * np.linalg.norm(big_g) * min(h)
 
 
 def main():
@@ -67,8 +69,8 @@ def main():
             worst, where = abs(s.flat[k]), (n, xi.reshape(-1, 3)[k])
     print(f"max |S| = {worst:.6f} at n = {np.round(where[0], 3)}, xi = {np.round(where[1], 3)}")
     print(f"stable for w*dt <= 2 / max|S| = {2.0 / worst:.6f}")
-    factor = max(h) / min(h) ** 2
-    print(f"max|S| / (8 * h_max / h_min^2) = {worst / (8.0 * factor):.6f} (time_step's bound is safe if <= 1)")
+    factor = 1.0 / min(h)
+    print(f"max|S| / (8 / h_min) = {worst / (8.0 * factor):.6f} (time_step's bound is safe if <= 1)")
 
 
 if __name__ == "__main__":

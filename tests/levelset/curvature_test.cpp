@@ -80,6 +80,8 @@ namespace {
 void check_fast_path_against_reference(const Grid<float>& phi, bool scaled) {
     const liveset::Vec3d h = phi.lattice().spacing();
     const float inv[3] = {1.0f / static_cast<float>(h.x), 1.0f / static_cast<float>(h.y), 1.0f / static_cast<float>(h.z)};
+    const float h_min = std::min({static_cast<float>(h.x), static_cast<float>(h.y), static_cast<float>(h.z)});
+    const float finest[3] = {h_min / static_cast<float>(h.x), h_min / static_cast<float>(h.y), h_min / static_cast<float>(h.z)};
     const auto reference = [&](liveset::Vec3i p) {
         float k = 0.0f;
         for (int a = 0; a < 3; ++a) {
@@ -105,7 +107,8 @@ void check_fast_path_against_reference(const Grid<float>& phi, bool scaled) {
         }
         return k;
     };
-    // central_gradient's norm, written out with clamped reads (one-sided at the border).
+    // central_gradient's norm (per finest voxel where `scaled`), written out with clamped reads
+    // (one-sided at the border).
     const auto reference_gradient_norm = [&](liveset::Vec3i p) {
         float g[3];
         for (int a = 0; a < 3; ++a) {
@@ -113,6 +116,7 @@ void check_fast_path_against_reference(const Grid<float>& phi, bool scaled) {
             lo[a] = std::max(p[a] - 1, 0);
             hi[a] = std::min(p[a] + 1, phi.dims()[a] - 1);
             g[a] = (phi(hi) - phi(lo)) / static_cast<float>(hi[a] - lo[a]);
+            if (scaled) g[a] *= finest[a];  // per finest voxel
         }
         return std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
     };

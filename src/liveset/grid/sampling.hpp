@@ -83,8 +83,10 @@ inline Vec3f interpolated_gradient(const Grid<float>& g, Vec3d p) {
 
 // Godunov upwind |∇φ| for ∂φ/∂t = F |∇φ| (φ < 0 inside, F > 0 moves the front inwards).
 // Information flows from where the front comes from: for F > 0 the upwind choice is
-// max(D-,0)/min(D+,0) mirrored, see Osher & Fedkiw, "Level Set Methods", ch. 6.
-inline float upwind_gradient_norm(const Grid<float>& g, Vec3i p, float speed) {
+// max(D-,0)/min(D+,0) mirrored, see Osher & Fedkiw, "Level Set Methods", ch. 6. Each axis's
+// differences are multiplied by `scale` (the level set's h_min/h per axis: |∇φ| per finest voxel;
+// 1.0f keeps the unscaled bits).
+inline float upwind_gradient_norm(const Grid<float>& g, Vec3i p, float speed, Vec3f scale = {1.0f, 1.0f, 1.0f}) {
     // One axis's squared upwind difference from its backward (D-) and forward (D+) differences,
     // with std::min's and std::max's bits but no branch on the differences' signs (min_of).
     const auto axis = [speed](float dm, float dp) {
@@ -103,7 +105,7 @@ inline float upwind_gradient_norm(const Grid<float>& g, Vec3i p, float speed) {
         const std::size_t i = l.index(p), stride[3] = {1, l.stride_y(), l.stride_z()};
         const float* v = g.values().data();
         const float c = v[i];
-        for (int a = 0; a < 3; ++a) sum += axis(c - v[i - stride[a]], v[i + stride[a]] - c);
+        for (int a = 0; a < 3; ++a) sum += axis((c - v[i - stride[a]]) * scale[a], (v[i + stride[a]] - c) * scale[a]);
         return std::sqrt(sum);
     }
     const float c = g(p);
@@ -111,7 +113,7 @@ inline float upwind_gradient_norm(const Grid<float>& g, Vec3i p, float speed) {
         Vec3i lo = p, hi = p;
         lo[a] -= 1;
         hi[a] += 1;
-        sum += axis(c - g.clamped(lo), g.clamped(hi) - c);
+        sum += axis((c - g.clamped(lo)) * scale[a], (g.clamped(hi) - c) * scale[a]);
     }
     return std::sqrt(sum);
 }

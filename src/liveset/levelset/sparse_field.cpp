@@ -232,13 +232,12 @@ std::vector<double> SparseField::zero_rates(const Speed& speed) const {
     return rate;
 }
 
-// h_max / h_min² of the voxel sizes, each rounded to float as the curvature's are (speed.cpp): 1 at
-// 1 mm, and the same for a size stored in float (NIfTI) or in double (MINC).
+// 1 / h_min of the voxel sizes, each rounded to float as the curvature's are (speed.cpp): 1 at 1 mm,
+// and the same for a size stored in float (NIfTI) or in double (MINC).
 double SparseField::parabolic_factor() const {
     const Vec3d h = phi_.lattice().spacing();
     const double x = static_cast<float>(h.x), y = static_cast<float>(h.y), z = static_cast<float>(h.z);
-    const double lo = std::min({x, y, z});
-    return std::max({x, y, z}) / (lo * lo);
+    return 1.0 / std::min({x, y, z});
 }
 
 double SparseField::time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const {
@@ -250,10 +249,11 @@ double SparseField::time_step(std::span<const double> rate, const Speed& speed, 
     double dt = options.max_dt;
     if (max_rate > 0.0) dt = std::min(dt, static_cast<double>(options.cfl) / max_rate);
     // The parabolic bound (docs/ARCHITECTURE.md, "Time step"): the difference-of-normals curvature
-    // (per millimetre) linearised about a front with |∇φ| = 1 (in index units) has eigenvalues of
-    // magnitude at most 8·h_max/h_min² over every frequency and normal, h the voxel sizes in mm
-    // (scripts/parabolic_bound.py --spacing; the checkerboard along the front reaches it: 8 at 1 mm),
-    // so forward Euler keeps every mode's amplification |1 − 8·w·f·dt| ≤ 1 up to w·f·dt = 1/4.
+    // (per millimetre) times |∇φ| per finest voxel, linearised about a front with |∇φ| = 1 in index
+    // units, has eigenvalues of magnitude at most 8/h_min over every frequency and normal, h the voxel
+    // sizes in mm (scripts/parabolic_bound.py --spacing; the checkerboard along the front across the
+    // finest axes reaches it: 8 at 1 mm), so forward Euler keeps every mode's amplification
+    // |1 − 8·w·f·dt| ≤ 1 up to w·f·dt = 1/4, f = 1/h_min.
     if (speed.curvature_weight() > 0.0f) dt = std::min(dt, 1.0 / (4.0 * speed.curvature_weight() * parabolic_factor()));
     return dt;
 }

@@ -156,9 +156,10 @@ public:
     void restore_activity(const ActivitySnapshot& snapshot);
 
     // --- updates ----------------------------------------------------------------------------
-    // One global step of ∂φ/∂t = |∇φ| F (|∇φ| in index units, κ in a curvature part per millimetre)
-    // with a CFL time step (|Δφ| ≤ cfl and the parabolic bound dt ≤ 1/(4·curvature weight·h_max/h_min²),
-    // h the voxel sizes in mm: the explicit scheme's stability limit), multithreaded over the
+    // One global step of ∂φ/∂t = |∇φ| F (φ in index units, |∇φ| per finest voxel: per mm times the
+    // smallest voxel size h_min, so a front moves alike in mm along every axis; κ in a curvature part
+    // per mm) with a CFL time step (|Δφ| ≤ cfl and the parabolic bound dt ≤ h_min/(4·curvature
+    // weight), the explicit scheme's stability limit; at 1 mm all of it in index units), multithreaded over the
     // zero layer (a band below options.parallel_band_min on the calling thread alone). Both modes
     // give the same φ, statuses and change report (as a set); kIncremental costs what moved (the
     // band when most of a small front moves), kFullBand the band.
@@ -209,7 +210,7 @@ private:
     void evaluate_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo, Vec3i hi);  // φ, far outside the box
     std::vector<double> zero_rates(const Speed& speed) const;  // |∇φ|F at each zero-layer point
     double time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const;
-    double parabolic_factor() const;  // the curvature's stability factor from the voxel sizes (time_step)
+    double parabolic_factor() const;  // the curvature's stability factor 1/h_min from the voxel sizes (time_step)
     StepResult step_full_band(const Speed& speed, const StepOptions& options);
     StepResult step_incremental(const Speed& speed, const StepOptions& options);  // incremental_step.cpp
     ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);  // timed repair_band

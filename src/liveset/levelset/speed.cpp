@@ -27,6 +27,21 @@ std::array<float, 3> inverse_spacing(const Lattice& lattice) {
     return {1.0f / static_cast<float>(h.x), 1.0f / static_cast<float>(h.y), 1.0f / static_cast<float>(h.z)};
 }
 
+// h_min / h per axis (sizes rounded to float as above): what turns an index difference into one
+// per finest voxel (per mm times h_min). 1.0f on every axis of an isotropic grid.
+Vec3f finest_scale(const Lattice& lattice) {
+    const Vec3d h = lattice.spacing();
+    const float x = static_cast<float>(h.x), y = static_cast<float>(h.y), z = static_cast<float>(h.z);
+    const float lo = std::min({x, y, z});
+    return {lo / x, lo / y, lo / z};
+}
+
+// The central |∇φ| per finest voxel.
+float central_norm(const Grid<float>& phi, Vec3i p, Vec3f scale) {
+    const Vec3f g = central_gradient(phi, p);
+    return norm(Vec3f{g.x * scale.x, g.y * scale.y, g.z * scale.z});
+}
+
 // Unit normal component along `a` at the half-way point p + ½·dir·e_a (dir = ±1), of the physical
 // gradient (each index difference times the inverse voxel size along its axis, `inv`).
 float half_point_normal(const Grid<float>& phi, Vec3i p, int a, int dir, const std::array<float, 3>& inv) {
@@ -92,28 +107,39 @@ struct Stencil1 {
 // sign: per axis the larger square of the one-sided differences pointing upwind, summed from 0 in
 // x, y, z order, then the square root. SSE's min and max may give another zero's sign than
 // min_of and max_of, but only squares of them are used, so every lane has the scalar bits.
+template <bool kScaled>
 [[gnu::always_inline]] inline __m128 upwind_gradient_norm4(__m128 speed, __m128 c, __m128 xm, __m128 xp, __m128 ym, __m128 yp,
-                                                           __m128 zm, __m128 zp) {
+                                                           __m128 zm, __m128 zp, __m128 sx, __m128 sy, __m128 sz) {
     const __m128 zero = _mm_setzero_ps();
     const __m128 rising = _mm_cmpgt_ps(speed, zero);  // φ increases: the scalar form's speed > 0
     const auto pick = [rising](__m128 if_rising, __m128 otherwise) {
         return _mm_or_ps(_mm_and_ps(rising, if_rising), _mm_andnot_ps(rising, otherwise));
     };
-    const auto axis = [&](__m128 minus, __m128 plus) {
-        const __m128 dm = _mm_sub_ps(c, minus), dp = _mm_sub_ps(plus, c);
+    const auto axis = [&](__m128 minus, __m128 plus, __m128 scale) {
+        __m128 dm = _mm_sub_ps(c, minus), dp = _mm_sub_ps(plus, c);
+        if constexpr (kScaled) {  // per finest voxel, as the scalar form's scale
+            dm = _mm_mul_ps(dm, scale);
+            dp = _mm_mul_ps(dp, scale);
+        }
         const __m128 a1 = pick(_mm_min_ps(dm, zero), _mm_max_ps(dm, zero));
         const __m128 a2 = pick(_mm_max_ps(dp, zero), _mm_min_ps(dp, zero));
         return _mm_max_ps(_mm_mul_ps(a1, a1), _mm_mul_ps(a2, a2));
     };
-    const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_add_ps(zero, axis(xm, xp)), axis(ym, yp)), axis(zm, zp));
+    const __m128 sum = _mm_add_ps(_mm_add_ps(_mm_add_ps(zero, axis(xm, xp, sx)), axis(ym, yp, sy)), axis(zm, zp, sz));
     return _mm_sqrt_ps(sum);
 }
 
-// The inverse voxel sizes in every lane.
+// The inverse voxel sizes and the per-finest-voxel scales in every lane.
 struct InverseSpacing4 {
     __m128 x, y, z;
-    explicit InverseSpacing4(const std::array<float, 3>& inv)
-        : x(_mm_set1_ps(inv[0])), y(_mm_set1_ps(inv[1])), z(_mm_set1_ps(inv[2])) {}
+    __m128 sx, sy, sz;
+    InverseSpacing4(const std::array<float, 3>& inv, Vec3f scale)
+        : x(_mm_set1_ps(inv[0])),
+          y(_mm_set1_ps(inv[1])),
+          z(_mm_set1_ps(inv[2])),
+          sx(_mm_set1_ps(scale.x)),
+          sy(_mm_set1_ps(scale.y)),
+          sz(_mm_set1_ps(scale.z)) {}
 };
 
 // With `speed` (four lanes' speeds), also each lane's upwind |∇φ| (index units) into `upwind`.
@@ -125,7 +151,8 @@ template <bool kScaled, class Stencil>
                                                            const InverseSpacing4& inv, float kappa[4], float gradient_norm[4],
                                                            const float* speed = nullptr, float* upwind = nullptr) {
     const __m128 c = st.at(0), xp = st.at(1), xm = st.at(-1), yp = st.at(sy), ym = st.at(-sy), zp = st.at(sz), zm = st.at(-sz);
-    if (speed != nullptr) _mm_storeu_ps(upwind, upwind_gradient_norm4(_mm_loadu_ps(speed), c, xm, xp, ym, yp, zm, zp));
+    if (speed != nullptr)
+        _mm_storeu_ps(upwind, upwind_gradient_norm4<kScaled>(_mm_loadu_ps(speed), c, xm, xp, ym, yp, zm, zp, inv.sx, inv.sy, inv.sz));
     const __m128 xpyp = st.at(1 + sy), xpym = st.at(1 - sy), xmyp = st.at(-1 + sy), xmym = st.at(-1 - sy);
     const __m128 xpzp = st.at(1 + sz), xpzm = st.at(1 - sz), xmzp = st.at(-1 + sz), xmzm = st.at(-1 - sz);
     const __m128 ypzp = st.at(sy + sz), ypzm = st.at(sy - sz), ymzp = st.at(-sy + sz), ymzm = st.at(-sy - sz);
@@ -141,6 +168,7 @@ template <bool kScaled, class Stencil>
         if constexpr (!kScaled) return d;
         return _mm_mul_ps(d, inv_h);
     };
+    const auto per_finest = per_mm;  // the same product, by h_min/h (the central |∇φ|)
     const __m128 nxp = normal(_mm_sub_ps(xp, c), quarter_difference(yp, xpyp, ym, xpym), quarter_difference(zp, xpzp, zm, xpzm),
                               inv.x, inv.y, inv.z);
     const __m128 nxm = normal(_mm_mul_ps(minus, _mm_sub_ps(xm, c)), quarter_difference(yp, xmyp, ym, xmym),
@@ -159,7 +187,8 @@ template <bool kScaled, class Stencil>
     k = _mm_add_ps(k, per_mm(_mm_sub_ps(nzp, nzm), inv.z));
     _mm_storeu_ps(kappa, k);
     const __m128 two = _mm_set1_ps(2.0f);
-    const __m128 gx = _mm_div_ps(_mm_sub_ps(xp, xm), two), gy = _mm_div_ps(_mm_sub_ps(yp, ym), two), gz = _mm_div_ps(_mm_sub_ps(zp, zm), two);
+    const __m128 gx = per_finest(_mm_div_ps(_mm_sub_ps(xp, xm), two), inv.sx), gy = per_finest(_mm_div_ps(_mm_sub_ps(yp, ym), two), inv.sy),
+                 gz = per_finest(_mm_div_ps(_mm_sub_ps(zp, zm), two), inv.sz);
     _mm_storeu_ps(gradient_norm, _mm_sqrt_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(gx, gx), _mm_mul_ps(gy, gy)), _mm_mul_ps(gz, gz))));
 }
 #endif
@@ -183,7 +212,8 @@ float mean_curvature(const Grid<float>& phi, Vec3i p) {
         const auto at = static_cast<std::ptrdiff_t>(i);
         float kappa[4], gradient_norm[4];
         curvature_and_gradient4<true>(Stencil1{v, at}, static_cast<std::ptrdiff_t>(l.stride_y()),
-                                      static_cast<std::ptrdiff_t>(l.stride_z()), InverseSpacing4(inv), kappa, gradient_norm);
+                                      static_cast<std::ptrdiff_t>(l.stride_z()), InverseSpacing4(inv, finest_scale(l)), kappa,
+                                      gradient_norm);
         return kappa[0];
 #else
         const std::size_t stride[3] = {1, l.stride_y(), l.stride_z()};
@@ -217,7 +247,10 @@ void batch_stencils(const Grid<float>& phi, std::span<const PointIndex> points, 
 #if defined(__SSE2__)
     const auto sy = static_cast<std::ptrdiff_t>(l.stride_y()), sz = static_cast<std::ptrdiff_t>(l.stride_z());
     Stencil4 st{phi.values().data(), {}};
-    const InverseSpacing4 inv(inverse_spacing(l));
+    const InverseSpacing4 inv(inverse_spacing(l), finest_scale(l));
+#endif
+    const Vec3f scale = finest_scale(l);  // the scalar stencils' (lattice border)
+#if defined(__SSE2__)
     std::size_t slot[4];  // where each filled lane's result goes
     float lane_speed[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     int filled = 0;
@@ -256,8 +289,8 @@ void batch_stencils(const Grid<float>& phi, std::span<const PointIndex> points, 
             continue;
         }
 #endif
-        out[n] = {mean_curvature(phi, p), norm(central_gradient(phi, p))};
-        if (with_upwind) upwind[n] = upwind_gradient_norm(phi, p, speed[n]);
+        out[n] = {mean_curvature(phi, p), central_norm(phi, p, scale)};
+        if (with_upwind) upwind[n] = upwind_gradient_norm(phi, p, speed[n], scale);
     }
 #if defined(__SSE2__)
     if (filled > 0) flush();
@@ -286,9 +319,10 @@ void curvature_gradient_and_upwind(const Grid<float>& phi, std::span<const Point
 }
 
 double rate_of(SpeedSample s, const Grid<float>& phi, Vec3i p) {
+    const Vec3f scale = finest_scale(phi.lattice());
     double r = 0.0;
-    if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi, p, s.propagation);
-    if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * norm(central_gradient(phi, p));
+    if (s.propagation != 0.0f) r += static_cast<double>(s.propagation) * upwind_gradient_norm(phi, p, s.propagation, scale);
+    if (s.curvature != 0.0f) r += static_cast<double>(s.curvature) * central_norm(phi, p, scale);
     return r;
 }
 

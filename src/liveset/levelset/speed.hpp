@@ -1,6 +1,8 @@
 // Speed terms for the level-set equation ∂φ/∂t = |∇φ| F (φ < 0 inside; F > 0 moves the front
 // inwards). A speed is evaluated only at zero-layer points, split into a propagation part
-// (multiplied by the upwind |∇φ|) and a curvature part (multiplied by the central |∇φ|).
+// (multiplied by the upwind |∇φ|) and a curvature part (multiplied by the central |∇φ|). Both |∇φ|
+// are per finest voxel (each axis's differences times h_min/h: 1 on an isotropic grid), so a front
+// moves alike in mm along every axis of an anisotropic one.
 #pragma once
 
 #include <cstdint>
@@ -36,7 +38,7 @@ public:
     // it with a faster form of exactly these bits (a batched curvature). Thread-safe like at().
     virtual void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const;
     // Upper bound of the coefficient w in the curvature part w·κ (κ per mm), for the parabolic
-    // time-step bound dt ≤ 1/(4w·h_max/h_min²). Zero when the speed has no curvature part.
+    // time-step bound dt ≤ h_min/(4w). Zero when the speed has no curvature part.
     virtual float curvature_weight() const = 0;
 
 private:
@@ -52,14 +54,14 @@ private:
 // On a 1 mm lattice every factor is 1.0f: the index-unit curvature, bit for bit.
 float mean_curvature(const Grid<float>& phi, Vec3i p);
 
-// mean_curvature() and the norm of central_gradient() at each of `points` into `out` (the same
+// mean_curvature() and the norm of central_gradient() per finest voxel at each of `points` into `out` (the same
 // size), four interior stencils at a time: the same bits as the single calls.
 struct CurvatureAndGradient {
     float kappa;
     float gradient_norm;
 };
 void mean_curvature_and_gradient(const Grid<float>& phi, std::span<const PointIndex> points, std::span<CurvatureAndGradient> out);
-// The same, and at each point upwind_gradient_norm(phi, p, speed[k]) (sampling.hpp) into `upwind`
+// The same, and at each point upwind_gradient_norm(phi, p, speed[k], h_min/h) (sampling.hpp) into `upwind`
 // (all four spans of the same size): the same bits as the single calls, from the same loads.
 void curvature_gradient_and_upwind(const Grid<float>& phi, std::span<const PointIndex> points, std::span<const float> speed,
                                    std::span<CurvatureAndGradient> out, std::span<float> upwind);
