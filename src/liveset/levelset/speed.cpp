@@ -142,7 +142,7 @@ struct InverseSpacing4 {
           sz(_mm_set1_ps(scale.z)) {}
 };
 
-// With `speed` (four lanes' speeds), also each lane's upwind |∇φ| (index units) into `upwind`.
+// With `speed` (four lanes' speeds), also each lane's upwind |∇φ| (per finest voxel) into `upwind`.
 // Without kScaled (a 1 mm lattice, where every inverse size is 1.0f and each product would give its
 // factor's bits) the multiplications are left out: the same bits, and the box flow's step 5 % faster
 // than with them (the three factors' registers spill the stencil's).
