@@ -9,10 +9,10 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <deque>
 #include <future>
-#include <atomic>
 #include <map>
 #include <memory>
 #include <optional>

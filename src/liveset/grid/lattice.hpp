@@ -35,6 +35,11 @@ public:
 
     Vec3i dims() const { return dims_; }
     Vec3d spacing() const { return spacing_; }
+    // The voxel sizes rounded to float, as the level set's stencils take them (its curvature and
+    // time step): a size stored in float (NIfTI) and the same size in double (MINC) agree here.
+    Vec3f spacing_float() const {
+        return {static_cast<float>(spacing_.x), static_cast<float>(spacing_.y), static_cast<float>(spacing_.z)};
+    }
     Vec3d origin() const { return origin_; }
     const Mat3d& direction() const { return direction_; }
 

@@ -232,12 +232,10 @@ std::vector<double> SparseField::zero_rates(const Speed& speed) const {
     return rate;
 }
 
-// 1 / h_min of the voxel sizes, each rounded to float as the curvature's are (speed.cpp): 1 at 1 mm,
-// and the same for a size stored in float (NIfTI) or in double (MINC).
+// 1 / h_min of the voxel sizes as the curvature takes them (Lattice::spacing_float): 1 at 1 mm.
 double SparseField::parabolic_factor() const {
-    const Vec3d h = phi_.lattice().spacing();
-    const double x = static_cast<float>(h.x), y = static_cast<float>(h.y), z = static_cast<float>(h.z);
-    return 1.0 / std::min({x, y, z});
+    const Vec3f h = phi_.lattice().spacing_float();
+    return 1.0 / static_cast<double>(std::min({h.x, h.y, h.z}));
 }
 
 double SparseField::time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const {

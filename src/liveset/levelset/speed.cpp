@@ -19,21 +19,19 @@ namespace liveset {
 
 namespace {
 
-// 1 / the voxel size along each axis, from the size rounded to float first: a size stored in float
-// (NIfTI) and the same size stored in double (MINC) give the same factors, and a 1 mm voxel gives
-// 1.0f exactly, so every product below keeps the index-unit curvature's bits there.
+// 1 / the voxel size along each axis, from the size rounded to float (Lattice::spacing_float): a
+// 1 mm voxel gives 1.0f exactly, so every product below keeps the index-unit curvature's bits there.
 std::array<float, 3> inverse_spacing(const Lattice& lattice) {
-    const Vec3d h = lattice.spacing();
-    return {1.0f / static_cast<float>(h.x), 1.0f / static_cast<float>(h.y), 1.0f / static_cast<float>(h.z)};
+    const Vec3f h = lattice.spacing_float();
+    return {1.0f / h.x, 1.0f / h.y, 1.0f / h.z};
 }
 
 // h_min / h per axis (sizes rounded to float as above): what turns an index difference into one
 // per finest voxel (per mm times h_min). 1.0f on every axis of an isotropic grid.
 Vec3f finest_scale(const Lattice& lattice) {
-    const Vec3d h = lattice.spacing();
-    const float x = static_cast<float>(h.x), y = static_cast<float>(h.y), z = static_cast<float>(h.z);
-    const float lo = std::min({x, y, z});
-    return {lo / x, lo / y, lo / z};
+    const Vec3f h = lattice.spacing_float();
+    const float lo = std::min({h.x, h.y, h.z});
+    return {lo / h.x, lo / h.y, lo / h.z};
 }
 
 // The central |∇φ| per finest voxel.
