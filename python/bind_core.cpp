@@ -70,7 +70,8 @@ struct SegmentArgs {
     std::optional<double> mu, epsilon, mu_raw, epsilon_raw;
     std::string window_from = "model";
     int classes = 3, iterations = 2000;
-    double n = 4.0, alpha = 0.1;
+    double n = 4.0;
+    std::optional<double> alpha;  // unset: automatic (alpha.hpp), as the CLI
     std::optional<bool> bias_correct;  // unset: on, skipped with a warning where it cannot run (as the CLI's default)
 };
 
@@ -307,7 +308,7 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
         else if (k == "classes") a.classes = value.cast<int>();
         else if (k == "iterations") a.iterations = value.cast<int>();
         else if (k == "n") a.n = value.cast<double>();
-        else if (k == "alpha") a.alpha = value.cast<double>();
+        else if (k == "alpha") a.alpha = value.cast<std::optional<double>>();
         else if (k == "bias_correct") a.bias_correct = value.cast<std::optional<bool>>();
         else throw std::invalid_argument("unknown segment option '" + k + "'");
     }

@@ -1,7 +1,7 @@
 #!/bin/bash
 # The paper's Figure 5 through the general commands, as a user repairs a scan of their own (no demo
 # code): segment with the tissue model's window narrowed as `demo --brain --repair` does (ε × 0.8, at
-# least 2.4 σ of the grey-matter class) -> `liveset repair --find-holes 10` on the bias-corrected image
+# least 2.4 σ of the grey-matter class, α 0.1 as the demo) -> `liveset repair --find-holes 10` on the bias-corrected image
 # -> scripts/judge_repair.py against the truth. Seeds: the demo's eight, in physical mm (BrainWeb's
 # LPS mm = its voxel index), so any grid of BrainWeb's space works (scripts/brainweb_geometry.py).
 # Usage: scripts/fig5_cli.sh T1 BRAIN_MASK LABELS OUT_DIR   (needs build/liveset; T1/mask NIfTI, MINC, ...)
@@ -21,7 +21,7 @@ j = json.load(open(sys.argv[1])); w = j['window']; m = j['tissue_model']
 sigma = m['classes'][m['seed_class']['index']]['sigma']
 print(w['mu_raw'], max(0.8 * w['epsilon_raw'], min(w['epsilon_raw'], 2.4 * sigma)))" "$out/window.json")
 # 2. The sub-optimally low threshold that leaves holes.
-"$L" segment "$t1" "${S[@]}" --roi "$mask" --bias-correct --mu-raw "$mu" --epsilon-raw "$eps" \
+"$L" segment "$t1" "${S[@]}" --roi "$mask" --bias-correct --mu-raw "$mu" --epsilon-raw "$eps" --alpha 0.1 \
     --out-mask "$out/seg.nii.gz" --out-phi "$out/phi.nii.gz" --quiet
 # 3. The truth-free repair on the corrected image.
 "$L" repair "$out/phi.nii.gz" --image "$out/corrected.nii.gz" --roi "$mask" --find-holes 10 \

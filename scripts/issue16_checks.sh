@@ -30,7 +30,9 @@ B=data/brainweb
 S8=(--seed 35,83,113 --seed 35,125,38 --seed 44,164,92 --seed 71,74,53 --seed 122,149,47 --seed 140,86,74 --seed 38,71,26 --seed 83,23,71)
 # --no-bias-correct: ITK's filter below runs on the raw T1, and so does liveset, to compare one front
 # (N4, the default since session 48, adds 0.5-0.8 s and changes the front: 716 iterations, Dice 0.939).
-segment=(segment "$B/t1.mha" "${S8[@]}" --roi "$B/brain_mask.nii.gz" --mu-raw 94 --epsilon-raw 22 --no-bias-correct --quiet)
+# --alpha 0.1: ITK runs with the curvature weight 0.1 maps to; liveset's automatic weight (session 50)
+# would take 0 on this scan and make the two fronts differ.
+segment=(segment "$B/t1.mha" "${S8[@]}" --roi "$B/brain_mask.nii.gz" --mu-raw 94 --epsilon-raw 22 --alpha 0.1 --no-bias-correct --quiet)
 load() { echo "-- load $(cut -d' ' -f1-3 /proc/loadavg), $(date -u +%H:%M:%S) UTC"; }
 summary() { /usr/bin/python3 -c 'import json, sys; d = json.load(sys.stdin); print({k: v for k, v in d.items() if not isinstance(v, (list, dict))})'; }
 

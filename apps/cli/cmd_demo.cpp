@@ -184,6 +184,7 @@ int run_demo(const DemoArgs& a, int threads, const DemoWindow& window) {
     // --repair-rule sheet alone segments with the model's window (docs/BENCHMARKS.md, session 10);
     // its tunnels at 96^3 include handles of bias-bright voxels that no growth can close.
     req.window.estimate = a.rule == "sheet" ? WindowSource::kModel : WindowSource::kSeeds;
+    req.alpha = 0.1;  // the curvature the presets were made with (the automatic α would pick its own)
     const bool quiet_progress = a.quiet || a.json;
     const SegmentRun run = segment_with_progress(ph.image, req, quiet_progress);
     if (run.interrupted) {

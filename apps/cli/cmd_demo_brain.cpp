@@ -58,6 +58,7 @@ void low_threshold(const Grid<float>& t1, const Grid<std::uint8_t>& roi, Segment
     req.mu_raw = w.mu();
     const double sigma = model->classes[static_cast<std::size_t>(w.seed_class)].sigma;
     req.epsilon_raw = std::max(kLowThreshold * w.epsilon(), std::min(w.epsilon(), kLowThresholdMinSigmas * sigma));
+    req.alpha = 0.1;  // the paper's Figure 5 set-up: a small curvature, holes from the window alone
     band.band = {w.lower, w.upper, model->classes[static_cast<std::size_t>(w.seed_class)].mean};
 }
 

@@ -178,6 +178,14 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
     j["epsilon_raw"] = o.scale.raw_length(o.params.epsilon);
     j["n"] = o.params.n;
     j["alpha"] = o.params.alpha;
+    j["alpha_choice"] = {{"source", o.alpha.automatic ? "automatic" : "given"}};
+    if (o.alpha.automatic) {
+        j["alpha_choice"]["anisotropy"] = o.alpha.anisotropy;
+        if (o.alpha.tissue_class >= 0 && o.model) {
+            j["alpha_choice"]["noise_ratio"] = o.alpha.noise_ratio;
+            j["alpha_choice"]["class"] = tissue_class_name(*o.model, o.alpha.tissue_class);
+        }
+    }
     j["window_estimated"] = o.window_source != WindowSource::kUser;
     j["window"] = {{"mu_raw", o.scale.to_raw(o.params.mu)},
                    {"epsilon_raw", o.scale.raw_length(o.params.epsilon)},
@@ -214,6 +222,19 @@ nlohmann::json bias_correction_report(const BiasCorrectionReport& r) {
             {"final_convergence", r.final_convergence}};
 }
 
+namespace {
+
+// "given", or how the automatic α came about: "automatic: GM's noise over contrast 0.17, voxels 1:1".
+std::string alpha_source(const nlohmann::json& j) {
+    if (!j.contains("alpha_choice") || j["alpha_choice"]["source"] != "automatic") return "given";
+    const nlohmann::json& a = j["alpha_choice"];
+    const std::string shape = fmt::format("voxels {:.2g}:1", a["anisotropy"].get<double>());
+    if (!a.contains("noise_ratio")) return "automatic: no usable tissue model, 0.1 for " + shape;
+    return fmt::format("automatic: {}'s noise over contrast {:.2f}, {}", a["class"].get<std::string>(), a["noise_ratio"].get<double>(), shape);
+}
+
+}  // namespace
+
 void print_segmentation_summary(const nlohmann::json& j) {
     if (j.contains("bias_correction")) {
         const nlohmann::json& b = j["bias_correction"];
@@ -240,9 +261,9 @@ void print_segmentation_summary(const nlohmann::json& j) {
     if (source == "model")
         from += fmt::format(": {}, {:.0f} % of the seed voxels", j["tissue_model"]["seed_class"]["name"].get<std::string>(),
                             100.0 * j["tissue_model"]["seed_class"]["share"].get<double>());
-    fmt::print("  window       {:.1f} .. {:.1f} raw (mu {:.1f} ± {:.1f}; {}), n {}, alpha {}\n", w["lower_raw"].get<double>(),
+    fmt::print("  window       {:.1f} .. {:.1f} raw (mu {:.1f} ± {:.1f}; {}), n {}, alpha {:.3g} ({})\n", w["lower_raw"].get<double>(),
                w["upper_raw"].get<double>(), w["mu_raw"].get<double>(), w["epsilon_raw"].get<double>(), from,
-               j["n"].get<double>(), j["alpha"].get<double>());
+               j["n"].get<double>(), j["alpha"].get<double>(), alpha_source(j));
     fmt::print("  volume       {} voxels, {:.1f} ml\n", j["voxels"].get<std::size_t>(), j["volume_mm3"].get<double>() / 1000.0);
 }
 

@@ -16,7 +16,8 @@ namespace liveset::cli {
 
 struct ThresholdArgs {
     std::optional<double> mu, epsilon, mu_raw, epsilon_raw;  // the window, normalised or raw units
-    double n = 4.0, alpha = 0.1;
+    double n = 4.0;
+    std::optional<double> alpha;  // unset: `segment` chooses it (alpha.hpp); `view` keeps the session's
     std::string step = "sleeping";  // --step: sleeping (segmentation.hpp, sleeping_step) or exact
 };
 

@@ -49,7 +49,7 @@ std::string choose_start_params(Session& s, const StartParams& start) {
     if (mu) p.mu = *mu;
     if (epsilon) p.epsilon = *epsilon;
     if (start.n_given) p.n = a.n;
-    if (start.alpha_given) p.alpha = a.alpha;
+    if (start.alpha_given && a.alpha) p.alpha = *a.alpha;
     if (mu || epsilon) {
         from_seeds = false;
         const std::string given = mu && epsilon ? "µ, ε" : (mu ? "µ" : "ε");

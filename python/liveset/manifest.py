@@ -16,7 +16,7 @@ FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "seed_radius")
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
 CHOICES = {"window_from": ("model", "seeds")}
 BOOLS = ("bias_correct",)
-DEFAULTS_EPOCH = 49  # see Subject.fingerprint
+DEFAULTS_EPOCH = 50  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -44,8 +44,8 @@ class Subject:
         files = [p for p in (self.image, self.roi, self.truth, self.init_mask) if p and p != "auto"]
         stats = [(p, os.stat(p).st_size, os.stat(p).st_mtime_ns) for p in files]
         # DEFAULTS_EPOCH: bumped when a default that changes the outputs changes (session 48: N4 by
-        # default; 49: the curvature per mm, which changes every scan not at 1 mm), so a resumed
-        # cohort recomputes what older defaults made.
+        # default; 49: the curvature per mm, which changes every scan not at 1 mm; 50: α chosen from
+        # the image unless given), so a resumed cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]

@@ -3,6 +3,8 @@
 // non-zero exit, no output file left behind).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
@@ -125,6 +127,21 @@ TEST(SegmentCli, PhantomSegmentMeshEval) {
     const nlohmann::json sj = nlohmann::json::parse(seg.out);
     EXPECT_EQ(sj["stop"], "converged");
     EXPECT_TRUE(sj["window_estimated"].get<bool>());
+    // α chosen from the image (alpha.hpp): the report says how, and it is the α the run used.
+    EXPECT_EQ(sj["alpha_choice"]["source"], "automatic");
+    const nlohmann::json& tm = sj["tissue_model"];
+    const int k = sj["alpha_choice"]["class"] == "GM" ? 1 : -1;
+    ASSERT_EQ(k, tm["seed_class"]["index"].get<int>());
+    const double sigma = tm["classes"][1]["sigma"], gap = std::min(tm["classes"][1]["mean"].get<double>() - tm["classes"][0]["mean"].get<double>(),
+                                                                   tm["classes"][2]["mean"].get<double>() - tm["classes"][1]["mean"].get<double>());
+    EXPECT_NEAR(sj["alpha_choice"]["noise_ratio"].get<double>(), sigma / gap, 1e-9);
+    EXPECT_NEAR(sj["alpha"].get<double>(), std::clamp((sigma / gap - 0.2) * 0.5, 0.0, 0.15), 1e-9);
+    const Result given = run_cli("segment " + (ph.dir / "t1.nii.gz").string() + ph.seeds + " --alpha 0.07 --iterations 3 --json --out-mask " +
+                                 (work_dir() / "seg_given.nii.gz").string());
+    ASSERT_EQ(given.rc, 0) << given.err;
+    const nlohmann::json gj = nlohmann::json::parse(given.out);
+    EXPECT_EQ(gj["alpha_choice"]["source"], "given");
+    EXPECT_DOUBLE_EQ(gj["alpha"].get<double>(), 0.07);
 
     // Outputs overlay the input: same geometry.
     const Grid<float> img = read_image((ph.dir / "t1.nii.gz").string());

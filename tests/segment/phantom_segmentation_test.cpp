@@ -17,6 +17,7 @@ TEST(PhantomSegmentation, DefaultsFromSeedsReachDiceAndLeaveHolesAtTheBias) {
     const Phantom ph = make_phantom();  // 128^3, the demo's input
     SegmentRequest req;
     for (const Vec3i& s : ph.seeds) req.seeds.push_back({{double(s.x), double(s.y), double(s.z)}, 2.0});
+    req.alpha = 0.1;  // the demo's (the paper's small curvature); the automatic α takes none here
     const SegmentOutcome out = segment_image(ph.image, req);
     EXPECT_EQ(out.result.reason, StopReason::kConverged);
     EXPECT_EQ(out.window_source, WindowSource::kModel);  // seeds alone: the tissue model's window

@@ -103,6 +103,7 @@ TEST(SessionRunner, ARunEqualsTheForegroundStepsAndLivesetSegment) {
     SegmentRequest req;  // `liveset segment`: the sleeping step from the same seeds
     for (const Vec3i& c : phantom48().seeds) req.seeds.push_back({c.cast<double>(), 2.0});
     req.loop.step = sleeping_step();
+    req.alpha = 0.1;  // the session's α (it does not choose one: docs/ARCHITECTURE.md)
     const SegmentOutcome cli = segment_image(phantom48().image, req);
     ASSERT_EQ(cli.result.reason, StopReason::kConverged);
     EXPECT_EQ(cli.result.iterations, st.steps);

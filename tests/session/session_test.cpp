@@ -93,6 +93,7 @@ TEST(Session, SegmentsFromSeedsExactlyAsLivesetSegment) {
     const Phantom& ph = phantom64();
     Session s(ph.image, options());
     SegmentRequest req;
+    req.alpha = s.params().alpha;  // the session's α (it does not choose one: docs/ARCHITECTURE.md)
     for (const Vec3i& c : ph.seeds) {
         req.seeds.push_back({c.cast<double>(), 2.0});
         s.add_seed({c.cast<double>(), 2.0});

@@ -104,6 +104,7 @@ TEST(Repair, SwarmClosesThePhantomPerforations) {
     // The segmentation the repair presets were made for: the seeds' statistics window (the demo's;
     // with the tissue model's window the rounds leave one tunnel — docs/BENCHMARKS.md).
     req.window.estimate = WindowSource::kSeeds;
+    req.alpha = 0.1;  // and the demo's curvature weight
     SegmentOutcome o = segment_image(ph.image, req);
     Grid<std::uint8_t> white(ph.labels.lattice(), 0);
     for (PointIndex i = 0; i < white.size(); ++i) white[i] = ph.labels[i] == kWhiteMatter;

@@ -95,9 +95,15 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
 
     ThresholdParams p;
     p.n = req.n;
-    p.alpha = req.alpha;
     choose_window(image, req, out, p);
     if (!req.mu && !req.mu_raw) p.mu = std::clamp(p.mu, 0.0, 1.0);  // an estimate beyond the scale's range
+    if (req.alpha) {
+        out.alpha.alpha = *req.alpha;
+    } else {
+        const TissueModel* model = out.model && out.model->usable() ? &*out.model : nullptr;
+        out.alpha = automatic_alpha(model, out.scale.to_raw(p.mu), image.lattice().spacing());
+    }
+    p.alpha = out.alpha.alpha;
     validate(p);
     out.params = p;
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "liveset/levelset/sparse_field.hpp"
+#include "liveset/segment/alpha.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
@@ -33,7 +34,9 @@ struct SegmentRequest {
     // (voxels above the Otsu threshold between background and the rest).
     const Grid<std::uint8_t>* model_region = nullptr;
     double n = 4.0;
-    double alpha = 0.1;
+    // The curvature weight; absent: automatic_alpha() (alpha.hpp) from the tissue model's noise
+    // ratio of the window's class and the voxel shape (the fallback 0.1 without a usable model).
+    std::optional<double> alpha;
     ScaleOptions scale;
     SegmentationOptions loop;
     int layers = 2;
@@ -43,6 +46,7 @@ struct SegmentOutcome {
     IntensityScale scale;
     ThresholdParams params;
     WindowSource window_source = WindowSource::kUser;
+    AlphaChoice alpha;  // the α params holds, and why
     std::optional<SeedStatistics> seed_stats;  // when the window was estimated
     std::optional<TissueModel> model;          // when it could be fitted (seeds given)
     std::optional<ModelWindow> model_window;   // when the window came from the model

@@ -1,0 +1,45 @@
+// automatic_alpha(): the curvature weight from the tissue model's noise ratio and the voxel shape.
+#include "liveset/segment/alpha.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+
+namespace liveset {
+
+namespace {
+
+// σ of the class nearest `centre` over its mean's distance to the nearest other class mean; NaN
+// (class −1) without a usable model of at least two classes with distinct means.
+double noise_ratio(const TissueModel* model, double centre, int& tissue_class) {
+    tissue_class = -1;
+    if (!model || !model->usable() || model->classes.size() < 2) return std::numeric_limits<double>::quiet_NaN();
+    const auto& c = model->classes;
+    std::size_t k = 0;
+    for (std::size_t i = 1; i < c.size(); ++i)
+        if (std::abs(c[i].mean - centre) < std::abs(c[k].mean - centre)) k = i;
+    double gap = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < c.size(); ++i)
+        if (i != k) gap = std::min(gap, std::abs(c[i].mean - c[k].mean));
+    if (!(gap > 0.0) || !std::isfinite(gap) || !std::isfinite(c[k].sigma)) return std::numeric_limits<double>::quiet_NaN();
+    tissue_class = static_cast<int>(k);
+    return c[k].sigma / gap;
+}
+
+}  // namespace
+
+AlphaChoice automatic_alpha(const TissueModel* model, double window_centre_raw, Vec3d spacing) {
+    AlphaChoice a;
+    a.automatic = true;
+    a.noise_ratio = noise_ratio(model, window_centre_raw, a.tissue_class);
+    const double base = std::isnan(a.noise_ratio)
+                            ? kFallbackAlpha
+                            : std::clamp((a.noise_ratio - kAlphaNoiseFloor) * kAlphaPerNoise, 0.0, kAlphaMax);
+    const double h_min = std::min({spacing.x, spacing.y, spacing.z});
+    const double h_max = std::max({spacing.x, spacing.y, spacing.z});
+    a.anisotropy = h_max / h_min;
+    a.alpha = base / (a.anisotropy * a.anisotropy * a.anisotropy);
+    return a;
+}
+
+}  // namespace liveset

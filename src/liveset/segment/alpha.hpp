@@ -1,0 +1,36 @@
+// The automatic curvature weight α of the threshold speed: as much smoothing as the image's noise
+// needs, less on voxels much longer along one axis than another.
+#pragma once
+
+#include <limits>
+
+#include "liveset/grid/vec3.hpp"
+#include "liveset/segment/tissue_model.hpp"
+
+namespace liveset {
+
+// What α a segmentation ran with, and why.
+struct AlphaChoice {
+    double alpha = 0.1;
+    bool automatic = false;
+    // σ of the window's tissue class over the distance from its mean to the nearest other class's
+    // mean (raw units; the tissue model's fit); NaN when no usable model was fitted.
+    double noise_ratio = std::numeric_limits<double>::quiet_NaN();
+    int tissue_class = -1;   // the class whose mean lies nearest the window's centre; -1 without a model
+    double anisotropy = 1.0;  // longest over shortest voxel side
+};
+
+// The rule (docs/ARCHITECTURE.md, "The automatic curvature weight"):
+//   α = clamp((noise_ratio − kAlphaNoiseFloor) × kAlphaPerNoise, 0, kAlphaMax) × (h_min / h_max)³,
+// with kFallbackAlpha in place of the first factor when the model is absent or unusable. The
+// curvature only pays where noise scatters single voxels across the window's edges (a clean scan
+// segments best without it; docs/BENCHMARKS.md, session 50), and on thick slices it costs the most.
+inline constexpr double kAlphaNoiseFloor = 0.2;
+inline constexpr double kAlphaPerNoise = 0.5;
+inline constexpr double kAlphaMax = 0.15;
+inline constexpr double kFallbackAlpha = 0.1;
+
+// `model` may be null; `window_centre_raw` picks the class; `spacing` is the voxel size in mm.
+AlphaChoice automatic_alpha(const TissueModel* model, double window_centre_raw, Vec3d spacing);
+
+}  // namespace liveset

@@ -1,0 +1,68 @@
+// automatic_alpha(): the rule on hand-made tissue models, voxel shapes and the fallbacks.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "liveset/segment/alpha.hpp"
+
+using namespace liveset;
+
+namespace {
+
+TissueModel three_classes(double gm_sigma) {
+    TissueModel m;
+    m.classes = {{37.0, 15.0, 0.15}, {98.0, gm_sigma, 0.24}, {132.0, 4.0, 0.2}};
+    return m;
+}
+
+// The rule written out: (σ / nearest gap − 0.2) / 2 in [0, 0.15], over the anisotropy cubed.
+double expected(double sigma, double gap, double anisotropy) {
+    return std::clamp((sigma / gap - 0.2) * 0.5, 0.0, 0.15) / (anisotropy * anisotropy * anisotropy);
+}
+
+}  // namespace
+
+TEST(AutomaticAlpha, NoneOnAQuietScanMoreWithNoiseCappedAndLessOnThickSlices) {
+    const TissueModel quiet = three_classes(5.7), loud = three_classes(13.1), wild = three_classes(60.0);
+    const AlphaChoice a = automatic_alpha(&quiet, 91.0, {1, 1, 1});
+    EXPECT_TRUE(a.automatic);
+    EXPECT_EQ(a.tissue_class, 1);
+    EXPECT_DOUBLE_EQ(a.noise_ratio, 5.7 / 34.0);  // GM's nearest other class is WM, 34 above
+    EXPECT_EQ(a.alpha, 0.0);
+    const AlphaChoice b = automatic_alpha(&loud, 91.0, {1, 1, 1});
+    EXPECT_NEAR(b.alpha, expected(13.1, 34.0, 1.0), 1e-12);
+    EXPECT_GT(b.alpha, 0.08);
+    EXPECT_DOUBLE_EQ(automatic_alpha(&wild, 91.0, {1, 1, 1}).alpha, kAlphaMax);
+    const AlphaChoice thick = automatic_alpha(&loud, 91.0, {1, 1, 3});
+    EXPECT_DOUBLE_EQ(thick.anisotropy, 3.0);
+    EXPECT_NEAR(thick.alpha, expected(13.1, 34.0, 3.0), 1e-12);
+    EXPECT_NEAR(automatic_alpha(&loud, 91.0, {0.5, 0.5, 2.0}).alpha, expected(13.1, 34.0, 4.0), 1e-12);
+    EXPECT_NEAR(automatic_alpha(&loud, 91.0, {0.8, 0.8, 0.8}).alpha, b.alpha, 1e-12);  // isotropic: any size alike
+}
+
+TEST(AutomaticAlpha, TheClassNearestTheWindowsCentreSetsTheRatio) {
+    const TissueModel m = three_classes(13.1);
+    const AlphaChoice wm = automatic_alpha(&m, 128.0, {1, 1, 1});
+    EXPECT_EQ(wm.tissue_class, 2);
+    EXPECT_DOUBLE_EQ(wm.noise_ratio, 4.0 / 34.0);
+    const AlphaChoice csf = automatic_alpha(&m, 20.0, {1, 1, 1});
+    EXPECT_EQ(csf.tissue_class, 0);
+    EXPECT_DOUBLE_EQ(csf.noise_ratio, 15.0 / 61.0);
+    EXPECT_NEAR(csf.alpha, expected(15.0, 61.0, 1.0), 1e-12);
+}
+
+TEST(AutomaticAlpha, WithoutAUsableModelTheFallbackStillFollowsTheVoxelShape) {
+    const AlphaChoice none = automatic_alpha(nullptr, 91.0, {1, 1, 1});
+    EXPECT_TRUE(none.automatic);
+    EXPECT_TRUE(std::isnan(none.noise_ratio));
+    EXPECT_EQ(none.tissue_class, -1);
+    EXPECT_DOUBLE_EQ(none.alpha, kFallbackAlpha);
+    EXPECT_NEAR(automatic_alpha(nullptr, 91.0, {0.5, 0.5, 5}).alpha, kFallbackAlpha / 1000.0, 1e-15);
+    TissueModel broken = three_classes(5.7);
+    broken.degenerate = "classes 1 and 2 merged";
+    EXPECT_DOUBLE_EQ(automatic_alpha(&broken, 91.0, {1, 1, 1}).alpha, kFallbackAlpha);
+    TissueModel one;
+    one.classes = {{98.0, 5.0, 1.0}};
+    EXPECT_DOUBLE_EQ(automatic_alpha(&one, 91.0, {1, 1, 1}).alpha, kFallbackAlpha);
+}
