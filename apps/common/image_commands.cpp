@@ -224,13 +224,16 @@ nlohmann::json bias_correction_report(const BiasCorrectionReport& r) {
 
 namespace {
 
-// "given", or how the automatic α came about: "automatic: GM's noise over contrast 0.17, voxels 1:1".
+// "given", or how the automatic α came about: "automatic: GM's noise over contrast 0.17, voxels 1:1";
+// without a ratio "automatic: no noise ratio from a tissue model, 0.1 / 3³ for voxels 3:1".
 std::string alpha_source(const nlohmann::json& j) {
     if (!j.contains("alpha_choice") || j["alpha_choice"]["source"] != "automatic") return "given";
     const nlohmann::json& a = j["alpha_choice"];
-    const std::string shape = fmt::format("voxels {:.2g}:1", a["anisotropy"].get<double>());
-    if (!a.contains("noise_ratio")) return "automatic: no usable tissue model, 0.1 for " + shape;
-    return fmt::format("automatic: {}'s noise over contrast {:.2f}, {}", a["class"].get<std::string>(), a["noise_ratio"].get<double>(), shape);
+    const double shape = a["anisotropy"].get<double>();
+    if (!a.contains("noise_ratio"))
+        return fmt::format("automatic: no noise ratio from a tissue model, 0.1 / {:.3g}³ for voxels {:.3g}:1", shape, shape);
+    return fmt::format("automatic: {}'s noise over contrast {:.2f}, voxels {:.3g}:1", a["class"].get<std::string>(),
+                       a["noise_ratio"].get<double>(), shape);
 }
 
 }  // namespace

@@ -11,7 +11,7 @@ void add_threshold_options(CLI::App& cmd, ThresholdArgs& a) {
     cmd.add_option("--mu-raw", a.mu_raw, "ideal intensity in the image's own units")->check(finite_number());
     cmd.add_option("--epsilon-raw", a.epsilon_raw, "half window in the image's own units")->check(finite_number());
     cmd.add_option("--n", a.n, "steepness of the threshold term")->check(finite_number())->capture_default_str();
-    cmd.add_option("--alpha", a.alpha, "curvature weight in [0,1), per millimetre (default for segment: automatic, from the tissue model's noise over contrast for the window's class, divided by the cube of the voxels' longest-to-shortest side ratio; 0.1 without a usable model)")->check(finite_number());
+    cmd.add_option("--alpha", a.alpha, "curvature weight in [0,1), per millimetre (default: automatic, from the tissue model's noise over contrast for the window's class - 0 on a quiet scan, up to 0.15 - or 0.1 without a usable model, either divided by the cube of the voxels' longest-to-shortest side ratio)")->check(finite_number());
     cmd.add_option("--step", a.step, "level-set step: sleeping (converged stretches of front sleep until something near them changes) or exact (the whole band every step)")
         ->check(CLI::IsMember({"sleeping", "exact"}))
         ->capture_default_str();

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "cli_common.hpp"
+#include "liveset/segment/alpha.hpp"
 #include "liveset/segment/window.hpp"
 
 namespace liveset::viewer {
@@ -29,13 +30,26 @@ std::string model_window_for_level_set(const Session& s, ThresholdParams& p, boo
                        w->seed_class + 1, w->mu(), w->epsilon());
 }
 
+// α as `liveset segment` chooses it for these seeds (segment/alpha.hpp), and a note saying how.
+std::string automatic_start_alpha(const Session& s, ThresholdParams& p, bool window_given) {
+    const std::optional<WindowEstimate> w = window_given ? std::nullopt : s.window_estimate();
+    const std::optional<TissueModel>& model = s.tissue_model();
+    const TissueModel* usable = model && model->usable() ? &*model : nullptr;
+    const int window_class = w && w->model_window ? w->model_window->seed_class : -1;
+    const AlphaChoice a = automatic_alpha(usable, s.scale().to_raw(p.mu), s.lattice().spacing_float(), window_class);
+    p.alpha = a.alpha;
+    if (a.tissue_class < 0) return fmt::format("α {:.3g} automatic (no noise ratio from a tissue model: 0.1 / {:.3g}³)", a.alpha, a.anisotropy);
+    return fmt::format("α {:.3g} automatic ({}'s noise over contrast {:.2f}, voxels {:.3g}:1, as liveset segment)", a.alpha,
+                       tissue_class_name(*model, a.tissue_class), a.noise_ratio, a.anisotropy);
+}
+
 }  // namespace
 
 std::string choose_start_params(Session& s, const StartParams& start) {
     const cli::ThresholdArgs& a = *start.args;
     ThresholdParams p = s.params();
     bool from_seeds = s.window_from_seeds();
-    std::string source;
+    std::string source, alpha_note;
     bool changed = false;
     if (!start.workspace.empty()) {
         source = "µ, ε, n, α from the workspace " + start.workspace;
@@ -44,6 +58,12 @@ std::string choose_start_params(Session& s, const StartParams& start) {
         changed = true;
     } else if (!s.seeds().empty() && from_seeds) {
         source = "µ, ε from the tissue model's window for the seeds' class";
+        if (!start.alpha_given) {  // seeds, no workspace: the α `liveset segment` would choose
+            const std::optional<double> mu_given = cli::unit_mu(a, s.scale());
+            if (mu_given) p.mu = *mu_given;  // the window's centre as it will be
+            alpha_note = automatic_start_alpha(s, p, mu_given && cli::unit_epsilon(a, s.scale()));
+            changed = true;
+        }
     }
     const std::optional<double> mu = cli::unit_mu(a, s.scale()), epsilon = cli::unit_epsilon(a, s.scale());
     if (mu) p.mu = *mu;
@@ -56,6 +76,7 @@ std::string choose_start_params(Session& s, const StartParams& start) {
         source = given + " from the command line" + (source.empty() || (mu && epsilon) ? "" : "; " + source);
     }
     if (start.n_given || start.alpha_given) source += (source.empty() ? "" : "; ") + std::string("n, α from the command line");
+    if (!alpha_note.empty()) source += (source.empty() ? "" : "; ") + alpha_note;
     if (changed || mu || epsilon || start.n_given || start.alpha_given) {
         try {
             s.set_params(p, from_seeds);

@@ -70,8 +70,9 @@ def test_segment_equals_cli_bitwise(phantom, cli_segmentation):
     assert seg.mask.array.dtype == np.uint8 and np.array_equal(seg.mask.array, cli_mask)
     assert np.array_equal(seg.phi.array.view(np.uint32), cli_phi.astype(np.float32).view(np.uint32))
     rep = cli_segmentation["report"]
-    for k in ("iterations", "stop", "voxels", "mu_raw", "epsilon_raw"):
+    for k in ("iterations", "stop", "voxels", "mu_raw", "epsilon_raw", "alpha", "alpha_choice"):
         assert seg.report[k] == rep[k], k
+    assert rep["alpha_choice"]["source"] == "automatic"
     # masks/phi go out with the input's affine
     np.testing.assert_allclose(seg.mask.to_nibabel().affine, nib.load(phantom["image"]).affine, atol=1e-6)
     # the tissue model gives the window segment used

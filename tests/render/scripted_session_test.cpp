@@ -262,5 +262,42 @@ TEST(ViewBench, ReportsTheRendererAndOnlyTheRepairingScenariosRebuildFragments) 
     }
 }
 
+// `liveset view IMAGE --seed ...` starts with the α `liveset segment` chooses for the same seeds
+// (segment/alpha.hpp; a noisy phantom on 1 x 1 x 1.5 mm voxels, so α is neither 0 nor 0.1), says
+// so, and its converged mask is segment's, voxel for voxel.
+TEST(ScriptedSession, SeedsOnTheCommandLineStartWithSegmentsAutomaticAlpha) {
+    PhantomOptions po;
+    po.size = 64;
+    po.noise = 0.12;
+    const Phantom ph = make_phantom(po);
+    const Lattice& l = ph.image.lattice();
+    Grid<float> image(Lattice(l.dims(), {1.0, 1.0, 1.5}, l.origin(), l.direction()));
+    for (PointIndex i = 0; i < image.size(); ++i) image[i] = ph.image[i];
+    const fs::path dir = work_dir();
+    const std::string path = (dir / "aniso_t1.nii.gz").string(), view_mask = (dir / "aniso_view.nii.gz").string(),
+                      seg_mask = (dir / "aniso_seg.nii.gz").string();
+    write_image(image, path);
+    std::string seeds;
+    for (const Vec3i& s : ph.seeds) seeds += fmt::format(" --seed {},{},{}", s.x, s.y, s.z);
+    const CliResult seg = run_cli("segment " + path + seeds + " --no-bias-correct --json --out-mask " + seg_mask);
+    ASSERT_EQ(seg.rc, 0) << seg.err;
+    const nlohmann::json report = nlohmann::json::parse(seg.out);
+    const double alpha = report["alpha"].get<double>();
+    ASSERT_EQ(report["alpha_choice"]["source"], "automatic");
+    EXPECT_NEAR(report["alpha_choice"]["anisotropy"].get<double>(), 1.5, 1e-9);
+    EXPECT_GT(alpha, 0.0);
+    EXPECT_LT(alpha, 0.1);
+    write_text(dir / "aniso.json", R"([{"segment": "converge"}, {"save_mask": ")" + view_mask + R"("}])");
+    const CliResult view = run_cli("view " + path + seeds + " --no-bias-correct --headless --no-autosave --script " +
+                                   (dir / "aniso.json").string());
+    ASSERT_EQ(view.rc, 0) << view.err;
+    EXPECT_NE((view.out + view.err).find(fmt::format("α {:.3g} automatic", alpha)), std::string::npos) << view.out << view.err;
+    const Grid<std::uint8_t> a = read_label_image(view_mask), b = read_label_image(seg_mask);
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differ = 0;
+    for (PointIndex i = 0; i < a.size(); ++i) differ += (a[i] != 0) != (b[i] != 0);
+    EXPECT_EQ(differ, 0u);
+}
+
 }  // namespace
 }  // namespace liveset

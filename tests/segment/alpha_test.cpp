@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
+#include "liveset/grid/lattice.hpp"
 #include "liveset/segment/alpha.hpp"
 
 using namespace liveset;
@@ -65,4 +67,34 @@ TEST(AutomaticAlpha, WithoutAUsableModelTheFallbackStillFollowsTheVoxelShape) {
     TissueModel one;
     one.classes = {{98.0, 5.0, 1.0}};
     EXPECT_DOUBLE_EQ(automatic_alpha(&one, 91.0, {1, 1, 1}).alpha, kFallbackAlpha);
+}
+
+TEST(AutomaticAlpha, TheWindowsOwnClassWinsAndDegenerateRatiosFallBack) {
+    const TissueModel m = three_classes(13.1);
+    // The window's class from the model (its seeds' class) is used even where another mean lies nearer.
+    const AlphaChoice own = automatic_alpha(&m, 120.0, {1, 1, 1}, 1);
+    EXPECT_EQ(own.tissue_class, 1);
+    EXPECT_DOUBLE_EQ(own.noise_ratio, 13.1 / 34.0);
+    EXPECT_EQ(automatic_alpha(&m, 120.0, {1, 1, 1}).tissue_class, 2);  // without it: the nearest mean
+    EXPECT_EQ(automatic_alpha(&m, 120.0, {1, 1, 1}, 7).tissue_class, 2);  // an index out of range is ignored
+    EXPECT_EQ(automatic_alpha(&m, 115.0, {1, 1, 1}).tissue_class, 1);  // a tie between 98 and 132: the darker
+    TissueModel two;
+    two.classes = {{98.0, 10.0, 0.5}, {132.0, 4.0, 0.5}};
+    EXPECT_NEAR(automatic_alpha(&two, 95.0, {1, 1, 1}).alpha, expected(10.0, 34.0, 1.0), 1e-12);
+    TissueModel flat = three_classes(13.1);
+    flat.classes[2].mean = flat.classes[1].mean;  // no gap: no ratio, the fallback
+    EXPECT_DOUBLE_EQ(automatic_alpha(&flat, 98.0, {1, 1, 1}).alpha, kFallbackAlpha);
+    TissueModel wild = three_classes(std::numeric_limits<double>::quiet_NaN());
+    const AlphaChoice nan = automatic_alpha(&wild, 98.0, {1, 1, 1});
+    EXPECT_EQ(nan.tissue_class, -1);
+    EXPECT_DOUBLE_EQ(nan.alpha, kFallbackAlpha);
+}
+
+// The voxel sizes a NIfTI stores (float) and a MINC stores (double) give the same α bit for bit.
+TEST(AutomaticAlpha, FloatAndDoubleVoxelSizesGiveTheSameBits) {
+    const TissueModel m = three_classes(11.0);
+    const Lattice as_float({8, 8, 8}, {0.9375, 0.9375, static_cast<double>(1.2f)});
+    const Lattice as_double({8, 8, 8}, {0.9375, 0.9375, 1.2});
+    EXPECT_EQ(automatic_alpha(&m, 98.0, as_float.spacing_float()).alpha, automatic_alpha(&m, 98.0, as_double.spacing_float()).alpha);
+    EXPECT_GT(automatic_alpha(&m, 98.0, as_double.spacing_float()).alpha, 0.0);
 }

@@ -11,13 +11,17 @@ namespace {
 
 // σ of the class nearest `centre` over its mean's distance to the nearest other class mean; NaN
 // (class −1) without a usable model of at least two classes with distinct means.
-double noise_ratio(const TissueModel* model, double centre, int& tissue_class) {
+double noise_ratio(const TissueModel* model, double centre, int window_class, int& tissue_class) {
     tissue_class = -1;
     if (!model || !model->usable() || model->classes.size() < 2) return std::numeric_limits<double>::quiet_NaN();
     const auto& c = model->classes;
     std::size_t k = 0;
-    for (std::size_t i = 1; i < c.size(); ++i)
-        if (std::abs(c[i].mean - centre) < std::abs(c[k].mean - centre)) k = i;
+    if (window_class >= 0 && static_cast<std::size_t>(window_class) < c.size()) {
+        k = static_cast<std::size_t>(window_class);
+    } else {
+        for (std::size_t i = 1; i < c.size(); ++i)
+            if (std::abs(c[i].mean - centre) < std::abs(c[k].mean - centre)) k = i;
+    }
     double gap = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < c.size(); ++i)
         if (i != k) gap = std::min(gap, std::abs(c[i].mean - c[k].mean));
@@ -28,14 +32,14 @@ double noise_ratio(const TissueModel* model, double centre, int& tissue_class) {
 
 }  // namespace
 
-AlphaChoice automatic_alpha(const TissueModel* model, double window_centre_raw, Vec3d spacing) {
+AlphaChoice automatic_alpha(const TissueModel* model, double window_centre_raw, Vec3f spacing, int window_class) {
     AlphaChoice a;
     a.automatic = true;
-    a.noise_ratio = noise_ratio(model, window_centre_raw, a.tissue_class);
+    a.noise_ratio = noise_ratio(model, window_centre_raw, window_class, a.tissue_class);
     const double base = std::isnan(a.noise_ratio)
                             ? kFallbackAlpha
                             : std::clamp((a.noise_ratio - kAlphaNoiseFloor) * kAlphaPerNoise, 0.0, kAlphaMax);
-    const double h_min = std::min({spacing.x, spacing.y, spacing.z});
+    const double h_min = std::min({spacing.x, spacing.y, spacing.z});  // float -> double: exact
     const double h_max = std::max({spacing.x, spacing.y, spacing.z});
     a.anisotropy = h_max / h_min;
     a.alpha = base / (a.anisotropy * a.anisotropy * a.anisotropy);

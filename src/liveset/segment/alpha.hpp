@@ -16,7 +16,7 @@ struct AlphaChoice {
     // σ of the window's tissue class over the distance from its mean to the nearest other class's
     // mean (raw units; the tissue model's fit); NaN when no usable model was fitted.
     double noise_ratio = std::numeric_limits<double>::quiet_NaN();
-    int tissue_class = -1;   // the class whose mean lies nearest the window's centre; -1 without a model
+    int tissue_class = -1;   // the window's class (see automatic_alpha); -1 without a ratio
     double anisotropy = 1.0;  // longest over shortest voxel side
 };
 
@@ -30,7 +30,10 @@ inline constexpr double kAlphaPerNoise = 0.5;
 inline constexpr double kAlphaMax = 0.15;
 inline constexpr double kFallbackAlpha = 0.1;
 
-// `model` may be null; `window_centre_raw` picks the class; `spacing` is the voxel size in mm.
-AlphaChoice automatic_alpha(const TissueModel* model, double window_centre_raw, Vec3d spacing);
+// `model` may be null. The class is `window_class` where the window came from the model (its seeds'
+// class), else the one whose mean lies nearest `window_centre_raw` (a tie: the darker). `spacing`
+// is the voxel size in mm as float (Lattice::spacing_float(): a NIfTI's float and a MINC's double
+// voxel sizes give the same α, as they give the same curvature).
+AlphaChoice automatic_alpha(const TissueModel* model, double window_centre_raw, Vec3f spacing, int window_class = -1);
 
 }  // namespace liveset

@@ -101,7 +101,8 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
         out.alpha.alpha = *req.alpha;
     } else {
         const TissueModel* model = out.model && out.model->usable() ? &*out.model : nullptr;
-        out.alpha = automatic_alpha(model, out.scale.to_raw(p.mu), image.lattice().spacing());
+        const int window_class = out.model_window ? out.model_window->seed_class : -1;
+        out.alpha = automatic_alpha(model, out.scale.to_raw(p.mu), image.lattice().spacing_float(), window_class);
     }
     p.alpha = out.alpha.alpha;
     validate(p);
