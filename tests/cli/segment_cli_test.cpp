@@ -132,8 +132,10 @@ TEST(SegmentCli, PhantomSegmentMeshEval) {
     const nlohmann::json& tm = sj["tissue_model"];
     const int k = sj["alpha_choice"]["class"] == "GM" ? 1 : -1;
     ASSERT_EQ(k, tm["seed_class"]["index"].get<int>());
-    const double sigma = tm["classes"][1]["sigma"], gap = std::min(tm["classes"][1]["mean"].get<double>() - tm["classes"][0]["mean"].get<double>(),
-                                                                   tm["classes"][2]["mean"].get<double>() - tm["classes"][1]["mean"].get<double>());
+    const double below = tm["classes"][1]["mean"].get<double>() - tm["classes"][0]["mean"].get<double>(),
+                 above = tm["classes"][2]["mean"].get<double>() - tm["classes"][1]["mean"].get<double>();
+    const int j = below <= above ? 0 : 2;  // the class with the nearest mean (a tie: the darker)
+    const double gap = std::min(below, above), sigma = std::max(tm["classes"][1]["sigma"].get<double>(), tm["classes"][j]["sigma"].get<double>());
     EXPECT_NEAR(sj["alpha_choice"]["noise_ratio"].get<double>(), sigma / gap, 1e-9);
     EXPECT_NEAR(sj["alpha"].get<double>(), std::clamp((sigma / gap - 0.2) * 0.5, 0.0, 0.15), 1e-9);
     const Result given = run_cli("segment " + (ph.dir / "t1.nii.gz").string() + ph.seeds + " --alpha 0.07 --iterations 3 --json --out-mask " +

@@ -30,7 +30,7 @@ TEST(AutomaticAlpha, NoneOnAQuietScanMoreWithNoiseCappedAndLessOnThickSlices) {
     const AlphaChoice a = automatic_alpha(&quiet, 91.0, {1, 1, 1});
     EXPECT_TRUE(a.automatic);
     EXPECT_EQ(a.tissue_class, 1);
-    EXPECT_DOUBLE_EQ(a.noise_ratio, 5.7 / 34.0);  // GM's nearest other class is WM, 34 above
+    EXPECT_DOUBLE_EQ(a.noise_ratio, 5.7 / 34.0);  // GM's nearest other class is WM, 34 above (σ 4 < 5.7)
     EXPECT_EQ(a.alpha, 0.0);
     const AlphaChoice b = automatic_alpha(&loud, 91.0, {1, 1, 1});
     EXPECT_NEAR(b.alpha, expected(13.1, 34.0, 1.0), 1e-12);
@@ -47,7 +47,7 @@ TEST(AutomaticAlpha, TheClassNearestTheWindowsCentreSetsTheRatio) {
     const TissueModel m = three_classes(13.1);
     const AlphaChoice wm = automatic_alpha(&m, 128.0, {1, 1, 1});
     EXPECT_EQ(wm.tissue_class, 2);
-    EXPECT_DOUBLE_EQ(wm.noise_ratio, 4.0 / 34.0);
+    EXPECT_DOUBLE_EQ(wm.noise_ratio, 13.1 / 34.0);  // WM's border with GM is blurred by GM's larger spread
     const AlphaChoice csf = automatic_alpha(&m, 20.0, {1, 1, 1});
     EXPECT_EQ(csf.tissue_class, 0);
     EXPECT_DOUBLE_EQ(csf.noise_ratio, 15.0 / 61.0);
@@ -81,6 +81,8 @@ TEST(AutomaticAlpha, TheWindowsOwnClassWinsAndDegenerateRatiosFallBack) {
     TissueModel two;
     two.classes = {{98.0, 10.0, 0.5}, {132.0, 4.0, 0.5}};
     EXPECT_NEAR(automatic_alpha(&two, 95.0, {1, 1, 1}).alpha, expected(10.0, 34.0, 1.0), 1e-12);
+    two.classes[1].sigma = 12.0;  // the neighbour's larger spread counts
+    EXPECT_NEAR(automatic_alpha(&two, 95.0, {1, 1, 1}).alpha, expected(12.0, 34.0, 1.0), 1e-12);
     TissueModel flat = three_classes(13.1);
     flat.classes[2].mean = flat.classes[1].mean;  // no gap: no ratio, the fallback
     EXPECT_DOUBLE_EQ(automatic_alpha(&flat, 98.0, {1, 1, 1}).alpha, kFallbackAlpha);

@@ -9,8 +9,9 @@ namespace liveset {
 
 namespace {
 
-// σ of the class nearest `centre` over its mean's distance to the nearest other class mean; NaN
-// (class −1) without a usable model of at least two classes with distinct means.
+// The larger σ of the window's class k and of the class j whose mean is nearest k's, over the
+// distance between their means; NaN (class −1) without a usable model of at least two classes with
+// distinct means.
 double noise_ratio(const TissueModel* model, double centre, int window_class, int& tissue_class) {
     tissue_class = -1;
     if (!model || !model->usable() || model->classes.size() < 2) return std::numeric_limits<double>::quiet_NaN();
@@ -22,12 +23,13 @@ double noise_ratio(const TissueModel* model, double centre, int window_class, in
         for (std::size_t i = 1; i < c.size(); ++i)
             if (std::abs(c[i].mean - centre) < std::abs(c[k].mean - centre)) k = i;
     }
-    double gap = std::numeric_limits<double>::infinity();
+    std::size_t j = k == 0 ? 1 : 0;  // the nearest other class: its border with k is the window's nearer edge
     for (std::size_t i = 0; i < c.size(); ++i)
-        if (i != k) gap = std::min(gap, std::abs(c[i].mean - c[k].mean));
-    if (!(gap > 0.0) || !std::isfinite(gap) || !std::isfinite(c[k].sigma)) return std::numeric_limits<double>::quiet_NaN();
+        if (i != k && std::abs(c[i].mean - c[k].mean) < std::abs(c[j].mean - c[k].mean)) j = i;
+    const double gap = std::abs(c[j].mean - c[k].mean), sigma = std::max(c[k].sigma, c[j].sigma);
+    if (!(gap > 0.0) || !std::isfinite(gap) || !std::isfinite(sigma)) return std::numeric_limits<double>::quiet_NaN();
     tissue_class = static_cast<int>(k);
-    return c[k].sigma / gap;
+    return sigma / gap;  // both spreads blur that border
 }
 
 }  // namespace

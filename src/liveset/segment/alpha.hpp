@@ -13,8 +13,9 @@ namespace liveset {
 struct AlphaChoice {
     double alpha = 0.1;
     bool automatic = false;
-    // σ of the window's tissue class over the distance from its mean to the nearest other class's
-    // mean (raw units; the tissue model's fit); NaN when no usable model was fitted.
+    // The larger σ of the window's tissue class and of the class with the nearest mean, over the
+    // distance between the two means (raw units; the tissue model's fit); NaN when no usable model
+    // was fitted.
     double noise_ratio = std::numeric_limits<double>::quiet_NaN();
     int tissue_class = -1;   // the window's class (see automatic_alpha); -1 without a ratio
     double anisotropy = 1.0;  // longest over shortest voxel side
