@@ -269,6 +269,7 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--seeds", va.seeds_file, "seed file: one I,J,K[:R] per line (the --seed format; the panel saves them)");
     v->add_option("--workspace", va.workspace, "continue a saved workspace (image, ROI, phi, seeds, parameters, swarm, camera); the panel saves it");
     add_threshold_options(*v, va);  // as `liveset segment`: --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
+    v->get_option("--alpha")->description("curvature weight in [0,1), per millimetre (default: with --seed given, the automatic one `segment` chooses for them, said in the start note; otherwise 0.1, or the workspace's)");
     v->add_option("--seed-radius", va.seed_radius, "default seed radius, voxels")->check(CLI::PositiveNumber)->capture_default_str();
     v->add_flag("--headless", va.headless, "no window: render with EGL into an offscreen framebuffer (needs --script or --bench)");
     v->add_option("--script", va.script, "replay a session: JSON list of actions (see README)");
