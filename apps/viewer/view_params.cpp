@@ -34,9 +34,8 @@ std::string model_window_for_level_set(const Session& s, ThresholdParams& p, boo
 std::string automatic_start_alpha(const Session& s, ThresholdParams& p, bool window_given) {
     const std::optional<WindowEstimate> w = window_given ? std::nullopt : s.window_estimate();
     const std::optional<TissueModel>& model = s.tissue_model();
-    const TissueModel* usable = model && model->usable() ? &*model : nullptr;
     const int window_class = w && w->model_window ? w->model_window->seed_class : -1;
-    const AlphaChoice a = automatic_alpha(usable, s.scale().to_raw(p.mu), s.lattice().spacing_float(), window_class);
+    const AlphaChoice a = automatic_alpha(model ? &*model : nullptr, s.scale().to_raw(p.mu), s.lattice().spacing_float(), window_class);
     p.alpha = a.alpha;
     if (a.tissue_class < 0) return fmt::format("α {:.3g} automatic (no noise ratio from a tissue model: 0.1 / {:.3g}³)", a.alpha, a.anisotropy);
     return fmt::format("α {:.3g} automatic ({}'s noise over contrast {:.2f}, voxels {:.3g}:1, as liveset segment)", a.alpha,
@@ -51,6 +50,7 @@ std::string choose_start_params(Session& s, const StartParams& start) {
     bool from_seeds = s.window_from_seeds();
     std::string source, alpha_note;
     bool changed = false;
+    const std::optional<double> mu = cli::unit_mu(a, s.scale()), epsilon = cli::unit_epsilon(a, s.scale());
     if (!start.workspace.empty()) {
         source = "µ, ε, n, α from the workspace " + start.workspace;
     } else if (start.level_set_loaded && s.seeds().empty()) {
@@ -59,13 +59,11 @@ std::string choose_start_params(Session& s, const StartParams& start) {
     } else if (!s.seeds().empty() && from_seeds) {
         source = "µ, ε from the tissue model's window for the seeds' class";
         if (!start.alpha_given) {  // seeds, no workspace: the α `liveset segment` would choose
-            const std::optional<double> mu_given = cli::unit_mu(a, s.scale());
-            if (mu_given) p.mu = *mu_given;  // the window's centre as it will be
-            alpha_note = automatic_start_alpha(s, p, mu_given && cli::unit_epsilon(a, s.scale()));
+            if (mu) p.mu = *mu;  // the window's centre as it will be
+            alpha_note = automatic_start_alpha(s, p, mu && epsilon);
             changed = true;
         }
     }
-    const std::optional<double> mu = cli::unit_mu(a, s.scale()), epsilon = cli::unit_epsilon(a, s.scale());
     if (mu) p.mu = *mu;
     if (epsilon) p.epsilon = *epsilon;
     if (start.n_given) p.n = a.n;

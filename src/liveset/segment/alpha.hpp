@@ -31,7 +31,7 @@ inline constexpr double kAlphaPerNoise = 0.5;
 inline constexpr double kAlphaMax = 0.15;
 inline constexpr double kFallbackAlpha = 0.1;
 
-// `model` may be null. The class is `window_class` where the window came from the model (its seeds'
+// `model` may be null or unusable (then the fallback). The class is `window_class` where the window came from the model (its seeds'
 // class), else the one whose mean lies nearest `window_centre_raw` (a tie: the darker). `spacing`
 // is the voxel size in mm as float (Lattice::spacing_float(): a NIfTI's float and a MINC's double
 // voxel sizes give the same α, as they give the same curvature).

@@ -100,9 +100,9 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     if (req.alpha) {
         out.alpha.alpha = *req.alpha;
     } else {
-        const TissueModel* model = out.model && out.model->usable() ? &*out.model : nullptr;
         const int window_class = out.model_window ? out.model_window->seed_class : -1;
-        out.alpha = automatic_alpha(model, out.scale.to_raw(p.mu), image.lattice().spacing_float(), window_class);
+        out.alpha = automatic_alpha(out.model ? &*out.model : nullptr, out.scale.to_raw(p.mu), image.lattice().spacing_float(),
+                                    window_class);
     }
     p.alpha = out.alpha.alpha;
     validate(p);
