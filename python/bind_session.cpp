@@ -11,7 +11,7 @@ namespace liveset::py {
 namespace {
 
 std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi, double n,
-                                      double alpha, int layers, int fragment_size, std::size_t history,
+                                      std::optional<double> alpha, int layers, int fragment_size, std::size_t history,
                                       int agents, double p, std::uint64_t seed, bool sleeping, const std::string& decision,
                                       double edit_range) {
     if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
@@ -24,7 +24,8 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     o.fragment_size = fragment_size;
     o.history = history;
     o.params.n = n;
-    o.params.alpha = alpha;
+    if (alpha) o.params.alpha = *alpha;
+    o.alpha_automatic = !alpha;  // None: as `segment` chooses it, and again as the seeds move the window
     if (agents < 1) throw std::invalid_argument("agents must be at least 1");
     o.repair.swarm.agents = static_cast<std::size_t>(agents);
     o.repair.swarm.act_probability = p;
@@ -97,13 +98,14 @@ void register_session(pyb::module_& m) {
             for (const SeedBall& b : s.seeds()) out.emplace_back(b.center.x, b.center.y, b.center.z, b.radius);
             return out;
         })
-        .def("set_params", [](Session& s, double mu, double epsilon, double n, double alpha, bool from_seeds) {
-            s.set_params({mu, epsilon, n, alpha}, from_seeds);
+        .def("set_params", [](Session& s, double mu, double epsilon, double n, double alpha, bool from_seeds, bool alpha_automatic) {
+            s.set_params({mu, epsilon, n, alpha}, from_seeds, alpha_automatic);
         })
         .def("params", [](const Session& s) {
             const ThresholdParams& p = s.params();
             return pyb::dict(pyb::arg("mu") = p.mu, pyb::arg("epsilon") = p.epsilon, pyb::arg("n") = p.n,
                              pyb::arg("alpha") = p.alpha, pyb::arg("window_from_seeds") = s.window_from_seeds(),
+                             pyb::arg("alpha_automatic") = s.alpha_automatic(),
                              pyb::arg("mu_raw") = s.scale().to_raw(p.mu), pyb::arg("epsilon_raw") = s.scale().raw_length(p.epsilon));
         })
         .def("segment_steps", [](Session& s, int count, bool until) { return run_steps(s, count, true, until); })

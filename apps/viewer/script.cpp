@@ -77,7 +77,7 @@ const std::set<std::string> kRepairKeys = {"preset", "agents", "p", "radius", "a
 
 void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
     if (!p.is_object()) err.fail("expected an object of parameters");
-    std::set<std::string> allowed = {"mu", "epsilon", "n", "alpha", "auto_window"};
+    std::set<std::string> allowed = {"mu", "epsilon", "n", "alpha", "auto_window", "auto_alpha"};
     allowed.insert(kRepairKeys.begin(), kRepairKeys.end());
     only_keys(p, allowed, err);
     if (p.contains("mu")) a.mu = number(p["mu"], err, "mu");
@@ -87,6 +87,11 @@ void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
     if (p.contains("auto_window")) {
         if (!p["auto_window"].is_boolean()) err.fail("auto_window must be true or false");
         a.auto_window = p["auto_window"].get<bool>();
+    }
+    if (p.contains("auto_alpha")) {
+        if (!p["auto_alpha"].is_boolean()) err.fail("auto_alpha must be true or false");
+        a.auto_alpha = p["auto_alpha"].get<bool>();
+        if (*a.auto_alpha && a.alpha) err.fail("give alpha or \"auto_alpha\": true, not both");
     }
     a.repair_fields = json::object();
     for (const std::string& k : kRepairKeys)

@@ -26,18 +26,21 @@ void ScriptPlayer::finish_entry(Viewer& viewer) {
     steps_done_ = 0;
 }
 
-// {"params": ...}: threshold parameters (µ or ε given: the window is no longer the seeds') and swarm settings.
+// {"params": ...}: threshold parameters (µ or ε given: the window is no longer the seeds'; α given: no
+// longer automatic) and swarm settings.
 void ScriptPlayer::apply_params(Viewer& viewer, const ScriptAction& a) {
     Session* s = viewer.session();
     ThresholdParams p = s->params();
     bool auto_window = s->window_from_seeds();
     if (a.mu || a.epsilon) auto_window = false;
     if (a.auto_window) auto_window = *a.auto_window;
+    bool auto_alpha = s->alpha_automatic() && !a.alpha;
+    if (a.auto_alpha) auto_alpha = *a.auto_alpha;
     if (a.mu) p.mu = *a.mu;
     if (a.epsilon) p.epsilon = *a.epsilon;
     if (a.n) p.n = *a.n;
     if (a.alpha) p.alpha = *a.alpha;
-    check(viewer, a, viewer.apply_params(p, auto_window));
+    check(viewer, a, viewer.apply_params(p, auto_window, auto_alpha));
     if (!a.repair_fields.empty()) check(viewer, a, viewer.apply_repair_options(apply_repair_fields(s->repair_options(), a.repair_fields)));
 }
 

@@ -192,6 +192,11 @@ int run_view(ViewArgs& a, int threads) {
     config.session.fragment_size = a.fragment_size;
     config.session.repair = demo_repair_options();
     config.session.segmentation.step = step_options(a);
+    // Images opened from the panel start as the command line's did: the window from the seeds as
+    // --window-from says, α automatic unless --alpha is given.
+    config.session.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
+    config.session.alpha_automatic = !a.alpha_given;
+    if (a.alpha_given && a.alpha) config.session.params.alpha = *a.alpha;
     config.image_path = a.image;
     config.roi_path = a.roi;
     config.bias_correct = a.bias_correct;
@@ -269,7 +274,7 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--seeds", va.seeds_file, "seed file: one I,J,K[:R] per line (the --seed format; the panel saves them)");
     v->add_option("--workspace", va.workspace, "continue a saved workspace (image, ROI, phi, seeds, parameters, swarm, camera); the panel saves it");
     add_threshold_options(*v, va);  // as `liveset segment`: --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
-    v->get_option("--alpha")->description("curvature weight in [0,1), per millimetre (default: with --seed given, the automatic one `segment` chooses for them, said in the start note; otherwise 0.1, or the workspace's)");
+    v->get_option("--alpha")->description("curvature weight in [0,1), per millimetre (default: automatic, as `segment` chooses it for the window and re-chosen as seeds move it - said in the start note; or the workspace's)");
     v->add_option("--seed-radius", va.seed_radius, "default seed radius, voxels")->check(CLI::PositiveNumber)->capture_default_str();
     v->add_flag("--headless", va.headless, "no window: render with EGL into an offscreen framebuffer (needs --script or --bench)");
     v->add_option("--script", va.script, "replay a session: JSON list of actions (see README)");

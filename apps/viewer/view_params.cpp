@@ -30,16 +30,12 @@ std::string model_window_for_level_set(const Session& s, ThresholdParams& p, boo
                        w->seed_class + 1, w->mu(), w->epsilon());
 }
 
-// α as `liveset segment` chooses it for these seeds (segment/alpha.hpp), and a note saying how.
-std::string automatic_start_alpha(const Session& s, ThresholdParams& p, bool window_given) {
-    const std::optional<WindowEstimate> w = window_given ? std::nullopt : s.window_estimate();
-    const std::optional<TissueModel>& model = s.tissue_model();
-    const int window_class = w && w->model_window ? w->model_window->seed_class : -1;
-    const AlphaChoice a = automatic_alpha(model ? &*model : nullptr, s.scale().to_raw(p.mu), s.lattice().spacing_float(), window_class);
-    p.alpha = a.alpha;
+// Where the session's automatic α came from (Session::automatic_alpha_choice, segment/alpha.hpp).
+std::string automatic_alpha_note(const Session& s) {
+    const AlphaChoice a = s.automatic_alpha_choice();
     if (a.tissue_class < 0) return fmt::format("α {:.3g} automatic (no noise ratio from a tissue model: 0.1 / {:.3g}³)", a.alpha, a.anisotropy);
     return fmt::format("α {:.3g} automatic ({}'s noise over contrast {:.2f}, voxels {:.3g}:1, as liveset segment)", a.alpha,
-                       tissue_class_name(*model, a.tissue_class), a.noise_ratio, a.anisotropy);
+                       tissue_class_name(*s.tissue_model(), a.tissue_class), a.noise_ratio, a.anisotropy);
 }
 
 }  // namespace
@@ -48,8 +44,11 @@ std::string choose_start_params(Session& s, const StartParams& start) {
     const cli::ThresholdArgs& a = *start.args;
     ThresholdParams p = s.params();
     bool from_seeds = s.window_from_seeds();
-    std::string source, alpha_note;
-    bool changed = false;
+    // α follows the image (as `liveset segment` chooses it, and again as seeds move the window)
+    // unless --alpha is given or a workspace brings its own choice.
+    const bool auto_alpha = !start.alpha_given && (start.workspace.empty() || s.alpha_automatic());
+    std::string source;
+    bool changed = auto_alpha != s.alpha_automatic();
     const std::optional<double> mu = cli::unit_mu(a, s.scale()), epsilon = cli::unit_epsilon(a, s.scale());
     if (!start.workspace.empty()) {
         source = "µ, ε, n, α from the workspace " + start.workspace;
@@ -58,11 +57,7 @@ std::string choose_start_params(Session& s, const StartParams& start) {
         changed = true;
     } else if (!s.seeds().empty() && from_seeds) {
         source = "µ, ε from the tissue model's window for the seeds' class";
-        if (!start.alpha_given) {  // seeds, no workspace: the α `liveset segment` would choose
-            if (mu) p.mu = *mu;  // the window's centre as it will be
-            alpha_note = automatic_start_alpha(s, p, mu && epsilon);
-            changed = true;
-        }
+        changed |= auto_alpha;
     }
     if (mu) p.mu = *mu;
     if (epsilon) p.epsilon = *epsilon;
@@ -74,15 +69,17 @@ std::string choose_start_params(Session& s, const StartParams& start) {
         source = given + " from the command line" + (source.empty() || (mu && epsilon) ? "" : "; " + source);
     }
     if (start.n_given || start.alpha_given) source += (source.empty() ? "" : "; ") + std::string("n, α from the command line");
-    if (!alpha_note.empty()) source += (source.empty() ? "" : "; ") + alpha_note;
     if (changed || mu || epsilon || start.n_given || start.alpha_given) {
         try {
-            s.set_params(p, from_seeds);
+            s.set_params(p, from_seeds, auto_alpha);
         } catch (const std::invalid_argument& e) {
             throw cli::UsageError(fmt::format("threshold parameters: {} (µ {:.4g}, ε {:.4g} raw)", e.what(), s.scale().to_raw(p.mu),
                                               s.scale().raw_length(p.epsilon)));
         }
         s.clear_history();  // Ctrl+Z must not go back to the defaults these replaced
+        // Without seeds or a level set there is no window yet to choose α for: said once there is.
+        if (auto_alpha && start.workspace.empty() && (!s.seeds().empty() || start.level_set_loaded))
+            source += (source.empty() ? "" : "; ") + automatic_alpha_note(s);
     }
     return source;
 }

@@ -100,6 +100,7 @@ void Viewer::show_session() {
     set_window_preset("auto");
     ui_params_ = session_->params();
     ui_auto_window_ = session_->window_from_seeds();
+    ui_auto_alpha_ = session_->alpha_automatic();
     ui_repair_ = session_->repair_options();
     seen_revision_ = session_->revision();
     holes_.reset();
@@ -470,6 +471,7 @@ void Viewer::undo(int times) {
     }
     ui_params_ = session_->params();
     ui_auto_window_ = session_->window_from_seeds();
+    ui_auto_alpha_ = session_->alpha_automatic();
     message_is_error_ = false;
 }
 
@@ -485,20 +487,22 @@ void Viewer::redo(int times) {
     }
     ui_params_ = session_->params();
     ui_auto_window_ = session_->window_from_seeds();
+    ui_auto_alpha_ = session_->alpha_automatic();
     message_is_error_ = false;
 }
 
-bool Viewer::apply_params(const ThresholdParams& params, bool window_from_seeds) {
+bool Viewer::apply_params(const ThresholdParams& params, bool window_from_seeds, bool alpha_automatic) {
     if (!session_) return fail("open an image first");
     halt_run();
     try {
-        session_->set_params(params, window_from_seeds);
+        session_->set_params(params, window_from_seeds, alpha_automatic);
     } catch (const std::invalid_argument& e) {
         ui_params_ = session_->params();
         return fail(e.what());
     }
     ui_params_ = session_->params();
     ui_auto_window_ = session_->window_from_seeds();
+    ui_auto_alpha_ = session_->alpha_automatic();
     return true;
 }
 

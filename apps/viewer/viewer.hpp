@@ -187,7 +187,7 @@ public:
     std::optional<render::Pick> click_3d(double x, double y, bool as_target);
     void undo(int times = 1);
     void redo(int times = 1);
-    bool apply_params(const ThresholdParams& params, bool window_from_seeds);
+    bool apply_params(const ThresholdParams& params, bool window_from_seeds, bool alpha_automatic);
     bool apply_repair_options(const RepairOptions& options);
     bool save_mask(const std::string& path);
     bool save_phi(const std::string& path);
@@ -390,6 +390,7 @@ private:
     double ui_mu_raw_ = 0.0, ui_epsilon_raw_ = 0.0;
     ThresholdParams ui_params_;
     bool ui_auto_window_ = true;
+    bool ui_auto_alpha_ = false;
     RepairOptions ui_repair_;
     SliceDisplay slices_;
     HoleTool holes_;                       // the hole finder's scan, list and selection
@@ -400,7 +401,7 @@ private:
     std::chrono::steady_clock::time_point open_started_;
     HoleScanOptions ui_holes_;             // the panel's finder settings
     std::vector<glm::vec3> hole_points_;   // the 3D pane's markers, refreshed per draw
-    bool hole_rows_logged_ = false;        // the list's rows were logged for a driving test
+    std::string hole_rows_logged_;         // the list's rows as last logged for a driving test ("": not yet)
 };
 
 }  // namespace liveset::viewer

@@ -50,7 +50,7 @@ void Viewer::poll_holes(bool wait) {
         request_redraw();  // the "finding..." line counts up
         return;
     }
-    hole_rows_logged_ = false;
+    hole_rows_logged_.clear();
     mark_all_panes();
     if (!holes_.error().empty()) {
         fail(holes_.error());
@@ -164,8 +164,9 @@ void Viewer::draw_hole_list() {
         ImGui::TextUnformatted("gap");
     }
     ImGui::EndTable();
-    if (!hole_rows_logged_ && !holes.empty()) {
-        hole_rows_logged_ = true;
+    // Logged again whenever the rows move (a scroll bar appearing re-wraps the text above them).
+    if (!holes.empty() && rects.dump() != hole_rows_logged_) {
+        hole_rows_logged_ = rects.dump();
         log_.add("hole_rows", {{"rows", rects}});
     }
 }

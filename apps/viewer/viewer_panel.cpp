@@ -30,7 +30,10 @@ bool Viewer::panel_button(const char* label, const char* name) {
 void Viewer::draw_panel() {
     ImGui::SetNextWindowPos(ImVec2(static_cast<float>(panel_rect_.x), static_cast<float>(panel_rect_.y)));
     ImGui::SetNextWindowSize(ImVec2(static_cast<float>(panel_rect_.w), static_cast<float>(panel_rect_.h)));
-    ImGui::Begin("liveset", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+    // The scroll bar always shown: text wrapped to the panel's width does not re-wrap (and move
+    // every row below it) when the content grows past the window's height.
+    ImGui::Begin("liveset", nullptr,
+                 ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_AlwaysVerticalScrollbar);
     ImGui::PushItemWidth(150.0f);
     draw_image_section();
     ImGui::Separator();
@@ -128,14 +131,19 @@ void Viewer::draw_segmentation_section() {
     if (ImGui::DragFloat("n", &n, 0.05f, 0.5f, 16.0f, "%.2f")) ui_params_.n = n, edited = true;
     done |= ImGui::IsItemDeactivatedAfterEdit();
     help_marker("steepness of the threshold speed at the window's edge (Eq. 3)");
-    if (ImGui::SliderFloat("alpha", &alpha, 0.0f, 0.95f, "%.2f")) ui_params_.alpha = alpha, edited = true;
+    ui_auto_alpha_ = session_->alpha_automatic();
+    if (ImGui::SliderFloat("alpha", &alpha, 0.0f, 0.95f, "%.2f")) ui_params_.alpha = alpha, ui_auto_alpha_ = false, edited = true;
     done |= ImGui::IsItemDeactivatedAfterEdit();
     help_marker("curvature weight (Eq. 2; the curvature is per mm): smoother fronts that leak less");
-    if (edited && apply_params(ui_params_, ui_auto_window_)) {
+    ImGui::SameLine();
+    if (ImGui::Checkbox("auto##alpha", &ui_auto_alpha_)) edited = done = true;
+    help_marker("alpha from the image's noise over the window's contrast and the voxel shape, as liveset segment chooses it");
+    if (edited && apply_params(ui_params_, ui_auto_window_, ui_auto_alpha_)) {
         params_note_.clear();  // the user's own values from now on
         const ThresholdParams& p = session_->params();
         log_.add("params", {{"mu", p.mu}, {"epsilon", p.epsilon}, {"mu_raw", sc.to_raw(p.mu)}, {"epsilon_raw", sc.raw_length(p.epsilon)},
-                            {"n", p.n}, {"alpha", p.alpha}, {"auto_window", session_->window_from_seeds()}});
+                            {"n", p.n}, {"alpha", p.alpha}, {"auto_window", session_->window_from_seeds()},
+                            {"auto_alpha", session_->alpha_automatic()}});
     }
     if (done) session_->end_action();
     if (panel_button(segment_running_ ? "Pause (Space)" : "Run (Space)", "run_segmentation")) set_segment_running(!segment_running_);

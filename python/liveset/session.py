@@ -24,9 +24,13 @@ class Session:
     Coordinates are voxel indices (i, j, k). Runs release the GIL and stop on Ctrl-C between
     steps (KeyboardInterrupt; the steps taken so far stay and can be undone). The image is taken as
     given: for the bias-corrected one that ``segment`` and ``liveset view`` work on by default, pass
-    ``segment(...).corrected``."""
+    ``segment(...).corrected``.
 
-    def __init__(self, image, roi=None, *, n: float = 4.0, alpha: float = 0.1, layers: int = 2,
+    ``alpha=None`` (the default) chooses the curvature weight as ``segment`` does (from the tissue
+    model's noise over the window's contrast and the voxel shape) and chooses it again whenever the
+    seeds move the window; a number fixes it (0.1 is the paper's)."""
+
+    def __init__(self, image, roi=None, *, n: float = 4.0, alpha: Optional[float] = None, layers: int = 2,
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
                  edit_range: Optional[float] = None):
@@ -35,7 +39,7 @@ class Session:
         r = None
         if roi is not None:
             r = np.asarray(roi) if isinstance(roi, np.ndarray) else as_image(roi, "roi").array
-        self._s = _liveset._Session(img.array, img.geometry, r, float(n), float(alpha), int(layers),
+        self._s = _liveset._Session(img.array, img.geometry, r, float(n), None if alpha is None else float(alpha), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),
                                     bool(sleeping), str(decision),
                                     float(_edit_range(decision, edit_range)))
@@ -54,18 +58,22 @@ class Session:
         return self._s.seeds()
 
     def set_params(self, mu: Optional[float] = None, epsilon: Optional[float] = None,
-                   n: Optional[float] = None, alpha: Optional[float] = None) -> None:
+                   n: Optional[float] = None, alpha=None) -> None:
         """Set n, alpha and the window (normalised units). Without mu and epsilon the window keeps
-        following the seeds (the tissue model's window, as ``liveset segment``)."""
+        following the seeds (the tissue model's window, as ``liveset segment``). alpha: a number
+        fixes it, ``"auto"`` chooses it as ``segment`` does, None keeps the current choice."""
         p = self.params
         from_seeds = mu is None and epsilon is None
+        automatic = p["alpha_automatic"] if alpha is None else (isinstance(alpha, str) and alpha == "auto")
+        if isinstance(alpha, str) and alpha != "auto":
+            raise ValueError(f"alpha must be a number or 'auto', not {alpha!r}")
         self._s.set_params(p["mu"] if mu is None else float(mu), p["epsilon"] if epsilon is None else float(epsilon),
-                           p["n"] if n is None else float(n), p["alpha"] if alpha is None else float(alpha),
-                           from_seeds)
+                           p["n"] if n is None else float(n), p["alpha"] if alpha is None or automatic else float(alpha),
+                           from_seeds, automatic)
 
     @property
     def params(self) -> dict:
-        """mu, epsilon (normalised), mu_raw, epsilon_raw, n, alpha, window_from_seeds."""
+        """mu, epsilon (normalised), mu_raw, epsilon_raw, n, alpha, window_from_seeds, alpha_automatic."""
         return self._s.params()
 
     # segmentation and repair
@@ -149,7 +157,8 @@ def repair(phi_or_mask, image, targets: Sequence[Sequence[float]], *, steps: int
     voxels by default), as ``liveset repair --decision``. Uses Session (exact step, not the CLI's
     ``liveset repair`` option set: no @STEP schedule, no log)."""
     img = as_image(image)
-    s = Session(img, roi=roi, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range)
+    # The swarm does not use alpha: a fixed one spares fitting the tissue model.
+    s = Session(img, roi=roi, alpha=0.1, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range)
     src = as_image(phi_or_mask, "phi_or_mask")
     a = np.asarray(src.array)
     if np.all((a == 0) | (a == 1)):

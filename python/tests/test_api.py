@@ -230,6 +230,29 @@ def test_session_steps_undo_redo_and_swarm(phantom):
         s.add_seed((1e4, 0, 0))
 
 
+def test_session_chooses_alpha_as_segment_does(phantom):
+    # A noisy phantom on 1 x 1 x 1.5 mm voxels, where the automatic alpha is neither 0 nor 0.1.
+    src = liveset.read(phantom["image"])
+    noisy = src.array + np.random.default_rng(5).normal(0, 0.12 * float(np.ptp(src.array)), src.shape)
+    img = liveset.Image(noisy.astype(np.float32), (1.0, 1.0, 1.5), src.origin, src.direction)
+    seeds = [tuple(map(float, x.split(","))) for x in phantom["seeds"]]
+    seg = liveset.segment(img, seeds, bias_correct=False)
+    assert seg.report["alpha_choice"]["source"] == "automatic" and 0 < seg.report["alpha"] < 0.1
+    s = liveset.Session(img)
+    for seed in seeds:
+        s.add_seed(seed)
+    assert s.params["alpha_automatic"] and s.params["alpha"] == seg.report["alpha"]
+    s.run(2000)
+    assert np.array_equal(s.mask().array, seg.mask.array)
+    s.set_params(alpha=0.2)
+    assert not s.params["alpha_automatic"] and s.params["alpha"] == 0.2
+    s.set_params(alpha="auto")
+    assert s.params["alpha_automatic"] and s.params["alpha"] == seg.report["alpha"]
+    assert liveset.Session(img, alpha=0.1).params["alpha"] == 0.1
+    with pytest.raises(ValueError, match="auto"):
+        s.set_params(alpha="automatic")
+
+
 def test_docs_example_runs(tmp_path):
     """docs/python_example.py end to end on a small phantom."""
     import subprocess

@@ -71,8 +71,9 @@ RepairRun scripted_repair() {
     // The seeds' statistics window, which the demo's repair presets were made for, and the exact
     // step (as the phantom demo; with the default sleeping step the segmentation ends with one
     // tunnel that these 20 rounds do not close: issue 18); no N4, as the phantom demo: the phantom's
-    // holes are bias bumps, which N4 partly flattens (3 perforations instead of 2).
-    const CliResult seg = run_cli("view " + image + " --window-from seeds --step exact --no-bias-correct --headless --script " +
+    // holes are bias bumps, which N4 partly flattens (3 perforations instead of 2); the paper's
+    // α 0.1, as the demo (the automatic one is about 0 on this phantom).
+    const CliResult seg = run_cli("view " + image + " --window-from seeds --step exact --alpha 0.1 --no-bias-correct --headless --script " +
                                   (dir / "segment.json").string());
     EXPECT_EQ(seg.rc, 0) << seg.err;
     const auto before = evals(seg.out);
@@ -106,7 +107,7 @@ RepairRun scripted_repair() {
                                   {{"save_phi": "{}"}}, {{"save_mask": "{}"}}, {{"eval": {{"truth": "{}"}}}}])",
                                rounds + 1, c.x, c.y, c.z, next_phi, mask, truth));
         const CliResult rep =
-            run_cli("view " + image + " --phi " + phi + " --no-bias-correct --headless --script " + (dir / "repair.json").string());
+            run_cli("view " + image + " --phi " + phi + " --alpha 0.1 --no-bias-correct --headless --script " + (dir / "repair.json").string());
         const auto e = evals(rep.out);
         if (rep.rc != 0 || e.size() != 1u) {
             ADD_FAILURE() << rep.err;
@@ -297,6 +298,24 @@ TEST(ScriptedSession, SeedsOnTheCommandLineStartWithSegmentsAutomaticAlpha) {
     std::size_t differ = 0;
     for (PointIndex i = 0; i < a.size(); ++i) differ += (a[i] != 0) != (b[i] != 0);
     EXPECT_EQ(differ, 0u);
+
+    // Seeds placed in the viewer (a script's seed entries, as clicks) rather than on the command
+    // line: α follows them the same way, so the viewer still gives segment's mask.
+    std::string clicks;
+    for (const Vec3i& s : ph.seeds) clicks += fmt::format(R"({{"seed": [{}, {}, {}]}}, )", s.x, s.y, s.z);
+    const std::string clicked_mask = (dir / "aniso_clicked.nii.gz").string();
+    write_text(dir / "clicked.json", "[" + clicks + R"({"segment": "converge"}, {"save_mask": ")" + clicked_mask + R"("}])");
+    const CliResult clicked = run_cli("view " + path + " --no-bias-correct --headless --no-autosave --script " + (dir / "clicked.json").string());
+    ASSERT_EQ(clicked.rc, 0) << clicked.err;
+    const Grid<std::uint8_t> c = read_label_image(clicked_mask);
+    differ = 0;
+    for (PointIndex i = 0; i < c.size(); ++i) differ += (c[i] != 0) != (b[i] != 0);
+    EXPECT_EQ(differ, 0u);
+    // A script's "alpha" fixes it; "auto_alpha" with "alpha" is refused before anything runs.
+    write_text(dir / "both.json", R"([{"params": {"alpha": 0.2, "auto_alpha": true}}])");
+    const CliResult both = run_cli("view " + path + " --no-bias-correct --headless --no-autosave --script " + (dir / "both.json").string());
+    EXPECT_NE(both.rc, 0);
+    EXPECT_NE(both.err.find("not both"), std::string::npos) << both.err;
 }
 
 }  // namespace

@@ -10,8 +10,8 @@ rm -f "$log"
 app=$!
 
 . "$(dirname "$0")/window_driver.sh"
-rect() {  # rect EVENT NAME: "x y w h" of a panel item from the first EVENT line
-    grep "\"type\":\"$1\"" "$log" | head -1 | grep -o "\"$2\":\[[0-9,]*\]" | head -1 | sed 's/.*\[//; s/\]//; s/,/ /g'
+rect() {  # rect EVENT NAME: "x y w h" of a panel item from the last EVENT line
+    grep "\"type\":\"$1\"" "$log" | tail -1 | grep -o "\"$2\":\[[0-9,]*\]" | head -1 | sed 's/.*\[//; s/\]//; s/,/ /g'
 }
 click_at() {  # click_at X Y W H: a left click in the middle of the rectangle
     xdotool mousemove --window "$window" $(($1 + $3 / 2)) $(($2 + $4 / 2))
@@ -24,6 +24,7 @@ window=$(xdotool search --sync --name '^liveset' | head -1)
 click_at $(rect ready find_holes)
 wait_for '"type":"holes"' 30
 wait_for '"type":"hole_rows"' 30
+sleep 1  # a few frames: the rows are logged again if the layout moves them
 click_at $(rect hole_rows hole_1)
 wait_for '"type":"select_hole"' 30
 xdotool key n

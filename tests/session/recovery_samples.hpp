@@ -24,6 +24,7 @@ inline RecoveryState sample_state() {
     s.marks.seeds = {{{1.5, 2.0, 3.0}, 2.0}, {{4.0, 1.0, 0.0}, 0.75}};
     s.marks.params = {0.42, 0.07, 3.0, 0.2};
     s.marks.window_from_seeds = false;
+    s.marks.alpha_automatic = true;
     s.marks.pristine = false;
     s.marks.iterations = 137;
     s.phi = Grid<float>(lattice);
@@ -49,6 +50,7 @@ inline void expect_same(const RecoveryState& a, const RecoveryState& b) {
     EXPECT_EQ(a.marks.params.n, b.marks.params.n);
     EXPECT_EQ(a.marks.params.alpha, b.marks.params.alpha);
     EXPECT_EQ(a.marks.window_from_seeds, b.marks.window_from_seeds);
+    EXPECT_EQ(a.marks.alpha_automatic, b.marks.alpha_automatic);
     EXPECT_EQ(a.marks.iterations, b.marks.iterations);
     EXPECT_TRUE(a.phi.lattice().same_geometry(b.phi.lattice(), 0.0));
     ASSERT_EQ(a.phi.size(), b.phi.size());

@@ -98,7 +98,8 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
     auto f32 = [](float v) { std::vector<std::uint8_t> b(4); std::memcpy(b.data(), &v, 4); return b; };
     const std::vector<Case> cases{
         {"wrong magic", 0, {'N', 'I', 'F', 'T'}, "wrong magic"},
-        {"version 2", 8, u32(2), "version 2"},
+        {"version 3", 8, u32(3), "version 3"},
+        {"version 0", 8, u32(0), "version 0"},
         {"path length beyond the file", kPathLength, u32(1000000), "too long"},
         {"zero dimension", dims_offset(s), i32(0), "invalid geometry"},
         {"negative dimension", dims_offset(s) + 4, i32(-5), "invalid geometry"},
@@ -106,7 +107,8 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
         {"NaN spacing", spacing_offset(s) + 8, f64(std::numeric_limits<double>::quiet_NaN()), "non-finite spacing"},
         {"epsilon 0", params_offset(s) + 8, f64(0.0), "invalid parameters"},
         {"alpha 1", params_offset(s) + 24, f64(1.0), "invalid parameters"},
-        {"flag 7", params_offset(s) + 32, {7}, "invalid flag"},
+        {"flags 7", params_offset(s) + 32, {7}, "invalid flag"},
+        {"flags 4", params_offset(s) + 32, {4}, "invalid flag"},
         {"negative iterations", params_offset(s) + 33, i32(-1), "negative iteration"},
         {"four billion seeds", params_offset(s) + 37, u32(0xFFFFFFFFu), "seed count"},
         {"seed radius 0", params_offset(s) + 41 + 24, f64(0.0), "non-positive radius"},
@@ -124,6 +126,23 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
     std::vector<std::uint8_t> flipped = good;
     flipped[good.size() / 2] ^= 1;
     EXPECT_NE(refusal(flipped).find("checksum"), std::string::npos) << refusal(flipped);
+}
+
+TEST(Recovery, VersionOneFilesStillReadWithAManualAlpha) {
+    // Version 1's flags byte held window_from_seeds alone; its files read as before, with α as saved.
+    const RecoveryState s = sample_state();
+    std::vector<std::uint8_t> bytes = encode_recovery(s);
+    const std::uint32_t one = 1;
+    std::memcpy(bytes.data() + 8, &one, 4);
+    bytes[params_offset(s) + 32] = 1;
+    reseal(bytes);
+    const RecoveryState old = decode_recovery(bytes.data(), bytes.size());
+    EXPECT_TRUE(old.marks.window_from_seeds);
+    EXPECT_FALSE(old.marks.alpha_automatic);
+    EXPECT_EQ(old.marks.params.alpha, s.marks.params.alpha);
+    bytes[params_offset(s) + 32] = 3;  // bit 1 did not exist in version 1
+    reseal(bytes);
+    EXPECT_NE(refusal(bytes).find("invalid flag"), std::string::npos) << refusal(bytes);
 }
 
 TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {

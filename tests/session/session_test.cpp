@@ -93,7 +93,7 @@ TEST(Session, SegmentsFromSeedsExactlyAsLivesetSegment) {
     const Phantom& ph = phantom64();
     Session s(ph.image, options());
     SegmentRequest req;
-    req.alpha = s.params().alpha;  // the session's α (it does not choose one: docs/ARCHITECTURE.md)
+    req.alpha = s.params().alpha;  // the session's fixed α (alpha_automatic off: SessionOptions' default)
     for (const Vec3i& c : ph.seeds) {
         req.seeds.push_back({c.cast<double>(), 2.0});
         s.add_seed({c.cast<double>(), 2.0});
@@ -116,6 +116,59 @@ TEST(Session, SegmentsFromSeedsExactlyAsLivesetSegment) {
     const Grid<std::uint8_t> mask = s.mask();
     EXPECT_TRUE(std::equal(mask.values().begin(), mask.values().end(), o.mask.values().begin(), o.mask.values().end()));
     expect_mesh_is_whole_volume_mesh(s);
+}
+
+// With alpha_automatic the session's α is the one segment_image chooses for the same seeds (and the
+// window they give), chosen again as seeds move the window; a given α turns it off, undo back on.
+TEST(Session, AutomaticAlphaIsSegmentsForTheSeedsAndFollowsThem) {
+    PhantomOptions po;
+    po.size = 48;
+    po.noise = 0.12;
+    const Phantom ph = make_phantom(po);
+    const Lattice& l = ph.image.lattice();
+    Grid<float> image(Lattice(l.dims(), {1.0, 1.0, 1.5}, l.origin(), l.direction()));  // α neither 0 nor 0.1
+    for (PointIndex i = 0; i < image.size(); ++i) image[i] = ph.image[i];
+    SessionOptions so = options();
+    so.alpha_automatic = true;
+    Session s(image, so);
+    EXPECT_TRUE(s.alpha_automatic());
+    SegmentRequest req;  // alpha unset: automatic
+    const auto alpha_for = [&](std::size_t seeds) {
+        req.seeds.clear();
+        for (std::size_t k = 0; k < seeds; ++k) req.seeds.push_back({ph.seeds[k].cast<double>(), 2.0});
+        req.loop.max_iterations = 1;
+        return segment_image(image, req).alpha;
+    };
+    s.add_seed({ph.seeds[0].cast<double>(), 2.0});
+    const AlphaChoice one = alpha_for(1);
+    EXPECT_EQ(one.tissue_class, s.automatic_alpha_choice().tissue_class);
+    EXPECT_EQ(s.params().alpha, one.alpha);
+    EXPECT_GT(one.alpha, 0.0);
+    EXPECT_LT(one.alpha, 0.1);
+    for (std::size_t k = 1; k < ph.seeds.size(); ++k) s.add_seed({ph.seeds[k].cast<double>(), 2.0});
+    EXPECT_EQ(s.params().alpha, alpha_for(ph.seeds.size()).alpha);  // chosen again for the window of all seeds
+    const double automatic = s.params().alpha;
+    s.end_action();
+
+    ThresholdParams p = s.params();
+    p.alpha = 0.3;
+    s.set_params(p, true);  // a given α: fixed from now on
+    s.end_action();
+    EXPECT_FALSE(s.alpha_automatic());
+    s.remove_seed(0);
+    EXPECT_EQ(s.params().alpha, 0.3);
+    s.end_action();
+    s.undo();
+    s.undo();  // back before the given α
+    EXPECT_TRUE(s.alpha_automatic());
+    EXPECT_EQ(s.params().alpha, automatic);
+
+    // A window set by hand: the class nearest its centre, as segment with --mu/--epsilon.
+    p = s.params();
+    p.mu = 0.95;
+    s.set_params(p, false, true);
+    const std::optional<TissueModel>& model = s.tissue_model();
+    EXPECT_EQ(s.params().alpha, automatic_alpha(model ? &*model : nullptr, s.scale().to_raw(0.95), image.lattice().spacing_float()).alpha);
 }
 
 TEST(Session, UndoRedoRestoreEveryActionBitForBit) {

@@ -20,7 +20,7 @@ static_assert(std::endian::native == std::endian::little, "recovery files are wr
 namespace {
 
 constexpr char kMagic[8] = {'L', 'S', 'R', 'E', 'C', 'O', 'V', '1'};
-constexpr std::uint32_t kVersion = 1;
+constexpr std::uint32_t kVersion = 2;  // 1: the flags byte held window_from_seeds only
 constexpr std::uint32_t kMaxPath = 4096;
 constexpr std::uint32_t kMaxSeeds = 100000;
 
@@ -53,7 +53,7 @@ std::vector<std::uint8_t> encode_header(const std::string& image, const SessionM
     for (double v : lattice.direction()) put(out, v);
     const ThresholdParams& p = marks.params;
     for (double v : {p.mu, p.epsilon, p.n, p.alpha}) put(out, v);
-    put(out, static_cast<std::uint8_t>(marks.window_from_seeds ? 1 : 0));
+    put(out, static_cast<std::uint8_t>((marks.window_from_seeds ? 1 : 0) | (marks.alpha_automatic ? 2 : 0)));
     put(out, static_cast<std::int32_t>(marks.iterations));
     put(out, static_cast<std::uint32_t>(marks.seeds.size()));
     for (const SeedBall& b : marks.seeds)
@@ -151,7 +151,7 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
     std::uint64_t stored;
     std::memcpy(&stored, data + size - sizeof stored, sizeof stored);
     const std::uint32_t version = r.get<std::uint32_t>("version");
-    if (version != kVersion) throw std::runtime_error("unsupported recovery file version " + std::to_string(version));
+    if (version != kVersion && version != 1) throw std::runtime_error("unsupported recovery file version " + std::to_string(version));
     if (hash.h != stored) throw std::runtime_error("damaged (checksum mismatch)");
 
     RecoveryState s;
@@ -192,9 +192,10 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
     } catch (const std::invalid_argument& e) {
         throw std::runtime_error(std::string("invalid parameters: ") + e.what());
     }
-    const std::uint8_t window = r.get<std::uint8_t>("parameters");
-    if (window > 1) throw std::runtime_error("invalid flag");
-    s.marks.window_from_seeds = window == 1;
+    const std::uint8_t flags = r.get<std::uint8_t>("parameters");
+    if (flags > (version == 1 ? 1 : 3)) throw std::runtime_error("invalid flag");
+    s.marks.window_from_seeds = (flags & 1) != 0;
+    s.marks.alpha_automatic = (flags & 2) != 0;
     s.marks.pristine = false;
     s.marks.iterations = r.get<std::int32_t>("iterations");
     if (s.marks.iterations < 0) throw std::runtime_error("negative iteration count");

@@ -43,6 +43,8 @@ Session::Session(Grid<float> image, const SessionOptions& options, std::optional
       repair_options_(options.repair),
       history_(field_, options.history) {
     marks_.params = options.params;
+    marks_.alpha_automatic = options.alpha_automatic;
+    if (marks_.alpha_automatic) marks_.params.alpha = automatic_alpha_choice().alpha;
     mesher_.full_rebuild(field_.phi(), field_.zero_layer());
     dirty_flags_.assign(mesher_.fragment_count(), 0);
 }
@@ -211,21 +213,33 @@ void Session::refresh_window() {
         marks_.params.mu = p->mu;
         marks_.params.epsilon = p->epsilon;
     }
+    if (marks_.alpha_automatic) marks_.params.alpha = alpha_choice_for(marks_.params, true).alpha;
     speed_.reset();
     segment_.converged = false;
 }
 
-void Session::set_params(const ThresholdParams& params, bool window_from_seeds) {
+AlphaChoice Session::alpha_choice_for(const ThresholdParams& params, bool window_from_seeds) const {
+    // As the pipeline (segment/pipeline.cpp): the seeds' class when the window is theirs, else the
+    // class nearest the window's centre.
+    const std::optional<WindowEstimate> w = window_from_seeds ? window_estimate() : std::nullopt;
+    const int window_class = w && w->model_window ? w->model_window->seed_class : -1;
+    const std::optional<TissueModel>& model = tissue_model();
+    return automatic_alpha(model ? &*model : nullptr, scale_.to_raw(params.mu), lattice().spacing_float(), window_class);
+}
+
+void Session::set_params(const ThresholdParams& params, bool window_from_seeds, bool alpha_automatic) {
     ThresholdParams p = params;
     if (window_from_seeds)
         if (const auto w = estimated_window()) {
             p.mu = w->mu;
             p.epsilon = w->epsilon;
         }
+    if (alpha_automatic) p.alpha = alpha_choice_for(p, window_from_seeds).alpha;
     validate(p);
     begin_action("parameters");
     marks_.params = p;
     marks_.window_from_seeds = window_from_seeds;
+    marks_.alpha_automatic = alpha_automatic;
     speed_.reset();
     segment_.converged = false;
     ++revision_;

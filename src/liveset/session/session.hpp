@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "liveset/mesh/fragment_mesher.hpp"
+#include "liveset/segment/alpha.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
@@ -49,6 +50,9 @@ struct SessionOptions {
     SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
     RepairOptions repair;              // swarm settings (steps unused: the caller steps)
     ThresholdParams params;            // initial n and α (µ, ε too when there are no seeds)
+    // α chosen as `liveset segment` chooses it (segment/alpha.hpp) instead of params.alpha, and
+    // re-chosen whenever the window changes, until set_params sets α itself.
+    bool alpha_automatic = false;
 };
 
 // What one call changed, for the renderer and the status line.
@@ -115,10 +119,14 @@ public:
     // --- threshold speed (Eq. 2-3; µ, ε in normalised units) --------------------------------
     const ThresholdParams& params() const { return marks_.params; }
     bool window_from_seeds() const { return marks_.window_from_seeds; }
-    // Sets n, α and, unless `window_from_seeds`, µ and ε (then estimated from the seeds as
-    // `liveset segment` does: the tissue model's window for the seeds' class, window.hpp).
-    // Throws std::invalid_argument.
-    void set_params(const ThresholdParams& params, bool window_from_seeds);
+    bool alpha_automatic() const { return marks_.alpha_automatic; }
+    // Sets n and, unless `window_from_seeds`, µ and ε (then estimated from the seeds as
+    // `liveset segment` does: the tissue model's window for the seeds' class, window.hpp), and,
+    // unless `alpha_automatic`, α (then chosen as `liveset segment` chooses it for that window,
+    // and again whenever the seeds move the window). Throws std::invalid_argument.
+    void set_params(const ThresholdParams& params, bool window_from_seeds, bool alpha_automatic = false);
+    // The α `liveset segment` would choose for the current window, with its reasons.
+    AlphaChoice automatic_alpha_choice() const { return alpha_choice_for(marks_.params, marks_.window_from_seeds); }
     // The window the seeds give (nullopt without seeds).
     std::optional<ThresholdParams> estimated_window() const;
     // The same with where it came from and its warnings (nullopt without seeds).
@@ -224,6 +232,7 @@ private:
     void adopt_marks(const SessionMarks& marks);
     void reset_after_load();
     void refresh_window();
+    AlphaChoice alpha_choice_for(const ThresholdParams& params, bool window_from_seeds) const;
     void make_repair_loop();
 
     SessionOptions options_;
