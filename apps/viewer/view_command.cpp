@@ -77,6 +77,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     so.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
     so.repair = demo_repair_options();
     so.segmentation.step = step_options(a);  // as `liveset segment` (same bits)
+    so.alpha_automatic = !a.alpha_given;     // chosen once there is a window (choose_start_params says how)
     try {
         return std::make_unique<Session>(std::move(image), so, std::move(roi));
     } catch (const std::invalid_argument& e) {

@@ -27,8 +27,9 @@ class Session:
     ``segment(...).corrected``.
 
     ``alpha=None`` (the default) chooses the curvature weight as ``segment`` does (from the tissue
-    model's noise over the window's contrast and the voxel shape) and chooses it again whenever the
-    seeds move the window; a number fixes it (0.1 is the paper's)."""
+    model's noise over the window's contrast and the voxel shape) once there is a window (the first
+    seed, ``set_params`` or the first step; ``params["alpha"]`` shows 0.1 until then) and again
+    whenever the seeds move the window; a number fixes it (0.1 is the paper's)."""
 
     def __init__(self, image, roi=None, *, n: float = 4.0, alpha: Optional[float] = None, layers: int = 2,
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,

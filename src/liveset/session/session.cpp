@@ -43,8 +43,7 @@ Session::Session(Grid<float> image, const SessionOptions& options, std::optional
       repair_options_(options.repair),
       history_(field_, options.history) {
     marks_.params = options.params;
-    marks_.alpha_automatic = options.alpha_automatic;
-    if (marks_.alpha_automatic) marks_.params.alpha = automatic_alpha_choice().alpha;
+    marks_.alpha_automatic = options.alpha_automatic;  // α chosen once there is a window (fitting the model takes seconds)
     mesher_.full_rebuild(field_.phi(), field_.zero_layer());
     dirty_flags_.assign(mesher_.fragment_count(), 0);
 }
@@ -253,7 +252,12 @@ SessionUpdate Session::segment_step() {
         segment_.vanished = true;
         return {};
     }
-    if (!speed_) speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi());
+    if (!speed_) {
+        // A level set loaded with no seed nor set window since: α for the window as it stands (the
+        // same value set_params and the seeds' refresh give, so idempotent everywhere else).
+        if (marks_.alpha_automatic) marks_.params.alpha = automatic_alpha_choice().alpha;
+        speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi());
+    }
     if (!convergence_) convergence_.emplace(field_.phi(), options_.segmentation);
     return edit("segment", Action::kContinued, [&] {
         StepResult step = field_.step(*speed_, options_.segmentation.step);

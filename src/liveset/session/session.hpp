@@ -50,8 +50,9 @@ struct SessionOptions {
     SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
     RepairOptions repair;              // swarm settings (steps unused: the caller steps)
     ThresholdParams params;            // initial n and α (µ, ε too when there are no seeds)
-    // α chosen as `liveset segment` chooses it (segment/alpha.hpp) instead of params.alpha, and
-    // re-chosen whenever the window changes, until set_params sets α itself.
+    // α chosen as `liveset segment` chooses it (segment/alpha.hpp) instead of params.alpha - once
+    // there is a window (a seed, set_params, or the first step) - and re-chosen whenever the window
+    // changes, until set_params sets α itself.
     bool alpha_automatic = false;
 };
 
