@@ -21,6 +21,7 @@
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/render/png_writer.hpp"
+#include "noisy_phantom.hpp"
 #include "scratch_dir.hpp"
 
 namespace liveset {
@@ -267,13 +268,9 @@ TEST(ViewBench, ReportsTheRendererAndOnlyTheRepairingScenariosRebuildFragments) 
 // (segment/alpha.hpp; a noisy phantom on 1 x 1 x 1.5 mm voxels, so α is neither 0 nor 0.1), says
 // so, and its converged mask is segment's, voxel for voxel.
 TEST(ScriptedSession, SeedsOnTheCommandLineStartWithSegmentsAutomaticAlpha) {
-    PhantomOptions po;
-    po.size = 64;
-    po.noise = 0.12;
-    const Phantom ph = make_phantom(po);
-    const Lattice& l = ph.image.lattice();
-    Grid<float> image(Lattice(l.dims(), {1.0, 1.0, 1.5}, l.origin(), l.direction()));
-    for (PointIndex i = 0; i < image.size(); ++i) image[i] = ph.image[i];
+    const testing::NoisyAnisotropicPhantom noisy = testing::noisy_anisotropic_phantom(64);
+    const Phantom& ph = noisy.phantom;
+    const Grid<float>& image = noisy.image;
     const fs::path dir = work_dir();
     const std::string path = (dir / "aniso_t1.nii.gz").string(), view_mask = (dir / "aniso_view.nii.gz").string(),
                       seg_mask = (dir / "aniso_seg.nii.gz").string();

@@ -16,6 +16,7 @@
 #include "liveset/segment/pipeline.hpp"
 #include "liveset/session/repair_presets.hpp"
 #include "liveset/session/session.hpp"
+#include "noisy_phantom.hpp"
 
 namespace liveset {
 namespace {
@@ -121,13 +122,9 @@ TEST(Session, SegmentsFromSeedsExactlyAsLivesetSegment) {
 // With alpha_automatic the session's α is the one segment_image chooses for the same seeds (and the
 // window they give), chosen again as seeds move the window; a given α turns it off, undo back on.
 TEST(Session, AutomaticAlphaIsSegmentsForTheSeedsAndFollowsThem) {
-    PhantomOptions po;
-    po.size = 48;
-    po.noise = 0.12;
-    const Phantom ph = make_phantom(po);
-    const Lattice& l = ph.image.lattice();
-    Grid<float> image(Lattice(l.dims(), {1.0, 1.0, 1.5}, l.origin(), l.direction()));  // α neither 0 nor 0.1
-    for (PointIndex i = 0; i < image.size(); ++i) image[i] = ph.image[i];
+    const testing::NoisyAnisotropicPhantom noisy = testing::noisy_anisotropic_phantom(48);
+    const Phantom& ph = noisy.phantom;
+    const Grid<float>& image = noisy.image;
     SessionOptions so = options();
     so.alpha_automatic = true;
     Session s(image, so);
