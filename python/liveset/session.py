@@ -60,11 +60,12 @@ class Session:
 
     def set_params(self, mu: Optional[float] = None, epsilon: Optional[float] = None,
                    n: Optional[float] = None, alpha=None) -> None:
-        """Set n, alpha and the window (normalised units). Without mu and epsilon the window keeps
-        following the seeds (the tissue model's window, as ``liveset segment``). alpha: a number
+        """Set n, alpha and the window (normalised units). Without mu and epsilon the window stays
+        as it was: following the seeds (the tissue model's window, as ``liveset segment``) or as
+        set. alpha: a number
         fixes it, ``"auto"`` chooses it as ``segment`` does, None keeps the current choice."""
         p = self.params
-        from_seeds = mu is None and epsilon is None
+        from_seeds = p["window_from_seeds"] if mu is None and epsilon is None else False
         automatic = p["alpha_automatic"] if alpha is None else (isinstance(alpha, str) and alpha == "auto")
         if isinstance(alpha, str) and alpha != "auto":
             raise ValueError(f"alpha must be a number or 'auto', not {alpha!r}")

@@ -134,6 +134,7 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     EXPECT_EQ(ws.marks.params.n, p.n);
     EXPECT_EQ(ws.marks.params.alpha, p.alpha);
     EXPECT_FALSE(ws.marks.window_from_seeds);
+    EXPECT_FALSE(ws.marks.alpha_automatic);
     EXPECT_EQ(ws.marks.iterations, 25);
     EXPECT_EQ(ws.repair.swarm.agents, 77u);
     EXPECT_EQ(ws.repair.swarm.act_probability, 0.3);
@@ -170,6 +171,20 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     EXPECT_TRUE(same_bits(continued.field().phi(), original->field().phi()));
     EXPECT_TRUE(same_status(continued.field().status(), original->field().status()));
     EXPECT_EQ(continued.segment_status().iterations, 35);
+
+    // The automatic α's flag travels too; a workspace written before it (no key) had a set α.
+    ThresholdParams q = original->params();
+    original->set_params(q, false, true);
+    const fs::path w2 = work_dir() / "automatic_alpha.json";
+    viewer::save_workspace(w2, *original, "t1.nii.gz", "", true, a_view());
+    const Workspace automatic = viewer::read_workspace(w2);
+    EXPECT_TRUE(automatic.marks.alpha_automatic);
+    EXPECT_EQ(automatic.marks.params.alpha, original->params().alpha);
+    nlohmann::json j = nlohmann::json::parse(testing_slurp(w2));
+    ASSERT_TRUE(j["params"].contains("alpha_automatic"));
+    j["params"].erase("alpha_automatic");
+    std::ofstream(w2) << j.dump();
+    EXPECT_FALSE(viewer::read_workspace(w2).marks.alpha_automatic);
 }
 
 TEST(WorkspaceFile, BadWorkspacesAreRefusedWithOneClearLine) {

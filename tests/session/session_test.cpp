@@ -160,12 +160,27 @@ TEST(Session, AutomaticAlphaIsSegmentsForTheSeedsAndFollowsThem) {
     EXPECT_TRUE(s.alpha_automatic());
     EXPECT_EQ(s.params().alpha, automatic);
 
-    // A window set by hand: the class nearest its centre, as segment with --mu/--epsilon.
+    // A window set by hand (or only µ of it): the class nearest its centre, as segment with --mu,
+    // --epsilon; here not the seeds' class, and a different α.
     p = s.params();
-    p.mu = 0.95;
+    p.mu = 0.1;
     s.set_params(p, false, true);
-    const std::optional<TissueModel>& model = s.tissue_model();
-    EXPECT_EQ(s.params().alpha, automatic_alpha(model ? &*model : nullptr, s.scale().to_raw(0.95), image.lattice().spacing_float()).alpha);
+    req.mu = 0.1;
+    const AlphaChoice given = alpha_for(ph.seeds.size());  // the undo put the removed seed back
+    EXPECT_NE(given.tissue_class, one.tissue_class);
+    EXPECT_EQ(s.params().alpha, given.alpha);
+    req.epsilon = s.params().epsilon;
+    EXPECT_EQ(s.params().alpha, alpha_for(ph.seeds.size()).alpha);
+
+    // No seeds (a level set loaded): no model, as segment --init-mask.
+    Session bare(image, so);
+    bare.load_mask(segment_image(image, req).mask);
+    bare.segment_step();
+    bare.end_action();
+    EXPECT_EQ(bare.params().alpha, automatic_alpha(nullptr, bare.scale().to_raw(bare.params().mu), image.lattice().spacing_float()).alpha);
+    ASSERT_TRUE(bare.can_undo());
+    bare.undo();  // the choice was part of the step's action
+    EXPECT_EQ(bare.params().alpha, so.params.alpha);
 }
 
 TEST(Session, UndoRedoRestoreEveryActionBitForBit) {

@@ -100,7 +100,10 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     if (req.alpha) {
         out.alpha.alpha = *req.alpha;
     } else {
-        const int window_class = out.model_window ? out.model_window->seed_class : -1;
+        // The seeds' class when the whole window is theirs; with µ or ε given, the class nearest µ
+        // (as the Session, whose window is either the seeds' or set).
+        const bool window_given = req.mu || req.mu_raw || req.epsilon || req.epsilon_raw;
+        const int window_class = out.model_window && !window_given ? out.model_window->seed_class : -1;
         out.alpha = automatic_alpha(out.model ? &*out.model : nullptr, out.scale.to_raw(p.mu), image.lattice().spacing_float(),
                                     window_class);
     }

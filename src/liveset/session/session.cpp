@@ -219,7 +219,9 @@ void Session::refresh_window() {
 
 AlphaChoice Session::alpha_choice_for(const ThresholdParams& params, bool window_from_seeds) const {
     // As the pipeline (segment/pipeline.cpp): the seeds' class when the window is theirs, else the
-    // class nearest the window's centre.
+    // class nearest the window's centre; without seeds no model (the pipeline fits it from seeds
+    // only: `segment --init-mask` takes the fallback).
+    if (marks_.seeds.empty()) return automatic_alpha(nullptr, scale_.to_raw(params.mu), lattice().spacing_float());
     const std::optional<WindowEstimate> w = window_from_seeds ? window_estimate() : std::nullopt;
     const int window_class = w && w->model_window ? w->model_window->seed_class : -1;
     const std::optional<TissueModel>& model = tissue_model();
@@ -252,14 +254,14 @@ SessionUpdate Session::segment_step() {
         segment_.vanished = true;
         return {};
     }
-    if (!speed_) {
-        // A level set loaded with no seed nor set window since: α for the window as it stands (the
-        // same value set_params and the seeds' refresh give, so idempotent everywhere else).
-        if (marks_.alpha_automatic) marks_.params.alpha = automatic_alpha_choice().alpha;
-        speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi());
-    }
     if (!convergence_) convergence_.emplace(field_.phi(), options_.segmentation);
     return edit("segment", Action::kContinued, [&] {
+        if (!speed_) {
+            // A level set loaded with no seed nor set window since: α for the window as it stands,
+            // within the action (the same value set_params and the seeds' refresh give elsewhere).
+            if (marks_.alpha_automatic) marks_.params.alpha = automatic_alpha_choice().alpha;
+            speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi());
+        }
         StepResult step = field_.step(*speed_, options_.segmentation.step);
         segment_.flips = convergence_->record_step(field_.phi(), step.changed.points);
         segment_.inside = convergence_->inside();
