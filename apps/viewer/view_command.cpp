@@ -78,6 +78,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     so.repair = demo_repair_options();
     so.segmentation.step = step_options(a);  // as `liveset segment` (same bits)
     so.alpha_automatic = !a.alpha_given;     // chosen once there is a window (choose_start_params says how)
+    so.model_region = std::move(prepared.fit_region);  // as `segment`: the brain mask found before N4 (none with a ROI)
     try {
         return std::make_unique<Session>(std::move(image), so, std::move(roi));
     } catch (const std::invalid_argument& e) {

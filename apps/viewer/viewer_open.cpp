@@ -46,11 +46,13 @@ bool Viewer::open_image(const std::string& path) {
             auto out = std::make_shared<Opened>();
             Grid<float> image = read_image(path);
             if (cancel->load()) return out;
-            const cli::PreparedImage prepared = cli::prepare_image(image, nullptr, mode, cancel.get());
+            cli::PreparedImage prepared = cli::prepare_image(image, nullptr, mode, cancel.get());
             if (cancel->load()) return out;
             out->corrected = prepared.bias.has_value();
             out->bias_skipped = prepared.bias_skipped;
-            out->session = std::make_unique<Session>(std::move(image), options);
+            SessionOptions with_region = options;
+            with_region.model_region = std::move(prepared.fit_region);  // as `segment` (view_command.cpp)
+            out->session = std::make_unique<Session>(std::move(image), with_region);
             return out;
         } catch (const std::exception& e) {
             return failed(e.what());

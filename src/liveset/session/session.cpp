@@ -42,6 +42,8 @@ Session::Session(Grid<float> image, const SessionOptions& options, std::optional
       mesher_(image_.lattice(), options.fragment_size),
       repair_options_(options.repair),
       history_(field_, options.history) {
+    if (options_.model_region && !(options_.model_region->dims() == image_.dims()))
+        throw std::invalid_argument("the tissue model's region differs in size from the image");
     marks_.params = options.params;
     marks_.alpha_automatic = options.alpha_automatic;  // α chosen once there is a window (fitting the model takes seconds)
     mesher_.full_rebuild(field_.phi(), field_.zero_layer());
@@ -182,7 +184,8 @@ std::optional<std::size_t> Session::seed_at(Vec3d p, double tolerance) const {
 const std::optional<TissueModel>& Session::tissue_model() const {
     if (!model_) {
         std::vector<std::string> ignored;  // window_estimate() reports an unusable model
-        model_ = fit_window_model(image_, model_region(image_, nullptr, roi(), options_.window.model.classes), options_.window.model, ignored);
+        const Grid<std::uint8_t>* region = options_.model_region ? &*options_.model_region : nullptr;
+        model_ = fit_window_model(image_, model_region(image_, region, roi(), options_.window.model.classes), options_.window.model, ignored);
     }
     return *model_;
 }

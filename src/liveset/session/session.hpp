@@ -47,6 +47,10 @@ struct SessionOptions {
     // session continuing it sees the same [0, 1] image.
     std::optional<IntensityScale> given_scale;
     WindowOptions window;         // how µ, ε are estimated from the seeds (as `liveset segment`)
+    // Where the tissue model is fitted, as SegmentRequest::model_region (the front ends pass the
+    // brain mask they found before bias correction, as `segment` does); none: the ROI, else the
+    // automatic brain mask of the image, else its foreground. Same dimensions as the image.
+    std::optional<Grid<std::uint8_t>> model_region;
     SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
     RepairOptions repair;              // swarm settings (steps unused: the caller steps)
     ThresholdParams params;            // initial n and α (µ, ε too when there are no seeds)
