@@ -57,6 +57,18 @@ void parse_size(const std::string& text, int& w, int& h) {
     if (w < 320 || h < 240 || w > 8192 || h > 8192) throw UsageError(fmt::format("--size {}: from 320x240 to 8192x8192", text));
 }
 
+// The session options of the command line: for its image and for images opened from the panel.
+SessionOptions session_options(const ViewArgs& a) {
+    SessionOptions so;
+    so.fragment_size = a.fragment_size;
+    so.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
+    so.repair = demo_repair_options();
+    so.segmentation.step = step_options(a);  // as `liveset segment` (same bits)
+    so.alpha_automatic = !a.alpha_given;     // chosen once there is a window (choose_start_params says how)
+    if (a.alpha_given && a.alpha) so.params.alpha = *a.alpha;
+    return so;
+}
+
 std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> roi;
@@ -72,12 +84,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     }
     if (!prepared.bias_skipped.empty()) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
     a.image_corrected = prepared.bias.has_value();
-    SessionOptions so;
-    so.fragment_size = a.fragment_size;
-    so.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
-    so.repair = demo_repair_options();
-    so.segmentation.step = step_options(a);  // as `liveset segment` (same bits)
-    so.alpha_automatic = !a.alpha_given;     // chosen once there is a window (choose_start_params says how)
+    SessionOptions so = session_options(a);
     so.model_region = std::move(prepared.fit_region);  // as `segment`: the brain mask found before N4 (none with a ROI)
     try {
         return std::make_unique<Session>(std::move(image), so, std::move(roi));
@@ -191,14 +198,7 @@ int run_view(ViewArgs& a, int threads) {
     if (!a.script.empty()) script = viewer::parse_script(a.script, session->lattice());
     viewer::ViewerConfig config;
     config.log_events = a.log_events;
-    config.session.fragment_size = a.fragment_size;
-    config.session.repair = demo_repair_options();
-    config.session.segmentation.step = step_options(a);
-    // Images opened from the panel start as the command line's did: the window from the seeds as
-    // --window-from says, α automatic unless --alpha is given.
-    config.session.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
-    config.session.alpha_automatic = !a.alpha_given;
-    if (a.alpha_given && a.alpha) config.session.params.alpha = *a.alpha;
+    config.session = session_options(a);  // images opened from the panel start as the command line's
     config.image_path = a.image;
     config.roi_path = a.roi;
     config.bias_correct = a.bias_correct;

@@ -62,8 +62,8 @@ class Session:
                    n: Optional[float] = None, alpha=None) -> None:
         """Set n, alpha and the window (normalised units). Without mu and epsilon the window stays
         as it was: following the seeds (the tissue model's window, as ``liveset segment``) or as
-        set. alpha: a number
-        fixes it, ``"auto"`` chooses it as ``segment`` does, None keeps the current choice."""
+        set. alpha: a number fixes it, ``"auto"`` chooses it as ``segment`` does, None keeps the
+        current choice."""
         p = self.params
         from_seeds = p["window_from_seeds"] if mu is None and epsilon is None else False
         automatic = p["alpha_automatic"] if alpha is None else (isinstance(alpha, str) and alpha == "auto")
@@ -159,8 +159,7 @@ def repair(phi_or_mask, image, targets: Sequence[Sequence[float]], *, steps: int
     voxels by default), as ``liveset repair --decision``. Uses Session (exact step, not the CLI's
     ``liveset repair`` option set: no @STEP schedule, no log)."""
     img = as_image(image)
-    # The swarm does not use alpha: a fixed one spares fitting the tissue model.
-    s = Session(img, roi=roi, alpha=0.1, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range)
+    s = Session(img, roi=roi, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range)
     src = as_image(phi_or_mask, "phi_or_mask")
     a = np.asarray(src.array)
     if np.all((a == 0) | (a == 1)):
