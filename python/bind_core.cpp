@@ -134,6 +134,30 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     return r;
 }
 
+// The image a Session works on, prepared as `liveset view` prepares it (prepare_image: N4 per
+// `bias_correct`, fitted in the ROI, else the automatic brain mask): the corrected image when N4
+// ran, the region the tissue model is fitted in (the brain mask found before N4; none with a ROI)
+// and the report's bias_correction / warnings.
+pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice, const pyb::object& roi,
+                                const std::optional<bool>& bias_correct) {
+    Grid<float> image = grid_from_array(values, lattice);
+    std::optional<Grid<std::uint8_t>> roi_mask;
+    if (!roi.is_none()) roi_mask = mask_from_array(roi.cast<pyb::array>(), lattice);
+    const Grid<std::uint8_t>* r = roi_mask ? &*roi_mask : nullptr;
+    cli::PreparedImage prepared;
+    {
+        pyb::gil_scoped_release nogil;
+        prepared = cli::prepare_image(image, r, bias_mode(bias_correct));
+    }
+    nlohmann::json j = nlohmann::json::object();
+    cli::add_bias_report(j, prepared, r);
+    pyb::dict d;
+    d["report"] = j.dump();
+    d["image"] = prepared.bias ? pyb::object(array_from_grid(std::move(image))) : pyb::object(pyb::none());
+    d["model_region"] = prepared.fit_region ? pyb::object(array_from_grid(std::move(*prepared.fit_region))) : pyb::object(pyb::none());
+    return d;
+}
+
 // The tissue model fitted where segment() fits it, and the window the seeds would get.
 std::string tissue_model(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a) {
     Grid<float> image = grid_from_array(values, lattice);
@@ -347,6 +371,11 @@ void register_core(pyb::module_& m) {
         const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
         SegmentArgs a = segment_args(kw);
         return tissue_model(v, l, a);
+    });
+    m.def("_prepare_session_image", [](const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi, const std::optional<bool>& bias_correct) {
+        if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
+        const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
+        return prepare_session_image(v, l, roi, bias_correct);
     });
     m.def("_mesh", [](const pyb::array& v, const pyb::tuple& geo, bool is_mask, const std::string& out) {
         if (v.ndim() != 3) throw std::invalid_argument("the input must be a 3D array");

@@ -10,7 +10,8 @@ namespace liveset::py {
 
 namespace {
 
-std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi, double n,
+std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi,
+                                      const pyb::object& model_region, double n,
                                       std::optional<double> alpha, int layers, int fragment_size, std::size_t history,
                                       int agents, double p, std::uint64_t seed, bool sleeping, const std::string& decision,
                                       double edit_range) {
@@ -20,6 +21,8 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     std::optional<Grid<std::uint8_t>> r;
     if (!roi.is_none()) r = mask_from_array(roi.cast<pyb::array>(), l);
     SessionOptions o;
+    // Where the tissue model is fitted (the brain mask prepare_image found before N4, as the viewer).
+    if (!model_region.is_none()) o.model_region = mask_from_array(model_region.cast<pyb::array>(), l);
     o.layers = layers;
     o.fragment_size = fragment_size;
     o.history = history;
@@ -82,7 +85,7 @@ Vec3d point(const std::vector<double>& p) {
 
 void register_session(pyb::module_& m) {
     pyb::class_<Session>(m, "_Session")
-        .def(pyb::init(&make_session), pyb::arg("image"), pyb::arg("geometry"), pyb::arg("roi"), pyb::arg("n"),
+        .def(pyb::init(&make_session), pyb::arg("image"), pyb::arg("geometry"), pyb::arg("roi"), pyb::arg("model_region"), pyb::arg("n"),
              pyb::arg("alpha"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
              pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"))
         .def("add_seed", [](Session& s, const std::vector<double>& c, double r) {

@@ -22,9 +22,17 @@ class Session:
     >>> s.undo(); m = s.mask()
 
     Coordinates are voxel indices (i, j, k). Runs release the GIL and stop on Ctrl-C between
-    steps (KeyboardInterrupt; the steps taken so far stay and can be undone). The image is taken as
-    given: for the bias-corrected one that ``segment`` and ``liveset view`` work on by default, pass
-    ``segment(...).corrected``.
+    steps (KeyboardInterrupt; the steps taken so far stay and can be undone).
+
+    The image is prepared as ``liveset view`` and ``segment`` prepare it: ``bias_correct=None``
+    (the default) runs N4 first, fitted in the ROI or else the automatic brain mask, and skips it
+    with a warning where it cannot run (an image too small for its grid); True requires it
+    (ValueError where it cannot run); False takes the image as given (pass False for an image that
+    is already corrected, e.g. ``segment(...).corrected``). Without a ROI the tissue model is
+    fitted in the brain mask found before N4, as ``segment`` fits it, so the same seeds give
+    ``segment``'s mask. ``image`` is the image the session works on (the corrected one when N4
+    ran), ``corrected`` True when N4 ran, ``report`` its ``bias_correction`` (or ``warnings``) as
+    in ``segment``'s report.
 
     ``alpha=None`` (the default) chooses the curvature weight as ``segment`` does (from the tissue
     model's noise over the window's contrast and the voxel shape) once there is a window (the first
@@ -34,13 +42,16 @@ class Session:
     def __init__(self, image, roi=None, *, n: float = 4.0, alpha: Optional[float] = None, layers: int = 2,
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
-                 edit_range: Optional[float] = None):
+                 edit_range: Optional[float] = None, bias_correct: Optional[bool] = None):
         img = as_image(image)
-        self.image = img
-        r = None
-        if roi is not None:
-            r = np.asarray(roi) if isinstance(roi, np.ndarray) else as_image(roi, "roi").array
-        self._s = _liveset._Session(img.array, img.geometry, r, float(n), None if alpha is None else float(alpha), int(layers),
+        r = _mask_arg(roi, img, "roi")
+        prepared = _liveset._prepare_session_image(img.array, img.geometry, r,
+                                                   None if bias_correct is None else bool(bias_correct))
+        self.corrected = prepared["image"] is not None
+        self.image = img.like(prepared["image"]) if self.corrected else img
+        self.report = json.loads(prepared["report"])
+        self._s = _liveset._Session(self.image.array, img.geometry, r, prepared["model_region"], float(n),
+                                    None if alpha is None else float(alpha), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),
                                     bool(sleeping), str(decision),
                                     float(_edit_range(decision, edit_range)))
@@ -159,7 +170,8 @@ def repair(phi_or_mask, image, targets: Sequence[Sequence[float]], *, steps: int
     voxels by default), as ``liveset repair --decision``. Uses Session (exact step, not the CLI's
     ``liveset repair`` option set: no @STEP schedule, no log)."""
     img = as_image(image)
-    s = Session(img, roi=roi, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range)
+    s = Session(img, roi=roi, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range,
+                bias_correct=False)  # the image as given, as `liveset repair --image`
     src = as_image(phi_or_mask, "phi_or_mask")
     a = np.asarray(src.array)
     if np.all((a == 0) | (a == 1)):
