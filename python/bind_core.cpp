@@ -136,14 +136,14 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
 
 // The image a Session works on, prepared as `liveset view` prepares it (prepare_image: N4 per
 // `bias_correct`, fitted in the ROI, else the automatic brain mask): the corrected image when N4
-// ran, the region the tissue model is fitted in (the brain mask found before N4; none with a ROI)
-// and the report's bias_correction / warnings.
-pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice, const pyb::object& roi,
+// ran, the ROI (a mask array, or "auto": the automatic brain mask, as segment), the region the
+// tissue model is fitted in (the brain mask found before N4; none with a ROI) and the report's
+// bias_correction / warnings / roi.
+pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice, const pyb::object& roi_arg,
                                 const std::optional<bool>& bias_correct) {
     Grid<float> image = grid_from_array(values, lattice);
-    std::optional<Grid<std::uint8_t>> roi_mask;
-    if (!roi.is_none()) roi_mask = mask_from_array(roi.cast<pyb::array>(), lattice);
-    const Grid<std::uint8_t>* r = roi_mask ? &*roi_mask : nullptr;
+    const std::optional<cli::Roi> roi = roi_of(roi_arg, image);  // "auto": from the image before N4, as segment
+    const Grid<std::uint8_t>* r = roi ? &roi->mask : nullptr;
     cli::PreparedImage prepared;
     {
         pyb::gil_scoped_release nogil;
@@ -151,8 +151,10 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
     }
     nlohmann::json j = nlohmann::json::object();
     cli::add_bias_report(j, prepared, r);
+    if (roi) j["roi"] = cli::roi_report(*roi);
     pyb::dict d;
     d["report"] = j.dump();
+    d["roi"] = roi ? pyb::object(array_from_grid(Grid<std::uint8_t>(roi->mask))) : pyb::object(pyb::none());
     d["image"] = prepared.bias ? pyb::object(array_from_grid(std::move(image))) : pyb::object(pyb::none());
     d["model_region"] = prepared.fit_region ? pyb::object(array_from_grid(std::move(*prepared.fit_region))) : pyb::object(pyb::none());
     return d;

@@ -72,7 +72,15 @@ SessionOptions session_options(const ViewArgs& a) {
 std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> roi;
-    if (!a.roi.empty()) roi = load_mask_like(a.roi, image.lattice(), "--roi");
+    if (std::optional<Roi> r = load_roi(a.roi, image, "--roi")) {  // a mask file, or "auto" as `segment --roi auto`
+        if (r->brain_mask) {
+            const nlohmann::json j = roi_report(*r);
+            fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({}, tissue window {:.1f}..{:.1f})\n",
+                       j["voxels"].get<std::size_t>(), r->brain_mask->skull_stripped ? "skull-stripped input" : "full head",
+                       r->brain_mask->tissue_low, r->brain_mask->tissue_high);
+        }
+        roi = std::move(r->mask);
+    }
     // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for (or a
     // continued workspace's image was corrected: then it must be again).
     const BiasCorrection mode = bias_mode(a.workspace_bias.value_or(a.bias_correct), a.bias_given || a.workspace_bias);
@@ -269,7 +277,7 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("image", va.image, "image to open (NIfTI, MetaImage, NRRD, MINC, DICOM folder)");
     v->add_option("--mask", va.mask, "start from this segmentation mask (non-zero inside)");
     v->add_option("--phi", va.phi, "start from this level set (< 0 inside)");
-    v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave");
+    v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave, or 'auto': a brain mask computed from the T1 (as segment --roi auto)");
     v->add_option("--seed", va.seeds, "seed I,J,K[:R] (voxels); repeatable");
     v->add_option("--window-from", va.window_from, "estimate the window from the tissue model (the seeds pick the class) or from the seeds' statistics, as `segment`")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     auto* bias = v->add_flag("--bias-correct,!--no-bias-correct", va.bias_correct, "correct the intensity non-uniformity first (N4), as `segment`. Default: on, skipped with a warning where it cannot run (asked for: an error); a continued workspace keeps its own setting");

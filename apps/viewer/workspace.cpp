@@ -224,7 +224,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
     for (const SeedBall& s : m.seeds) seeds.push_back({s.center.x, s.center.y, s.center.z, s.radius});
     json j{{"liveset_workspace", kWorkspaceVersion},
            {"image", image.empty() ? std::string() : fs::absolute(image).string()},
-           {"roi", roi.empty() ? std::string() : fs::absolute(roi).string()},
+           {"roi", roi.empty() || roi == "auto" ? roi : fs::absolute(roi).string()},  // "auto": computed again on reading
            {"bias_corrected", bias_corrected},
            {"geometry", {{"dims", {l.dims().x, l.dims().y, l.dims().z}}, {"spacing", vec(l.spacing())}, {"origin", vec(l.origin())},
                          {"direction", l.direction()}}},

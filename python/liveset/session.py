@@ -30,9 +30,11 @@ class Session:
     (ValueError where it cannot run); False takes the image as given (pass False for an image that
     is already corrected, e.g. ``segment(...).corrected``). Without a ROI the tissue model is
     fitted in the brain mask found before N4, as ``segment`` fits it, so the same seeds give
-    ``segment``'s mask. ``image`` is the image the session works on (the corrected one when N4
-    ran), ``corrected`` True when N4 ran, ``report`` its ``bias_correction`` (or ``warnings``) as
-    in ``segment``'s report.
+    ``segment``'s mask. ``roi``: None, a mask (Image, nibabel image or array) the front may not
+    leave, or ``"auto"``: the automatic brain mask, as ``segment(roi="auto")``. ``image`` is the
+    image the session works on (the corrected one when N4 ran), ``corrected`` True when N4 ran,
+    ``roi`` the ROI as an Image (None without one), ``report`` the ``bias_correction`` (or
+    ``warnings``) and ``roi`` entries of ``segment``'s report.
 
     ``alpha=None`` (the default) chooses the curvature weight as ``segment`` does (from the tissue
     model's noise over the window's contrast and the voxel shape) once there is a window (the first
@@ -44,13 +46,13 @@ class Session:
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
                  edit_range: Optional[float] = None, bias_correct: Optional[bool] = None):
         img = as_image(image)
-        r = _mask_arg(roi, img, "roi")
-        prepared = _liveset._prepare_session_image(img.array, img.geometry, r,
+        prepared = _liveset._prepare_session_image(img.array, img.geometry, _mask_arg(roi, img, "roi", allow_auto=True),
                                                    None if bias_correct is None else bool(bias_correct))
         self.corrected = prepared["image"] is not None
         self.image = img.like(prepared["image"]) if self.corrected else img
+        self.roi = None if prepared["roi"] is None else img.like(prepared["roi"])
         self.report = json.loads(prepared["report"])
-        self._s = _liveset._Session(self.image.array, img.geometry, r, prepared["model_region"], float(n),
+        self._s = _liveset._Session(self.image.array, img.geometry, prepared["roi"], prepared["model_region"], float(n),
                                     None if alpha is None else float(alpha), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),
                                     bool(sleeping), str(decision),

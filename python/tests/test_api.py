@@ -271,8 +271,19 @@ def test_session_prepares_the_image_as_segment_does(phantom):
     s.run(2000)
     assert s.status["converged"]
     assert int(seg.mask.array.sum()) > 1000 and np.array_equal(s.mask().array, seg.mask.array)
+    # roi="auto": segment's automatic brain mask, N4 fitted in it
+    seg = liveset.segment(img, seeds, roi="auto")
+    s = liveset.Session(img, roi="auto")
+    assert np.array_equal(s.roi.array, seg.roi.array) and s.report["roi"]["source"] == "auto"
+    assert np.array_equal(s.image.array, seg.corrected.array)
+    for seed in seeds:
+        s.add_seed(seed)
+    s.run(2000)
+    assert np.array_equal(s.mask().array, seg.mask.array)
     with pytest.raises(ValueError, match="does not overlay|shape"):
         liveset.Session(img, roi=np.ones((3, 3, 3), np.uint8))
+    with pytest.raises(ValueError, match="auto"):
+        liveset.Session(img, roi="brain")
 
 
 def test_docs_example_runs(tmp_path):

@@ -9,7 +9,9 @@
 // and its four scenarios, of which only the repairing ones rebuild fragments.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -345,6 +347,49 @@ TEST(ScriptedSession, WithBiasCorrectionAndNoRoiTheViewerFitsTheModelWhereSegmen
     }
     EXPECT_GT(inside, 10000u);
     EXPECT_EQ(differ, 0u);
+}
+
+// `--roi auto` is `segment --roi auto`'s brain mask (the same mask from the same clicks), and a
+// workspace saved with it keeps "auto" (not a path to a file named auto) and continues exactly.
+TEST(ScriptedSession, RoiAutoIsSegmentsBrainMaskAndTheWorkspaceKeepsIt) {
+    PhantomOptions po;
+    po.size = 64;
+    const Phantom ph = make_phantom(po);
+    const fs::path dir = work_dir();
+    const std::string path = (dir / "auto_t1.nii.gz").string(), view_mask = (dir / "auto_view.nii.gz").string(),
+                      seg_mask = (dir / "auto_seg.nii.gz").string(), again = (dir / "auto_again.nii.gz").string(),
+                      ws = (dir / "auto_ws.json").string();
+    write_image(ph.image, path);
+    std::string seeds, clicks;
+    for (const Vec3i& s : ph.seeds) {
+        seeds += fmt::format(" --seed {},{},{}", s.x, s.y, s.z);
+        clicks += fmt::format(R"({{"seed": [{}, {}, {}]}}, )", s.x, s.y, s.z);
+    }
+    write_text(dir / "clicked_auto.json",
+               "[" + clicks + R"({"segment": 40}, {"save_workspace": ")" + ws + R"("}, {"segment": "converge"}, {"save_mask": ")" + view_mask + R"("}])");
+    const CliResult seg = run_cli("segment " + path + seeds + " --roi auto --out-mask " + seg_mask);
+    ASSERT_EQ(seg.rc, 0) << seg.err;
+    const CliResult view = run_cli("view " + path + " --roi auto --headless --no-autosave --script " + (dir / "clicked_auto.json").string());
+    ASSERT_EQ(view.rc, 0) << view.err;
+    EXPECT_NE(view.err.find("--roi auto: brain mask of"), std::string::npos) << view.err;
+    const Grid<std::uint8_t> a = read_label_image(view_mask), b = read_label_image(seg_mask);
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differ = 0, inside = 0;
+    for (PointIndex i = 0; i < a.size(); ++i) {
+        differ += (a[i] != 0) != (b[i] != 0);
+        inside += b[i] != 0;
+    }
+    EXPECT_GT(inside, 10000u);
+    EXPECT_EQ(differ, 0u);
+    std::ifstream in(ws);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["roi"], "auto");
+    // Continued from the workspace (its ROI recomputed from the image): the same converged mask.
+    write_text(dir / "continue_auto.json", R"([{"segment": "converge"}, {"save_mask": ")" + again + R"("}])");
+    const CliResult cont = run_cli("view " + path + " --workspace " + ws + " --headless --no-autosave --script " + (dir / "continue_auto.json").string());
+    ASSERT_EQ(cont.rc, 0) << cont.err;
+    const Grid<std::uint8_t> c = read_label_image(again);
+    EXPECT_TRUE(std::ranges::equal(c.values(), a.values()));
 }
 
 }  // namespace
