@@ -133,6 +133,10 @@ int run_segment(const SegmentArgs& a, int threads) {
         if (!a.quiet) fmt::print(stderr, "liveset: warning: {}\n", w);
         j["warnings"].push_back(w);
     }
+    if (const std::string w = leak_warning(o.mask, prepared, roi_mask, "--roi auto"); !w.empty()) {
+        if (!a.quiet) fmt::print(stderr, "liveset: warning: {}\n", w);
+        j["warnings"].push_back(w);
+    }
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {

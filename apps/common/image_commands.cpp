@@ -106,6 +106,24 @@ void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, cons
     if (!prepared.bias_skipped.empty()) report["warnings"].push_back(prepared.bias_skipped);
 }
 
+std::string leak_warning(const Grid<std::uint8_t>& mask, const PreparedImage& prepared, const Grid<std::uint8_t>* roi,
+                         std::string_view roi_hint) {
+    if (roi != nullptr || !prepared.fit_region) return {};
+    const Grid<std::uint8_t>& brain = *prepared.fit_region;
+    std::size_t inside = 0, outside = 0;
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if (mask[p] == 0) continue;
+        ++inside;
+        outside += brain[p] == 0;
+    }
+    const double share = inside > 0 ? static_cast<double>(outside) / static_cast<double>(inside) : 0.0;
+    if (share <= kLeakShare) return {};
+    return fmt::format("{:.0f} % of the segmented voxels ({} of {}) lie outside the automatic brain mask: without a ROI the front "
+                       "leaks into scalp, muscle or eyes; for brain tissue pass {} (or your own brain mask)",
+                       100.0 * share, outside, inside, roi_hint);
+}
+
 nlohmann::json roi_report(const Roi& roi) {
     const Vec3d s = roi.mask.lattice().spacing();
     std::size_t voxels = 0;

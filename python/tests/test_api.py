@@ -286,6 +286,25 @@ def test_session_prepares_the_image_as_segment_does(phantom):
         liveset.Session(img, roi="brain")
 
 
+def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
+    # An analytic head (WM, GM, CSF, skull, scalp) with a bridge of WM intensity to the scalp.
+    g = np.indices((64, 64, 64)).astype(float)
+    r = 1.5 * np.sqrt(((g - 31.5) ** 2).sum(axis=0))
+    a = np.select([r < 18, r < 27, r < 29, r < 35, r < 42], [130.0, 95.0, 45.0, 8.0, 160.0], 0.0)
+    a = np.abs(a + np.random.default_rng(5).normal(0, 3, a.shape))
+    bridge = np.zeros(a.shape, bool)
+    bridge[40:, 29:35, 29:35] = True
+    a[bridge & (r < 42)] = 130.0
+    img = liveset.Image(a.astype(np.float32), (1.5, 1.5, 1.5))
+    kw = dict(mu_raw=130, epsilon_raw=40, iterations=400, bias_correct=False)
+    leaked = liveset.segment(img, [(32, 32, 32, 3)], **kw)
+    warned = [w for w in leaked.report["warnings"] if "outside the automatic brain mask" in w]
+    assert len(warned) == 1 and "roi='auto'" in warned[0]
+    inside = liveset.segment(img, [(32, 32, 32, 3)], roi="auto", **kw)
+    assert not any("outside the automatic brain mask" in w for w in inside.report["warnings"])
+    assert int(inside.mask.array.sum()) < int(leaked.mask.array.sum())
+
+
 def test_docs_example_runs(tmp_path):
     """docs/python_example.py end to end on a small phantom."""
     import subprocess

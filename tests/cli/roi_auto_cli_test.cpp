@@ -45,6 +45,30 @@ fs::path head_image() {
     return path;
 }
 
+// The same head with a bridge of white-matter intensity from the brain through CSF and skull to
+// the scalp (a vessel or muscle in a real head): a window holding the scalp's intensity leaks
+// along it without a ROI.
+fs::path bridged_head_image() {
+    static const fs::path path = [] {
+        Grid<float> g = read_image(head_image().string());
+        for (int z = 29; z <= 34; ++z)
+            for (int y = 29; y <= 34; ++y)
+                for (int x = 40; x < 64; ++x)
+                    if (1.5 * norm(Vec3d{x - 31.5, y - 31.5, z - 31.5}) < 42) g({x, y, z}) = 130.0f;
+        const fs::path p = work_dir() / "bridged_head.nii.gz";
+        write_image(g, p.string());
+        return p;
+    }();
+    return path;
+}
+
+// The warnings of a `--json` report that name the leak.
+std::size_t leak_warnings(const nlohmann::json& j) {
+    std::size_t n = 0;
+    for (const auto& w : j["warnings"]) n += w.get<std::string>().find("outside the automatic brain mask") != std::string::npos;
+    return n;
+}
+
 }  // namespace
 
 TEST(RoiAutoCli, WritesTheAutomaticBrainMaskAndSegmentsInsideIt) {
@@ -138,4 +162,31 @@ TEST(RoiAutoCli, AMaskIsItsNonZeroRealValues) {
     EXPECT_NE(r.rc, 0);
     EXPECT_EQ(lines(r.err), 1) << r.err;
     EXPECT_FALSE(fs::exists(out));
+}
+
+// Without a ROI, a segmentation of which more than 5 % lies outside the automatic brain mask (the
+// front leaked into the scalp) is warned about, with the count against the library's mask; none
+// when it stays inside, none with --roi auto.
+TEST(RoiAutoCli, WithoutARoiALeakOutOfTheBrainIsWarnedAbout) {
+    const fs::path seg = work_dir() / "leak.nii.gz";
+    const std::string o = " --seed 32,32,32:3 --mu-raw 130 --epsilon-raw 40 --iterations 400 --no-bias-correct --json --out-mask " + seg.string();
+    const auto leaked = run_cli("segment " + bridged_head_image().string() + o);
+    ASSERT_EQ(leaked.rc, 0) << leaked.err;
+    const nlohmann::json j = nlohmann::json::parse(leaked.out);
+    ASSERT_EQ(leak_warnings(j), 1u) << j["warnings"].dump();
+    const Grid<std::uint8_t> brain = auto_brain_mask(read_image(bridged_head_image().string()));
+    const Grid<std::uint8_t> mask = read_label_image(seg.string());
+    std::size_t outside = 0, inside = 0;
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+        inside += mask[static_cast<PointIndex>(i)] != 0;
+        outside += mask[static_cast<PointIndex>(i)] != 0 && brain[static_cast<PointIndex>(i)] == 0;
+    }
+    EXPECT_GT(static_cast<double>(outside), 0.05 * static_cast<double>(inside));
+    std::string counts = std::to_string(outside) + " of " + std::to_string(inside);
+    EXPECT_NE(j["warnings"].dump().find(counts), std::string::npos) << j["warnings"].dump() << " expected " << counts;
+    for (const std::string& args : {"segment " + head_image().string() + o, "segment " + bridged_head_image().string() + " --roi auto" + o}) {
+        const auto r = run_cli(args);
+        ASSERT_EQ(r.rc, 0) << r.err;
+        EXPECT_EQ(leak_warnings(nlohmann::json::parse(r.out)), 0u) << args << ": " << r.out;
+    }
 }
