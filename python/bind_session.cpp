@@ -40,7 +40,11 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     o.repair.swarm.edit_range = edit_range;
     if (sleeping) o.segmentation.step = sleeping_step();
     pyb::gil_scoped_release nogil;
-    return std::make_unique<Session>(std::move(image), o, std::move(r));
+    auto s = std::make_unique<Session>(std::move(image), o, std::move(r));
+    // Scripts read φ and the mask, never the viewer's fragment meshes: the mesher only collects
+    // the changed points (bounded by the lattice), and φ is the same bits either way.
+    s->set_deferred_meshing(true);
+    return s;
 }
 
 pyb::dict status_of(const Session& s) {
