@@ -106,10 +106,9 @@ void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, cons
     if (!prepared.bias_skipped.empty()) report["warnings"].push_back(prepared.bias_skipped);
 }
 
-std::string leak_warning(const Grid<std::uint8_t>& mask, const PreparedImage& prepared, const Grid<std::uint8_t>* roi,
-                         std::string_view roi_hint) {
-    if (roi != nullptr || !prepared.fit_region) return {};
-    const Grid<std::uint8_t>& brain = *prepared.fit_region;
+std::string leak_warning(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* brain_mask, std::string_view roi_hint) {
+    if (brain_mask == nullptr) return {};
+    const Grid<std::uint8_t>& brain = *brain_mask;
     std::size_t inside = 0, outside = 0;
     for (std::size_t i = 0; i < mask.size(); ++i) {
         const auto p = static_cast<PointIndex>(i);

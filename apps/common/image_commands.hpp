@@ -72,12 +72,12 @@ PreparedImage prepare_image(Grid<float>& image, const Grid<std::uint8_t>* roi, B
 // The report's "bias_correction" object (bias_correction_report and where it was fitted), or, when
 // the default correction was skipped, its warning appended to the report's "warnings".
 void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi);
-// Without a ROI on a head (prepare_image found the automatic brain mask): a warning when more than
-// kLeakShare of the segmented voxels lie outside that mask (the front leaked into scalp, muscle or
-// eyes), naming `roi_hint` ("--roi auto", "roi='auto'") as the cure; empty otherwise.
+// Without a ROI on a head, `brain` is the automatic brain mask prepare_image found (its
+// fit_region; null with a ROI or when none was found): a warning when more than kLeakShare of the
+// segmented voxels lie outside it (the front leaked into scalp, muscle or eyes), naming `roi_hint`
+// ("--roi auto", "roi='auto'") as the cure; empty otherwise.
 inline constexpr double kLeakShare = 0.05;
-std::string leak_warning(const Grid<std::uint8_t>& mask, const PreparedImage& prepared, const Grid<std::uint8_t>* roi,
-                         std::string_view roi_hint);
+std::string leak_warning(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* brain, std::string_view roi_hint);
 
 // True when every voxel is exactly 0 or 1 (a mask stored as a float image).
 bool is_binary_mask(const Grid<float>& image);

@@ -259,14 +259,31 @@ void Viewer::segment_step() {
 
 void Viewer::check_segment_end() {
     const SegmentStatus& st = session_->segment_status();
-    if (st.converged || st.vanished) {
-        const bool was_running = segment_running_;
-        segment_running_ = false;
-        session_->end_action();
-        message_ = st.vanished ? "the front vanished" : fmt::format("converged after {} iterations", st.iterations);
-        message_is_error_ = st.vanished;
-        if (was_running) log_.add("segmentation", {{"running", false}, {"iterations", st.iterations}, {"converged", st.converged}});
+    if (!st.converged && !st.vanished) {
+        segment_end_reported_ = false;
+        return;
     }
+    const bool was_running = segment_running_;
+    segment_running_ = false;
+    session_->end_action();
+    message_ = st.vanished ? "the front vanished" : fmt::format("converged after {} iterations", st.iterations);
+    message_is_error_ = st.vanished;
+    // Without a ROI on a head, as `segment`: a front that leaked out of the automatic brain mask
+    // (checked once per convergence; steps taken after it keep the warning in the message).
+    if (!segment_end_reported_) {
+        const Grid<std::uint8_t>* brain = session_->roi() || !session_->options().model_region ? nullptr : &*session_->options().model_region;
+        leak_warning_ = st.converged && brain ? cli::leak_warning(session_->mask(), brain, "--roi auto on the command line") : std::string();
+        if (!leak_warning_.empty()) {
+            log_.add("warning", {{"message", leak_warning_}});
+            if (config_.headless) fmt::print(stderr, "liveset: warning: {}\n", leak_warning_);
+        }
+        segment_end_reported_ = true;
+    }
+    if (!leak_warning_.empty()) {
+        message_ += ", but " + leak_warning_;
+        message_is_error_ = true;
+    }
+    if (was_running) log_.add("segmentation", {{"running", false}, {"iterations", st.iterations}, {"converged", st.converged}});
 }
 
 void Viewer::swarm_step() {

@@ -372,6 +372,8 @@ private:
     std::string message_;
     std::string renderer_;  // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
     bool message_is_error_ = false;
+    bool segment_end_reported_ = false;  // the convergence's leak check done (check_segment_end)
+    std::string leak_warning_;           // its warning, empty when none
     FrameStats current_, last_;
     double fps_ = 0.0, frame_ms_ = 0.0;
     std::deque<double> frame_starts_, frame_work_ms_;  // the frames of the last second: start (s), work (ms)

@@ -98,6 +98,11 @@ void Viewer::draw_tools_section() {
 void Viewer::draw_segmentation_section() {
     const SegmentStatus& st = session_->segment_status();
     ImGui::Text("%zu seed(s), %d iterations%s", session_->seeds().size(), st.iterations, st.converged ? ", converged" : "");
+    if (st.converged && !leak_warning_.empty()) {  // next to the run, not only in the status line at the panel's foot
+        ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
+        ImGui::TextWrapped("%s", leak_warning_.c_str());
+        ImGui::PopStyleColor();
+    }
     bool edited = false, done = false;
     ui_params_ = session_->params();  // edits apply at once: the session holds the truth
     ui_auto_window_ = session_->window_from_seeds();

@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "analytic_head.hpp"
 #include "cli/cli_run.hpp"
 #include "cli/rod_shell.hpp"
 #include "liveset/eval/perforations.hpp"
@@ -390,6 +391,30 @@ TEST(ScriptedSession, RoiAutoIsSegmentsBrainMaskAndTheWorkspaceKeepsIt) {
     ASSERT_EQ(cont.rc, 0) << cont.err;
     const Grid<std::uint8_t> c = read_label_image(again);
     EXPECT_TRUE(std::ranges::equal(c.values(), a.values()));
+}
+
+// As `segment`: without a ROI on a head, a front that leaked out of the automatic brain mask is
+// warned about when it converges (stderr when headless, the event log); with --roi auto it is not.
+TEST(ScriptedSession, AFrontThatLeaksOutOfTheBrainWithoutARoiIsWarnedAbout) {
+    const fs::path dir = work_dir();
+    const std::string path = (dir / "bridged_head.nii.gz").string(), events = (dir / "leak_events.jsonl").string();
+    write_image(testing::analytic_head(true), path);
+    write_text(dir / "leak.json", R"([{"segment": "converge"}])");
+    const std::string common = " --seed 32,32,32:3 --mu-raw 130 --epsilon-raw 40 --no-bias-correct --headless --no-autosave --script " +
+                               (dir / "leak.json").string();
+    const CliResult leaked = run_cli("view " + path + common + " --log-events " + events);
+    ASSERT_EQ(leaked.rc, 0) << leaked.err;
+    EXPECT_NE(leaked.err.find("outside the automatic brain mask"), std::string::npos) << leaked.err;
+    std::ifstream in(events);
+    std::size_t logged = 0;
+    for (std::string line; std::getline(in, line);) {
+        const nlohmann::json e = nlohmann::json::parse(line);
+        logged += e.value("type", "") == "warning" && e["message"].get<std::string>().find("outside the automatic brain mask") != std::string::npos;
+    }
+    EXPECT_EQ(logged, 1u);
+    const CliResult inside = run_cli("view " + path + " --roi auto" + common);
+    ASSERT_EQ(inside.rc, 0) << inside.err;
+    EXPECT_EQ(inside.err.find("outside the automatic brain mask"), std::string::npos) << inside.err;
 }
 
 }  // namespace
