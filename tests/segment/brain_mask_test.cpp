@@ -11,6 +11,7 @@
 #include <string>
 
 #include "liveset/io/image_io.hpp"
+#include "noisy_phantom.hpp"
 #include "liveset/segment/brain_mask.hpp"
 
 using namespace liveset;
@@ -49,7 +50,7 @@ Grid<T> every_other(const Grid<T>& g) {
     return out;
 }
 
-enum class Variant { kPlain, kScaled, kBias, kNoise, kStripped };
+enum class Variant { kPlain, kScaled, kBias, kNoise, kHeavyNoise, kStripped };
 
 // A variant of an image (the same truth holds for each); kStripped multiplies by `brain`.
 Grid<float> make_variant(const Grid<float>& t1, const Mask& brain, Variant v) {
@@ -57,6 +58,7 @@ Grid<float> make_variant(const Grid<float>& t1, const Mask& brain, Variant v) {
     const Vec3i d = t1.dims();
     std::mt19937 rng(12345);
     std::normal_distribution<float> noise(0.0f, 8.0f);  // ~6 % of white matter
+    std::normal_distribution<float> heavy(0.0f, 12.0f);  // ~9 % of white matter: BrainWeb's noisiest
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
             for (int x = 0; x < d.x; ++x) {
@@ -69,6 +71,7 @@ Grid<float> make_variant(const Grid<float>& t1, const Mask& brain, Variant v) {
                         o *= static_cast<float>(1.0 + 0.2 * std::sin(1.3 * u + 0.4) * std::cos(1.1 * w - 0.3) * std::cos(0.9 * s + 0.2));
                         break;
                     case Variant::kNoise: o += noise(rng); break;
+                    case Variant::kHeavyNoise: o = std::abs(o + heavy(rng)); break;  // magnitude
                     case Variant::kStripped: o = brain({x, y, z}) != 0 ? o : 0.0f; break;
                 }
             }
@@ -120,8 +123,10 @@ double dice(const Mask& a, const Mask& b) {
 }
 
 // A full head (stripped_with == nullptr) or the image cut with `stripped_with`, whose non-zero brain
-// the mask must then cover whole.
-TruthCheck run_variant(const char* name, const Grid<float>& image, const Mask& labels, const Mask* stripped_with = nullptr) {
+// the mask must then cover whole. `leak_bound`: the share of non-brain voxels in the GM window
+// allowed inside (noisy images: more, as the smoothed tissue test lets the mask follow the cortex).
+TruthCheck run_variant(const char* name, const Grid<float>& image, const Mask& labels, const Mask* stripped_with = nullptr,
+                       double leak_bound = 0.015) {
     const bool expect_stripped = stripped_with != nullptr;
     BrainMaskReport r;
     const auto t0 = std::chrono::steady_clock::now();
@@ -129,9 +134,9 @@ TruthCheck run_variant(const char* name, const Grid<float>& image, const Mask& l
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const TruthCheck c = check_against_truth(mask, labels, image);
     std::printf("%-9s dice %.4f  GM in %.4f  WM in %.4f  scalp/muscle/skin/fat in %.4f  GM-window leak %.4f  "
-                "(window %.1f..%.1f, contact %.2f, stripped %d, %.1f s)\n",
+                "(window %.1f..%.1f, contact %.2f, stripped %d, %.0f %% of the head, %.1f s)\n",
                 name, c.dice, c.gm, c.wm, c.extracranial, c.leak, r.tissue_low, r.tissue_high, r.surface_contact,
-                int(r.skull_stripped), s);
+                int(r.skull_stripped), 100.0 * double(r.mask_voxels) / double(r.head_voxels), s);
     EXPECT_EQ(r.skull_stripped, expect_stripped) << name << ": surface contact " << r.surface_contact;
     if (expect_stripped) {  // the truth is the non-zero brain (brain_mask.nii.gz also keeps some non-brain)
         Mask nonzero(image.lattice());
@@ -145,7 +150,7 @@ TruthCheck run_variant(const char* name, const Grid<float>& image, const Mask& l
     if (!expect_stripped) {
         EXPECT_GE(c.dice, 0.95) << name;
         EXPECT_LE(c.extracranial, 0.03) << name;
-        EXPECT_LE(c.leak, 0.015) << name;
+        EXPECT_LE(c.leak, leak_bound) << name;
     }
     EXPECT_EQ(r.mask_voxels, static_cast<std::size_t>(std::count(mask.values().begin(), mask.values().end(), 1)));
     return c;
@@ -163,6 +168,14 @@ TEST(BrainMask, BrainWebSkullStrippedPassesThrough) {
     run_variant("stripped", make_variant(bw.t1, bw.brain_mask, Variant::kStripped), bw.labels, &bw.brain_mask);
 }
 
+// Noise at BrainWeb's harshest (σ 12, ~9 % of white matter) at 1 mm: the tissue test on the
+// smoothed image keeps the cortex inside (without the smoothing 88 % of GM was, Dice 0.81 → 0.87
+// for a GM segmentation inside it).
+TEST(BrainMask, HeavyNoiseKeepsTheCortexInside) {
+    const BrainWeb& bw = brainweb();
+    run_variant("noise12", make_variant(bw.t1, bw.brain_mask, Variant::kHeavyNoise), bw.labels, nullptr, 0.025);
+}
+
 TEST(BrainMask, BrainWebVariantsAt2mm) {
     const BrainWeb& bw = brainweb();
     const Grid<float> t1 = every_other(bw.t1);
@@ -170,7 +183,7 @@ TEST(BrainMask, BrainWebVariantsAt2mm) {
     run_variant("2mm", t1, labels);
     run_variant("scaled", make_variant(t1, brain, Variant::kScaled), labels);
     run_variant("bias", make_variant(t1, brain, Variant::kBias), labels);
-    run_variant("noise", make_variant(t1, brain, Variant::kNoise), labels);
+    run_variant("noise", make_variant(t1, brain, Variant::kNoise), labels, nullptr, 0.025);
     run_variant("strip2mm", make_variant(t1, brain, Variant::kStripped), labels, &brain);
 }
 
@@ -260,6 +273,26 @@ TEST(BrainMask, AnalyticSkullStrippedHeadIsTheWholeForeground) {
     for (std::size_t i = 0; i < mask.size(); ++i) ASSERT_EQ(mask[static_cast<PointIndex>(i)], brain[static_cast<PointIndex>(i)]) << i;
 }
 
+// A brain without skull under heavy noise (the test phantom, noise 12 %, 1 x 1 x 1.5 mm): whatever
+// the method finds, it is not a fragment — either it refuses with one line (callers then fit the
+// model elsewhere) or the mask holds most of the grey matter.
+TEST(BrainMask, ANoisyBrainWithoutSkullIsNoBrainRatherThanAFragment) {
+    const liveset::testing::NoisyAnisotropicPhantom noisy = liveset::testing::noisy_anisotropic_phantom(64);
+    try {
+        const Mask m = auto_brain_mask(noisy.image);
+        std::size_t gm = 0, gm_in = 0;
+        for (PointIndex i = 0; i < m.size(); ++i) {
+            gm += noisy.phantom.truth[i] != 0;
+            gm_in += noisy.phantom.truth[i] != 0 && m[i] != 0;
+        }
+        EXPECT_GE(double(gm_in), 0.9 * double(gm));
+    } catch (const std::invalid_argument& e) {
+        const std::string what = e.what();
+        EXPECT_TRUE(what.find("no brain") != std::string::npos || what.find("empty") != std::string::npos) << what;
+        EXPECT_EQ(what.find('\n'), std::string::npos);
+    }
+}
+
 TEST(BrainMask, BadInputThrowsOneLine) {
     const Lattice lat({48, 48, 48});
     auto message = [](const Grid<float>& g) {
@@ -300,4 +333,12 @@ TEST(BrainMask, BadInputThrowsOneLine) {
     bad = {};
     bad.background_fraction = 1.5;
     EXPECT_THROW(auto_brain_mask(shell, bad), std::invalid_argument);
+    for (double s : {-1.0, 11.0, std::nan("")}) {
+        bad = {};
+        bad.smoothing_mm = s;
+        EXPECT_THROW(validate(bad), std::invalid_argument) << s;
+        bad = {};
+        bad.min_head_share = s / 10;
+        EXPECT_THROW(validate(bad), std::invalid_argument) << s;
+    }
 }

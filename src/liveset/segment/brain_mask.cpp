@@ -183,10 +183,10 @@ Mask intersect(Mask a, const Mask& b) {
 }
 
 // Tissue window → erosion → largest component → regrowth inside the window → fill → close → rim.
-Mask extract_brain(const Grid<float>& image, const Mask& head, const BrainMaskOptions& o, BrainMaskReport& r) {
+Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o, BrainMaskReport& r) {
     Mask tissue(image.lattice());
     for (std::size_t i = 0; i < tissue.size(); ++i) {
-        const double v = image[static_cast<PointIndex>(i)];
+        const double v = smooth[static_cast<PointIndex>(i)];
         tissue[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && v >= r.tissue_low && v <= r.tissue_high;
     }
     r.tissue_voxels = count(tissue);
@@ -214,6 +214,8 @@ void validate(const BrainMaskOptions& o) {
     };
     require(std::isfinite(o.background_fraction) && o.background_fraction > 0 && o.background_fraction < 1,
             "background_fraction must lie in (0, 1)");
+    require(std::isfinite(o.min_head_share) && o.min_head_share >= 0 && o.min_head_share < 1, "min_head_share must lie in [0, 1)");
+    require(std::isfinite(o.smoothing_mm) && o.smoothing_mm >= 0 && o.smoothing_mm <= 10, "smoothing_mm must lie in [0, 10]");
     require(std::isfinite(o.erosion_mm) && o.erosion_mm > 0 && o.erosion_mm <= 50, "erosion_mm must lie in (0, 50]");
     require(std::isfinite(o.regrow_margin_mm) && o.regrow_margin_mm >= 0 && o.regrow_margin_mm <= 50, "regrow_margin_mm must lie in [0, 50]");
     require(std::isfinite(o.closing_mm) && o.closing_mm >= 0 && o.closing_mm <= 50, "closing_mm must lie in [0, 50]");
@@ -231,16 +233,21 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     const Mask head = fill_holes(close_mm(head_foreground(image, r.background_threshold), o.head_closing_mm));
     r.head_voxels = count(head);
     const Grid<float> depth = depth_mm(head);
+    const Grid<float> smooth = gaussian_mm(image, o.smoothing_mm);
     white_matter_peak(image, head, depth, r);
     const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
     r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;  // CSF/skin | GM/muscle cut
     r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
-    Mask brain = extract_brain(image, head, o, r);
+    Mask brain = extract_brain(image, smooth, head, o, r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
     r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
     if (r.skull_stripped) brain = stripped_foreground(image, r.background_threshold);
     r.mask_voxels = count(brain);
     if (r.mask_voxels == 0) throw std::invalid_argument("brain mask: the mask is empty");
+    const double share = static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1));
+    if (!r.skull_stripped && share < o.min_head_share)
+        throw std::invalid_argument("brain mask: no brain found (the mask holds " + std::to_string(r.mask_voxels) + " voxels, " +
+                                    std::to_string(static_cast<int>(std::lround(100 * share))) + " % of the head)");
     const Vec3d s = image.lattice().spacing();
     r.mask_volume_mm3 = static_cast<double>(r.mask_voxels) * s.x * s.y * s.z;
     if (report != nullptr) *report = r;
