@@ -26,22 +26,13 @@ fs::path work_dir() {
     return dir;
 }
 
-fs::path head_image() {
-    static const fs::path path = [] {
-        const fs::path p = work_dir() / "head.nii.gz";
-        write_image(liveset::testing::analytic_head(false), p.string());
-        return p;
-    }();
-    return path;
-}
-
-fs::path bridged_head_image() {
-    static const fs::path path = [] {
-        const fs::path p = work_dir() / "bridged_head.nii.gz";
-        write_image(liveset::testing::analytic_head(true), p.string());
-        return p;
-    }();
-    return path;
+// The analytic head (analytic_head.hpp) as a file, with or without its bridge to the scalp.
+fs::path head_image(bool bridge = false) {
+    static const fs::path paths[2] = {work_dir() / "head.nii.gz", work_dir() / "bridged_head.nii.gz"};
+    static bool written[2] = {false, false};
+    if (!written[bridge]) write_image(liveset::testing::analytic_head(bridge), paths[bridge].string());
+    written[bridge] = true;
+    return paths[bridge];
 }
 
 // The warnings of a `--json` report that name the leak.
@@ -152,11 +143,11 @@ TEST(RoiAutoCli, AMaskIsItsNonZeroRealValues) {
 TEST(RoiAutoCli, WithoutARoiALeakOutOfTheBrainIsWarnedAbout) {
     const fs::path seg = work_dir() / "leak.nii.gz";
     const std::string o = " --seed 32,32,32:3 --mu-raw 130 --epsilon-raw 40 --iterations 400 --no-bias-correct --json --out-mask " + seg.string();
-    const auto leaked = run_cli("segment " + bridged_head_image().string() + o);
+    const auto leaked = run_cli("segment " + head_image(true).string() + o);
     ASSERT_EQ(leaked.rc, 0) << leaked.err;
     const nlohmann::json j = nlohmann::json::parse(leaked.out);
     ASSERT_EQ(leak_warnings(j), 1u) << j["warnings"].dump();
-    const Grid<std::uint8_t> brain = auto_brain_mask(read_image(bridged_head_image().string()));
+    const Grid<std::uint8_t> brain = auto_brain_mask(read_image(head_image(true).string()));
     const Grid<std::uint8_t> mask = read_label_image(seg.string());
     std::size_t outside = 0, inside = 0;
     for (std::size_t i = 0; i < mask.size(); ++i) {
@@ -166,7 +157,7 @@ TEST(RoiAutoCli, WithoutARoiALeakOutOfTheBrainIsWarnedAbout) {
     EXPECT_GT(static_cast<double>(outside), 0.05 * static_cast<double>(inside));
     std::string counts = std::to_string(outside) + " of " + std::to_string(inside);
     EXPECT_NE(j["warnings"].dump().find(counts), std::string::npos) << j["warnings"].dump() << " expected " << counts;
-    for (const std::string& args : {"segment " + head_image().string() + o, "segment " + bridged_head_image().string() + " --roi auto" + o}) {
+    for (const std::string& args : {"segment " + head_image().string() + o, "segment " + head_image(true).string() + " --roi auto" + o}) {
         const auto r = run_cli(args);
         ASSERT_EQ(r.rc, 0) << r.err;
         EXPECT_EQ(leak_warnings(nlohmann::json::parse(r.out)), 0u) << args << ": " << r.out;

@@ -318,78 +318,75 @@ TEST(ScriptedSession, SeedsOnTheCommandLineStartWithSegmentsAutomaticAlpha) {
     EXPECT_NE(both.err.find("not both"), std::string::npos) << both.err;
 }
 
-// With bias correction (the default) and no ROI, `view` fits the tissue model where `segment` does:
-// in the brain mask found before N4 (it once took the corrected image's: 43 voxels of this mask
-// differed), so seeds placed in the viewer still give segment's mask.
-TEST(ScriptedSession, WithBiasCorrectionAndNoRoiTheViewerFitsTheModelWhereSegmentDoes) {
+// The 64³ phantom written to the work folder as NAME_t1.nii.gz, with its seeds as `--seed`
+// options and as script entries (clicks).
+struct ClickedPhantom {
+    std::string path, seeds, clicks;
+};
+ClickedPhantom clicked_phantom(const std::string& name) {
     PhantomOptions po;
     po.size = 64;
     const Phantom ph = make_phantom(po);
-    const fs::path dir = work_dir();
-    const std::string path = (dir / "n4_t1.nii.gz").string(), view_mask = (dir / "n4_view.nii.gz").string(),
-                      seg_mask = (dir / "n4_seg.nii.gz").string();
-    write_image(ph.image, path);
-    std::string seeds, clicks;
+    ClickedPhantom c{(work_dir() / (name + "_t1.nii.gz")).string(), "", ""};
+    write_image(ph.image, c.path);
     for (const Vec3i& s : ph.seeds) {
-        seeds += fmt::format(" --seed {},{},{}", s.x, s.y, s.z);
-        clicks += fmt::format(R"({{"seed": [{}, {}, {}]}}, )", s.x, s.y, s.z);
+        c.seeds += fmt::format(" --seed {},{},{}", s.x, s.y, s.z);
+        c.clicks += fmt::format(R"({{"seed": [{}, {}, {}]}}, )", s.x, s.y, s.z);
     }
-    write_text(dir / "clicked_n4.json", "[" + clicks + R"({"segment": "converge"}, {"save_mask": ")" + view_mask + R"("}])");
-    const CliResult seg = run_cli("segment " + path + seeds + " --out-mask " + seg_mask);
-    ASSERT_EQ(seg.rc, 0) << seg.err;
-    const CliResult view = run_cli("view " + path + " --headless --no-autosave --script " + (dir / "clicked_n4.json").string());
-    ASSERT_EQ(view.rc, 0) << view.err;
-    const Grid<std::uint8_t> a = read_label_image(view_mask), b = read_label_image(seg_mask);
-    ASSERT_EQ(a.size(), b.size());
+    return c;
+}
+
+// The voxels where two label images differ (asserting that the second holds a real segmentation).
+std::size_t differing_voxels(const std::string& a_path, const std::string& b_path) {
+    const Grid<std::uint8_t> a = read_label_image(a_path), b = read_label_image(b_path);
+    EXPECT_EQ(a.size(), b.size());
     std::size_t differ = 0, inside = 0;
-    for (PointIndex i = 0; i < a.size(); ++i) {
+    for (PointIndex i = 0; i < std::min(a.size(), b.size()); ++i) {
         differ += (a[i] != 0) != (b[i] != 0);
         inside += b[i] != 0;
     }
     EXPECT_GT(inside, 10000u);
-    EXPECT_EQ(differ, 0u);
+    return differ;
+}
+
+// With bias correction (the default) and no ROI, `view` fits the tissue model where `segment` does:
+// in the brain mask found before N4 (it once took the corrected image's: 43 voxels of this mask
+// differed), so seeds placed in the viewer still give segment's mask.
+TEST(ScriptedSession, WithBiasCorrectionAndNoRoiTheViewerFitsTheModelWhereSegmentDoes) {
+    const ClickedPhantom ph = clicked_phantom("n4");
+    const fs::path dir = work_dir();
+    const std::string view_mask = (dir / "n4_view.nii.gz").string(), seg_mask = (dir / "n4_seg.nii.gz").string();
+    write_text(dir / "clicked_n4.json", "[" + ph.clicks + R"({"segment": "converge"}, {"save_mask": ")" + view_mask + R"("}])");
+    const CliResult seg = run_cli("segment " + ph.path + ph.seeds + " --out-mask " + seg_mask);
+    ASSERT_EQ(seg.rc, 0) << seg.err;
+    const CliResult view = run_cli("view " + ph.path + " --headless --no-autosave --script " + (dir / "clicked_n4.json").string());
+    ASSERT_EQ(view.rc, 0) << view.err;
+    EXPECT_EQ(differing_voxels(view_mask, seg_mask), 0u);
 }
 
 // `--roi auto` is `segment --roi auto`'s brain mask (the same mask from the same clicks), and a
 // workspace saved with it keeps "auto" (not a path to a file named auto) and continues exactly.
 TEST(ScriptedSession, RoiAutoIsSegmentsBrainMaskAndTheWorkspaceKeepsIt) {
-    PhantomOptions po;
-    po.size = 64;
-    const Phantom ph = make_phantom(po);
+    const ClickedPhantom ph = clicked_phantom("auto");
     const fs::path dir = work_dir();
-    const std::string path = (dir / "auto_t1.nii.gz").string(), view_mask = (dir / "auto_view.nii.gz").string(),
-                      seg_mask = (dir / "auto_seg.nii.gz").string(), again = (dir / "auto_again.nii.gz").string(),
-                      ws = (dir / "auto_ws.json").string();
-    write_image(ph.image, path);
-    std::string seeds, clicks;
-    for (const Vec3i& s : ph.seeds) {
-        seeds += fmt::format(" --seed {},{},{}", s.x, s.y, s.z);
-        clicks += fmt::format(R"({{"seed": [{}, {}, {}]}}, )", s.x, s.y, s.z);
-    }
+    const std::string view_mask = (dir / "auto_view.nii.gz").string(), seg_mask = (dir / "auto_seg.nii.gz").string(),
+                      again = (dir / "auto_again.nii.gz").string(), ws = (dir / "auto_ws.json").string();
     write_text(dir / "clicked_auto.json",
-               "[" + clicks + R"({"segment": 40}, {"save_workspace": ")" + ws + R"("}, {"segment": "converge"}, {"save_mask": ")" + view_mask + R"("}])");
-    const CliResult seg = run_cli("segment " + path + seeds + " --roi auto --out-mask " + seg_mask);
+               "[" + ph.clicks + R"({"segment": 40}, {"save_workspace": ")" + ws + R"("}, {"segment": "converge"}, {"save_mask": ")" + view_mask + R"("}])");
+    const CliResult seg = run_cli("segment " + ph.path + ph.seeds + " --roi auto --out-mask " + seg_mask);
     ASSERT_EQ(seg.rc, 0) << seg.err;
-    const CliResult view = run_cli("view " + path + " --roi auto --headless --no-autosave --script " + (dir / "clicked_auto.json").string());
+    const CliResult view = run_cli("view " + ph.path + " --roi auto --headless --no-autosave --script " + (dir / "clicked_auto.json").string());
     ASSERT_EQ(view.rc, 0) << view.err;
     EXPECT_NE(view.err.find("--roi auto: brain mask of"), std::string::npos) << view.err;
-    const Grid<std::uint8_t> a = read_label_image(view_mask), b = read_label_image(seg_mask);
-    ASSERT_EQ(a.size(), b.size());
-    std::size_t differ = 0, inside = 0;
-    for (PointIndex i = 0; i < a.size(); ++i) {
-        differ += (a[i] != 0) != (b[i] != 0);
-        inside += b[i] != 0;
-    }
-    EXPECT_GT(inside, 10000u);
-    EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(differing_voxels(view_mask, seg_mask), 0u);
     std::ifstream in(ws);
     const nlohmann::json j = nlohmann::json::parse(in);
     EXPECT_EQ(j["roi"], "auto");
     // Continued from the workspace (its ROI recomputed from the image): the same converged mask.
     write_text(dir / "continue_auto.json", R"([{"segment": "converge"}, {"save_mask": ")" + again + R"("}])");
-    const CliResult cont = run_cli("view " + path + " --workspace " + ws + " --headless --no-autosave --script " + (dir / "continue_auto.json").string());
+    const CliResult cont = run_cli("view " + ph.path + " --workspace " + ws + " --headless --no-autosave --script " + (dir / "continue_auto.json").string());
     ASSERT_EQ(cont.rc, 0) << cont.err;
-    const Grid<std::uint8_t> c = read_label_image(again);
+    const Grid<std::uint8_t> a = read_label_image(view_mask), c = read_label_image(again);
     EXPECT_TRUE(std::ranges::equal(c.values(), a.values()));
 }
 
