@@ -119,7 +119,7 @@ std::string leak_warning(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t
     const double share = inside > 0 ? static_cast<double>(outside) / static_cast<double>(inside) : 0.0;
     if (share <= kLeakShare) return {};
     return fmt::format("{:.0f} % of the segmented voxels ({} of {}) lie outside the automatic brain mask: without a ROI the front "
-                       "leaks into scalp, muscle or eyes; for brain tissue pass {} (or your own brain mask)",
+                       "may have leaked into scalp, muscle or eyes; for brain tissue pass {} (or your own brain mask)",
                        100.0 * share, outside, inside, roi_hint);
 }
 

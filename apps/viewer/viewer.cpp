@@ -85,6 +85,8 @@ void Viewer::show_session() {
     slice_shown_ = {-1, -1, -1};
     contour_slice_ = {-1, -1, -1};
     segment_running_ = swarm_running_ = false;
+    segment_end_reported_ = false;  // a new session: its convergence is checked afresh
+    leak_warning_.clear();
     if (!session_) {
         mark_all_panes();
         return;
@@ -269,7 +271,8 @@ void Viewer::check_segment_end() {
     message_ = st.vanished ? "the front vanished" : fmt::format("converged after {} iterations", st.iterations);
     message_is_error_ = st.vanished;
     // Without a ROI on a head, as `segment`: a front that leaked out of the automatic brain mask
-    // (checked once per convergence; steps taken after it keep the warning in the message).
+    // (checked once per convergence, reset by a non-converged step, a run's start or a new
+    // session; steps taken after it keep the warning in the message).
     if (!segment_end_reported_) {
         const Grid<std::uint8_t>* brain = session_->roi() || !session_->options().model_region ? nullptr : &*session_->options().model_region;
         leak_warning_ = st.converged && brain ? cli::leak_warning(session_->mask(), brain, "--roi auto on the command line") : std::string();
@@ -410,6 +413,7 @@ void Viewer::set_segment_running(bool on) {
     }
     if (on) swarm_running_ = false;
     segment_running_ = on;
+    if (on) segment_end_reported_ = false;  // a background run reports only its end: check that end afresh
     if (!on) session_->end_action();
     message_ = on ? "segmenting" : "segmentation paused";
     message_is_error_ = false;

@@ -27,7 +27,7 @@ struct WorkspaceView {
 };
 
 struct Workspace {
-    std::string image, roi;          // absolute paths (roi empty: none)
+    std::string image, roi;          // absolute paths (roi empty: none; "auto": the automatic brain mask, computed again)
     bool bias_corrected = false;     // the session's image was the N4-corrected one (absent in older files: no)
     Lattice lattice;                 // the image's geometry when saved
     std::uint64_t image_checksum = 0;  // image_checksum() of its voxels
@@ -45,7 +45,7 @@ std::uint64_t image_checksum(const Grid<float>& image);
 // The state file next to a workspace file: "<W>.state".
 std::filesystem::path workspace_state_path(const std::filesystem::path& workspace);
 
-// Writes W.state then W atomically. `image` and `roi` are made absolute; `bias_corrected`: the
+// Writes W.state then W atomically. `image` and `roi` are made absolute (a `roi` of "auto" is kept); `bias_corrected`: the
 // session's image is image's N4-corrected copy. Throws std::runtime_error.
 void save_workspace(const std::filesystem::path& path, const Session& session, const std::string& image, const std::string& roi,
                     bool bias_corrected, const WorkspaceView& view);

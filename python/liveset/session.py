@@ -46,6 +46,8 @@ class Session:
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
                  edit_range: Optional[float] = None, bias_correct: Optional[bool] = None):
         img = as_image(image)
+        if decision not in ("intensity", "random", "cut") or int(agents) < 1:  # before N4's seconds
+            raise ValueError("decision must be 'intensity', 'random' or 'cut', and agents at least 1")
         prepared = _liveset._prepare_session_image(img.array, img.geometry, _mask_arg(roi, img, "roi", allow_auto=True),
                                                    None if bias_correct is None else bool(bias_correct))
         self.corrected = prepared["image"] is not None

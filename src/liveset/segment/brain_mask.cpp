@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -245,9 +246,12 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     r.mask_voxels = count(brain);
     if (r.mask_voxels == 0) throw std::invalid_argument("brain mask: the mask is empty");
     const double share = static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1));
-    if (!r.skull_stripped && share < o.min_head_share)
-        throw std::invalid_argument("brain mask: no brain found (the mask holds " + std::to_string(r.mask_voxels) + " voxels, " +
-                                    std::to_string(static_cast<int>(std::lround(100 * share))) + " % of the head)");
+    if (!r.skull_stripped && share < o.min_head_share) {
+        char why[160];
+        std::snprintf(why, sizeof why, "brain mask: no brain found (the mask holds %zu voxels, %.1f %% of the head, under %.1f %%)",
+                      r.mask_voxels, 100 * share, 100 * o.min_head_share);
+        throw std::invalid_argument(why);
+    }
     const Vec3d s = image.lattice().spacing();
     r.mask_volume_mm3 = static_cast<double>(r.mask_voxels) * s.x * s.y * s.z;
     if (report != nullptr) *report = r;

@@ -36,7 +36,7 @@ struct BrainMaskOptions {
     // `stripped_near_mm` of the head's surface (a full head has scalp and skull in between). The
     // mask is then the filled non-background foreground. Set detect_skull_stripped false to skip.
     bool detect_skull_stripped = true;
-    // A full head's brain fills a large part of it (BrainWeb: 55 %); a mask under this share of
+    // A full head's brain fills a large part of it (BrainWeb: 46 %); a mask under this share of
     // the solid head is not a brain (e.g. a noisy scan without skull whose core shrank to a
     // fragment) and is refused as "no brain found", so callers fall back as for no head.
     double min_head_share = 0.1;
