@@ -124,7 +124,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     if (!out || out->result.reason == StopReason::kInterrupted) throw pyb::error_already_set();  // a pending KeyboardInterrupt
     nlohmann::json j = cli::segmentation_report(*out, lattice);
     cli::add_bias_report(j, prepared, roi_mask);
-    if (const std::string w = cli::leak_warning(out->mask, roi_mask ? nullptr : prepared.fit(nullptr), "roi='auto'"); !w.empty()) j["warnings"].push_back(w);
+    if (const std::string w = cli::leak_warning(out->mask, prepared.fit(nullptr), "roi='auto'"); !w.empty()) j["warnings"].push_back(w);
     if (roi) j["roi"] = cli::roi_report(*roi);
     pyb::dict r;
     r["phi"] = array_from_grid(Grid<float>(out->field->phi()));

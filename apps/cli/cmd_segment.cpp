@@ -133,7 +133,7 @@ int run_segment(const SegmentArgs& a, int threads) {
         if (!a.quiet) fmt::print(stderr, "liveset: warning: {}\n", w);
         j["warnings"].push_back(w);
     }
-    if (const std::string w = leak_warning(o.mask, roi_mask ? nullptr : prepared.fit(nullptr), "--roi auto"); !w.empty()) {
+    if (const std::string w = leak_warning(o.mask, prepared.fit(nullptr), "--roi auto"); !w.empty()) {
         if (!a.quiet) fmt::print(stderr, "liveset: warning: {}\n", w);
         j["warnings"].push_back(w);
     }

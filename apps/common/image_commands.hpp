@@ -72,8 +72,8 @@ PreparedImage prepare_image(Grid<float>& image, const Grid<std::uint8_t>* roi, B
 // The report's "bias_correction" object (bias_correction_report and where it was fitted), or, when
 // the default correction was skipped, its warning appended to the report's "warnings".
 void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi);
-// Without a ROI on a head, `brain` is the automatic brain mask prepare_image found (its
-// fit_region; null with a ROI or when none was found): a warning when more than kLeakShare of the
+// Without a ROI on a head, `brain` is the automatic brain mask prepare_image found
+// (`prepared.fit(nullptr)`: null with a ROI or when none was found): a warning when more than kLeakShare of the
 // segmented voxels lie outside it (the front leaked into scalp, muscle or eyes), naming `roi_hint`
 // ("--roi auto", "roi='auto'") as the cure; empty otherwise.
 inline constexpr double kLeakShare = 0.05;

@@ -73,12 +73,9 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> roi;
     if (std::optional<Roi> r = load_roi(a.roi, image, "--roi")) {  // a mask file, or "auto" as `segment --roi auto`
-        if (r->brain_mask) {
-            const nlohmann::json j = roi_report(*r);
-            fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({}, tissue window {:.1f}..{:.1f})\n",
-                       j["voxels"].get<std::size_t>(), r->brain_mask->skull_stripped ? "skull-stripped input" : "full head",
-                       r->brain_mask->tissue_low, r->brain_mask->tissue_high);
-        }
+        if (const auto& b = r->brain_mask)
+            fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({}, tissue window {:.1f}..{:.1f})\n", b->mask_voxels,
+                       b->skull_stripped ? "skull-stripped input" : "full head", b->tissue_low, b->tissue_high);
         roi = std::move(r->mask);
     }
     // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for (or a

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 #include <span>
 #include <vector>
@@ -131,10 +132,11 @@ Grid<float> gaussian_mm(const Grid<float>& image, double sigma_mm) {
         const int r = static_cast<int>(std::ceil(3.0 * sigma));
         const int n = d[axis];
         if (r < 1 || n < 2) continue;
-        std::vector<float> w(static_cast<std::size_t>(2 * r + 1));
-        double sum = 0;
-        for (int k = -r; k <= r; ++k) sum += std::exp(-0.5 * k * k / (sigma * sigma));
-        for (int k = -r; k <= r; ++k) w[static_cast<std::size_t>(k + r)] = static_cast<float>(std::exp(-0.5 * k * k / (sigma * sigma)) / sum);
+        std::vector<double> g(static_cast<std::size_t>(2 * r + 1));
+        for (int k = -r; k <= r; ++k) g[static_cast<std::size_t>(k + r)] = std::exp(-0.5 * k * k / (sigma * sigma));
+        const double sum = std::accumulate(g.begin(), g.end(), 0.0);
+        std::vector<float> w(g.size());
+        for (std::size_t k = 0; k < g.size(); ++k) w[k] = static_cast<float>(g[k] / sum);
         // One line along `axis` per (u, v) of the other two axes; each output reads its own line only.
         const int ua = axis == 0 ? 1 : 0, va = axis == 2 ? 1 : 2;
         const std::size_t lines = static_cast<std::size_t>(d[ua]) * static_cast<std::size_t>(d[va]);
