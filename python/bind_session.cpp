@@ -4,6 +4,7 @@
 
 #include "bindings.hpp"
 #include "cli_common.hpp"
+#include "image_commands.hpp"
 #include "liveset/session/session.hpp"
 
 namespace liveset::py {
@@ -77,6 +78,13 @@ pyb::dict run_steps(Session& s, int count, bool segment, bool until_converged) {
     if (interrupt.raised()) interrupt.rethrow();
     pyb::dict d = status_of(s);
     d["steps"] = done;
+    // A segmentation that converged without a ROI, out of the brain mask its model was fitted in:
+    // the warning `segment` and the viewer give (image_commands.hpp).
+    std::vector<std::string> warnings;
+    if (segment && s.segment_status().converged) {
+        if (std::string w = cli::session_leak_warning(s, "roi='auto'"); !w.empty()) warnings.push_back(std::move(w));
+    }
+    d["warnings"] = warnings;
     return d;
 }
 

@@ -27,6 +27,7 @@
 #include "liveset/session/repair_presets.hpp"
 #include "liveset/swarm/repair.hpp"
 #include "liveset/swarm/repair_schedule.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::cli {
 
@@ -46,10 +47,6 @@ struct DemoArgs {
     bool repair = false;  // with --brain: the paper's Figure 5 (low threshold, finder, swarm repair)
     BrainDemoArgs brain_args;
 };
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // --repair-rule sheet: the sheet rule (EditDecision::kSheet) with the grey matter's band from the
 // tissue model of the phantom, shifted to the sheet's intensity around each target.

@@ -21,14 +21,11 @@
 #include "demo_pictures.hpp"
 #include "liveset/render/surface_picture.hpp"
 #include "liveset/segment/window.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::cli {
 
 namespace {
-
-double ms_since(std::chrono::steady_clock::time_point t0) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
 
 constexpr double kLowThreshold = 0.8;           // ε of the --repair segmentation: 80 % of the model window's
 constexpr double kLowThresholdMinSigmas = 2.4;  // ... but at least 2.4 σ of the GM class (low_threshold)

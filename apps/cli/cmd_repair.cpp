@@ -26,6 +26,7 @@
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/window.hpp"
 #include "liveset/swarm/repair.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::cli {
 
@@ -124,7 +125,7 @@ std::vector<RepairStepLog> run_targets(Session& session, std::vector<RepairTarge
         while (next < order.size() && order[next].step <= step) session.set_target(order[next++].position);
         RepairStepLog rec = session.swarm_step().swarm;
         rec.step = step;
-        rec.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        rec.ms = ms_since(t0);
         rec.cpu_ms = 1000.0 * static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
         log.push_back(rec);
     }

@@ -23,6 +23,7 @@
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/session/session.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::cli {
 
@@ -91,7 +92,7 @@ int run_soak(const SoakArgs& a, int threads) {
         // One swarm step, re-aimed at the edited point every 500 iterations.
         if (it % 500 == 0) session.set_target(c.cast<double>());
         session.swarm_step();
-        ms.push_back(std::chrono::duration<double, std::milli>(clock::now() - t0).count());
+        ms.push_back(ms_since(t0));
 
         if ((it + 1) % a.check_every == 0 || it + 1 == a.iterations) {
             const InvariantReport inv = check_invariants(field);

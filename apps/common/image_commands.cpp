@@ -123,6 +123,12 @@ std::string leak_warning(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t
                        100.0 * share, outside, inside, roi_hint);
 }
 
+std::string session_leak_warning(const Session& session, std::string_view roi_hint) {
+    const std::optional<Grid<std::uint8_t>>& brain = session.options().model_region;
+    if (session.roi() || !brain) return {};
+    return leak_warning(session.mask(), &*brain, roi_hint);
+}
+
 nlohmann::json roi_report(const Roi& roi) {
     const Vec3d s = roi.mask.lattice().spacing();
     std::size_t voxels = 0;

@@ -78,6 +78,9 @@ void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, cons
 // ("--roi auto", "roi='auto'") as the cure; empty otherwise.
 inline constexpr double kLeakShare = 0.05;
 std::string leak_warning(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* brain, std::string_view roi_hint);
+// leak_warning for an editing session (the viewer, Python's Session): its mask against the brain mask
+// its tissue model was fitted in (SessionOptions::model_region); empty with a ROI or without that mask.
+std::string session_leak_warning(const Session& session, std::string_view roi_hint);
 
 // True when every voxel is exactly 0 or 1 (a mask stored as a float image).
 bool is_binary_mask(const Grid<float>& image);

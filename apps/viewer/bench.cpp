@@ -10,6 +10,7 @@
 #include "cli_common.hpp"
 #include "liveset/render/framebuffer.hpp"
 #include "liveset/session/repair_presets.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::viewer {
 
@@ -80,7 +81,7 @@ int run_bench(Viewer& viewer, const BenchOptions& o, int width, int height) {
             const auto t0 = Clock::now();
             if (sc.agents) viewer.swarm_step();  // accounted in this frame's statistics
             viewer.frame(window.id(), width, height, 1.0 / 60.0);
-            const double ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+            const double ms = ms_since(t0);
             if (f < 0) continue;
             const FrameStats& st = viewer.last_frame();
             t.level_set += st.level_set_ms;

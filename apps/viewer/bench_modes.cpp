@@ -13,13 +13,13 @@
 #include "cli_common.hpp"
 #include "liveset/render/framebuffer.hpp"
 #include "liveset/segment/pipeline.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::viewer {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 struct Summary {
     double median = 0, worst = 0;

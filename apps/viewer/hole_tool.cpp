@@ -1,5 +1,6 @@
 // The viewer's hole finder: a worker-thread scan of a copied segmentation (hole_tool.hpp).
 #include "hole_tool.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -60,7 +61,7 @@ bool HoleTool::start(const Session& session, const HoleScanOptions& options) {
 
 double HoleTool::running_ms() const {
     if (!job_.valid()) return 0.0;
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - started_).count();
+    return ms_since(started_);
 }
 
 bool HoleTool::poll(std::chrono::milliseconds wait) {

@@ -39,6 +39,7 @@ struct ViewArgs : ThresholdArgs {
     bool bias_correct = true;           // N4 first, as `segment` (also for images opened from the panel)
     bool bias_given = false;            // --bias-correct or --no-bias-correct on the command line
     std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
+    std::string workspace_warning;      // the continued workspace's ROI is not the one it was saved with
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
 };
 
@@ -153,8 +154,10 @@ std::unique_ptr<Session> open_session(ViewArgs& a, std::optional<viewer::Workspa
     std::unique_ptr<Session> s = load_session(a);
     if (ws) {
         try {
-            viewer::check_workspace_image(*ws, a.workspace, s->image());
+            viewer::check_workspace_image(*ws, a.workspace, s->image(), s->roi());
             viewer::apply_workspace(*s, *ws);
+            a.workspace_warning = viewer::workspace_roi_warning(*ws, a.workspace, *s);
+            if (!a.workspace_warning.empty()) fmt::print(stderr, "liveset: warning: {}\n", a.workspace_warning);
         } catch (const std::exception& e) {
             fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
             ws.reset();
@@ -209,6 +212,7 @@ int run_view(ViewArgs& a, int threads) {
     config.bias_correct = a.bias_correct;
     config.image_corrected = a.image_corrected;
     config.params_note = note;
+    config.open_warning = a.workspace_warning;
     config.workspace_path = a.workspace;
     if (ws) config.workspace_view = ws->view;
     // Windows autosave by default; headless runs (scripts, tests) only into an explicit --recovery-dir.

@@ -12,13 +12,13 @@
 #include "imgui_bridge.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/render/png_writer.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::viewer {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 nlohmann::json to_json(Vec3d v) { return {v.x, v.y, v.z}; }
 
@@ -48,6 +48,11 @@ Viewer::Viewer(std::unique_ptr<Session> session, std::string image_name, const V
     if (config.workspace_view && session_) {
         apply_workspace_view(*config.workspace_view);
         own_files_.push_back(workspace_path_);
+    }
+    if (!config.open_warning.empty()) {
+        message_ = config.open_warning;
+        message_is_error_ = true;
+        log_.add("warning", {{"message", config.open_warning}});
     }
 }
 
@@ -274,8 +279,7 @@ void Viewer::check_segment_end() {
     // (checked once per convergence, reset by a non-converged step, a run's start or a new
     // session; steps taken after it keep the warning in the message).
     if (!segment_end_reported_) {
-        const Grid<std::uint8_t>* brain = session_->roi() || !session_->options().model_region ? nullptr : &*session_->options().model_region;
-        leak_warning_ = st.converged && brain ? cli::leak_warning(session_->mask(), brain, "--roi auto on the command line") : std::string();
+        leak_warning_ = st.converged ? cli::session_leak_warning(*session_, "--roi auto on the command line") : std::string();
         if (!leak_warning_.empty()) {
             log_.add("warning", {{"message", leak_warning_}});
             if (config_.headless) fmt::print(stderr, "liveset: warning: {}\n", leak_warning_);

@@ -93,6 +93,7 @@ struct ViewerConfig {
     bool bias_correct = true;
     bool image_corrected = false;
     std::string params_note;  // where the start parameters came from (panel and stderr)
+    std::string open_warning;  // what the start should warn about (the workspace's ROI changed): status line and event log
     std::string workspace_path;                   // the panel's workspace file (--workspace)
     std::optional<WorkspaceView> workspace_view;  // camera, cursor, ... of the workspace continued
 };

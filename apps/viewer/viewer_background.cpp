@@ -8,6 +8,7 @@
 #include <chrono>
 
 #include "viewer.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::viewer {
 
@@ -87,7 +88,7 @@ void Viewer::handover() {
         const auto t1 = Clock::now();
         if (!coarse.empty()) coarse_surface_.upload(lod_->mesher(), coarse);
         current_.mesh_ms += std::chrono::duration<double, std::milli>(t1 - t0).count();
-        current_.upload_ms += std::chrono::duration<double, std::milli>(Clock::now() - t1).count();
+        current_.upload_ms += ms_since(t1);
     } else {
         upload_fine();
     }

@@ -3,13 +3,13 @@
 #include <chrono>
 
 #include "viewer.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset::viewer {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 }  // namespace
 

@@ -176,6 +176,7 @@ Workspace parse_workspace(const json& j) {
         throw std::runtime_error(std::string("bad geometry: ") + e.what());
     }
     ws.image_checksum = field(j, "image_fnv").get<std::uint64_t>();
+    if (j.contains("roi_fnv") && !j["roi_fnv"].is_null()) ws.roi_checksum = field(j, "roi_fnv").get<std::uint64_t>();
     if (!field(j, "seeds").is_array()) throw std::runtime_error("field 'seeds' is not a list");
     for (const json& s : field(j, "seeds")) {
         if (!s.is_array() || s.size() != 4) throw std::runtime_error("a seed is not [i, j, k, radius]");
@@ -200,6 +201,17 @@ Workspace parse_workspace(const json& j) {
     return ws;
 }
 
+// How the ROI now differs from the one a workspace was saved with; empty when it does not (or
+// nothing was recorded).
+std::string roi_change(const Workspace& ws, const Grid<std::uint8_t>* roi) {
+    if (!ws.roi_checksum || (roi && mask_checksum(*roi) == *ws.roi_checksum)) return {};
+    if (!roi) return "no ROI now";
+    std::size_t voxels = 0;
+    for (std::uint8_t v : roi->values()) voxels += v != 0;
+    return ws.roi == "auto" ? fmt::format("the automatic brain mask computed again has {} voxels", voxels)
+                            : fmt::format("{} has {} voxels now", ws.roi, voxels);
+}
+
 }  // namespace
 
 std::uint64_t image_checksum(const Grid<float>& image) {
@@ -207,6 +219,15 @@ std::uint64_t image_checksum(const Grid<float>& image) {
     for (std::size_t i = 0; i < image.size(); ++i) {
         const std::uint32_t bits = std::bit_cast<std::uint32_t>(image[static_cast<PointIndex>(i)]);
         h.add(&bits, sizeof bits);
+    }
+    return h.h;
+}
+
+std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask) {
+    recovery_format::Fnv h;
+    for (std::size_t i = 0; i < mask.size(); ++i) {
+        const std::uint8_t inside = mask[static_cast<PointIndex>(i)] != 0;
+        h.add(&inside, 1);
     }
     return h.h;
 }
@@ -229,6 +250,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
            {"geometry", {{"dims", {l.dims().x, l.dims().y, l.dims().z}}, {"spacing", vec(l.spacing())}, {"origin", vec(l.origin())},
                          {"direction", l.direction()}}},
            {"image_fnv", image_checksum(session.image())},
+           {"roi_fnv", session.roi() ? json(mask_checksum(*session.roi())) : json(nullptr)},
            {"state", {{"file", workspace_state_path(path).filename().string()}, {"fnv", trailing_checksum(state)}}},
            {"seeds", seeds},
            {"params", {{"mu", m.params.mu}, {"epsilon", m.params.epsilon}, {"n", m.params.n}, {"alpha", m.params.alpha},
@@ -288,12 +310,22 @@ Workspace read_workspace(const fs::path& path) {
     return ws;
 }
 
-void check_workspace_image(const Workspace& ws, const fs::path& path, const Grid<float>& image) {
+void check_workspace_image(const Workspace& ws, const fs::path& path, const Grid<float>& image, const Grid<std::uint8_t>* roi) {
     if (!image.lattice().same_geometry(ws.lattice, 1e-6))
         throw std::runtime_error(fmt::format("workspace {} was saved for another image: {} there, {} here (size, spacing, origin or direction)",
                                              path.string(), ws.lattice.describe(), image.lattice().describe()));
-    if (image_checksum(image) != ws.image_checksum)
-        throw std::runtime_error(fmt::format("workspace {} was saved for another image: same geometry, other voxel values (or another N4 correction of it)", path.string()));
+    if (image_checksum(image) == ws.image_checksum) return;
+    if (const std::string change = roi_change(ws, roi); ws.bias_corrected && !change.empty())
+        throw std::runtime_error(fmt::format("workspace {} was saved with another ROI ({}), and N4 fitted in it corrects the image otherwise",
+                                             path.string(), change));
+    throw std::runtime_error(fmt::format("workspace {} was saved for another image: same geometry, other voxel values (or another N4 correction of it)", path.string()));
+}
+
+std::string workspace_roi_warning(const Workspace& ws, const fs::path& path, const Session& session) {
+    const std::string change = roi_change(ws, session.roi());
+    if (change.empty()) return {};
+    return fmt::format("workspace {} was saved with another ROI ({}): the level set continues as saved, but the front may now "
+                       "move where it could not", path.string(), change);
 }
 
 void apply_workspace(Session& session, const Workspace& ws) {

@@ -3,6 +3,7 @@ the same session the viewer drives, and ``repair`` on top of it."""
 from __future__ import annotations
 
 import json
+import warnings
 from typing import Optional, Sequence
 
 import numpy as np
@@ -95,12 +96,16 @@ class Session:
 
     # segmentation and repair
     def step(self, steps: int = 1) -> dict:
-        """Take `steps` segmentation steps (one undoable action); returns the status."""
-        return self._s.segment_steps(int(steps), False)
+        """Take `steps` segmentation steps (one undoable action); returns the status and
+        ``warnings`` (see ``run``)."""
+        return _warned(self._s.segment_steps(int(steps), False))
 
     def run(self, max_steps: int = 2000) -> dict:
-        """Segmentation steps until the front converges (or vanishes), at most max_steps."""
-        return self._s.segment_steps(int(max_steps), True)
+        """Segmentation steps until the front converges (or vanishes), at most max_steps; returns
+        the status and ``warnings``: without a ROI, a converged front with more than 5 % of its
+        voxels outside the automatic brain mask is warned about as ``segment`` warns (also issued
+        as a Python ``UserWarning``); pass ``roi="auto"`` for brain tissue."""
+        return _warned(self._s.segment_steps(int(max_steps), True))
 
     @property
     def status(self) -> dict:
@@ -154,6 +159,13 @@ class Session:
 
     def phi(self) -> Image:
         return self.image.like(self._s.phi())
+
+
+def _warned(status: dict) -> dict:
+    """Issues a run's warnings (a leak out of the brain) as Python warnings too."""
+    for w in status["warnings"]:
+        warnings.warn(w, UserWarning, stacklevel=3)
+    return status
 
 
 def _edit_range(decision: str, edit_range: Optional[float]) -> float:

@@ -1,6 +1,7 @@
 """The Python API against independent answers: nibabel for geometry, the CLI for segment/eval,
 numpy brute force for overlap, an analytic sphere for mesh positions."""
 import json
+import warnings
 import os
 import signal
 import threading
@@ -286,8 +287,8 @@ def test_session_prepares_the_image_as_segment_does(phantom):
         liveset.Session(img, roi="brain")
 
 
-def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
-    # An analytic head (WM, GM, CSF, skull, scalp) with a bridge of WM intensity to the scalp.
+def _bridged_head():
+    """An analytic head (WM, GM, CSF, skull, scalp) with a bridge of WM intensity to the scalp."""
     g = np.indices((64, 64, 64)).astype(float)
     r = 1.5 * np.sqrt(((g - 31.5) ** 2).sum(axis=0))
     a = np.select([r < 18, r < 27, r < 29, r < 35, r < 42], [130.0, 95.0, 45.0, 8.0, 160.0], 0.0)
@@ -295,7 +296,11 @@ def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
     bridge = np.zeros(a.shape, bool)
     bridge[40:, 29:35, 29:35] = True
     a[bridge & (r < 42)] = 130.0
-    img = liveset.Image(a.astype(np.float32), (1.5, 1.5, 1.5))
+    return liveset.Image(a.astype(np.float32), (1.5, 1.5, 1.5))
+
+
+def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
+    img = _bridged_head()
     kw = dict(mu_raw=130, epsilon_raw=40, iterations=400, bias_correct=False)
     leaked = liveset.segment(img, [(32, 32, 32, 3)], **kw)
     warned = [w for w in leaked.report["warnings"] if "outside the automatic brain mask" in w]
@@ -303,6 +308,29 @@ def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
     inside = liveset.segment(img, [(32, 32, 32, 3)], roi="auto", **kw)
     assert not any("outside the automatic brain mask" in w for w in inside.report["warnings"])
     assert int(inside.mask.array.sum()) < int(leaked.mask.array.sum())
+
+
+def test_session_warns_as_segment_when_its_front_leaks_out_of_the_brain():
+    img = _bridged_head()
+    seg = liveset.segment(img, [(32, 32, 32, 3)], mu_raw=130, epsilon_raw=40, iterations=1000, bias_correct=False)
+    expected = [w for w in seg.report["warnings"] if "outside the automatic brain mask" in w]
+    assert len(expected) == 1
+    for roi in (None, "auto"):
+        s = liveset.Session(img, roi=roi, bias_correct=False)
+        s.add_seed((32, 32, 32), 3)
+        p = s.params  # the window segment was given, in the session's normalised units
+        per_raw = p["epsilon"] / p["epsilon_raw"]
+        s.set_params(mu=p["mu"] + (130 - p["mu_raw"]) * per_raw, epsilon=40 * per_raw, alpha=seg.report["alpha"])
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            status = s.run(1000)
+        assert status["converged"]
+        if roi is None:  # the same front as segment's, the same warning, also as a Python warning
+            assert np.array_equal(s.mask().array, seg.mask.array)
+            assert status["warnings"] == expected and [str(w.message) for w in caught] == expected
+        else:
+            assert status["warnings"] == [] and not caught
+            assert int(s.mask().array.sum()) < int(seg.mask.array.sum())
 
 
 def test_docs_example_runs(tmp_path):

@@ -30,15 +30,7 @@ bool on_same_border_plane(const Vertex& a, const Vertex& b, Vec3i dims) {
     return false;
 }
 
-void expect_identical(const Mesh& a, const Mesh& b) {
-    ASSERT_EQ(a.vertices.size(), b.vertices.size());
-    ASSERT_EQ(a.indices, b.indices);
-    for (std::size_t i = 0; i < a.vertices.size(); ++i)
-        for (int k = 0; k < 3; ++k) {
-            ASSERT_EQ(a.vertices[i].position[k], b.vertices[i].position[k]);
-            ASSERT_EQ(a.vertices[i].normal[k], b.vertices[i].normal[k]);
-        }
-}
+using testing::expect_identical;
 
 TEST(MarchingCubes, RandomFieldsAreCrackFreeAndConsistentlyOriented) {
     const Vec3i dims{9, 10, 11};

@@ -1,12 +1,15 @@
 // Shared φ fields for the mesh tests: exact sphere and torus signed distances and seeded random
-// grids (φ < 0 inside).
+// grids (φ < 0 inside); and the bit-for-bit mesh comparison.
 #pragma once
 
 #include <cmath>
 #include <cstdint>
 #include <random>
 
+#include <gtest/gtest.h>
+
 #include "liveset/grid/grid.hpp"
+#include "liveset/mesh/mesh.hpp"
 
 namespace liveset::testing {
 
@@ -48,6 +51,17 @@ inline Grid<float> random_field(Vec3i dims, std::uint32_t seed, bool outside_bor
                 g({x, y, z}) = v;
             }
     return g;
+}
+
+// The same vertices (positions and normals, bit for bit) and the same triangles in the same order.
+inline void expect_identical(const Mesh& a, const Mesh& b) {
+    ASSERT_EQ(a.vertices.size(), b.vertices.size());
+    ASSERT_EQ(a.indices, b.indices);
+    for (std::size_t i = 0; i < a.vertices.size(); ++i)
+        for (int k = 0; k < 3; ++k) {
+            ASSERT_EQ(a.vertices[i].position[k], b.vertices[i].position[k]) << "vertex " << i;
+            ASSERT_EQ(a.vertices[i].normal[k], b.vertices[i].normal[k]) << "vertex " << i;
+        }
 }
 
 }  // namespace liveset::testing

@@ -20,15 +20,7 @@ using testing::random_field;
 using testing::sphere_field;
 using testing::torus_field;
 
-void expect_identical(const Mesh& a, const Mesh& b) {
-    ASSERT_EQ(a.vertices.size(), b.vertices.size());
-    ASSERT_EQ(a.indices, b.indices);
-    for (std::size_t i = 0; i < a.vertices.size(); ++i)
-        for (int k = 0; k < 3; ++k) {
-            ASSERT_EQ(a.vertices[i].position[k], b.vertices[i].position[k]) << "vertex " << i;
-            ASSERT_EQ(a.vertices[i].normal[k], b.vertices[i].normal[k]) << "vertex " << i;
-        }
-}
+using testing::expect_identical;
 
 void check_all_settings(const Grid<float>& phi) {
     const Mesh ref = marching_cubes_naive(phi);

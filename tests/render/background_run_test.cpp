@@ -15,6 +15,7 @@
 #include "liveset/render/framebuffer.hpp"
 #include "liveset/render/headless_context.hpp"
 #include "viewer.hpp"
+#include "viewer_test_util.hpp"
 
 #ifdef __SANITIZE_THREAD__
 #include <tbb/global_control.h>
@@ -23,31 +24,18 @@
 namespace liveset::viewer {
 namespace {
 
+using testing::phantom48;
+using testing::seeded_session;
+
 #ifdef __SANITIZE_THREAD__
 // Under ThreadSanitizer (build-tsan, not CI): no oneTBB worker threads (an uninstrumented scheduler).
 const tbb::global_control one_tbb_thread(tbb::global_control::max_allowed_parallelism, 1);
 #endif
 
-const Phantom& phantom() {
-    static const Phantom ph = [] {
-        PhantomOptions o;
-        o.size = 48;
-        return make_phantom(o);
-    }();
-    return ph;
-}
-
 SessionOptions sleeping() {
     SessionOptions o;
     o.segmentation.step = sleeping_step();
     return o;
-}
-
-std::unique_ptr<Session> seeded_session() {
-    auto s = std::make_unique<Session>(phantom().image, sleeping());
-    for (const Vec3i& c : phantom().seeds) s->add_seed({c.cast<double>(), 2.0});
-    s->end_action();
-    return s;
 }
 
 std::vector<std::uint32_t> bits(const Session& s) {
@@ -90,10 +78,10 @@ void frames_until_steps(Viewer& v, const render::Framebuffer& fb, int steps) {
 
 TEST(BackgroundRun, ASegmentationRunEqualsTheForegroundStepsAtAnyPace) {
     render::HeadlessContext context;
-    auto reference = seeded_session();
+    auto reference = seeded_session(sleeping());
     while (!reference->segment_status().converged && reference->segment_status().iterations < 5000) reference->segment_step();
     for (const double pace : {1.0, 40.0}) {
-        Viewer v(seeded_session(), "phantom", config(pace));
+        Viewer v(seeded_session(sleeping()), "phantom", config(pace));
         render::Framebuffer fb(640, 480);
         v.frame(fb.id(), 640, 480, 1.0 / 60.0);
         v.set_segment_running(true);
@@ -113,7 +101,7 @@ TEST(BackgroundRun, ASegmentationRunEqualsTheForegroundStepsAtAnyPace) {
 
 TEST(BackgroundRun, PauseSeedAndUndoDuringARunStopTheWorkerFirst) {
     render::HeadlessContext context;
-    Viewer v(seeded_session(), "phantom", config(5.0));
+    Viewer v(seeded_session(sleeping()), "phantom", config(5.0));
     render::Framebuffer fb(640, 480);
     v.frame(fb.id(), 640, 480, 1.0 / 60.0);
     const std::vector<std::uint32_t> before = bits(*v.session());
@@ -122,7 +110,7 @@ TEST(BackgroundRun, PauseSeedAndUndoDuringARunStopTheWorkerFirst) {
     v.set_segment_running(false);  // pause: the worker is joined, the session is ours
     ASSERT_FALSE(v.background_active());
     const int k = v.session()->segment_status().iterations;
-    auto reference = seeded_session();
+    auto reference = seeded_session(sleeping());
     for (int i = 0; i < k; ++i) reference->segment_step();
     EXPECT_TRUE(bits(*v.session()) == bits(*reference)) << k << " steps";
     v.undo();  // the run, one action
@@ -130,7 +118,7 @@ TEST(BackgroundRun, PauseSeedAndUndoDuringARunStopTheWorkerFirst) {
 
     v.set_segment_running(true);  // again, a seed placed while it runs
     frames_while_running(v, fb, 2);
-    const Vec3d extra = phantom().seeds.front().cast<double>() + Vec3d{1.0, 1.0, 0.0};
+    const Vec3d extra = phantom48().seeds.front().cast<double>() + Vec3d{1.0, 1.0, 0.0};
     EXPECT_TRUE(v.add_seed(extra, 1.5)) << v.message();
     EXPECT_TRUE(v.segment_running());  // the run goes on after the seed, as in the foreground
     v.frame(fb.id(), 640, 480, 1.0 / 60.0);  // starts the new worker; also counts the steps before the seed

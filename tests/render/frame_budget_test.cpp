@@ -12,9 +12,13 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/render/headless_context.hpp"
 #include "viewer.hpp"
+#include "viewer_test_util.hpp"
 
 namespace liveset::viewer {
 namespace {
+
+using testing::phantom48;
+using testing::seeded_session;
 
 // Steps one frame takes when every step costs `step` ms and the upload `upload` ms.
 int steps_in_frame(FrameBudget& b, double step, double upload) {
@@ -96,22 +100,6 @@ TEST(FrameBudget, RefusesBadOptions) {
     EXPECT_THROW(FrameBudget{o}, std::invalid_argument);
 }
 
-const Phantom& phantom() {
-    static const Phantom ph = [] {
-        PhantomOptions o;
-        o.size = 48;
-        return make_phantom(o);
-    }();
-    return ph;
-}
-
-std::unique_ptr<Session> seeded_session() {
-    auto s = std::make_unique<Session>(phantom().image, SessionOptions{});
-    for (const Vec3i& c : phantom().seeds) s->add_seed({c.cast<double>(), 2.0});
-    s->end_action();
-    return s;
-}
-
 bool same_phi(const Session& a, const Session& b) {
     const auto& pa = a.field().phi().values();
     const auto& pb = b.field().phi().values();
@@ -128,8 +116,8 @@ int run_in_viewer(double frame_ms) {
     c.headless = true;
     c.budget.frame_ms = frame_ms;
     c.budget.background = false;  // steps in frames (background_run_test.cpp: on a worker)
-    Viewer v(seeded_session(), "phantom", c);
-    auto reference = seeded_session();
+    Viewer v(seeded_session(SessionOptions{}), "phantom", c);
+    auto reference = seeded_session(SessionOptions{});
     render::Framebuffer window(640, 480);
     v.set_segment_running(true);
     int frames = 0;
@@ -172,7 +160,7 @@ TEST(ViewerBudget, CoarseSurfaceWhileDraggingFullSurfaceOnceReleasedSameSilhouet
     c.budget.lod_above_ms = 0.0;     // the phantom's surface draws fast: force the level of detail
     c.budget.lod_factor = 2;
     c.budget.still_ms = 0.0;         // full quality as soon as nothing is held
-    auto s = seeded_session();
+    auto s = seeded_session(SessionOptions{});
     for (int i = 0; i < 30; ++i) s->segment_step();
     s->end_action();
     Viewer v(std::move(s), "phantom", c);

@@ -34,7 +34,7 @@ namespace fs = std::filesystem;
 using testing::run_cli;
 using testing::CliResult;
 
-fs::path work_dir() {
+fs::path scripts_dir() {
     static const fs::path d = testing::scratch_dir("script_test");
     return d;
 }
@@ -62,7 +62,7 @@ struct RepairRun {
 RepairRun scripted_repair() {
     RepairRun run;
     const Phantom ph = make_phantom();  // 128^3: the demo's size, where its swarm settings are tuned
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     const std::string image = (dir / "t1.nii.gz").string(), truth = (dir / "truth.nii.gz").string();
     write_image(ph.image, image);
     write_label_image(ph.truth, truth);
@@ -143,7 +143,7 @@ TEST(ScriptedSession, SegmentsThePhantomThenTheSwarmRepairsItToNoHoles) {
 // At zoom 4 about voxel (20, 20, 24) the axial pane's centre pixel is that voxel's centre: its grey
 // is the window's mapping of the voxel's intensity (mid-grey, then a tenth of the way up).
 TEST(ScriptedSession, DisplayWindowAndZoomReachTheSlicePixels) {
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     PhantomOptions o;
     o.size = 48;
     const Phantom ph = make_phantom(o);
@@ -172,7 +172,7 @@ TEST(ScriptedSession, DisplayWindowAndZoomReachTheSlicePixels) {
 // core (a handle): a script choosing the cut rule and aiming at the rod removes rod voxels only and
 // leaves genus 0 — the viewer's panel sets the same option (its "rule" combo).
 TEST(ScriptedSession, TheCutRuleCutsAHandleAtTheTarget) {
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     const testing::RodShell c = testing::rod_shell();
     ASSERT_EQ(mask_topology(c.mask).genus, 1);
     write_image(c.image, (dir / "rod_t1.nii.gz").string());
@@ -187,7 +187,7 @@ TEST(ScriptedSession, TheCutRuleCutsAHandleAtTheTarget) {
 }
 
 TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     PhantomOptions o;
     o.size = 48;
     const std::string image = (dir / "small.nii.gz").string();
@@ -242,7 +242,7 @@ TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
 }
 
 TEST(ViewBench, ReportsTheRendererAndOnlyTheRepairingScenariosRebuildFragments) {
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     PhantomOptions o;
     o.size = 48;
     const Phantom ph = make_phantom(o);
@@ -274,7 +274,7 @@ TEST(ScriptedSession, SeedsOnTheCommandLineStartWithSegmentsAutomaticAlpha) {
     const testing::NoisyAnisotropicPhantom noisy = testing::noisy_anisotropic_phantom(64);
     const Phantom& ph = noisy.phantom;
     const Grid<float>& image = noisy.image;
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     const std::string path = (dir / "aniso_t1.nii.gz").string(), view_mask = (dir / "aniso_view.nii.gz").string(),
                       seg_mask = (dir / "aniso_seg.nii.gz").string();
     write_image(image, path);
@@ -327,7 +327,7 @@ ClickedPhantom clicked_phantom(const std::string& name) {
     PhantomOptions po;
     po.size = 64;
     const Phantom ph = make_phantom(po);
-    ClickedPhantom c{(work_dir() / (name + "_t1.nii.gz")).string(), "", ""};
+    ClickedPhantom c{(scripts_dir() / (name + "_t1.nii.gz")).string(), "", ""};
     write_image(ph.image, c.path);
     for (const Vec3i& s : ph.seeds) {
         c.seeds += fmt::format(" --seed {},{},{}", s.x, s.y, s.z);
@@ -354,7 +354,7 @@ std::size_t differing_voxels(const std::string& a_path, const std::string& b_pat
 // differed), so seeds placed in the viewer still give segment's mask.
 TEST(ScriptedSession, WithBiasCorrectionAndNoRoiTheViewerFitsTheModelWhereSegmentDoes) {
     const ClickedPhantom ph = clicked_phantom("n4");
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     const std::string view_mask = (dir / "n4_view.nii.gz").string(), seg_mask = (dir / "n4_seg.nii.gz").string();
     write_text(dir / "clicked_n4.json", "[" + ph.clicks + R"({"segment": "converge"}, {"save_mask": ")" + view_mask + R"("}])");
     const CliResult seg = run_cli("segment " + ph.path + ph.seeds + " --out-mask " + seg_mask);
@@ -368,7 +368,7 @@ TEST(ScriptedSession, WithBiasCorrectionAndNoRoiTheViewerFitsTheModelWhereSegmen
 // a path to a file named auto) and continues exactly. On the analytic head with a bridge to the
 // scalp, where the ROI decides the result: without it the front leaks along the bridge.
 TEST(ScriptedSession, RoiAutoIsSegmentsBrainMaskAndTheWorkspaceKeepsIt) {
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     const std::string path = (dir / "auto_head.nii.gz").string(), view_mask = (dir / "auto_view.nii.gz").string(),
                       seg_mask = (dir / "auto_seg.nii.gz").string(), again = (dir / "auto_again.nii.gz").string(),
                       ws = (dir / "auto_ws.json").string();
@@ -398,7 +398,7 @@ TEST(ScriptedSession, RoiAutoIsSegmentsBrainMaskAndTheWorkspaceKeepsIt) {
 // As `segment`: without a ROI on a head, a front that leaked out of the automatic brain mask is
 // warned about when it converges (stderr when headless, the event log); with --roi auto it is not.
 TEST(ScriptedSession, AFrontThatLeaksOutOfTheBrainWithoutARoiIsWarnedAbout) {
-    const fs::path dir = work_dir();
+    const fs::path dir = scripts_dir();
     const std::string path = (dir / "bridged_head.nii.gz").string(), events = (dir / "leak_events.jsonl").string();
     write_image(testing::analytic_head(true), path);
     write_text(dir / "leak.json", R"([{"segment": "converge"}])");

@@ -20,9 +20,13 @@
 #include "liveset/segment/window.hpp"
 #include "scratch_dir.hpp"
 #include "workspace.hpp"
+#include "viewer_test_util.hpp"
 
 namespace liveset {
 namespace {
+
+using testing::have;
+using testing::same_bits;
 
 namespace fs = std::filesystem;
 using testing::CliResult;
@@ -55,14 +59,6 @@ std::string script(const std::string& name, const std::string& json) {
     const fs::path p = fixture().dir / name;
     std::ofstream(p) << json;
     return p.string();
-}
-
-bool same_bits(const Grid<float>& a, const Grid<float>& b) {
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (std::bit_cast<std::uint32_t>(a[static_cast<PointIndex>(i)]) != std::bit_cast<std::uint32_t>(b[static_cast<PointIndex>(i)]))
-            return false;
-    return true;
 }
 
 std::size_t lines(const std::string& text) { return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')); }
@@ -223,6 +219,64 @@ TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
     EXPECT_NE(r.err.find("outside the region of interest"), std::string::npos) << r.err;
 }
 
+// A workspace records its ROI's checksum. Without N4: reopened with the ROI file unchanged it says
+// nothing; after the file changed on disk it continues the level set as saved and warns on stderr
+// and in the event log (the status line shows it), naming the ROI and its voxel count now. With
+// N4 (fitted in the ROI) the image itself changed: refused in one line that names the ROI.
+TEST(ViewCommand, AWorkspaceWhoseRoiChangedOnDiskSaysSo) {
+    const Fixture& f = fixture();
+    Grid<std::uint8_t> roi(f.ph.image.lattice());
+    const Vec3i d = roi.dims();
+    const auto write_roi = [&](int margin, const std::string& path) {
+        for (int z = 0; z < d.z; ++z)
+            for (int y = 0; y < d.y; ++y)
+                for (int x = 0; x < d.x; ++x) roi({x, y, z}) = z >= margin && z < d.z - margin;
+        write_label_image(roi, path);
+        std::size_t n = 0;
+        for (std::uint8_t v : roi.values()) n += v;
+        return n;
+    };
+    const std::string roi_path = (f.dir / "ws_roi.nii.gz").string(), w = (f.dir / "ws_roi.json").string(), w_n4 = (f.dir / "ws_roi_n4.json").string();
+    const std::string p_saved = (f.dir / "ws_roi_saved.nii.gz").string(), p_again = (f.dir / "ws_roi_again.nii.gz").string();
+    write_roi(2, roi_path);
+    CliResult r = run_cli(fmt::format("view {} --no-bias-correct --roi {} --seeds {} --headless --script {}", f.image, roi_path, f.seeds,
+                                      script("ws_roi_a.json", R"([{"segment": 10}, {"save_phi": ")" + p_saved + R"("}, {"save_workspace": ")" + w + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    r = run_cli(fmt::format("view {} --roi {} --seeds {} --headless --script {}", f.image, roi_path, f.seeds,
+                            script("ws_roi_n4.json", R"([{"segment": 10}, {"save_workspace": ")" + w_n4 + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    ASSERT_TRUE(viewer::read_workspace(w).roi_checksum.has_value());
+    EXPECT_EQ(*viewer::read_workspace(w).roi_checksum, viewer::mask_checksum(read_label_image(roi_path)));
+    for (const std::string& ws : {w, w_n4}) {
+        r = run_cli(fmt::format("view --workspace {} --headless --script {}", ws, script("ws_roi_b.json", "[]")));
+        ASSERT_EQ(r.rc, 0) << r.err;
+        EXPECT_EQ(r.err.find("ROI"), std::string::npos) << r.err;
+        EXPECT_NE(r.err.find("from the workspace " + ws), std::string::npos) << r.err;
+    }
+
+    const std::size_t now = write_roi(3, roi_path);
+    const std::string change = fmt::format("({} has {} voxels now)", fs::absolute(roi_path).string(), now);
+    const fs::path log = f.dir / "ws_roi.jsonl";
+    r = run_cli(fmt::format("view --workspace {} --headless --log-events {} --script {}", w, log.string(),
+                            script("ws_roi_c.json", R"([{"save_phi": ")" + p_again + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find(fmt::format("warning: workspace {} was saved with another ROI {}", w, change)), std::string::npos) << r.err;
+    EXPECT_TRUE(same_bits(read_image(p_again), read_image(p_saved)));  // the level set continues as saved
+    bool logged = false;
+    std::ifstream in(log);
+    for (std::string line; std::getline(in, line);) {
+        const nlohmann::json e = nlohmann::json::parse(line);
+        logged = logged || (e["type"] == "warning" && e["message"].get<std::string>().find("another ROI " + change) != std::string::npos);
+    }
+    EXPECT_TRUE(logged);
+
+    r = run_cli(fmt::format("view --workspace {} --headless --script {}", w_n4, script("ws_roi_d.json", "[]")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_EQ(lines(r.err), 1u) << r.err;
+    EXPECT_NE(r.err.find(fmt::format("error: workspace {} was saved with another ROI {}, and N4 fitted in it corrects the image otherwise; "
+                                     "the viewer opens without it", w_n4, change)), std::string::npos) << r.err;
+}
+
 // Scripts save and load seed files: what load_seeds read, save_seeds writes back; a file with a
 // seed outside the ROI loads the others and fails the entry naming the refused seed.
 TEST(ViewCommand, ScriptsSaveAndLoadSeedFiles) {
@@ -257,7 +311,6 @@ TEST(ViewCommand, ScriptsSaveAndLoadSeedFiles) {
 
 // --- real windows -----------------------------------------------------------------------------
 
-bool have(const char* tool) { return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0; }
 
 // Runs a driver under Xvfb in `dir`; its output on failure.
 std::string run_driver(const fs::path& dir, const std::string& driver, const std::string& args, int& rc) {

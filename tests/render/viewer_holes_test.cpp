@@ -18,15 +18,18 @@
 #include "liveset/render/slice_renderer.hpp"
 #include "scratch_dir.hpp"
 #include "session/hole_phantom.hpp"
+#include "viewer_test_util.hpp"
 
 namespace liveset {
 namespace {
+
+using testing::vec3i;
 
 namespace fs = std::filesystem;
 using testing::run_cli;
 using testing::CliResult;
 
-fs::path work_dir() {
+fs::path holes_dir() {
     static const fs::path d = testing::scratch_dir("viewer_holes");
     return d;
 }
@@ -38,7 +41,7 @@ struct Files {
 const Files& files() {
     static const Files f = [] {
         const testing::DrilledPhantom& d = testing::drilled_phantom();
-        Files r{(work_dir() / "t1.nii.gz").string(), (work_dir() / "drilled.nii.gz").string()};
+        Files r{(holes_dir() / "t1.nii.gz").string(), (holes_dir() / "drilled.nii.gz").string()};
         write_image(d.phantom.image, r.image);
         write_label_image(d.mask, r.mask);
         return r;
@@ -69,7 +72,6 @@ std::vector<nlohmann::json> events(const fs::path& log, const std::string& type)
     return r;
 }
 
-Vec3i vec(const nlohmann::json& j) { return {j[0].get<int>(), j[1].get<int>(), j[2].get<int>()}; }
 
 bool is_highlight(const render::Image& img, int x, int y) {
     if (x < 0 || y < 0 || x >= img.width || y >= img.height) return false;
@@ -81,7 +83,7 @@ bool is_highlight(const render::Image& img, int x, int y) {
 TEST(ViewerHoles, FindSelectRepairAndTheFindersVerdict) {
     const testing::DrilledPhantom& d = testing::drilled_phantom();
     const Files& f = files();
-    const fs::path dir = work_dir(), log = dir / "events.jsonl", shot = dir / "axial.png";
+    const fs::path dir = holes_dir(), log = dir / "events.jsonl", shot = dir / "axial.png";
     const int w = 256, h = 256;
     std::ofstream(dir / "holes.json") << fmt::format(
         R"([{{"find_holes": {{}}}}, {{"select_hole": 1}}, {{"screenshot": "{}", "pane": "axial", "size": [{}, {}]}},
@@ -95,20 +97,20 @@ TEST(ViewerHoles, FindSelectRepairAndTheFindersVerdict) {
 
     // The drill is listed first, its site a drilled voxel; 1-based voxel = target + 1.
     const nlohmann::json& first = reports[0]["sites"][0];
-    const Vec3i site = vec(first["target"]);
+    const Vec3i site = vec3i(first["target"]);
     EXPECT_EQ(first["rank"], 1);
     EXPECT_TRUE(d.drilled(site)) << first.dump();
-    EXPECT_EQ(vec(first["voxel1"]), (site + Vec3i{1, 1, 1}));
+    EXPECT_EQ(vec3i(first["voxel1"]), (site + Vec3i{1, 1, 1}));
     EXPECT_EQ(reports[0]["band_from"], "tissue model");
 
     // select_hole: the cursor on the site (all three slices follow: one cursor), the swarm's target.
     const std::vector<nlohmann::json> cursors = events(log, "cursor");
     ASSERT_FALSE(cursors.empty());
     EXPECT_EQ(cursors.back()["how"], "hole");
-    EXPECT_EQ(vec(cursors.back()["voxel"]), site);
+    EXPECT_EQ(vec3i(cursors.back()["voxel"]), site);
     const std::vector<nlohmann::json> targets = events(log, "target");
     ASSERT_EQ(targets.size(), 1u);
-    EXPECT_EQ(vec(targets[0]["index"]), site);
+    EXPECT_EQ(vec3i(targets[0]["index"]), site);
 
     // The selected marker: highlight pixels on the ring about the site's projection (the diagonals,
     // clear of the crosshair), none far from it.
@@ -137,16 +139,16 @@ TEST(ViewerHoles, FindSelectRepairAndTheFindersVerdict) {
     const nlohmann::json& after = reports[1];
     ASSERT_EQ(after["verdicts"].size(), 1u) << after.dump();
     const nlohmann::json& v = after["verdicts"][0];
-    EXPECT_EQ(vec(v["target"]), site);
+    EXPECT_EQ(vec3i(v["target"]), site);
     EXPECT_GT(v["before"].get<int>(), 0);
     EXPECT_TRUE(v["closed"].get<bool>()) << v.dump();
     EXPECT_LE(2 * v["after"].get<int>(), v["before"].get<int>());
-    for (const nlohmann::json& s : after["sites"]) EXPECT_GT(norm((vec(s["target"]) - site).cast<double>()), 6.0) << s.dump();
+    for (const nlohmann::json& s : after["sites"]) EXPECT_GT(norm((vec3i(s["target"]) - site).cast<double>()), 6.0) << s.dump();
 }
 
 TEST(ViewerHoles, BadEntriesAreRefusedWithOneLine) {
     const Files& f = files();
-    const fs::path dir = work_dir();
+    const fs::path dir = holes_dir();
     struct Case {
         std::string script, phrase;
     };

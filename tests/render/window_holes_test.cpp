@@ -14,15 +14,17 @@
 #include "liveset/io/image_io.hpp"
 #include "scratch_dir.hpp"
 #include "session/hole_phantom.hpp"
+#include "viewer_test_util.hpp"
 
 namespace liveset {
 namespace {
 
+using testing::have;
+using testing::vec3i;
+
 namespace fs = std::filesystem;
 
-bool have(const char* tool) { return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0; }
 
-Vec3i vec(const nlohmann::json& j) { return {j[0].get<int>(), j[1].get<int>(), j[2].get<int>()}; }
 
 TEST(WindowHoles, FindHolesThenClickTheFirstRowUnderXvfb) {
     if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))
@@ -57,13 +59,13 @@ TEST(WindowHoles, FindHolesThenClickTheFirstRowUnderXvfb) {
     ASSERT_EQ(selected.size(), 2u);
     EXPECT_EQ(selected[0]["rank"], 1);
     EXPECT_EQ(selected[1]["rank"], 1 % count + 1);  // the N key: the next one (the list wraps round)
-    const Vec3i site = vec(selected[0]["site"]);
+    const Vec3i site = vec3i(selected[0]["site"]);
     EXPECT_TRUE(d.drilled(site)) << selected[0].dump();
     ASSERT_GE(cursors.size(), 2u);
-    EXPECT_EQ(vec(cursors[0]["voxel"]), site);
+    EXPECT_EQ(vec3i(cursors[0]["voxel"]), site);
     EXPECT_EQ(cursors[0]["how"], "hole");
     ASSERT_GE(targets.size(), 1u);
-    EXPECT_EQ(vec(targets[0]["index"]), site);
+    EXPECT_EQ(vec3i(targets[0]["index"]), site);
     fs::remove_all(dir);
 }
 

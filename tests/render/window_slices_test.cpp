@@ -18,13 +18,15 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/render/png_writer.hpp"
 #include "scratch_dir.hpp"
+#include "viewer_test_util.hpp"
 
 namespace liveset {
 namespace {
 
+using testing::have;
+
 namespace fs = std::filesystem;
 
-bool have(const char* tool) { return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0; }
 
 std::array<int, 3> rgb_at(const render::Image& img, int x, int y) {
     const std::size_t k = 4 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(img.width) + static_cast<std::size_t>(x));

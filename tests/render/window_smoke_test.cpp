@@ -17,13 +17,15 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/recovery.hpp"
 #include "scratch_dir.hpp"
+#include "viewer_test_util.hpp"
 
 namespace liveset {
 namespace {
 
+using testing::have;
+
 namespace fs = std::filesystem;
 
-bool have(const char* tool) { return std::system((std::string("command -v ") + tool + " >/dev/null 2>&1").c_str()) == 0; }
 
 TEST(WindowSmoke, DragClickKeysAndAButtonUnderXvfb) {
     if (!have("xvfb-run") || !have("xdotool") || !have("xauth"))

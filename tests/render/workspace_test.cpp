@@ -19,9 +19,12 @@
 #include "liveset/session/repair_presets.hpp"
 #include "seed_file.hpp"
 #include "workspace.hpp"
+#include "viewer_test_util.hpp"
 
 namespace liveset {
 namespace {
+
+using testing::same_bits;
 
 namespace fs = std::filesystem;
 using viewer::Workspace;
@@ -42,17 +45,9 @@ SessionOptions options() {
     return o;
 }
 
-fs::path work_dir() {
+fs::path workspaces_dir() {
     static const fs::path d = testing::scratch_dir("workspace_test");
     return d;
-}
-
-bool same_bits(const Grid<float>& a, const Grid<float>& b) {
-    if (a.size() != b.size()) return false;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (std::bit_cast<std::uint32_t>(a[static_cast<PointIndex>(i)]) != std::bit_cast<std::uint32_t>(b[static_cast<PointIndex>(i)]))
-            return false;
-    return true;
 }
 
 bool same_status(const Grid<std::int8_t>& a, const Grid<std::int8_t>& b) {
@@ -112,7 +107,7 @@ std::string error_of(const std::function<void()>& f) {
 
 TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     const auto original = worked_session();
-    const fs::path w = work_dir() / "roundtrip.json";
+    const fs::path w = workspaces_dir() / "roundtrip.json";
     viewer::save_workspace(w, *original, "t1.nii.gz", "", true, a_view());
     ASSERT_TRUE(fs::exists(viewer::workspace_state_path(w)));
 
@@ -156,7 +151,7 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
 
     // Continued in a fresh session on the same image: the same state, and the same next steps.
     Session continued(phantom48().image, options());
-    viewer::check_workspace_image(ws, w, continued.image());
+    viewer::check_workspace_image(ws, w, continued.image(), continued.roi());
     viewer::apply_workspace(continued, ws);
     EXPECT_TRUE(same_bits(continued.field().phi(), original->field().phi()));
     EXPECT_TRUE(same_status(continued.field().status(), original->field().status()));
@@ -175,7 +170,7 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     // The automatic α's flag travels too; a workspace written before it (no key) had a set α.
     ThresholdParams q = original->params();
     original->set_params(q, false, true);
-    const fs::path w2 = work_dir() / "automatic_alpha.json";
+    const fs::path w2 = workspaces_dir() / "automatic_alpha.json";
     viewer::save_workspace(w2, *original, "t1.nii.gz", "", true, a_view());
     const Workspace automatic = viewer::read_workspace(w2);
     EXPECT_TRUE(automatic.marks.alpha_automatic);
@@ -189,7 +184,7 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
 
 TEST(WorkspaceFile, BadWorkspacesAreRefusedWithOneClearLine) {
     const auto s = worked_session();
-    const fs::path dir = work_dir() / "bad";
+    const fs::path dir = workspaces_dir() / "bad";
     fs::create_directories(dir);
     const fs::path good = dir / "good.json";
     viewer::save_workspace(good, *s, "t1.nii.gz", "", false, a_view());
@@ -240,7 +235,7 @@ TEST(WorkspaceFile, BadWorkspacesAreRefusedWithOneClearLine) {
 
     // Another image: other dimensions, other spacing (same size), other voxels (same geometry).
     const Workspace ws = viewer::read_workspace(good);
-    const auto check = [&](const Grid<float>& image) { return error_of([&] { viewer::check_workspace_image(ws, good, image); }); };
+    const auto check = [&](const Grid<float>& image) { return error_of([&] { viewer::check_workspace_image(ws, good, image, nullptr); }); };
     EXPECT_EQ(check(phantom48().image), "(no error)");
     PhantomOptions o;
     o.size = 40;
@@ -257,7 +252,7 @@ TEST(SeedFile, RoundTripIsBitExactInTheCliFormat) {
     const std::vector<SeedBall> seeds = {{{35, 83, 113}, 2.0}, {{0.1, 1.0 / 3.0, 1e-7}, 2.5}, {{180, 216.75, 179}, 1.0 / 7.0}};
     const std::string text = cli::format_seed_file(seeds);
     EXPECT_NE(text.find("\n35,83,113:2\n"), std::string::npos) << text;  // what `--seed 35,83,113:2` takes
-    const fs::path p = work_dir() / "seeds.txt";
+    const fs::path p = workspaces_dir() / "seeds.txt";
     cli::write_seed_file(p, seeds);
     const std::vector<SeedBall> back = cli::read_seed_file(p, 2.0);
     ASSERT_EQ(back.size(), seeds.size());
@@ -290,7 +285,7 @@ TEST(ViewerWorkspace, NothingOverwrittenWithoutAskingAndUnsavedTracksTheWork) {
     EXPECT_FALSE(v.unsaved());
     ASSERT_TRUE(v.add_seed(phantom48().seeds[0].cast<double>(), 2.0));
     EXPECT_TRUE(v.unsaved());
-    const fs::path foreign = work_dir() / "foreign.json";
+    const fs::path foreign = workspaces_dir() / "foreign.json";
     std::ofstream(foreign) << "someone else's file\n";
     EXPECT_FALSE(v.save_workspace(foreign.string()));
     EXPECT_EQ(testing_slurp(foreign), "someone else's file\n");

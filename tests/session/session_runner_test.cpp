@@ -54,15 +54,15 @@ std::unique_ptr<Session> seeded_session() {
     return s;
 }
 
-struct Snapshot {
+struct StepBits {
     std::vector<std::uint32_t> phi;
     std::vector<std::int8_t> status;
     int iterations = 0;
-    bool operator==(const Snapshot&) const = default;
+    bool operator==(const StepBits&) const = default;
 };
 
-Snapshot snapshot(const Session& s) {
-    Snapshot out;
+StepBits step_bits(const Session& s) {
+    StepBits out;
     for (float v : s.field().phi().values()) out.phi.push_back(std::bit_cast<std::uint32_t>(v));
     out.status.assign(s.field().status().values().begin(), s.field().status().values().end());
     out.iterations = s.segment_status().iterations;
@@ -70,11 +70,11 @@ Snapshot snapshot(const Session& s) {
 }
 
 // The foreground reference: `steps` steps (0: until converged or vanished) on the caller's thread.
-Snapshot foreground(int steps) {
+StepBits foreground(int steps) {
     auto s = seeded_session();
     for (int i = 0; steps == 0 ? !s->segment_status().converged && !s->segment_status().vanished && i < 5000 : i < steps; ++i)
         s->segment_step();
-    return snapshot(*s);
+    return step_bits(*s);
 }
 
 void expect_mesh_is_marching_cubes(Session& s) {
@@ -96,9 +96,9 @@ TEST(SessionRunner, ARunEqualsTheForegroundStepsAndLivesetSegment) {
     EXPECT_TRUE(st.error.empty()) << st.error;
     EXPECT_TRUE(st.status.converged);
     EXPECT_FALSE(s->deferred_meshing());
-    const Snapshot fg = foreground(0);
+    const StepBits fg = foreground(0);
     EXPECT_EQ(st.steps, fg.iterations);
-    EXPECT_TRUE(snapshot(*s) == fg);
+    EXPECT_TRUE(step_bits(*s) == fg);
 
     SegmentRequest req;  // `liveset segment`: the sleeping step from the same seeds
     for (const Vec3i& c : phantom48().seeds) req.seeds.push_back({c.cast<double>(), 2.0});
@@ -134,7 +134,7 @@ TEST(SessionRunner, HandOversAtAnyTimeChangeNothing) {
     EXPECT_GT(handovers, 1u);
     EXPECT_GT(flushed, 0u);
     EXPECT_TRUE(std::isfinite(checksum));
-    EXPECT_TRUE(snapshot(*s) == foreground(0));
+    EXPECT_TRUE(step_bits(*s) == foreground(0));
     expect_mesh_is_marching_cubes(*s);
 }
 
@@ -158,29 +158,29 @@ TEST(SessionRunner, StoppedAndContinuedEqualsUninterrupted) {
         done += runner.poll().steps;
     }
     ASSERT_EQ(done, kSteps);
-    EXPECT_TRUE(snapshot(*s) == foreground(kSteps));
+    EXPECT_TRUE(step_bits(*s) == foreground(kSteps));
     EXPECT_TRUE(check_invariants(s->field()).ok()) << check_invariants(s->field()).summary();
 }
 
 TEST(SessionRunner, ARunIsOneUndoableAction) {
     auto s = seeded_session();
     s->end_action();
-    const Snapshot before = snapshot(*s);
+    const StepBits before = step_bits(*s);
     const std::size_t depth = s->undo_depth();
     SessionRunner runner(*s);
     runner.start(RunWork::kSegment, 40);
     ASSERT_TRUE(runner.wait_finished(120000.0));
     runner.poll();
     s->end_action();
-    const Snapshot after = snapshot(*s);
+    const StepBits after = step_bits(*s);
     EXPECT_EQ(after.iterations, 40);
     EXPECT_EQ(s->undo_depth(), depth + 1);
     EXPECT_EQ(s->next_undo_label(), "segment");
     s->undo();
-    EXPECT_TRUE(snapshot(*s) == before);
+    EXPECT_TRUE(step_bits(*s) == before);
     expect_mesh_is_marching_cubes(*s);
     s->redo();
-    EXPECT_TRUE(snapshot(*s) == after);
+    EXPECT_TRUE(step_bits(*s) == after);
     expect_mesh_is_marching_cubes(*s);
 }
 
@@ -206,7 +206,7 @@ TEST(SessionRunner, ASeedBetweenRunsGivesTheForegroundSequence) {
     for (int i = 0; i < 25; ++i) ref->segment_step();
     ref->add_seed(extra);
     for (int i = 0; i < second; ++i) ref->segment_step();
-    EXPECT_TRUE(snapshot(*s) == snapshot(*ref));
+    EXPECT_TRUE(step_bits(*s) == step_bits(*ref));
     expect_mesh_is_marching_cubes(*s);
 }
 
@@ -225,7 +225,7 @@ TEST(SessionRunner, ASwarmRunEqualsForegroundSwarmSteps) {
     ASSERT_TRUE(runner.wait_finished(120000.0));
     EXPECT_EQ(runner.poll().steps, 20);
     for (int i = 0; i < 20; ++i) b->swarm_step();
-    EXPECT_TRUE(snapshot(*a) == snapshot(*b));
+    EXPECT_TRUE(step_bits(*a) == step_bits(*b));
     expect_mesh_is_marching_cubes(*a);
 }
 

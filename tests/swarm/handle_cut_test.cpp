@@ -18,14 +18,14 @@
 namespace liveset {
 namespace {
 
-constexpr int kN = 32;
-const Vec3i kC{16, 16, 16};
-constexpr double kCore = 9, kOuter = 12;
+constexpr int kCutN = 32;
+const Vec3i kCutC{16, 16, 16};
+constexpr double kCutCore = 9, kCutOuter = 12;
 
-// inner: the ball r <= kCore; truth: the shell kCore < r <= kOuter; the mask: the shell plus what
+// inner: the ball r <= kCutCore; truth: the shell kCutCore < r <= kCutOuter; the mask: the shell plus what
 // the case adds.
 struct Case {
-    Grid<std::uint8_t> mask{Lattice({kN, kN, kN}), 0}, truth{Lattice({kN, kN, kN}), 0}, inner{Lattice({kN, kN, kN}), 0};
+    Grid<std::uint8_t> mask{Lattice({kCutN, kCutN, kCutN}), 0}, truth{Lattice({kCutN, kCutN, kCutN}), 0}, inner{Lattice({kCutN, kCutN, kCutN}), 0};
     std::vector<Vec3i> handle;  // the voxels a cut may remove
 };
 
@@ -33,16 +33,16 @@ bool same(const Grid<std::uint8_t>& a, const Grid<std::uint8_t>& b) {
     return std::ranges::equal(a.values(), b.values());
 }
 
-double radius(Vec3i q) { return norm((q - kC).cast<double>()); }
+double radius(Vec3i q) { return norm((q - kCutC).cast<double>()); }
 
 Case shell() {
     Case c;
-    for (int z = 0; z < kN; ++z)
-        for (int y = 0; y < kN; ++y)
-            for (int x = 0; x < kN; ++x) {
+    for (int z = 0; z < kCutN; ++z)
+        for (int y = 0; y < kCutN; ++y)
+            for (int x = 0; x < kCutN; ++x) {
                 const double r = radius({x, y, z});
-                c.inner({x, y, z}) = r <= kCore;
-                c.truth({x, y, z}) = c.mask({x, y, z}) = r > kCore && r <= kOuter;
+                c.inner({x, y, z}) = r <= kCutCore;
+                c.truth({x, y, z}) = c.mask({x, y, z}) = r > kCutCore && r <= kCutOuter;
             }
     return c;
 }
@@ -51,7 +51,7 @@ Case shell() {
 // tissue on the shell's inner face at −y (no handle).
 Case rod_and_bump() {
     Case c = shell();
-    for (int x = 0; x < kN; ++x)
+    for (int x = 0; x < kCutN; ++x)
         if (c.inner({x, 16, 16})) {
             c.mask({x, 16, 16}) = 1;
             c.handle.push_back({x, 16, 16});
@@ -59,7 +59,7 @@ Case rod_and_bump() {
     for (int z = 14; z <= 18; ++z)
         for (int x = 14; x <= 18; ++x)
             for (int y = 7; y <= 9; ++y)
-                if (c.inner({x, y, z}) && radius({x, y, z}) > kCore - 1.5) c.mask({x, y, z}) = 1;
+                if (c.inner({x, y, z}) && radius({x, y, z}) > kCutCore - 1.5) c.mask({x, y, z}) = 1;
     return c;
 }
 
@@ -73,7 +73,7 @@ Case blob_on_a_bridge() {
                 c.mask({x, y, z}) = 1;
                 c.inner({x, y, z}) = 0;
             }
-    for (int z = 18; z < kN && c.inner({16, 16, z}); ++z) c.mask({16, 16, z}) = 1;
+    for (int z = 18; z < kCutN && c.inner({16, 16, z}); ++z) c.mask({16, 16, z}) = 1;
     return c;
 }
 

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "liveset/levelset/shapes.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
 
@@ -62,7 +63,7 @@ BoxFlowReport run_curvature_flow(SparseField& field, int max_steps, const StepOp
         }
     }
     if (!report.interrupted && field.zero_layer().empty()) report.vanished = true;
-    report.total_ms = std::chrono::duration<double, std::milli>(clock::now() - start).count();
+    report.total_ms = ms_since(start);
     return report;
 }
 

@@ -12,6 +12,7 @@
 
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/sparse_field.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
 
@@ -86,7 +87,7 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
     result.whole_band = dense;
     result.value_pass = dense && pass_next_;  // repair_dense's choice
     result.changed = dense ? repair_dense(edits) : repair_band(edits, RepairScope::kLocal);
-    last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    last_update_ms_ = ms_since(start);
     return result;
 }
 

@@ -10,6 +10,7 @@
 
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/sparse_field.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
 
@@ -82,7 +83,7 @@ ChangedPoints SparseField::restore(std::span<const PointState> states) {
         changed.points.push_back(i);
     }
     activity_.wake_near(changed.points, lattice(), steps_);  // so does an undo
-    last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    last_update_ms_ = ms_since(start);
     return changed;
 }
 

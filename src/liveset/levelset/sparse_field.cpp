@@ -22,6 +22,7 @@
 #include "liveset/grid/radix_sort.hpp"
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/layer_value.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
 
@@ -347,7 +348,7 @@ StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& op
 ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
     const auto start = std::chrono::steady_clock::now();
     ChangedPoints changed = repair_band(edits, scope);
-    last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    last_update_ms_ = ms_since(start);
     return changed;
 }
 

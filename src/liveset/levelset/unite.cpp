@@ -10,6 +10,7 @@
 
 #include "liveset/levelset/band_detail.hpp"
 #include "liveset/levelset/sparse_field.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
 
@@ -79,7 +80,7 @@ ChangedPoints SparseField::unite_in_box(Vec3i lo, Vec3i hi, const std::function<
     sweep_layers(region);
     ChangedPoints changed = finish(region);
     activity_.wake_near(changed.points, lattice(), steps_);
-    last_update_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    last_update_ms_ = ms_since(start);
     return changed;
 }
 

@@ -5,6 +5,7 @@
 #include "liveset/grid/reorient.hpp"
 #include "liveset/preprocess/bspline_field.hpp"
 #include "liveset/segment/tissue_model.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 #include <itkImage.h>
 #include <itkIterationReporter.h>
@@ -53,7 +54,7 @@ void check_option(double value, double low, double high, const char* what) {
 }
 
 double elapsed_ms(Clock::time_point since) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - since).count();
+    return ms_since(since);
 }
 
 // Inputs N4 can work with: a non-empty image with >= 2 voxels per axis, finite values, and a mask

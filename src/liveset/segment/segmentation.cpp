@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "liveset/levelset/shapes.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
 
@@ -81,7 +82,7 @@ SegmentationResult run_segmentation(SparseField& field, const Speed& speed, cons
         pr.changed = step.changed.size();
         pr.awake = step.awake;
         pr.flips = convergence.record_step(field.phi(), step.changed.sign_changes.value());  // only steps change the field here
-        pr.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
+        pr.ms = ms_since(t0);
         pr.zero_layer = field.zero_layer().size();
         pr.band = field.band_size();
         pr.inside = convergence.inside();

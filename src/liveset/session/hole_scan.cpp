@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "liveset/segment/window.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
 
@@ -41,7 +42,7 @@ HoleScan scan_holes(Grid<std::uint8_t> mask, const Grid<float>& image, const Gri
     }
     s.holes = find_holes(mask, image, roi, s.finder);
     s.mask = std::move(mask);
-    s.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    s.ms = ms_since(t0);
     return s;
 }
 

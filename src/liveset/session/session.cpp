@@ -12,6 +12,7 @@
 #include "liveset/levelset/shapes.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/segment/pipeline.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
 
@@ -19,7 +20,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 const SessionOptions& checked(const SessionOptions& o) {
     if (o.history < 20) throw std::invalid_argument("the undo history must keep at least 20 actions");

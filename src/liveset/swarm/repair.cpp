@@ -1,5 +1,6 @@
 // The repair loop: swarm move -> surface edits -> topology guard (topology_guard.cpp) -> local level-set update.
 #include "liveset/swarm/repair.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -80,7 +81,7 @@ RepairStep RepairLoop::step() {
             go.cut_handles = swarm_.options().decision == EditDecision::kCut;
             const auto g0 = clock::now();
             out.log.guarded = guard_topology(field_, edits, go);
-            out.log.guard_ms = std::chrono::duration<double, std::milli>(clock::now() - g0).count();
+            out.log.guard_ms = ms_since(g0);
         }
         out.log.modified = edits.size();
         if (!edits.empty()) {
@@ -89,7 +90,7 @@ RepairStep RepairLoop::step() {
             out.log.level_set_ms = field_.last_update_ms();
         }
     }
-    out.log.ms = std::chrono::duration<double, std::milli>(clock::now() - t0).count();
+    out.log.ms = ms_since(t0);
     return out;
 }
 
@@ -114,7 +115,7 @@ std::vector<RepairStepLog> run_repair(SparseField& field, const Grid<float>& ima
         const std::clock_t c0 = std::clock();
         while (next < order.size() && order[next].step <= step) loop.set_target(order[next++].position);
         RepairStepLog rec = loop.step().log;
-        rec.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+        rec.ms = ms_since(t0);
         rec.cpu_ms = 1000.0 * static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC;
         log.push_back(rec);
     }

@@ -4,6 +4,7 @@
 
 #include "liveset/eval/perforations.hpp"
 #include "liveset/eval/topology.hpp"
+#include "liveset/base/stopwatch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -189,7 +190,7 @@ RepairScheduleResult run_repair_schedule(RepairDriver& driver, const RepairOptio
             const RepairStepLog l = driver.step();
             round.modified += l.modified;
             round.fragments += l.fragments;
-            round.ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            round.ms += ms_since(t0);
             ++round.steps;
         }
         out.rounds.push_back(round);
