@@ -19,14 +19,18 @@ inline render::HeadlessContext& gl_context() {
     return context;
 }
 
-inline const Phantom& phantom64() {
+// The default phantom of size N³, made once per test program.
+template <int N>
+const Phantom& phantom_of_size() {
     static const Phantom ph = [] {
         PhantomOptions o;
-        o.size = 64;
+        o.size = N;
         return make_phantom(o);
     }();
     return ph;
 }
+
+inline const Phantom& phantom64() { return phantom_of_size<64>(); }
 
 // A session on the 64^3 phantom with its grey-matter truth as the level set.
 inline std::unique_ptr<Session> truth_session() {

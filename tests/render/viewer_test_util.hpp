@@ -11,17 +11,11 @@
 
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/session.hpp"
+#include "render_test_util.hpp"
 
 namespace liveset::testing {
 
-inline const Phantom& phantom48() {
-    static const Phantom ph = [] {
-        PhantomOptions o;
-        o.size = 48;
-        return make_phantom(o);
-    }();
-    return ph;
-}
+inline const Phantom& phantom48() { return phantom_of_size<48>(); }
 
 // A session on the 48³ phantom with its seeds added (one undoable action).
 inline std::unique_ptr<Session> seeded_session(const SessionOptions& options) {
