@@ -39,7 +39,7 @@ struct ViewArgs : ThresholdArgs {
     bool bias_correct = true;           // N4 first, as `segment` (also for images opened from the panel)
     bool bias_given = false;            // --bias-correct or --no-bias-correct on the command line
     std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
-    std::string workspace_warning;      // the continued workspace's ROI is not the one it was saved with
+    std::string workspace_warning;      // the workspace was refused, or its ROI is not the one it was saved with
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
 };
 
@@ -144,6 +144,7 @@ std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
         return ws;
     } catch (const std::runtime_error& e) {
         fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
+        a.workspace_warning = fmt::format("{}; opened without it", e.what());  // the status line and event log too
         return std::nullopt;
     }
 }
@@ -154,12 +155,13 @@ std::unique_ptr<Session> open_session(ViewArgs& a, std::optional<viewer::Workspa
     std::unique_ptr<Session> s = load_session(a);
     if (ws) {
         try {
-            viewer::check_workspace_image(*ws, a.workspace, s->image(), s->roi());
+            viewer::check_workspace_image(*ws, a.workspace, s->image(), s->roi(), a.roi);
             viewer::apply_workspace(*s, *ws);
-            a.workspace_warning = viewer::workspace_roi_warning(*ws, a.workspace, *s);
+            a.workspace_warning = viewer::workspace_roi_warning(*ws, a.workspace, *s, a.roi);
             if (!a.workspace_warning.empty()) fmt::print(stderr, "liveset: warning: {}\n", a.workspace_warning);
         } catch (const std::exception& e) {
             fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
+            a.workspace_warning = fmt::format("{}; opened without it", e.what());  // the status line and event log too
             ws.reset();
             a.workspace_bias.reset();  // the command line's setting again
             s = load_session(a);

@@ -176,7 +176,10 @@ Workspace parse_workspace(const json& j) {
         throw std::runtime_error(std::string("bad geometry: ") + e.what());
     }
     ws.image_checksum = field(j, "image_fnv").get<std::uint64_t>();
-    if (j.contains("roi_fnv") && !j["roi_fnv"].is_null()) ws.roi_checksum = field(j, "roi_fnv").get<std::uint64_t>();
+    if (j.contains("roi_fnv")) {  // absent in older files: nothing recorded; null: saved without a ROI
+        ws.roi_recorded = true;
+        if (!j["roi_fnv"].is_null()) ws.roi_checksum = field(j, "roi_fnv").get<std::uint64_t>();
+    }
     if (!field(j, "seeds").is_array()) throw std::runtime_error("field 'seeds' is not a list");
     for (const json& s : field(j, "seeds")) {
         if (!s.is_array() || s.size() != 4) throw std::runtime_error("a seed is not [i, j, k, radius]");
@@ -201,15 +204,20 @@ Workspace parse_workspace(const json& j) {
     return ws;
 }
 
-// How the ROI now differs from the one a workspace was saved with; empty when it does not (or
-// nothing was recorded).
-std::string roi_change(const Workspace& ws, const Grid<std::uint8_t>* roi) {
-    if (!ws.roi_checksum || (roi && mask_checksum(*roi) == *ws.roi_checksum)) return {};
-    if (!roi) return "no ROI now";
+// How the ROI the workspace is opened with (`roi`, given as `source`: a path or "auto") differs
+// from the one it was saved with; empty when it does not, or when nothing was recorded.
+std::string roi_change(const Workspace& ws, const Grid<std::uint8_t>* roi, const std::string& source) {
+    if (!ws.roi_recorded) return {};
+    if (roi ? ws.roi_checksum && mask_checksum(*roi) == *ws.roi_checksum : !ws.roi_checksum) return {};
+    if (!roi) return "opened without one";
     std::size_t voxels = 0;
     for (std::uint8_t v : roi->values()) voxels += v != 0;
-    return ws.roi == "auto" ? fmt::format("the automatic brain mask computed again has {} voxels", voxels)
-                            : fmt::format("{} has {} voxels now", ws.roi, voxels);
+    const auto name = [](const std::string& r) { return r == "auto" ? std::string("the automatic brain mask") : r; };
+    const std::string now = name(source == "auto" ? source : fs::absolute(source).string());
+    if (!ws.roi_checksum) return fmt::format("saved without one, opened with {} of {} voxels", now, voxels);
+    if (now != name(ws.roi)) return fmt::format("saved with {}, opened with {} of {} voxels", name(ws.roi), now, voxels);
+    return source == "auto" ? fmt::format("the automatic brain mask computed again has {} voxels", voxels)
+                            : fmt::format("{} has {} voxels now", now, voxels);
 }
 
 }  // namespace
@@ -310,22 +318,23 @@ Workspace read_workspace(const fs::path& path) {
     return ws;
 }
 
-void check_workspace_image(const Workspace& ws, const fs::path& path, const Grid<float>& image, const Grid<std::uint8_t>* roi) {
+void check_workspace_image(const Workspace& ws, const fs::path& path, const Grid<float>& image, const Grid<std::uint8_t>* roi,
+                           const std::string& roi_source) {
     if (!image.lattice().same_geometry(ws.lattice, 1e-6))
         throw std::runtime_error(fmt::format("workspace {} was saved for another image: {} there, {} here (size, spacing, origin or direction)",
                                              path.string(), ws.lattice.describe(), image.lattice().describe()));
     if (image_checksum(image) == ws.image_checksum) return;
-    if (const std::string change = roi_change(ws, roi); ws.bias_corrected && !change.empty())
-        throw std::runtime_error(fmt::format("workspace {} was saved with another ROI ({}), and N4 fitted in it corrects the image otherwise",
-                                             path.string(), change));
+    if (const std::string change = roi_change(ws, roi, roi_source); ws.bias_corrected && !change.empty())
+        throw std::runtime_error(fmt::format("workspace {}: its ROI is not the one it was saved with ({}), and N4 fitted in the ROI "
+                                             "corrects the image otherwise", path.string(), change));
     throw std::runtime_error(fmt::format("workspace {} was saved for another image: same geometry, other voxel values (or another N4 correction of it)", path.string()));
 }
 
-std::string workspace_roi_warning(const Workspace& ws, const fs::path& path, const Session& session) {
-    const std::string change = roi_change(ws, session.roi());
+std::string workspace_roi_warning(const Workspace& ws, const fs::path& path, const Session& session, const std::string& roi_source) {
+    const std::string change = roi_change(ws, session.roi(), roi_source);
     if (change.empty()) return {};
-    return fmt::format("workspace {} was saved with another ROI ({}): the level set continues as saved, but the front may now "
-                       "move where it could not", path.string(), change);
+    return fmt::format("workspace {}: its ROI is not the one it was saved with ({}): the level set continues as saved, but the "
+                       "front may now move where it could not", path.string(), change);
 }
 
 void apply_workspace(Session& session, const Workspace& ws) {

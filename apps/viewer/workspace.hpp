@@ -31,7 +31,8 @@ struct Workspace {
     bool bias_corrected = false;     // the session's image was the N4-corrected one (absent in older files: no)
     Lattice lattice;                 // the image's geometry when saved
     std::uint64_t image_checksum = 0;  // image_checksum() of its voxels
-    std::optional<std::uint64_t> roi_checksum;  // mask_checksum() of the session's ROI (absent: none, or an older file)
+    bool roi_recorded = false;                   // the file records the ROI's checksum (not in older files)
+    std::optional<std::uint64_t> roi_checksum;  // mask_checksum() of the session's ROI (absent: saved without one)
     SessionMarks marks;              // seeds, parameters, iterations
     RepairOptions repair;            // swarm settings
     std::optional<Vec3d> target;     // the swarm's target (the swarm respawns there)
@@ -55,13 +56,16 @@ void save_workspace(const std::filesystem::path& path, const Session& session, c
 // Reads and checks W and W.state. Throws std::runtime_error with one line naming the file.
 Workspace read_workspace(const std::filesystem::path& path);
 // Throws std::runtime_error when `ws` was saved for another image (geometry or voxels differ;
-// named as a changed ROI when N4 was fitted in one that changed). `roi`: the ROI it is opened with.
+// named as a changed ROI when N4 was fitted in one that changed). `roi`: the ROI it is opened with,
+// given as `roi_source` (a path or "auto"; empty without one).
 void check_workspace_image(const Workspace& ws, const std::filesystem::path& path, const Grid<float>& image,
-                           const Grid<std::uint8_t>* roi);
-// A warning when the ROI the workspace is continued with (`session`'s) is not the one it was saved
-// with: a ROI file changed on disk, or "auto" computed again by another liveset; the front then
-// continues bit for bit but may move where it could not. Empty when they agree or nothing was recorded.
-std::string workspace_roi_warning(const Workspace& ws, const std::filesystem::path& path, const Session& session);
+                           const Grid<std::uint8_t>* roi, const std::string& roi_source);
+// A warning when the ROI the workspace is continued with (`session`'s, given as `roi_source`) is not
+// the one it was saved with: another ROI given, none, one where it had none, a ROI file changed on
+// disk, or "auto" computed again by another liveset; the level set continues as saved but the front
+// may move where it could not. Empty when they agree or the file recorded nothing.
+std::string workspace_roi_warning(const Workspace& ws, const std::filesystem::path& path, const Session& session,
+                                  const std::string& roi_source);
 // Continues the workspace in `session` (the image it was saved for): φ and the layers bit for bit,
 // seeds, parameters and iteration count, swarm settings and target. Throws std::invalid_argument.
 void apply_workspace(Session& session, const Workspace& ws);

@@ -219,11 +219,12 @@ TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
     EXPECT_NE(r.err.find("outside the region of interest"), std::string::npos) << r.err;
 }
 
-// A workspace records its ROI's checksum. Without N4: reopened with the ROI file unchanged it says
-// nothing; after the file changed on disk it continues the level set as saved and warns on stderr
-// and in the event log (the status line shows it), naming the ROI and its voxel count now. With
-// N4 (fitted in the ROI) the image itself changed: refused in one line that names the ROI.
-TEST(ViewCommand, AWorkspaceWhoseRoiChangedOnDiskSaysSo) {
+// A workspace records its ROI's checksum. Without N4: reopened with the ROI unchanged it says
+// nothing; after the ROI file changed on disk it continues the level set as saved and warns on
+// stderr and in the event log, naming the ROI and its voxel count now; so it does when opened with
+// another ROI, or with one where it was saved without. With N4 (fitted in the ROI) the image itself
+// changed: refused in one line that names the ROI, and logged.
+TEST(ViewCommand, AWorkspaceWhoseRoiChangedSaysSo) {
     const Fixture& f = fixture();
     Grid<std::uint8_t> roi(f.ph.image.lattice());
     const Vec3i d = roi.dims();
@@ -236,45 +237,62 @@ TEST(ViewCommand, AWorkspaceWhoseRoiChangedOnDiskSaysSo) {
         for (std::uint8_t v : roi.values()) n += v;
         return n;
     };
-    const std::string roi_path = (f.dir / "ws_roi.nii.gz").string(), w = (f.dir / "ws_roi.json").string(), w_n4 = (f.dir / "ws_roi_n4.json").string();
+    const auto logged = [](const fs::path& log, const std::string& text) {
+        std::ifstream in(log);
+        for (std::string line; std::getline(in, line);) {
+            const nlohmann::json e = nlohmann::json::parse(line);
+            if (e["type"] == "warning" && e["message"].get<std::string>().find(text) != std::string::npos) return true;
+        }
+        return false;
+    };
+    const std::string roi_path = (f.dir / "ws_roi.nii.gz").string(), other = (f.dir / "ws_roi_other.nii.gz").string();
+    const std::string w = (f.dir / "ws_roi.json").string(), w_n4 = (f.dir / "ws_roi_n4.json").string(), w_none = (f.dir / "ws_roi_none.json").string();
     const std::string p_saved = (f.dir / "ws_roi_saved.nii.gz").string(), p_again = (f.dir / "ws_roi_again.nii.gz").string();
     write_roi(2, roi_path);
+    const std::size_t other_voxels = write_roi(4, other);
     CliResult r = run_cli(fmt::format("view {} --no-bias-correct --roi {} --seeds {} --headless --script {}", f.image, roi_path, f.seeds,
                                       script("ws_roi_a.json", R"([{"segment": 10}, {"save_phi": ")" + p_saved + R"("}, {"save_workspace": ")" + w + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     r = run_cli(fmt::format("view {} --roi {} --seeds {} --headless --script {}", f.image, roi_path, f.seeds,
                             script("ws_roi_n4.json", R"([{"segment": 10}, {"save_workspace": ")" + w_n4 + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
+    r = run_cli(fmt::format("view {} --no-bias-correct --seeds {} --headless --script {}", f.image, f.seeds,
+                            script("ws_roi_none.json", R"([{"save_workspace": ")" + w_none + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
     ASSERT_TRUE(viewer::read_workspace(w).roi_checksum.has_value());
     EXPECT_EQ(*viewer::read_workspace(w).roi_checksum, viewer::mask_checksum(read_label_image(roi_path)));
-    for (const std::string& ws : {w, w_n4}) {
+    EXPECT_TRUE(viewer::read_workspace(w_none).roi_recorded);
+    EXPECT_FALSE(viewer::read_workspace(w_none).roi_checksum.has_value());
+    for (const std::string& ws : {w, w_n4, w_none}) {
         r = run_cli(fmt::format("view --workspace {} --headless --script {}", ws, script("ws_roi_b.json", "[]")));
         ASSERT_EQ(r.rc, 0) << r.err;
         EXPECT_EQ(r.err.find("ROI"), std::string::npos) << r.err;
         EXPECT_NE(r.err.find("from the workspace " + ws), std::string::npos) << r.err;
     }
+    const std::string differs = "its ROI is not the one it was saved with ";
+    r = run_cli(fmt::format("view --workspace {} --roi {} --headless --script {}", w, other, script("ws_roi_e.json", "[]")));
+    EXPECT_NE(r.err.find(fmt::format("warning: workspace {}: {}(saved with {}, opened with {} of {} voxels)", w, differs,
+                                     fs::absolute(roi_path).string(), fs::absolute(other).string(), other_voxels)), std::string::npos) << r.err;
+    r = run_cli(fmt::format("view --workspace {} --roi {} --headless --script {}", w_none, other, script("ws_roi_f.json", "[]")));
+    EXPECT_NE(r.err.find(fmt::format("warning: workspace {}: {}(saved without one, opened with {} of {} voxels)", w_none, differs,
+                                     fs::absolute(other).string(), other_voxels)), std::string::npos) << r.err;
 
     const std::size_t now = write_roi(3, roi_path);
     const std::string change = fmt::format("({} has {} voxels now)", fs::absolute(roi_path).string(), now);
-    const fs::path log = f.dir / "ws_roi.jsonl";
+    const fs::path log = f.dir / "ws_roi.jsonl", log_n4 = f.dir / "ws_roi_n4.jsonl";
     r = run_cli(fmt::format("view --workspace {} --headless --log-events {} --script {}", w, log.string(),
                             script("ws_roi_c.json", R"([{"save_phi": ")" + p_again + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
-    EXPECT_NE(r.err.find(fmt::format("warning: workspace {} was saved with another ROI {}", w, change)), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(fmt::format("warning: workspace {}: {}{}", w, differs, change)), std::string::npos) << r.err;
     EXPECT_TRUE(same_bits(read_image(p_again), read_image(p_saved)));  // the level set continues as saved
-    bool logged = false;
-    std::ifstream in(log);
-    for (std::string line; std::getline(in, line);) {
-        const nlohmann::json e = nlohmann::json::parse(line);
-        logged = logged || (e["type"] == "warning" && e["message"].get<std::string>().find("another ROI " + change) != std::string::npos);
-    }
-    EXPECT_TRUE(logged);
+    EXPECT_TRUE(logged(log, differs + change));
 
-    r = run_cli(fmt::format("view --workspace {} --headless --script {}", w_n4, script("ws_roi_d.json", "[]")));
+    r = run_cli(fmt::format("view --workspace {} --headless --log-events {} --script {}", w_n4, log_n4.string(), script("ws_roi_d.json", "[]")));
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_EQ(lines(r.err), 1u) << r.err;
-    EXPECT_NE(r.err.find(fmt::format("error: workspace {} was saved with another ROI {}, and N4 fitted in it corrects the image otherwise; "
-                                     "the viewer opens without it", w_n4, change)), std::string::npos) << r.err;
+    const std::string refused = fmt::format("workspace {}: {}{}, and N4 fitted in the ROI corrects the image otherwise", w_n4, differs, change);
+    EXPECT_NE(r.err.find("error: " + refused + "; the viewer opens without it"), std::string::npos) << r.err;
+    EXPECT_TRUE(logged(log_n4, refused));
 }
 
 // Scripts save and load seed files: what load_seeds read, save_seeds writes back; a file with a

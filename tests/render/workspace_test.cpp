@@ -29,14 +29,7 @@ using testing::same_bits;
 namespace fs = std::filesystem;
 using viewer::Workspace;
 
-const Phantom& phantom48() {
-    static const Phantom ph = [] {
-        PhantomOptions o;
-        o.size = 48;
-        return make_phantom(o);
-    }();
-    return ph;
-}
+using testing::phantom48;
 
 SessionOptions options() {
     SessionOptions o;
@@ -151,7 +144,7 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
 
     // Continued in a fresh session on the same image: the same state, and the same next steps.
     Session continued(phantom48().image, options());
-    viewer::check_workspace_image(ws, w, continued.image(), continued.roi());
+    viewer::check_workspace_image(ws, w, continued.image(), continued.roi(), "");
     viewer::apply_workspace(continued, ws);
     EXPECT_TRUE(same_bits(continued.field().phi(), original->field().phi()));
     EXPECT_TRUE(same_status(continued.field().status(), original->field().status()));
@@ -235,7 +228,7 @@ TEST(WorkspaceFile, BadWorkspacesAreRefusedWithOneClearLine) {
 
     // Another image: other dimensions, other spacing (same size), other voxels (same geometry).
     const Workspace ws = viewer::read_workspace(good);
-    const auto check = [&](const Grid<float>& image) { return error_of([&] { viewer::check_workspace_image(ws, good, image, nullptr); }); };
+    const auto check = [&](const Grid<float>& image) { return error_of([&] { viewer::check_workspace_image(ws, good, image, nullptr, ""); }); };
     EXPECT_EQ(check(phantom48().image), "(no error)");
     PhantomOptions o;
     o.size = 40;
