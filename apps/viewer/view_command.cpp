@@ -127,6 +127,12 @@ void load_inputs(Session& s, const ViewArgs& a) {
     s.end_action();
 }
 
+// A workspace that cannot be continued: one line on stderr, and the status line and event log.
+void refuse_workspace(ViewArgs& a, const std::exception& e) {
+    fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
+    a.workspace_warning = fmt::format("{}; opened without it", e.what());
+}
+
 // --workspace W: read and check it; on any problem one line on stderr and the viewer opens
 // without it. Fills in the image and the ROI from it when the command line gives none.
 std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
@@ -143,8 +149,7 @@ std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
         a.workspace_bias = ws.bias_corrected;
         return ws;
     } catch (const std::runtime_error& e) {
-        fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
-        a.workspace_warning = fmt::format("{}; opened without it", e.what());  // the status line and event log too
+        refuse_workspace(a, e);
         return std::nullopt;
     }
 }
@@ -160,8 +165,7 @@ std::unique_ptr<Session> open_session(ViewArgs& a, std::optional<viewer::Workspa
             a.workspace_warning = viewer::workspace_roi_warning(*ws, a.workspace, *s, a.roi);
             if (!a.workspace_warning.empty()) fmt::print(stderr, "liveset: warning: {}\n", a.workspace_warning);
         } catch (const std::exception& e) {
-            fmt::print(stderr, "liveset: error: {}; the viewer opens without it\n", e.what());
-            a.workspace_warning = fmt::format("{}; opened without it", e.what());  // the status line and event log too
+            refuse_workspace(a, e);
             ws.reset();
             a.workspace_bias.reset();  // the command line's setting again
             s = load_session(a);

@@ -53,10 +53,6 @@ void check_option(double value, double low, double high, const char* what) {
     fail(os.str());
 }
 
-double elapsed_ms(Clock::time_point since) {
-    return ms_since(since);
-}
-
 // Inputs N4 can work with: a non-empty image with >= 2 voxels per axis, finite values, and a mask
 // (when given) on the same lattice.
 void check_inputs(const Grid<float>& image, const Grid<std::uint8_t>* mask) {
@@ -383,10 +379,10 @@ Grid<float> correct_bias(const Grid<float>& image, const Grid<std::uint8_t>* mas
         } catch (const itk::ExceptionObject& e) {
             throw std::runtime_error(std::string("bias correction: N4 failed: ") + e.GetDescription());
         }
-        report.n4_ms = elapsed_ms(n4_start);
+        report.n4_ms = ms_since(n4_start);
         corrected = report.interrupted ? image : divide_field(image, full_resolution_log_field(lattice, plan, image.lattice()), fit, report);
     }
-    report.ms = elapsed_ms(start);
+    report.ms = ms_since(start);
     if (report_out != nullptr) *report_out = std::move(report);
     return corrected;
 }

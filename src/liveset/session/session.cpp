@@ -20,7 +20,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-
 const SessionOptions& checked(const SessionOptions& o) {
     if (o.history < 20) throw std::invalid_argument("the undo history must keep at least 20 actions");
     o.window.validate();
