@@ -72,6 +72,7 @@ struct SegmentArgs {
     int classes = 3, iterations = 2000;
     double n = 4.0;
     std::optional<double> alpha;  // unset: automatic (alpha.hpp), as the CLI
+    std::optional<double> smooth_mm;  // only with alpha (the automatic choice sets both), as --smooth
     std::optional<bool> bias_correct;  // unset: on, skipped with a warning where it cannot run (as the CLI's default)
 };
 
@@ -81,6 +82,7 @@ SegmentRequest request_for(const SegmentArgs& a, const Lattice& lattice, bool ne
     if (a.epsilon && a.epsilon_raw) throw UsageError("give epsilon or epsilon_raw, not both");
     if (a.window_from != "model" && a.window_from != "seeds") throw UsageError("window_from must be 'model' or 'seeds'");
     if (a.iterations < 1) throw UsageError("iterations must be at least 1");
+    if (a.smooth_mm && !a.alpha) throw UsageError("smooth_mm needs alpha: the automatic choice sets both");
     SegmentRequest req;
     cli::fill_segment_request(req, a, lattice);
     if (need_seeds && req.seeds.empty() && a.init_mask.is_none()) throw UsageError("give at least one seed I,J,K[:R] (or seeds_mm, or init_mask)");
@@ -336,6 +338,7 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
         else if (k == "iterations") a.iterations = value.cast<int>();
         else if (k == "n") a.n = value.cast<double>();
         else if (k == "alpha") a.alpha = value.cast<std::optional<double>>();
+        else if (k == "smooth_mm") a.smooth_mm = value.cast<std::optional<double>>();
         else if (k == "bias_correct") a.bias_correct = value.cast<std::optional<bool>>();
         else throw std::invalid_argument("unknown segment option '" + k + "'");
     }

@@ -13,7 +13,7 @@ namespace {
 
 std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi,
                                       const pyb::object& model_region, double n,
-                                      std::optional<double> alpha, int layers, int fragment_size, std::size_t history,
+                                      std::optional<double> alpha, std::optional<double> smooth_mm, int layers, int fragment_size, std::size_t history,
                                       int agents, double p, std::uint64_t seed, bool sleeping, const std::string& decision,
                                       double edit_range) {
     if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
@@ -28,8 +28,10 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     o.fragment_size = fragment_size;
     o.history = history;
     o.params.n = n;
+    if (smooth_mm && !alpha) throw std::invalid_argument("smooth_mm needs alpha: the automatic choice sets both");
     if (alpha) o.params.alpha = *alpha;
-    o.alpha_automatic = !alpha;  // None: as `segment` chooses it, and again as the seeds move the window
+    if (smooth_mm) o.params.smooth_mm = *smooth_mm;
+    o.alpha_automatic = !alpha;  // None: as `segment` chooses α and σ, and again as the seeds move the window
     if (agents < 1) throw std::invalid_argument("agents must be at least 1");
     o.repair.swarm.agents = static_cast<std::size_t>(agents);
     o.repair.swarm.act_probability = p;
@@ -98,7 +100,7 @@ Vec3d point(const std::vector<double>& p) {
 void register_session(pyb::module_& m) {
     pyb::class_<Session>(m, "_Session")
         .def(pyb::init(&make_session), pyb::arg("image"), pyb::arg("geometry"), pyb::arg("roi"), pyb::arg("model_region"), pyb::arg("n"),
-             pyb::arg("alpha"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
+             pyb::arg("alpha"), pyb::arg("smooth_mm"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
              pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"))
         .def("add_seed", [](Session& s, const std::vector<double>& c, double r) {
             if (!s.lattice().contains(point(c))) throw std::invalid_argument("the seed lies outside the image");
@@ -113,13 +115,12 @@ void register_session(pyb::module_& m) {
             for (const SeedBall& b : s.seeds()) out.emplace_back(b.center.x, b.center.y, b.center.z, b.radius);
             return out;
         })
-        .def("set_params", [](Session& s, double mu, double epsilon, double n, double alpha, bool from_seeds, bool alpha_automatic) {
-            s.set_params({mu, epsilon, n, alpha}, from_seeds, alpha_automatic);
-        })
+        .def("set_params", [](Session& s, double mu, double epsilon, double n, double alpha, double smooth_mm, bool from_seeds,
+                              bool alpha_automatic) { s.set_params({mu, epsilon, n, alpha, smooth_mm}, from_seeds, alpha_automatic); })
         .def("params", [](const Session& s) {
             const ThresholdParams& p = s.params();
             return pyb::dict(pyb::arg("mu") = p.mu, pyb::arg("epsilon") = p.epsilon, pyb::arg("n") = p.n,
-                             pyb::arg("alpha") = p.alpha, pyb::arg("window_from_seeds") = s.window_from_seeds(),
+                             pyb::arg("alpha") = p.alpha, pyb::arg("smooth_mm") = p.smooth_mm, pyb::arg("window_from_seeds") = s.window_from_seeds(),
                              pyb::arg("alpha_automatic") = s.alpha_automatic(),
                              pyb::arg("mu_raw") = s.scale().to_raw(p.mu), pyb::arg("epsilon_raw") = s.scale().raw_length(p.epsilon));
         })

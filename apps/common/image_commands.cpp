@@ -201,6 +201,7 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
     j["epsilon_raw"] = o.scale.raw_length(o.params.epsilon);
     j["n"] = o.params.n;
     j["alpha"] = o.params.alpha;
+    j["smooth_mm"] = o.params.smooth_mm;
     j["alpha_choice"] = {{"source", o.alpha.automatic ? "automatic" : "given"}};
     if (o.alpha.automatic) {
         j["alpha_choice"]["anisotropy"] = o.alpha.anisotropy;
@@ -290,6 +291,9 @@ void print_segmentation_summary(const nlohmann::json& j) {
     fmt::print("  window       {:.1f} .. {:.1f} raw (mu {:.1f} ± {:.1f}; {}), n {}, alpha {:.3g} ({})\n", w["lower_raw"].get<double>(),
                w["upper_raw"].get<double>(), w["mu_raw"].get<double>(), w["epsilon_raw"].get<double>(), from,
                j["n"].get<double>(), j["alpha"].get<double>(), alpha_source(j));
+    if (j.contains("smooth_mm") && j["smooth_mm"].get<double>() > 0.0)
+        fmt::print("  smoothing    Gaussian sigma {:.3g} mm before the threshold term ({})\n", j["smooth_mm"].get<double>(),
+                   j["alpha_choice"]["source"] == "automatic" ? "automatic: the noise ratio is over 0.2" : "given");
     fmt::print("  volume       {} voxels, {:.1f} ml\n", j["voxels"].get<std::size_t>(), j["volume_mm3"].get<double>() / 1000.0);
 }
 

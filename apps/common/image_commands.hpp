@@ -142,6 +142,7 @@ void fill_segment_request(SegmentRequest& req, const Options& a, const Lattice& 
     }
     req.n = a.n;
     req.alpha = a.alpha;
+    req.smooth_mm = a.smooth_mm;
     req.loop.max_iterations = a.iterations;
     req.loop.step = sleeping_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
     req.mu = a.mu;

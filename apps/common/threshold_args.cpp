@@ -2,6 +2,7 @@
 #include "threshold_args.hpp"
 
 #include "cli_common.hpp"
+#include "liveset/segment/smoothing.hpp"
 
 namespace liveset::cli {
 
@@ -12,6 +13,9 @@ void add_threshold_options(CLI::App& cmd, ThresholdArgs& a) {
     cmd.add_option("--epsilon-raw", a.epsilon_raw, "half window in the image's own units")->check(finite_number());
     cmd.add_option("--n", a.n, "steepness of the threshold term")->check(finite_number())->capture_default_str();
     cmd.add_option("--alpha", a.alpha, "curvature weight in [0,1), per millimetre (default: automatic, from the tissue model's noise over contrast for the window's class - 0 on a quiet scan, up to 0.15 - or 0.1 without a usable model, either divided by the cube of the voxels' longest-to-shortest side ratio)")->check(finite_number());
+    cmd.add_option("--smooth", a.smooth_mm, "sigma in mm of the Gaussian blur of the image the threshold term reads, with --alpha (default: automatic with alpha - half the finest voxel side when the tissue model's noise over contrast exceeds 0.2, else none; 0 with a given --alpha)")
+        ->check(finite_number())
+        ->check(CLI::Range(0.0, kMaxSmoothMm));
     cmd.add_option("--step", a.step, "level-set step: sleeping (converged stretches of front sleep until something near them changes) or exact (the whole band every step)")
         ->check(CLI::IsMember({"sleeping", "exact"}))
         ->capture_default_str();
@@ -22,6 +26,7 @@ StepOptions step_options(const ThresholdArgs& a) { return a.step == "exact" ? St
 void check_threshold_args(const ThresholdArgs& a) {
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");
     if (a.epsilon && a.epsilon_raw) throw UsageError("give --epsilon or --epsilon-raw, not both");
+    if (a.smooth_mm && !a.alpha) throw UsageError("--smooth needs --alpha: the automatic choice sets both");
 }
 
 std::optional<double> unit_mu(const ThresholdArgs& a, const IntensityScale& scale) {

@@ -1,5 +1,5 @@
 // The threshold-speed options `liveset segment` and `liveset view` share (--mu, --epsilon, --mu-raw,
-// --epsilon-raw, --n, --alpha, --step): one registration with the same help and checks, one rule for the
+// --epsilon-raw, --n, --alpha, --smooth, --step): one registration with the same help and checks, one rule for the
 // pairs, and the mapping of raw values to the normalised units the speed uses.
 #pragma once
 
@@ -18,12 +18,13 @@ struct ThresholdArgs {
     std::optional<double> mu, epsilon, mu_raw, epsilon_raw;  // the window, normalised or raw units
     double n = 4.0;
     std::optional<double> alpha;  // unset: `segment` chooses it (alpha.hpp); `view` keeps the session's
+    std::optional<double> smooth_mm;  // --smooth: only with --alpha (the automatic choice sets both)
     std::string step = "sleeping";  // --step: sleeping (segmentation.hpp, sleeping_step) or exact
 };
 
-// Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha and --step on `cmd`.
+// Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha, --smooth and --step on `cmd`.
 void add_threshold_options(CLI::App& cmd, ThresholdArgs& a);
-// UsageError "give --mu or --mu-raw, not both" (and the same for ε).
+// UsageError "give --mu or --mu-raw, not both" (and the same for ε), and for --smooth without --alpha.
 void check_threshold_args(const ThresholdArgs& a);
 // The window's µ / ε in normalised units through `scale` (raw values mapped as segment_image maps
 // them); nullopt where not given.

@@ -58,6 +58,7 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
     req.epsilon = s->params().epsilon;
     req.n = s->params().n;
     req.alpha = s->params().alpha;
+    req.smooth_mm = s->params().smooth_mm;  // the session's blur, automatic or given
     req.loop.step = s->options().segmentation.step;  // `view --step` as `segment --step` (default: sleeping)
     const auto c0 = Clock::now();
     const SegmentOutcome cli = segment_image(s->image(), req);

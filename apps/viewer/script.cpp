@@ -77,13 +77,14 @@ const std::set<std::string> kRepairKeys = {"preset", "agents", "p", "radius", "a
 
 void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
     if (!p.is_object()) err.fail("expected an object of parameters");
-    std::set<std::string> allowed = {"mu", "epsilon", "n", "alpha", "auto_window", "auto_alpha"};
+    std::set<std::string> allowed = {"mu", "epsilon", "n", "alpha", "smooth_mm", "auto_window", "auto_alpha"};
     allowed.insert(kRepairKeys.begin(), kRepairKeys.end());
     only_keys(p, allowed, err);
     if (p.contains("mu")) a.mu = number(p["mu"], err, "mu");
     if (p.contains("epsilon")) a.epsilon = number(p["epsilon"], err, "epsilon");
     if (p.contains("n")) a.n = number(p["n"], err, "n");
     if (p.contains("alpha")) a.alpha = number(p["alpha"], err, "alpha");
+    if (p.contains("smooth_mm")) a.smooth_mm = number(p["smooth_mm"], err, "smooth_mm");
     if (p.contains("auto_window")) {
         if (!p["auto_window"].is_boolean()) err.fail("auto_window must be true or false");
         a.auto_window = p["auto_window"].get<bool>();
@@ -91,7 +92,7 @@ void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
     if (p.contains("auto_alpha")) {
         if (!p["auto_alpha"].is_boolean()) err.fail("auto_alpha must be true or false");
         a.auto_alpha = p["auto_alpha"].get<bool>();
-        if (*a.auto_alpha && a.alpha) err.fail("give alpha or \"auto_alpha\": true, not both");
+        if (*a.auto_alpha && (a.alpha || a.smooth_mm)) err.fail("give alpha (or smooth_mm) or \"auto_alpha\": true, not both");
     }
     a.repair_fields = json::object();
     for (const std::string& k : kRepairKeys)
@@ -114,6 +115,7 @@ void parse_params(const json& p, ScriptAction& a, const EntryError& err) {
         if (a.mu) t.mu = *a.mu;
         if (a.n) t.n = *a.n;
         if (a.alpha) t.alpha = *a.alpha;
+        if (a.smooth_mm) t.smooth_mm = *a.smooth_mm;
         validate(t);
     } catch (const std::invalid_argument& e) {
         err.fail(e.what());

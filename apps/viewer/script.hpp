@@ -4,7 +4,7 @@
 // output paths), each problem one line naming the entry: `script s.json entry 3 ("segment"): ...`.
 //
 //   {"seed": [i, j, k], "radius": 2}          seed ball (voxels); "remove_seed": [i, j, k]
-//   {"params": {"mu": .., "epsilon": .., "n": .., "alpha": .., "auto_window": true, "auto_alpha": true,
+//   {"params": {"mu": .., "epsilon": .., "n": .., "alpha": .., "smooth_mm": .., "auto_window": true, "auto_alpha": true,
 //               "preset": "demo", "agents": 200, "p": 0.1, "radius": 3, "amount": .., "seed": ..,
 //               "expand_sigmas": .., "contract_sigmas": .., "edit_range": .., "sample_depth": ..}}
 //   {"segment": 100} or {"segment": "converge", "max": 2000}
@@ -62,7 +62,7 @@ struct ScriptAction {
     bool until_converged = false;  // segment
     double x = 0.0, y = 0.0;       // click pixel
     // params: only the given fields change
-    std::optional<double> mu, epsilon, n, alpha;
+    std::optional<double> mu, epsilon, n, alpha, smooth_mm;
     std::optional<bool> auto_window, auto_alpha;
     nlohmann::json repair_fields;         // kept to apply onto the current options
     // camera

@@ -36,10 +36,13 @@ void ScriptPlayer::apply_params(Viewer& viewer, const ScriptAction& a) {
     if (a.auto_window) auto_window = *a.auto_window;
     bool auto_alpha = s->alpha_automatic() && !a.alpha;
     if (a.auto_alpha) auto_alpha = *a.auto_alpha;
+    if (a.smooth_mm && auto_alpha) fail(a, "smooth_mm needs alpha: the automatic choice sets both");
     if (a.mu) p.mu = *a.mu;
     if (a.epsilon) p.epsilon = *a.epsilon;
     if (a.n) p.n = *a.n;
     if (a.alpha) p.alpha = *a.alpha;
+    if (s->alpha_automatic() && !auto_alpha) p.smooth_mm = 0.0;  // a given α: no blur unless given, as `segment --alpha`
+    if (a.smooth_mm) p.smooth_mm = *a.smooth_mm;
     check(viewer, a, viewer.apply_params(p, auto_window, auto_alpha));
     if (!a.repair_fields.empty()) check(viewer, a, viewer.apply_repair_options(apply_repair_fields(s->repair_options(), a.repair_fields)));
 }

@@ -67,6 +67,7 @@ SessionOptions session_options(const ViewArgs& a) {
     so.segmentation.step = step_options(a);  // as `liveset segment` (same bits)
     so.alpha_automatic = !a.alpha_given;     // chosen once there is a window (choose_start_params says how)
     if (a.alpha_given && a.alpha) so.params.alpha = *a.alpha;
+    if (a.alpha_given && a.smooth_mm) so.params.smooth_mm = *a.smooth_mm;
     return so;
 }
 

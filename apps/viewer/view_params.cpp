@@ -30,12 +30,14 @@ std::string model_window_for_level_set(const Session& s, ThresholdParams& p, boo
                        w->seed_class + 1, w->mu(), w->epsilon());
 }
 
-// Where the session's automatic α came from (Session::automatic_alpha_choice, segment/alpha.hpp).
+// Where the session's automatic α (and pre-smoothing) came from (Session::automatic_alpha_choice,
+// segment/alpha.hpp).
 std::string automatic_alpha_note(const Session& s) {
     const AlphaChoice a = s.automatic_alpha_choice();
     if (a.tissue_class < 0) return fmt::format("α {:.3g} automatic (no noise ratio from a tissue model: 0.1 / {:.3g}³)", a.alpha, a.anisotropy);
-    return fmt::format("α {:.3g} automatic ({}'s noise over contrast {:.2f}, voxels {:.3g}:1, as liveset segment)", a.alpha,
-                       tissue_class_name(*s.tissue_model(), a.tissue_class), a.noise_ratio, a.anisotropy);
+    const std::string blur = a.smooth_mm > 0.0 ? fmt::format("; the image blurred by σ {:.3g} mm, the noise ratio being over 0.2", a.smooth_mm) : "";
+    return fmt::format("α {:.3g} automatic ({}'s noise over contrast {:.2f}, voxels {:.3g}:1, as liveset segment){}", a.alpha,
+                       tissue_class_name(*s.tissue_model(), a.tissue_class), a.noise_ratio, a.anisotropy, blur);
 }
 
 }  // namespace
@@ -63,12 +65,14 @@ std::string choose_start_params(Session& s, const StartParams& start) {
     if (epsilon) p.epsilon = *epsilon;
     if (start.n_given) p.n = a.n;
     if (start.alpha_given && a.alpha) p.alpha = *a.alpha;
+    if (start.alpha_given) p.smooth_mm = a.smooth_mm.value_or(0.0);  // as `segment --alpha` (no blur unless --smooth)
     if (mu || epsilon) {
         from_seeds = false;
         const std::string given = mu && epsilon ? "µ, ε" : (mu ? "µ" : "ε");
         source = given + " from the command line" + (source.empty() || (mu && epsilon) ? "" : "; " + source);
     }
-    if (start.n_given || start.alpha_given) source += (source.empty() ? "" : "; ") + std::string("n, α from the command line");
+    if (start.n_given || start.alpha_given)
+        source += (source.empty() ? "" : "; ") + std::string(a.smooth_mm ? "n, α, smoothing from the command line" : "n, α from the command line");
     if (changed || mu || epsilon || start.n_given || start.alpha_given) {
         try {
             s.set_params(p, from_seeds, auto_alpha);

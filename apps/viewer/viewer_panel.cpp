@@ -137,17 +137,24 @@ void Viewer::draw_segmentation_section() {
     done |= ImGui::IsItemDeactivatedAfterEdit();
     help_marker("steepness of the threshold speed at the window's edge (Eq. 3)");
     ui_auto_alpha_ = session_->alpha_automatic();
-    if (ImGui::SliderFloat("alpha", &alpha, 0.0f, 0.95f, "%.2f")) ui_params_.alpha = alpha, ui_auto_alpha_ = false, edited = true;
+    if (ImGui::SliderFloat("alpha", &alpha, 0.0f, 0.95f, "%.2f")) {
+        if (ui_auto_alpha_) ui_params_.smooth_mm = 0.0;  // a given α: no blur unless set, as `segment --alpha`
+        ui_params_.alpha = alpha, ui_auto_alpha_ = false, edited = true;
+    }
     done |= ImGui::IsItemDeactivatedAfterEdit();
     help_marker("curvature weight (Eq. 2; the curvature is per mm): smoother fronts that leak less");
     ImGui::SameLine();
     if (ImGui::Checkbox("auto##alpha", &ui_auto_alpha_)) edited = done = true;
-    help_marker("alpha from the image's noise over the window's contrast and the voxel shape, as liveset segment chooses it");
+    help_marker("alpha (and the smoothing) from the image's noise over the window's contrast and the voxel shape, as liveset segment chooses them");
+    float smooth = static_cast<float>(ui_params_.smooth_mm);
+    if (ImGui::SliderFloat("smooth mm", &smooth, 0.0f, 3.0f, "%.2f")) ui_params_.smooth_mm = smooth, ui_auto_alpha_ = false, edited = true;
+    done |= ImGui::IsItemDeactivatedAfterEdit();
+    help_marker("sigma of the Gaussian blur of the image the threshold term reads (automatic with alpha: half the finest voxel side on a noisy scan)");
     if (edited && apply_params(ui_params_, ui_auto_window_, ui_auto_alpha_)) {
         params_note_.clear();  // the user's own values from now on
         const ThresholdParams& p = session_->params();
         log_.add("params", {{"mu", p.mu}, {"epsilon", p.epsilon}, {"mu_raw", sc.to_raw(p.mu)}, {"epsilon_raw", sc.raw_length(p.epsilon)},
-                            {"n", p.n}, {"alpha", p.alpha}, {"auto_window", session_->window_from_seeds()},
+                            {"n", p.n}, {"alpha", p.alpha}, {"smooth_mm", p.smooth_mm}, {"auto_window", session_->window_from_seeds()},
                             {"auto_alpha", session_->alpha_automatic()}});
     }
     if (done) session_->end_action();

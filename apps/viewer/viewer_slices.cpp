@@ -50,7 +50,7 @@ void Viewer::render_slice_pane(Pane pane, render::Framebuffer& fb, const Rect& r
     }
     const ThresholdParams params = session_->params();
     const std::vector<std::uint8_t> rgba = render::overlay_texels(g, slice, slices_.overlay, &session_->field().phi(), session_->roi(),
-                                                                  &session_->unit_image(), &params);
+                                                                  slices_.overlay.preview ? &session_->speed_image() : nullptr, &params);
     slice_renderers_[i]->set_overlay(g.width, g.height, rgba);
     render::SliceOverlay overlay;
     overlay.layer = true;

@@ -187,6 +187,8 @@ Workspace parse_workspace(const json& j) {
     }
     const json& p = field(j, "params");
     ws.marks.params = {number(p, "mu"), number(p, "epsilon"), number(p, "n"), number(p, "alpha")};
+    // Absent in workspaces written before the pre-smoothing: they ran without it.
+    if (p.contains("smooth_mm")) ws.marks.params.smooth_mm = number(p, "smooth_mm");
     ws.marks.window_from_seeds = field(p, "window_from_seeds").get<bool>();
     // Absent in workspaces written before the automatic α: their α was set by hand.
     ws.marks.alpha_automatic = p.contains("alpha_automatic") && field(p, "alpha_automatic").get<bool>();
@@ -262,7 +264,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
            {"state", {{"file", workspace_state_path(path).filename().string()}, {"fnv", trailing_checksum(state)}}},
            {"seeds", seeds},
            {"params", {{"mu", m.params.mu}, {"epsilon", m.params.epsilon}, {"n", m.params.n}, {"alpha", m.params.alpha},
-                       {"window_from_seeds", m.window_from_seeds}, {"alpha_automatic", m.alpha_automatic},
+                       {"smooth_mm", m.params.smooth_mm}, {"window_from_seeds", m.window_from_seeds}, {"alpha_automatic", m.alpha_automatic},
                        {"mu_raw", session.scale().to_raw(m.params.mu)}, {"epsilon_raw", session.scale().raw_length(m.params.epsilon)}}},
            {"iterations", m.iterations},
            {"activity", activity_json(session.activity_snapshot())},

@@ -65,7 +65,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
             roi=None, init_mask=None, mu: Optional[float] = None, epsilon: Optional[float] = None,
             mu_raw: Optional[float] = None, epsilon_raw: Optional[float] = None,
             window_from: str = "model", classes: int = 3, n: float = 4.0, alpha: Optional[float] = None,
-            iterations: int = 2000, bias_correct: Optional[bool] = None,
+            smooth_mm: Optional[float] = None, iterations: int = 2000, bias_correct: Optional[bool] = None,
             progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
     """Threshold level-set segmentation from seeds (paper Eq. 2-3), exactly as ``liveset segment``
     with the same options (the same image and options give the same mask, bit for bit).
@@ -78,7 +78,9 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
     mu/epsilon: the window in normalised units, or mu_raw/epsilon_raw in the image's own; by
         default the tissue model's window for the seeds' class (``window_from="seeds"``: their
         statistics). n, alpha, iterations, classes: as the CLI (alpha None: chosen
-        from the image, the report's "alpha_choice" says how). bias_correct: None (the default)
+        from the image, the report's "alpha_choice" says how). smooth_mm: the σ in mm of the
+        image's blur before the threshold term, only with alpha (None: 0 with a given alpha; the
+        automatic alpha chooses it, half the finest voxel side on a noisy scan). bias_correct: None (the default)
         runs N4 first as ``liveset segment`` does, skipped with a report warning where it cannot run
         (an image too small for its grid); True requires it (ValueError where it cannot run); False
         turns it off.
@@ -91,7 +93,8 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
     kw = dict(seeds=[_seed_text(s) for s in seeds], seeds_mm=[_seed_text(s) for s in seeds_mm],
               seed_radius=float(seed_radius), mu=mu, epsilon=epsilon, mu_raw=mu_raw,
               epsilon_raw=epsilon_raw, window_from=window_from, classes=int(classes), n=float(n),
-              alpha=None if alpha is None else float(alpha), iterations=int(iterations),
+              alpha=None if alpha is None else float(alpha),
+              smooth_mm=None if smooth_mm is None else float(smooth_mm), iterations=int(iterations),
               bias_correct=None if bias_correct is None else bool(bias_correct))
     kw["roi"] = _mask_arg(roi, img, "roi", allow_auto=True)
     kw["init_mask"] = _mask_arg(init_mask, img, "init_mask")

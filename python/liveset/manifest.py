@@ -12,11 +12,11 @@ from dataclasses import dataclass, field
 REQUIRED = ("subject", "image", "seeds")
 # Optional columns: files, the evaluation, and `liveset segment`'s options (empty cell: default).
 FILES = ("roi", "truth", "init_mask")
-FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "seed_radius")
+FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "smooth_mm", "seed_radius")
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
 CHOICES = {"window_from": ("model", "seeds")}
 BOOLS = ("bias_correct",)
-DEFAULTS_EPOCH = 50  # see Subject.fingerprint
+DEFAULTS_EPOCH = 54  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -45,7 +45,8 @@ class Subject:
         stats = [(p, os.stat(p).st_size, os.stat(p).st_mtime_ns) for p in files]
         # DEFAULTS_EPOCH: bumped when a default that changes the outputs changes (session 48: N4 by
         # default; 49: the curvature per mm, which changes every scan not at 1 mm; 50: α chosen from
-        # the image unless given), so a resumed cohort recomputes what older defaults made.
+        # the image unless given; 54: noisy scans pre-smoothed unless α is given), so a resumed
+        # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]
@@ -133,6 +134,8 @@ def _subject(row: dict, line: int, base: str, where: str) -> Subject:
         raise ManifestError(f"{where}: label needs a truth")
     if ("mu" in s.options) + ("mu_raw" in s.options) > 1 or ("epsilon" in s.options) + ("epsilon_raw" in s.options) > 1:
         raise ManifestError(f"{where}: give mu or mu_raw (epsilon or epsilon_raw), not both")
+    if "smooth_mm" in s.options and "alpha" not in s.options:
+        raise ManifestError(f"{where}: smooth_mm needs alpha (the automatic choice sets both)")
     return s
 
 

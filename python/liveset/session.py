@@ -40,15 +40,20 @@ class Session:
     ``alpha=None`` (the default) chooses the curvature weight as ``segment`` does (from the tissue
     model's noise over the window's contrast and the voxel shape) once there is a window (the first
     seed, ``set_params`` or the first step; ``params["alpha"]`` shows 0.1 until then) and again
-    whenever the seeds move the window; a number fixes it (0.1 is the paper's)."""
+    whenever the seeds move the window, with the pre-smoothing (``params["smooth_mm"]``: the σ in mm
+    of the blur of the image the threshold term reads, half the finest voxel side on a noisy scan);
+    a number fixes it (0.1 is the paper's), and ``smooth_mm`` then sets the blur (default 0)."""
 
-    def __init__(self, image, roi=None, *, n: float = 4.0, alpha: Optional[float] = None, layers: int = 2,
+    def __init__(self, image, roi=None, *, n: float = 4.0, alpha: Optional[float] = None,
+                 smooth_mm: Optional[float] = None, layers: int = 2,
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
                  edit_range: Optional[float] = None, bias_correct: Optional[bool] = None):
         img = as_image(image)
         if decision not in ("intensity", "random", "cut") or int(agents) < 1:  # before N4's seconds
             raise ValueError("decision must be 'intensity', 'random' or 'cut', and agents at least 1")
+        if smooth_mm is not None and alpha is None:
+            raise ValueError("smooth_mm needs alpha: the automatic choice sets both")
         prepared = _liveset._prepare_session_image(img.array, img.geometry, _mask_arg(roi, img, "roi", allow_auto=True),
                                                    None if bias_correct is None else bool(bias_correct))
         self.corrected = prepared["image"] is not None
@@ -56,7 +61,8 @@ class Session:
         self.roi = None if prepared["roi"] is None else img.like(prepared["roi"])
         self.report = json.loads(prepared["report"])
         self._s = _liveset._Session(self.image.array, img.geometry, prepared["roi"], prepared["model_region"], float(n),
-                                    None if alpha is None else float(alpha), int(layers),
+                                    None if alpha is None else float(alpha),
+                                    None if smooth_mm is None else float(smooth_mm), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),
                                     bool(sleeping), str(decision),
                                     float(_edit_range(decision, edit_range)))
@@ -75,23 +81,30 @@ class Session:
         return self._s.seeds()
 
     def set_params(self, mu: Optional[float] = None, epsilon: Optional[float] = None,
-                   n: Optional[float] = None, alpha=None) -> None:
+                   n: Optional[float] = None, alpha=None, smooth_mm: Optional[float] = None) -> None:
         """Set n, alpha and the window (normalised units). Without mu and epsilon the window stays
         as it was: following the seeds (the tissue model's window, as ``liveset segment``) or as
-        set. alpha: a number fixes it, ``"auto"`` chooses it as ``segment`` does, None keeps the
-        current choice."""
+        set. alpha: a number fixes it, ``"auto"`` chooses it and the pre-smoothing as ``segment``
+        does, None keeps the current choice. smooth_mm: the blur's σ in mm, with a fixed alpha
+        (None keeps the current value; 0 when alpha goes from automatic to a number, as
+        ``segment(alpha=...)``)."""
         p = self.params
         from_seeds = p["window_from_seeds"] if mu is None and epsilon is None else False
         automatic = p["alpha_automatic"] if alpha is None else (isinstance(alpha, str) and alpha == "auto")
         if isinstance(alpha, str) and alpha != "auto":
             raise ValueError(f"alpha must be a number or 'auto', not {alpha!r}")
+        if smooth_mm is not None and automatic:
+            raise ValueError("smooth_mm needs a fixed alpha: the automatic choice sets both")
+        if smooth_mm is None and p["alpha_automatic"] and not automatic:
+            smooth_mm = 0.0  # a given alpha: no blur unless given, as segment(alpha=...)
         self._s.set_params(p["mu"] if mu is None else float(mu), p["epsilon"] if epsilon is None else float(epsilon),
                            p["n"] if n is None else float(n), p["alpha"] if alpha is None or automatic else float(alpha),
-                           from_seeds, automatic)
+                           p["smooth_mm"] if smooth_mm is None else float(smooth_mm), from_seeds, automatic)
 
     @property
     def params(self) -> dict:
-        """mu, epsilon (normalised), mu_raw, epsilon_raw, n, alpha, window_from_seeds, alpha_automatic."""
+        """mu, epsilon (normalised), mu_raw, epsilon_raw, n, alpha, smooth_mm, window_from_seeds,
+        alpha_automatic."""
         return self._s.params()
 
     # segmentation and repair

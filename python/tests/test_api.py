@@ -244,15 +244,37 @@ def test_session_chooses_alpha_as_segment_does(phantom):
     for seed in seeds:
         s.add_seed(seed)
     assert s.params["alpha_automatic"] and s.params["alpha"] == seg.report["alpha"]
+    # Noisy: the automatic choice blurs the image the threshold term reads, in both alike.
+    assert seg.report["smooth_mm"] == 0.5 and s.params["smooth_mm"] == seg.report["smooth_mm"]
     s.run(2000)
     assert np.array_equal(s.mask().array, seg.mask.array)
-    s.set_params(alpha=0.2)
-    assert not s.params["alpha_automatic"] and s.params["alpha"] == 0.2
+    s.set_params(alpha=0.2)  # a given alpha drops the automatic blur, as segment(alpha=0.2)
+    assert not s.params["alpha_automatic"] and s.params["alpha"] == 0.2 and s.params["smooth_mm"] == 0.0
+    s.set_params(smooth_mm=0.7)
+    s.set_params(alpha=0.25)  # fixed to fixed: the blur stays
+    assert s.params["smooth_mm"] == 0.7 and s.params["alpha"] == 0.25
     s.set_params(alpha="auto")
-    assert s.params["alpha_automatic"] and s.params["alpha"] == seg.report["alpha"]
+    assert s.params["alpha_automatic"] and s.params["alpha"] == seg.report["alpha"] and s.params["smooth_mm"] == 0.5
     assert liveset.Session(img, alpha=0.1, bias_correct=False).params["alpha"] == 0.1
+    assert liveset.Session(img, alpha=0.1, bias_correct=False).params["smooth_mm"] == 0.0
     with pytest.raises(ValueError, match="auto"):
         s.set_params(alpha="automatic")
+    with pytest.raises(ValueError, match="smooth_mm needs"):
+        s.set_params(smooth_mm=1.0)  # automatic alpha: the choice sets both
+    with pytest.raises(ValueError, match="smooth_mm needs alpha"):
+        liveset.Session(img, smooth_mm=1.0, bias_correct=False)
+    with pytest.raises(ValueError, match="smooth_mm needs alpha"):
+        liveset.segment(img, seeds, smooth_mm=1.0, bias_correct=False)
+    # Given with alpha: the same mask as the session with the same alpha and smoothing.
+    fixed = liveset.segment(img, seeds, alpha=0.05, smooth_mm=0.8, bias_correct=False)
+    assert fixed.report["smooth_mm"] == 0.8 and fixed.report["alpha_choice"]["source"] == "given"
+    t = liveset.Session(img, alpha=0.05, smooth_mm=0.8, bias_correct=False)
+    for seed in seeds:
+        t.add_seed(seed)
+    t.run(2000)
+    assert np.array_equal(t.mask().array, fixed.mask.array)
+    unblurred = liveset.segment(img, seeds, alpha=0.05, bias_correct=False)
+    assert unblurred.report["smooth_mm"] == 0 and not np.array_equal(unblurred.mask.array, fixed.mask.array)
 
 
 def test_session_prepares_the_image_as_segment_does(phantom):
@@ -320,7 +342,8 @@ def test_session_warns_as_segment_when_its_front_leaks_out_of_the_brain():
         s.add_seed((32, 32, 32), 3)
         p = s.params  # the window segment was given, in the session's normalised units
         per_raw = p["epsilon"] / p["epsilon_raw"]
-        s.set_params(mu=p["mu"] + (130 - p["mu_raw"]) * per_raw, epsilon=40 * per_raw, alpha=seg.report["alpha"])
+        s.set_params(mu=p["mu"] + (130 - p["mu_raw"]) * per_raw, epsilon=40 * per_raw, alpha=seg.report["alpha"],
+                     smooth_mm=seg.report["smooth_mm"])
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             status = s.run(1000)

@@ -121,6 +121,7 @@ def test_worker_killed_mid_subject_loses_nothing(cohort, tmp_path):
     ("subject,image,seeds", "a,s1/t1.nii.gz,\"1,2,3;1,2,480\"", "row 2: seed 1,2,480 lies outside the image (48x48x48"),
     ("subject,image,seeds", "a,s1/phantom.json,\"1,2,3\"", "row 2: image: cannot read"),
     ("subject,image,seeds,colour", "a,s1/t1.nii.gz,\"1,2,3\",red", "unknown column(s) colour"),
+    ("subject,image,seeds,smooth_mm", "a,s1/t1.nii.gz,\"1,2,3\",0.5", "row 2: smooth_mm needs alpha"),
 ])
 def test_bad_manifest_one_line_before_any_work(cohort, tmp_path, header, row, message):
     m = cohort["root"] / "bad.csv"

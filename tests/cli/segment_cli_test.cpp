@@ -295,6 +295,9 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
         {"segment " + img + " --seed 32,32,32 --epsilon 0" + o, "epsilon"},
         {"segment " + img + " --seed 32,32,32 --epsilon -0.1" + o, "epsilon"},
         {"segment " + img + " --seed 32,32,32 --alpha 1.5" + o, "alpha"},
+        {"segment " + img + " --seed 32,32,32 --smooth 0.5" + o, "--smooth needs --alpha"},
+        {"segment " + img + " --seed 32,32,32 --alpha 0.1 --smooth -1" + o, "--smooth"},
+        {"segment " + img + " --seed 32,32,32 --alpha 0.1 --smooth 50" + o, "--smooth"},
         {"segment " + img + " --seed 32,32,32 --mu nan" + o, ""},
         // ("the image", not eval's "truth": the message names what the mask must overlay)
         {"segment " + img + " --seed 32,32,32 --roi " + (work_dir() / "small_mask.nii.gz").string() + o, "differ from image dims"},

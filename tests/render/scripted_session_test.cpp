@@ -267,6 +267,19 @@ TEST(ViewBench, ReportsTheRendererAndOnlyTheRepairingScenariosRebuildFragments) 
     }
 }
 
+// The voxels where two label images differ (asserting that the second holds a real segmentation).
+std::size_t differing_voxels(const std::string& a_path, const std::string& b_path) {
+    const Grid<std::uint8_t> a = read_label_image(a_path), b = read_label_image(b_path);
+    EXPECT_EQ(a.size(), b.size());
+    std::size_t differ = 0, inside = 0;
+    for (PointIndex i = 0; i < std::min(a.size(), b.size()); ++i) {
+        differ += (a[i] != 0) != (b[i] != 0);
+        inside += b[i] != 0;
+    }
+    EXPECT_GT(inside, 10000u);
+    return differ;
+}
+
 // `liveset view IMAGE --seed ...` starts with the α `liveset segment` chooses for the same seeds
 // (segment/alpha.hpp; a noisy phantom on 1 x 1 x 1.5 mm voxels, so α is neither 0 nor 0.1), says
 // so, and its converged mask is segment's, voxel for voxel.
@@ -288,11 +301,13 @@ TEST(ScriptedSession, SeedsOnTheCommandLineStartWithSegmentsAutomaticAlpha) {
     EXPECT_NEAR(report["alpha_choice"]["anisotropy"].get<double>(), 1.5, 1e-9);
     EXPECT_GT(alpha, 0.0);
     EXPECT_LT(alpha, 0.1);
+    EXPECT_EQ(report["smooth_mm"].get<double>(), 0.5);  // noisy: the automatic blur too (segment/alpha.hpp)
     write_text(dir / "aniso.json", R"([{"segment": "converge"}, {"save_mask": ")" + view_mask + R"("}])");
     const CliResult view = run_cli("view " + path + seeds + " --no-bias-correct --headless --no-autosave --script " +
                                    (dir / "aniso.json").string());
     ASSERT_EQ(view.rc, 0) << view.err;
     EXPECT_NE((view.out + view.err).find(fmt::format("α {:.3g} automatic", alpha)), std::string::npos) << view.out << view.err;
+    EXPECT_NE((view.out + view.err).find("blurred by σ 0.5 mm"), std::string::npos) << view.out << view.err;
     const Grid<std::uint8_t> a = read_label_image(view_mask), b = read_label_image(seg_mask);
     ASSERT_EQ(a.size(), b.size());
     std::size_t differ = 0;
@@ -316,6 +331,22 @@ TEST(ScriptedSession, SeedsOnTheCommandLineStartWithSegmentsAutomaticAlpha) {
     const CliResult both = run_cli("view " + path + " --no-bias-correct --headless --no-autosave --script " + (dir / "both.json").string());
     EXPECT_NE(both.rc, 0);
     EXPECT_NE(both.err.find("not both"), std::string::npos) << both.err;
+
+    // A script's "alpha" with "smooth_mm" gives `segment --alpha --smooth`'s mask; "smooth_mm" alone
+    // while α is automatic is refused (the automatic choice sets both), as `--smooth` without `--alpha`.
+    const std::string given_seg = (dir / "aniso_given_seg.nii.gz").string(), given_view = (dir / "aniso_given_view.nii.gz").string();
+    const CliResult fixed = run_cli("segment " + path + seeds + " --no-bias-correct --alpha 0.04 --smooth 0.8 --out-mask " + given_seg);
+    ASSERT_EQ(fixed.rc, 0) << fixed.err;
+    write_text(dir / "given.json", "[" + clicks + R"({"params": {"alpha": 0.04, "smooth_mm": 0.8}}, {"segment": "converge"}, {"save_mask": ")" +
+                                       given_view + R"("}])");
+    const CliResult given = run_cli("view " + path + " --no-bias-correct --headless --no-autosave --script " + (dir / "given.json").string());
+    ASSERT_EQ(given.rc, 0) << given.err;
+    EXPECT_EQ(differing_voxels(given_view, given_seg), 0u);
+    EXPECT_GT(differing_voxels(given_seg, seg_mask), 0u);  // the given blur and α make another mask
+    write_text(dir / "alone.json", "[" + clicks + R"({"params": {"smooth_mm": 0.8}}])");
+    const CliResult alone = run_cli("view " + path + " --no-bias-correct --headless --no-autosave --script " + (dir / "alone.json").string());
+    EXPECT_NE(alone.rc, 0);
+    EXPECT_NE(alone.err.find("smooth_mm needs alpha"), std::string::npos) << alone.err;
 }
 
 // The 64³ phantom written to the work folder as NAME_t1.nii.gz, with its seeds as `--seed`
@@ -336,18 +367,6 @@ ClickedPhantom clicked_phantom(const std::string& name) {
     return c;
 }
 
-// The voxels where two label images differ (asserting that the second holds a real segmentation).
-std::size_t differing_voxels(const std::string& a_path, const std::string& b_path) {
-    const Grid<std::uint8_t> a = read_label_image(a_path), b = read_label_image(b_path);
-    EXPECT_EQ(a.size(), b.size());
-    std::size_t differ = 0, inside = 0;
-    for (PointIndex i = 0; i < std::min(a.size(), b.size()); ++i) {
-        differ += (a[i] != 0) != (b[i] != 0);
-        inside += b[i] != 0;
-    }
-    EXPECT_GT(inside, 10000u);
-    return differ;
-}
 
 // With bias correction (the default) and no ROI, `view` fits the tissue model where `segment` does:
 // in the brain mask found before N4 (it once took the corrected image's: 43 voxels of this mask

@@ -156,11 +156,18 @@ TEST(ViewCommand, APhiLoadedAloneSaysWhereItsParametersCameFrom) {
     EXPECT_NEAR(scale.to_raw(ws.marks.params.mu), 500.0, 1e-9);
     EXPECT_NEAR(scale.raw_length(ws.marks.params.epsilon), 120.0, 1e-9);
     EXPECT_EQ(ws.marks.params.alpha, 0.2);
+    EXPECT_EQ(ws.marks.params.smooth_mm, 0.0);  // a given α without --smooth: no blur, as segment
     EXPECT_FALSE(ws.marks.window_from_seeds);
+    r = run_cli(fmt::format("view {} --no-bias-correct --phi {} --alpha 0.2 --smooth 0.6 --headless --script {}", f.image, phi,
+                            script("g2.json", R"([{"save_workspace": ")" + w + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("n, α, smoothing from the command line"), std::string::npos) << r.err;
+    EXPECT_EQ(viewer::read_workspace(w).marks.params.smooth_mm, 0.6);
 
     // The same validation as `liveset segment`: one line and a non-zero status.
     for (const std::string& bad : {std::string("--mu 0.5 --mu-raw 500"), std::string("--epsilon 0.1 --epsilon-raw 3"),
-                                   std::string("--mu-raw 1e9"), std::string("--alpha 1.5"), std::string("--epsilon-raw -4")}) {
+                                   std::string("--mu-raw 1e9"), std::string("--alpha 1.5"), std::string("--epsilon-raw -4"),
+                                   std::string("--smooth 0.5"), std::string("--alpha 0.1 --smooth -2")}) {
         r = run_cli(fmt::format("view {} --phi {} {} --headless --script {}", f.image, phi, bad, script("h.json", "[]")));
         EXPECT_NE(r.rc, 0) << bad;
         EXPECT_EQ(lines(r.err), 1u) << bad << ": " << r.err;

@@ -160,8 +160,18 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     EXPECT_TRUE(same_status(continued.field().status(), original->field().status()));
     EXPECT_EQ(continued.segment_status().iterations, 35);
 
-    // The automatic α's flag travels too; a workspace written before it (no key) had a set α.
+    // The automatic α's flag travels too; a workspace written before it (no key) had a set α. The
+    // smoothing σ travels as well; one written before it (no key) ran without.
     ThresholdParams q = original->params();
+    q.smooth_mm = 0.75;
+    original->set_params(q, false, false);
+    const fs::path w1 = workspaces_dir() / "smoothed.json";
+    viewer::save_workspace(w1, *original, "t1.nii.gz", "", true, a_view());
+    EXPECT_EQ(viewer::read_workspace(w1).marks.params.smooth_mm, 0.75);
+    nlohmann::json j1 = nlohmann::json::parse(testing_slurp(w1));
+    j1["params"].erase("smooth_mm");
+    std::ofstream(w1) << j1.dump();
+    EXPECT_EQ(viewer::read_workspace(w1).marks.params.smooth_mm, 0.0);
     original->set_params(q, false, true);
     const fs::path w2 = workspaces_dir() / "automatic_alpha.json";
     viewer::save_workspace(w2, *original, "t1.nii.gz", "", true, a_view());

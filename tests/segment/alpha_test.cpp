@@ -100,3 +100,15 @@ TEST(AutomaticAlpha, FloatAndDoubleVoxelSizesGiveTheSameBits) {
     EXPECT_EQ(automatic_alpha(&m, 98.0, as_float.spacing_float()).alpha, automatic_alpha(&m, 98.0, as_double.spacing_float()).alpha);
     EXPECT_GT(automatic_alpha(&m, 98.0, as_double.spacing_float()).alpha, 0.0);
 }
+
+// The pre-smoothing follows the same noise floor: half the finest voxel side above it (in mm, the
+// same along every axis), none at or below it or without a ratio.
+TEST(AutomaticAlpha, ThePreSmoothingIsHalfTheFinestVoxelAboveTheNoiseFloor) {
+    const TissueModel quiet = three_classes(5.7), loud = three_classes(13.1), edge = three_classes(0.2 * 34.0);
+    EXPECT_EQ(automatic_alpha(&quiet, 91.0, {1, 1, 1}).smooth_mm, 0.0);
+    EXPECT_EQ(automatic_alpha(&edge, 91.0, {1, 1, 1}).smooth_mm, 0.0);  // exactly at the floor: α 0, no blur
+    EXPECT_DOUBLE_EQ(automatic_alpha(&loud, 91.0, {1, 1, 1}).smooth_mm, 0.5);
+    EXPECT_DOUBLE_EQ(automatic_alpha(&loud, 91.0, {0.7f, 0.9f, 3.0f}).smooth_mm, 0.5 * static_cast<double>(0.7f));
+    EXPECT_DOUBLE_EQ(automatic_alpha(&loud, 91.0, {2, 2, 2}).smooth_mm, 1.0);
+    EXPECT_EQ(automatic_alpha(nullptr, 91.0, {1, 1, 1}).smooth_mm, 0.0);  // the fallback α measures no noise
+}

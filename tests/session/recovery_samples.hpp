@@ -22,7 +22,7 @@ inline RecoveryState sample_state() {
     s.image = "/data/subject 01/t1.nii.gz";
     s.unix_time = 1795000000;
     s.marks.seeds = {{{1.5, 2.0, 3.0}, 2.0}, {{4.0, 1.0, 0.0}, 0.75}};
-    s.marks.params = {0.42, 0.07, 3.0, 0.2};
+    s.marks.params = {0.42, 0.07, 3.0, 0.2, 0.45};
     s.marks.window_from_seeds = false;
     s.marks.alpha_automatic = true;
     s.marks.pristine = false;
@@ -49,6 +49,7 @@ inline void expect_same(const RecoveryState& a, const RecoveryState& b) {
     EXPECT_EQ(a.marks.params.epsilon, b.marks.params.epsilon);
     EXPECT_EQ(a.marks.params.n, b.marks.params.n);
     EXPECT_EQ(a.marks.params.alpha, b.marks.params.alpha);
+    EXPECT_EQ(a.marks.params.smooth_mm, b.marks.params.smooth_mm);
     EXPECT_EQ(a.marks.window_from_seeds, b.marks.window_from_seeds);
     EXPECT_EQ(a.marks.alpha_automatic, b.marks.alpha_automatic);
     EXPECT_EQ(a.marks.iterations, b.marks.iterations);

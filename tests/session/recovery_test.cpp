@@ -48,7 +48,17 @@ constexpr std::size_t kPathLength = 24;
 std::size_t dims_offset(const RecoveryState& s) { return kPathLength + 4 + s.image.size(); }
 std::size_t spacing_offset(const RecoveryState& s) { return dims_offset(s) + 12; }
 std::size_t params_offset(const RecoveryState& s) { return spacing_offset(s) + 15 * 8; }
-std::size_t voxels_offset(const RecoveryState& s) { return params_offset(s) + 4 * 8 + 1 + 4 + 4 + s.marks.seeds.size() * 32; }
+std::size_t voxels_offset(const RecoveryState& s) { return params_offset(s) + 5 * 8 + 1 + 4 + 4 + s.marks.seeds.size() * 32; }
+
+// The same state in an older layout: `version` (1 or 2) had no smoothing σ after α.
+std::vector<std::uint8_t> older(const RecoveryState& s, std::uint32_t version) {
+    std::vector<std::uint8_t> bytes = encode_recovery(s);
+    const auto at = bytes.begin() + static_cast<std::ptrdiff_t>(params_offset(s) + 32);
+    bytes.erase(at, at + 8);
+    std::memcpy(bytes.data() + 8, &version, 4);
+    reseal(bytes);
+    return bytes;
+}
 
 TEST(Recovery, EncodedStateDecodesBitForBit) {
     RecoveryState s = sample_state();
@@ -98,7 +108,7 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
     auto f32 = [](float v) { std::vector<std::uint8_t> b(4); std::memcpy(b.data(), &v, 4); return b; };
     const std::vector<Case> cases{
         {"wrong magic", 0, {'N', 'I', 'F', 'T'}, "wrong magic"},
-        {"version 3", 8, u32(3), "version 3"},
+        {"version 4", 8, u32(4), "version 4"},
         {"version 0", 8, u32(0), "version 0"},
         {"path length beyond the file", kPathLength, u32(1000000), "too long"},
         {"zero dimension", dims_offset(s), i32(0), "invalid geometry"},
@@ -107,11 +117,14 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
         {"NaN spacing", spacing_offset(s) + 8, f64(std::numeric_limits<double>::quiet_NaN()), "non-finite spacing"},
         {"epsilon 0", params_offset(s) + 8, f64(0.0), "invalid parameters"},
         {"alpha 1", params_offset(s) + 24, f64(1.0), "invalid parameters"},
-        {"flags 7", params_offset(s) + 32, {7}, "invalid flag"},
-        {"flags 4", params_offset(s) + 32, {4}, "invalid flag"},
-        {"negative iterations", params_offset(s) + 33, i32(-1), "negative iteration"},
-        {"four billion seeds", params_offset(s) + 37, u32(0xFFFFFFFFu), "seed count"},
-        {"seed radius 0", params_offset(s) + 41 + 24, f64(0.0), "non-positive radius"},
+        {"negative smoothing", params_offset(s) + 32, f64(-0.5), "invalid parameters"},
+        {"smoothing beyond its cap", params_offset(s) + 32, f64(1e6), "invalid parameters"},
+        {"NaN smoothing", params_offset(s) + 32, f64(std::numeric_limits<double>::quiet_NaN()), "parameters"},
+        {"flags 7", params_offset(s) + 40, {7}, "invalid flag"},
+        {"flags 4", params_offset(s) + 40, {4}, "invalid flag"},
+        {"negative iterations", params_offset(s) + 41, i32(-1), "negative iteration"},
+        {"four billion seeds", params_offset(s) + 45, u32(0xFFFFFFFFu), "seed count"},
+        {"seed radius 0", params_offset(s) + 49 + 24, f64(0.0), "non-positive radius"},
         {"voxel count off by one", voxels_offset(s), u64(s.phi.size() + 1), "voxel count"},
         {"NaN in phi", voxels_offset(s) + 8 + 4 * 17, f32(std::numeric_limits<float>::quiet_NaN()), "NaN"},
         {"infinity in phi", voxels_offset(s) + 8, f32(std::numeric_limits<float>::infinity()), "NaN or infinite"},
@@ -131,18 +144,28 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
 TEST(Recovery, VersionOneFilesStillReadWithAManualAlpha) {
     // Version 1's flags byte held window_from_seeds alone; its files read as before, with α as saved.
     const RecoveryState s = sample_state();
-    std::vector<std::uint8_t> bytes = encode_recovery(s);
-    const std::uint32_t one = 1;
-    std::memcpy(bytes.data() + 8, &one, 4);
+    std::vector<std::uint8_t> bytes = older(s, 1);
     bytes[params_offset(s) + 32] = 1;
     reseal(bytes);
     const RecoveryState old = decode_recovery(bytes.data(), bytes.size());
     EXPECT_TRUE(old.marks.window_from_seeds);
     EXPECT_FALSE(old.marks.alpha_automatic);
     EXPECT_EQ(old.marks.params.alpha, s.marks.params.alpha);
+    EXPECT_EQ(old.marks.params.smooth_mm, 0.0);  // before the pre-smoothing: none, as they ran
     bytes[params_offset(s) + 32] = 3;  // bit 1 did not exist in version 1
     reseal(bytes);
     EXPECT_NE(refusal(bytes).find("invalid flag"), std::string::npos) << refusal(bytes);
+}
+
+TEST(Recovery, VersionTwoFilesReadWithoutSmoothing) {
+    const RecoveryState s = sample_state();
+    ASSERT_GT(s.marks.params.smooth_mm, 0.0);
+    const std::vector<std::uint8_t> bytes = older(s, 2);
+    const RecoveryState old = decode_recovery(bytes.data(), bytes.size());
+    EXPECT_EQ(old.marks.params.smooth_mm, 0.0);
+    RecoveryState expected = s;
+    expected.marks.params.smooth_mm = 0.0;
+    expect_same(old, expected);  // everything else as saved, φ and statuses bit for bit
 }
 
 TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {

@@ -14,6 +14,7 @@
 #include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/pipeline.hpp"
+#include "liveset/segment/smoothing.hpp"
 #include "liveset/session/repair_presets.hpp"
 #include "liveset/session/session.hpp"
 #include "noisy_phantom.hpp"
@@ -119,6 +120,68 @@ TEST(Session, SegmentsFromSeedsExactlyAsLivesetSegment) {
     expect_mesh_is_whole_volume_mesh(s);
 }
 
+// On a noisy scan the automatic choice blurs the image the threshold term reads: the session, with
+// α automatic, still segments bit for bit as segment_image does without --alpha, and its
+// speed_image() (the slice preview's) is that blur.
+TEST(Session, SegmentsANoisyScanWithTheAutomaticBlurExactlyAsLivesetSegment) {
+    const testing::NoisyAnisotropicPhantom noisy = testing::noisy_anisotropic_phantom(48);
+    SessionOptions so = options();
+    so.alpha_automatic = true;
+    Session s(noisy.image, so);
+    SegmentRequest req;
+    for (const Vec3i& c : noisy.phantom.seeds) {
+        req.seeds.push_back({c.cast<double>(), 2.0});
+        s.add_seed({c.cast<double>(), 2.0});
+    }
+    int steps = 0;
+    while (!s.segment_status().converged && steps < 2000) {
+        s.segment_step();
+        ++steps;
+    }
+    const SegmentOutcome o = segment_image(noisy.image, req);
+    ASSERT_EQ(o.result.reason, StopReason::kConverged);
+    ASSERT_GT(o.params.smooth_mm, 0.0);
+    EXPECT_EQ(s.params().smooth_mm, o.params.smooth_mm);
+    EXPECT_EQ(s.params().alpha, o.params.alpha);
+    EXPECT_EQ(steps, o.result.iterations);
+    for (std::size_t i = 0; i < o.field->phi().size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(s.field().phi()[p]), std::bit_cast<std::uint32_t>(o.field->phi()[p])) << i;
+    }
+    const Grid<float> blurred = gaussian_smooth(s.unit_image(), o.params.smooth_mm);
+    EXPECT_TRUE(std::equal(blurred.values().begin(), blurred.values().end(), s.speed_image().values().begin()));
+    // Without the blur (a given α and σ 0) the front ends elsewhere: the blur is what made the match.
+    req.alpha = o.params.alpha;
+    const SegmentOutcome plain = segment_image(noisy.image, req);
+    EXPECT_FALSE(std::equal(plain.mask.values().begin(), plain.mask.values().end(), o.mask.values().begin()));
+}
+
+// A change of the blur alone is an undoable action of its own, and it changes the next steps.
+TEST(Session, AChangeOfTheBlurAloneIsUndoneAndRedone) {
+    const testing::NoisyAnisotropicPhantom noisy = testing::noisy_anisotropic_phantom(48);
+    Session s(noisy.image, options());
+    for (const Vec3i& c : noisy.phantom.seeds) s.add_seed({c.cast<double>(), 2.0});
+    s.end_action();
+    ThresholdParams p = s.params();
+    ASSERT_EQ(p.smooth_mm, 0.0);
+    p.smooth_mm = 0.7;
+    s.set_params(p, s.window_from_seeds());
+    s.end_action();
+    EXPECT_EQ(s.params().smooth_mm, 0.7);
+    ASSERT_TRUE(s.can_undo());
+    s.undo();
+    EXPECT_EQ(s.params().smooth_mm, 0.0);
+    s.redo();
+    EXPECT_EQ(s.params().smooth_mm, 0.7);
+    for (int i = 0; i < 20; ++i) s.segment_step();
+    const Grid<float> blurred = s.field().phi();
+    s.undo();  // the steps
+    s.undo();  // the blur
+    EXPECT_EQ(s.params().smooth_mm, 0.0);
+    for (int i = 0; i < 20; ++i) s.segment_step();
+    EXPECT_FALSE(std::equal(blurred.values().begin(), blurred.values().end(), s.field().phi().values().begin()));
+}
+
 // With alpha_automatic the session's α is the one segment_image chooses for the same seeds (and the
 // window they give), chosen again as seeds move the window; a given α turns it off, undo back on.
 TEST(Session, AutomaticAlphaIsSegmentsForTheSeedsAndFollowsThem) {
@@ -140,6 +203,8 @@ TEST(Session, AutomaticAlphaIsSegmentsForTheSeedsAndFollowsThem) {
     const AlphaChoice one = alpha_for(1);
     EXPECT_EQ(one.tissue_class, s.automatic_alpha_choice().tissue_class);
     EXPECT_EQ(s.params().alpha, one.alpha);
+    EXPECT_EQ(s.params().smooth_mm, one.smooth_mm);  // noisy: blurred by half a voxel, as segment
+    EXPECT_EQ(one.smooth_mm, 0.5 * static_cast<double>(image.lattice().spacing_float().x));
     EXPECT_GT(one.alpha, 0.0);
     EXPECT_LT(one.alpha, 0.1);
     for (std::size_t k = 1; k < ph.seeds.size(); ++k) s.add_seed({ph.seeds[k].cast<double>(), 2.0});

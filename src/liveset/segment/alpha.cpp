@@ -1,9 +1,12 @@
-// automatic_alpha(): the curvature weight from the tissue model's noise ratio and the voxel shape.
+// automatic_alpha(): the curvature weight and the pre-smoothing from the tissue model's noise ratio
+// and the voxel shape.
 #include "liveset/segment/alpha.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+
+#include "liveset/segment/smoothing.hpp"
 
 namespace liveset {
 
@@ -45,6 +48,7 @@ AlphaChoice automatic_alpha(const TissueModel* model, double window_centre_raw, 
     const double h_max = std::max({spacing.x, spacing.y, spacing.z});
     a.anisotropy = h_max / h_min;
     a.alpha = base / (a.anisotropy * a.anisotropy * a.anisotropy);
+    if (a.noise_ratio > kAlphaNoiseFloor) a.smooth_mm = std::min(kSmoothVoxels * h_min, kMaxSmoothMm);  // NaN compares false
     return a;
 }
 

@@ -1,5 +1,6 @@
-// The automatic curvature weight α of the threshold speed: as much smoothing as the image's noise
-// needs, less on voxels much longer along one axis than another.
+// The automatic regularisation of the threshold speed: the curvature weight α - as much smoothing
+// as the image's noise needs, less on voxels much longer along one axis than another - and, on a
+// noisy scan, a slight Gaussian blur of the image the data term reads (smoothing.hpp).
 #pragma once
 
 #include <limits>
@@ -19,6 +20,9 @@ struct AlphaChoice {
     double noise_ratio = std::numeric_limits<double>::quiet_NaN();
     int tissue_class = -1;   // the window's class (see automatic_alpha); -1 without a ratio
     double anisotropy = 1.0;  // longest over shortest voxel side
+    // σ (mm) of the pre-smoothing (ThresholdParams::smooth_mm): kSmoothVoxels × the finest voxel
+    // side when the noise ratio exceeds kAlphaNoiseFloor, else 0 (also without a ratio).
+    double smooth_mm = 0.0;
 };
 
 // The rule (docs/ARCHITECTURE.md, "The automatic curvature weight"):
@@ -26,6 +30,8 @@ struct AlphaChoice {
 // with kFallbackAlpha in place of the first factor when the model is absent or unusable. The
 // curvature only pays where noise scatters single voxels across the window's edges (a clean scan
 // segments best without it; docs/BENCHMARKS.md, session 50), and on thick slices it costs the most.
+// Above the same noise floor the image is blurred by σ = kSmoothVoxels finest voxel sides before D
+// is tabulated (docs/BENCHMARKS.md, session 54): single noisy voxels no longer cut the front off.
 inline constexpr double kAlphaNoiseFloor = 0.2;
 inline constexpr double kAlphaPerNoise = 0.5;
 inline constexpr double kAlphaMax = 0.15;

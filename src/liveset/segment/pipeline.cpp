@@ -88,6 +88,8 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     validate(req.loop);
     if ((req.mu && req.mu_raw) || (req.epsilon && req.epsilon_raw))
         throw std::invalid_argument("give the window in normalised or raw units, not both");
+    if (req.smooth_mm && !req.alpha)
+        throw std::invalid_argument("give the smoothing together with alpha: the automatic choice sets both");
 
     SegmentOutcome out;
     out.scale = robust_scale(image, req.roi, req.scale);
@@ -99,6 +101,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     if (!req.mu && !req.mu_raw) p.mu = std::clamp(p.mu, 0.0, 1.0);  // an estimate beyond the scale's range
     if (req.alpha) {
         out.alpha.alpha = *req.alpha;
+        out.alpha.smooth_mm = req.smooth_mm.value_or(0.0);
     } else {
         // The seeds' class when the whole window is theirs; with µ or ε given, the class nearest µ
         // (as the Session, whose window is either the seeds' or set).
@@ -108,6 +111,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
                                     window_class);
     }
     p.alpha = out.alpha.alpha;
+    p.smooth_mm = out.alpha.smooth_mm;
     validate(p);
     out.params = p;
 

@@ -37,6 +37,9 @@ struct SegmentRequest {
     // The curvature weight; absent: automatic_alpha() (alpha.hpp) from the tissue model's noise
     // ratio of the window's class and the voxel shape (the fallback 0.1 without a usable model).
     std::optional<double> alpha;
+    // With α given: the σ (mm) of the image's pre-smoothing (ThresholdParams::smooth_mm; absent: 0).
+    // The automatic α chooses it too (alpha.hpp), so it may not be given without α.
+    std::optional<double> smooth_mm;
     ScaleOptions scale;
     SegmentationOptions loop;
     int layers = 2;
@@ -46,7 +49,7 @@ struct SegmentOutcome {
     IntensityScale scale;
     ThresholdParams params;
     WindowSource window_source = WindowSource::kUser;
-    AlphaChoice alpha;  // the α params holds, and why
+    AlphaChoice alpha;  // the α and smoothing params holds, and why
     std::optional<SeedStatistics> seed_stats;  // when the window was estimated
     std::optional<TissueModel> model;          // when it could be fitted (seeds given)
     std::optional<ModelWindow> model_window;   // when the window came from the model

@@ -4,11 +4,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+
+#include "liveset/segment/smoothing.hpp"
 
 namespace liveset {
 
@@ -18,6 +21,11 @@ void validate(const ThresholdParams& p) {
     if (!std::isfinite(p.epsilon) || p.epsilon <= 0.0) fail("epsilon must be positive");
     if (!std::isfinite(p.n) || p.n <= 0.0 || p.n > 100.0) fail("n must be in (0, 100]");
     if (!std::isfinite(p.alpha) || p.alpha < 0.0 || p.alpha >= 1.0) fail("alpha must be in [0, 1)");
+    if (!std::isfinite(p.smooth_mm) || p.smooth_mm < 0.0 || p.smooth_mm > kMaxSmoothMm) {
+        std::ostringstream os;
+        os << "the smoothing sigma must be in [0, " << kMaxSmoothMm << "] mm";
+        fail(os.str());
+    }
 }
 
 double threshold_term(double intensity, const ThresholdParams& p) {
@@ -38,7 +46,9 @@ ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdPar
         throw std::invalid_argument(os.str());
     }
     const double w = 0.5 * (1.0 - params.alpha);
-    const std::span<const float> img = unit_image.values();
+    std::optional<Grid<float>> smoothed;
+    if (params.smooth_mm > 0.0) smoothed = gaussian_smooth(unit_image, params.smooth_mm);
+    const std::span<const float> img = smoothed ? smoothed->values() : unit_image.values();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, img.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const auto pi = static_cast<PointIndex>(i);

@@ -22,10 +22,12 @@ struct ThresholdParams {
     double epsilon = 0.1;  // acceptable error (half window), normalised units, > 0
     double n = 4.0;        // steepness of D at the window edge, > 0
     double alpha = 0.1;    // curvature weight in [0, 1)
+    // σ (mm) of the Gaussian the image is blurred with before D is tabulated (smoothing.hpp); 0: none.
+    double smooth_mm = 0.0;
 };
 
 // Throws std::invalid_argument with a one-line message for non-finite values, ε ≤ 0, n ≤ 0,
-// α outside [0, 1), µ outside [0, 1].
+// α outside [0, 1), µ outside [0, 1], a smoothing σ outside [0, kMaxSmoothMm].
 void validate(const ThresholdParams& params);
 
 // D(I) of Eq. 3 for one normalised intensity.
@@ -34,7 +36,8 @@ double threshold_term(double intensity, const ThresholdParams& params);
 class ThresholdSpeed final : public Speed {
 public:
     // `unit_image` (normalised to [0, 1]) and `roi` (optional, non-zero = allowed) must outlive
-    // the speed and match each other's dimensions; D is tabulated per voxel at construction.
+    // the speed and match each other's dimensions; D is tabulated per voxel at construction (of the
+    // image blurred by params.smooth_mm when it is positive).
     ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi = nullptr);
 
     SpeedSample at(const Grid<float>& phi, Vec3i p) const override;

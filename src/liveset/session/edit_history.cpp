@@ -17,7 +17,7 @@ bool same_marks(const SessionMarks& a, const SessionMarks& b) {
     for (std::size_t i = 0; i < a.seeds.size(); ++i)
         if (!(a.seeds[i].center == b.seeds[i].center) || a.seeds[i].radius != b.seeds[i].radius) return false;
     return a.params.mu == b.params.mu && a.params.epsilon == b.params.epsilon && a.params.n == b.params.n &&
-           a.params.alpha == b.params.alpha && a.window_from_seeds == b.window_from_seeds &&
+           a.params.alpha == b.params.alpha && a.params.smooth_mm == b.params.smooth_mm && a.window_from_seeds == b.window_from_seeds &&
            a.alpha_automatic == b.alpha_automatic && a.pristine == b.pristine &&
            a.iterations == b.iterations;
 }

@@ -24,7 +24,7 @@ struct SessionMarks {
     std::vector<SeedBall> seeds;
     ThresholdParams params;
     bool window_from_seeds = true;  // µ, ε follow the seeds
-    bool alpha_automatic = false;   // α follows the image and the window (segment/alpha.hpp)
+    bool alpha_automatic = false;   // α and smooth_mm follow the image and the window (segment/alpha.hpp)
     bool pristine = true;           // φ is the union of the seed balls (no step taken since)
     int iterations = 0;             // segmentation steps taken
 };

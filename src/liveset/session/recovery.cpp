@@ -20,7 +20,7 @@ static_assert(std::endian::native == std::endian::little, "recovery files are wr
 namespace {
 
 constexpr char kMagic[8] = {'L', 'S', 'R', 'E', 'C', 'O', 'V', '1'};
-constexpr std::uint32_t kVersion = 2;  // 1: the flags byte held window_from_seeds only
+constexpr std::uint32_t kVersion = 3;  // 1: the flags byte held window_from_seeds only; 2: no smooth_mm
 constexpr std::uint32_t kMaxPath = 4096;
 constexpr std::uint32_t kMaxSeeds = 100000;
 
@@ -52,7 +52,7 @@ std::vector<std::uint8_t> encode_header(const std::string& image, const SessionM
     for (double v : {s.x, s.y, s.z, o.x, o.y, o.z}) put(out, v);
     for (double v : lattice.direction()) put(out, v);
     const ThresholdParams& p = marks.params;
-    for (double v : {p.mu, p.epsilon, p.n, p.alpha}) put(out, v);
+    for (double v : {p.mu, p.epsilon, p.n, p.alpha, p.smooth_mm}) put(out, v);
     put(out, static_cast<std::uint8_t>((marks.window_from_seeds ? 1 : 0) | (marks.alpha_automatic ? 2 : 0)));
     put(out, static_cast<std::int32_t>(marks.iterations));
     put(out, static_cast<std::uint32_t>(marks.seeds.size()));
@@ -151,7 +151,7 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
     std::uint64_t stored;
     std::memcpy(&stored, data + size - sizeof stored, sizeof stored);
     const std::uint32_t version = r.get<std::uint32_t>("version");
-    if (version != kVersion && version != 1) throw std::runtime_error("unsupported recovery file version " + std::to_string(version));
+    if (version < 1 || version > kVersion) throw std::runtime_error("unsupported recovery file version " + std::to_string(version));
     if (hash.h != stored) throw std::runtime_error("damaged (checksum mismatch)");
 
     RecoveryState s;
@@ -187,6 +187,7 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
     p.epsilon = r.finite("parameters");
     p.n = r.finite("parameters");
     p.alpha = r.finite("parameters");
+    if (version >= 3) p.smooth_mm = r.finite("parameters");  // older files: no smoothing, as they ran
     try {
         validate(p);
     } catch (const std::invalid_argument& e) {

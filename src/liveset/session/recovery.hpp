@@ -2,13 +2,15 @@
 // periodically, at exit without saving, and from a crash signal handler, so that the next start can
 // offer to restore it. One small binary format of our own (little-endian):
 //
-//   "LSRECOV1"  u32 version (2)  u32 signal (0: autosave)  i64 unix time
+//   "LSRECOV1"  u32 version (3)  u32 signal (0: autosave)  i64 unix time
 //   u32 n + n bytes: the image's path          i32 dims[3]  f64 spacing[3] origin[3] direction[9]
-//   f64 µ ε n α  u8 flags  i32 iterations  u32 seeds + (f64 x y z radius) per seed
+//   f64 µ ε n α σ  u8 flags  i32 iterations  u32 seeds + (f64 x y z radius) per seed
 //   u64 voxels (= dims product)  f32 φ[voxels]  i8 sparse-field status[voxels]
 //   u64 FNV-1a of every byte before it
 //
-// flags: bit 0 window_from_seeds, bit 1 alpha_automatic (version 1, still read, had bit 0 only).
+// flags: bit 0 window_from_seeds, bit 1 alpha_automatic (version 1, still read, had bit 0 only;
+// versions 1 and 2 have no smoothing σ: read as 0 - with a fixed α as they ran; an automatic α
+// takes today's rule, blur included, when the session next builds its speed).
 // The viewer's crash path (apps/viewer/crash_recovery) writes the same bytes with async-signal-safe
 // calls only, from the pieces in recovery_format. Every read is checked (sizes, magic, checksum,
 // geometry) and refused with one line. Standard library only.

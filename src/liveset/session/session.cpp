@@ -12,6 +12,7 @@
 #include "liveset/levelset/shapes.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/segment/pipeline.hpp"
+#include "liveset/segment/smoothing.hpp"
 #include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
@@ -19,6 +20,12 @@ namespace liveset {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The automatic regularisation's two values (segment/alpha.hpp), as segment_image takes them.
+void take_automatic(ThresholdParams& p, const AlphaChoice& a) {
+    p.alpha = a.alpha;
+    p.smooth_mm = a.smooth_mm;
+}
 
 const SessionOptions& checked(const SessionOptions& o) {
     if (o.history < 20) throw std::invalid_argument("the undo history must keep at least 20 actions");
@@ -180,6 +187,13 @@ std::optional<std::size_t> Session::seed_at(Vec3d p, double tolerance) const {
     return best;
 }
 
+const Grid<float>& Session::speed_image() const {
+    const double sigma = marks_.params.smooth_mm;
+    if (sigma <= 0.0) return unit_;
+    if (!smoothed_ || smoothed_->first != sigma) smoothed_.emplace(sigma, gaussian_smooth(unit_, sigma));
+    return smoothed_->second;
+}
+
 const std::optional<TissueModel>& Session::tissue_model() const {
     if (!model_) {
         std::vector<std::string> ignored;  // window_estimate() reports an unusable model
@@ -214,7 +228,7 @@ void Session::refresh_window() {
         marks_.params.mu = p->mu;
         marks_.params.epsilon = p->epsilon;
     }
-    if (marks_.alpha_automatic) marks_.params.alpha = alpha_choice_for(marks_.params, true).alpha;
+    if (marks_.alpha_automatic) take_automatic(marks_.params, alpha_choice_for(marks_.params, true));
     speed_.reset();
     segment_.converged = false;
 }
@@ -237,7 +251,7 @@ void Session::set_params(const ThresholdParams& params, bool window_from_seeds, 
             p.mu = w->mu;
             p.epsilon = w->epsilon;
         }
-    if (alpha_automatic) p.alpha = alpha_choice_for(p, window_from_seeds).alpha;
+    if (alpha_automatic) take_automatic(p, alpha_choice_for(p, window_from_seeds));
     validate(p);
     begin_action("parameters");
     marks_.params = p;
@@ -261,7 +275,7 @@ SessionUpdate Session::segment_step() {
         if (!speed_) {
             // A level set loaded with no seed nor set window since: α for the window as it stands,
             // within the action (the same value set_params and the seeds' refresh give elsewhere).
-            if (marks_.alpha_automatic) marks_.params.alpha = automatic_alpha_choice().alpha;
+            if (marks_.alpha_automatic) take_automatic(marks_.params, automatic_alpha_choice());
             speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi());
         }
         StepResult step = field_.step(*speed_, options_.segmentation.step);

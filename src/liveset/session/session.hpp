@@ -24,6 +24,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "liveset/mesh/fragment_mesher.hpp"
@@ -54,9 +55,9 @@ struct SessionOptions {
     SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
     RepairOptions repair;              // swarm settings (steps unused: the caller steps)
     ThresholdParams params;            // initial n and α (µ, ε too when there are no seeds)
-    // α chosen as `liveset segment` chooses it (segment/alpha.hpp) instead of params.alpha - once
-    // there is a window (a seed, set_params, or the first step) - and re-chosen whenever the window
-    // changes, until set_params sets α itself.
+    // α and the pre-smoothing chosen as `liveset segment` chooses them (segment/alpha.hpp) instead
+    // of params.alpha and params.smooth_mm - once there is a window (a seed, set_params, or the
+    // first step) - and re-chosen whenever the window changes, until set_params sets them itself.
     bool alpha_automatic = false;
 };
 
@@ -92,6 +93,9 @@ public:
     const Lattice& lattice() const { return image_.lattice(); }
     const Grid<float>& image() const { return image_; }
     const Grid<float>& unit_image() const { return unit_; }
+    // The image the threshold term reads: unit_image() blurred by params().smooth_mm (the same
+    // values the speed tabulates; computed on first use for each σ). For the slice preview.
+    const Grid<float>& speed_image() const;
     const IntensityScale& scale() const { return scale_; }
     const Grid<std::uint8_t>* roi() const { return roi_ ? &*roi_ : nullptr; }
     const SparseField& field() const { return field_; }
@@ -127,8 +131,8 @@ public:
     bool alpha_automatic() const { return marks_.alpha_automatic; }
     // Sets n and, unless `window_from_seeds`, µ and ε (then estimated from the seeds as
     // `liveset segment` does: the tissue model's window for the seeds' class, window.hpp), and,
-    // unless `alpha_automatic`, α (then chosen as `liveset segment` chooses it for that window,
-    // and again whenever the seeds move the window). Throws std::invalid_argument.
+    // unless `alpha_automatic`, α and the smoothing σ (then chosen as `liveset segment` chooses
+    // them for that window, and again whenever the seeds move the window). Throws std::invalid_argument.
     void set_params(const ThresholdParams& params, bool window_from_seeds, bool alpha_automatic = false);
     // The α `liveset segment` would choose for the current window, with its reasons.
     AlphaChoice automatic_alpha_choice() const { return alpha_choice_for(marks_.params, marks_.window_from_seeds); }
@@ -250,6 +254,7 @@ private:
     SessionMarks marks_;
     std::unique_ptr<ThresholdSpeed> speed_;  // for marks_.params; rebuilt lazily
     mutable std::optional<std::optional<TissueModel>> model_;  // fitted lazily (inner nullopt: failed)
+    mutable std::optional<std::pair<double, Grid<float>>> smoothed_;  // speed_image()'s σ and values
     std::optional<FrontConvergence> convergence_;
     SegmentStatus segment_;
     RepairOptions repair_options_;

@@ -1,0 +1,38 @@
+#!/usr/bin/python3
+# BrainWeb variants for the pre-smoothing (docs/BENCHMARKS.md, session 54): Rician noise, other grids,
+# other units, skull-stripped + noise. Each in OUT/NAME/{t1,labels,mask}.nii.gz.
+# Usage: /usr/bin/python3 scripts/brainweb_noise_variants.py OUT_DIR  (Debian's python3-nibabel, -scipy)
+import os, sys, zlib
+import nibabel as nib, numpy as np
+from scipy import ndimage
+here = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'data', 'brainweb')
+out = sys.argv[1] if len(sys.argv) > 1 else 'brainweb-noise-variants'
+raw = open(os.path.join(here, 't1.mha'), 'rb').read()
+start = raw.index(b'ElementDataFile = LOCAL\n') + len(b'ElementDataFile = LOCAL\n')
+t1 = np.frombuffer(zlib.decompress(raw[start:]), dtype=np.uint8).reshape(180, 217, 181).transpose(2, 1, 0).astype(np.float32)
+labels = np.asarray(nib.load(os.path.join(here, 'labels_crisp.nii.gz')).dataobj).astype(np.uint8)
+mask = (np.asarray(nib.load(os.path.join(here, 'brain_mask.nii.gz')).dataobj) > 0).astype(np.uint8)
+base = nib.load(os.path.join(here, 'labels_crisp.nii.gz')).affine
+n = np.array(t1.shape, float)
+rng = np.random.default_rng(54)
+def rician(a, s): return np.sqrt((a + rng.normal(0, s, a.shape))**2 + rng.normal(0, s, a.shape)**2)
+def save(name, T, L, M, aff):
+    d = os.path.join(out, name); os.makedirs(d, exist_ok=True)
+    nib.save(nib.Nifti1Image(T.astype(np.float32), aff), os.path.join(d, 't1.nii.gz'))
+    nib.save(nib.Nifti1Image(L.astype(np.uint8), aff), os.path.join(d, 'labels.nii.gz'))
+    nib.save(nib.Nifti1Image(M.astype(np.uint8), aff), os.path.join(d, 'mask.nii.gz'))
+    print(name, T.shape, flush=True)
+def res(h):
+    h = np.array(h, float); m = np.diag(h)
+    shape = tuple(int(v) for v in np.floor((n - 1) / h) + 1)
+    aff = base @ np.block([[m, np.zeros((3, 1))], [np.zeros((1, 3)), np.ones((1, 1))]])
+    r = lambda a, o: ndimage.affine_transform(a, m, output_shape=shape, order=o)
+    return r(t1, 1), r(labels, 0), r(mask, 0), aff
+save('ric5', rician(t1, 5), labels, mask, base)
+save('ric9', rician(t1, 9), labels, mask, base)
+save('ric14', rician(t1, 14), labels, mask, base)
+save('scaledn', rician(t1, 9) * 7.3 + 300, labels, mask, base)
+save('strippedn', rician(t1 * (mask > 0), 9) * (mask > 0), labels, mask, base)
+T, L, M, a = res([1.3, 1.3, 1.3]); save('iso13r', rician(T, 8), L, M, a)
+T, L, M, a = res([0.9, 0.9, 2.0]); save('z2r', rician(T, 7), L, M, a)
+T, L, M, a = res([1.6, 1.6, 1.6]); save('iso16r', rician(T, 6), L, M, a)
