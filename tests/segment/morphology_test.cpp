@@ -86,42 +86,6 @@ TEST(Morphology, DepthIsTheDistanceToTheNearestOutsideVoxel) {
     }
 }
 
-// The separable blur equals the brute-force 3D convolution with the product of the per-axis
-// truncated, normalised Gaussians (σ in mm on anisotropic voxels, indices clamped at the edges).
-TEST(Morphology, GaussianBlurMatchesBruteForceConvolution) {
-    const Lattice lat({11, 9, 7}, {1.0, 2.0, 0.5});
-    Grid<float> g(lat);
-    std::mt19937 rng(3);
-    std::uniform_real_distribution<float> u(0.0f, 100.0f);
-    for (float& v : g.values()) v = u(rng);
-    const double sigma_mm = 1.3;
-    const Grid<float> blurred = gaussian_mm(g, sigma_mm);
-    std::array<std::vector<double>, 3> w;
-    std::array<int, 3> r{};
-    for (int a = 0; a < 3; ++a) {
-        const double s = sigma_mm / lat.spacing()[a];
-        r[a] = static_cast<int>(std::ceil(3 * s));
-        double sum = 0;
-        for (int k = -r[a]; k <= r[a]; ++k) sum += std::exp(-0.5 * k * k / (s * s));
-        for (int k = -r[a]; k <= r[a]; ++k) w[a].push_back(std::exp(-0.5 * k * k / (s * s)) / sum);
-    }
-    const Vec3i d = lat.dims();
-    for (PointIndex i = 0; i < g.size(); ++i) {
-        const Vec3i p = lat.coord(i);
-        double expect = 0;
-        for (int kz = -r[2]; kz <= r[2]; ++kz)
-            for (int ky = -r[1]; ky <= r[1]; ++ky)
-                for (int kx = -r[0]; kx <= r[0]; ++kx) {
-                    const Vec3i q{std::clamp(p.x + kx, 0, d.x - 1), std::clamp(p.y + ky, 0, d.y - 1), std::clamp(p.z + kz, 0, d.z - 1)};
-                    expect += w[0][static_cast<std::size_t>(kx + r[0])] * w[1][static_cast<std::size_t>(ky + r[1])] *
-                              w[2][static_cast<std::size_t>(kz + r[2])] * g(q);
-                }
-        EXPECT_NEAR(blurred[i], expect, 1e-3) << p;
-    }
-    const Grid<float> same = gaussian_mm(g, 0.0);
-    EXPECT_TRUE(std::equal(same.values().begin(), same.values().end(), g.values().begin()));
-}
-
 TEST(Morphology, LargestComponentAndFillHoles) {
     Mask m(Lattice({12, 10, 10}));
     // a hollow 5x5x5 box (a 3x3x3 cavity) and a separate 2x2x2 cube; a 1-voxel diagonal neighbour

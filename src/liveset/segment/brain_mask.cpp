@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "liveset/segment/morphology.hpp"
+#include "liveset/segment/smoothing.hpp"
 
 namespace liveset {
 
@@ -234,7 +235,7 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     const Mask head = fill_holes(close_mm(head_foreground(image, r.background_threshold), o.head_closing_mm));
     r.head_voxels = count(head);
     const Grid<float> depth = depth_mm(head);
-    const Grid<float> smooth = gaussian_mm(image, o.smoothing_mm);
+    const Grid<float> smooth = gaussian_smooth(image, o.smoothing_mm);
     white_matter_peak(image, head, depth, r);
     const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
     r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;  // CSF/skin | GM/muscle cut

@@ -16,9 +16,10 @@ namespace liveset {
 struct BrainMaskOptions {
     // Head threshold: p2 + fraction·(p98 − p2) of the intensities (FSL BET's robust 10 %).
     double background_fraction = 0.1;
-    // A voxel is brain tissue when the image blurred by a Gaussian of this σ (mm) lies in the
-    // tissue window (the window itself comes from the image as it is), so noise does not punch the
-    // cortex out of the mask: BrainWeb + noise σ 12, 86.7 % → 99.6 % of GM inside. 0: no blur.
+    // A voxel is brain tissue when the image blurred by a Gaussian of this σ (mm; gaussian_smooth,
+    // smoothing.hpp) lies in the tissue window (the window itself comes from the image as it is), so
+    // noise does not punch the cortex out of the mask: BrainWeb + noise σ 12, 86.7 % → 99.6 % of GM
+    // inside. 0: no blur.
     double smoothing_mm = 1.0;
     // Erosion of the brain-tissue mask that cuts the bridges (optic nerves, vessels, partial volume)
     // to scalp, muscle and eyes before the largest component is taken.

@@ -1,16 +1,10 @@
-// Binary morphology in mm through eval's exact separable distance transform, and a Gaussian blur in mm (see morphology.hpp).
+// Binary morphology in mm through eval's exact separable distance transform (see morphology.hpp).
 #include "liveset/segment/morphology.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <numeric>
 #include <stdexcept>
-#include <span>
 #include <vector>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "liveset/eval/surface_distance.hpp"
 #include "liveset/eval/topology.hpp"
@@ -120,46 +114,6 @@ Grid<float> depth_mm(const Grid<std::uint8_t>& mask) {
     Grid<float> out(mask.lattice());
     for (std::size_t i = 0; i < out.size(); ++i) out[static_cast<PointIndex>(i)] = static_cast<float>(std::sqrt(d2[static_cast<PointIndex>(i)]));
     return out;
-}
-
-Grid<float> gaussian_mm(const Grid<float>& image, double sigma_mm) {
-    if (!(sigma_mm > 0)) return image;
-    Grid<float> a = image, b(image.lattice());
-    const Vec3i d = image.dims();
-    const std::array<std::size_t, 3> stride{1, static_cast<std::size_t>(d.x), static_cast<std::size_t>(d.x) * static_cast<std::size_t>(d.y)};
-    for (int axis = 0; axis < 3; ++axis) {
-        const double sigma = sigma_mm / image.lattice().spacing()[axis];
-        const int r = static_cast<int>(std::ceil(3.0 * sigma));
-        const int n = d[axis];
-        if (r < 1 || n < 2) continue;
-        std::vector<double> g(static_cast<std::size_t>(2 * r + 1));
-        for (int k = -r; k <= r; ++k) g[static_cast<std::size_t>(k + r)] = std::exp(-0.5 * k * k / (sigma * sigma));
-        const double sum = std::accumulate(g.begin(), g.end(), 0.0);
-        std::vector<float> w(g.size());
-        for (std::size_t k = 0; k < g.size(); ++k) w[k] = static_cast<float>(g[k] / sum);
-        // One line along `axis` per (u, v) of the other two axes; each output reads its own line only.
-        const int ua = axis == 0 ? 1 : 0, va = axis == 2 ? 1 : 2;
-        const std::size_t lines = static_cast<std::size_t>(d[ua]) * static_cast<std::size_t>(d[va]);
-        const std::span<const float> in = a.values();
-        const std::span<float> out = b.values();
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines, 256), [&](const tbb::blocked_range<std::size_t>& range) {
-            std::vector<float> line(static_cast<std::size_t>(n + 2 * r));
-            for (std::size_t l = range.begin(); l != range.end(); ++l) {
-                const std::size_t u = l % static_cast<std::size_t>(d[ua]), v = l / static_cast<std::size_t>(d[ua]);
-                const std::size_t base = u * stride[static_cast<std::size_t>(ua)] + v * stride[static_cast<std::size_t>(va)];
-                const std::size_t step = stride[static_cast<std::size_t>(axis)];
-                for (int i = -r; i < n + r; ++i)  // edges clamped
-                    line[static_cast<std::size_t>(i + r)] = in[base + static_cast<std::size_t>(std::clamp(i, 0, n - 1)) * step];
-                for (int i = 0; i < n; ++i) {
-                    float acc = 0;
-                    for (int k = 0; k <= 2 * r; ++k) acc += w[static_cast<std::size_t>(k)] * line[static_cast<std::size_t>(i + k)];
-                    out[base + static_cast<std::size_t>(i) * step] = acc;
-                }
-            }
-        });
-        std::swap(a, b);
-    }
-    return a;
 }
 
 }  // namespace liveset

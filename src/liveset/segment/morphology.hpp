@@ -34,8 +34,6 @@ Grid<std::uint8_t> fill_holes(const Grid<std::uint8_t>& mask);
 // Distance in mm from every voxel to the nearest voxel outside the mask (0 outside; +infinity when
 // the mask has no outside voxel).
 Grid<float> depth_mm(const Grid<std::uint8_t>& mask);
-// Gaussian blur with standard deviation `sigma_mm` in millimetres along each axis (separable,
-// truncated at 3σ, edges clamped); sigma_mm <= 0 returns the image unchanged.
-Grid<float> gaussian_mm(const Grid<float>& image, double sigma_mm);
+// (The Gaussian blur in millimetres is gaussian_smooth(), smoothing.hpp.)
 
 }  // namespace liveset
