@@ -4,19 +4,16 @@
 # sagittally as MINC (rawtominc). T1 trilinear, labels and brain mask nearest; every file keeps BrainWeb's
 # physical space, so the demo's seeds given in mm (LPS = BrainWeb's voxel index) stay valid.
 # Usage: /usr/bin/python3 scripts/brainweb_geometry.py OUT_DIR   (nibabel, numpy, scipy; minc-tools' rawtominc)
-import os, subprocess, sys, zlib
+import os, subprocess, sys
 import nibabel as nib
 import numpy as np
 from scipy import ndimage
 
-here = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'data', 'brainweb')
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import brainweb_data
+
 out = sys.argv[1] if len(sys.argv) > 1 else 'brainweb-geometry'
-raw = open(os.path.join(here, 't1.mha'), 'rb').read()
-start = raw.index(b'ElementDataFile = LOCAL\n') + len(b'ElementDataFile = LOCAL\n')
-t1 = np.frombuffer(zlib.decompress(raw[start:]), dtype=np.uint8).reshape(180, 217, 181).transpose(2, 1, 0).astype(np.float32)
-labels = np.asarray(nib.load(os.path.join(here, 'labels_crisp.nii.gz')).dataobj).astype(np.uint8)
-mask = (np.asarray(nib.load(os.path.join(here, 'brain_mask.nii.gz')).dataobj) > 0).astype(np.uint8)
-base = nib.load(os.path.join(here, 'labels_crisp.nii.gz')).affine  # RAS: diag(-1, -1, 1), origin 0
+t1, labels, mask, base = brainweb_data.load()  # base: RAS diag(-1, -1, 1), origin 0
 
 
 def resample(a, new_index_to_old, shape, order):

@@ -2,17 +2,14 @@
 # BrainWeb variants for the pre-smoothing (docs/BENCHMARKS.md, session 54): Rician noise, other grids,
 # other units, skull-stripped + noise. Each in OUT/NAME/{t1,labels,mask}.nii.gz.
 # Usage: /usr/bin/python3 scripts/brainweb_noise_variants.py OUT_DIR  (Debian's python3-nibabel, -scipy)
-import os, sys, zlib
+import os, sys
 import nibabel as nib, numpy as np
 from scipy import ndimage
-here = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'data', 'brainweb')
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import brainweb_data
+
 out = sys.argv[1] if len(sys.argv) > 1 else 'brainweb-noise-variants'
-raw = open(os.path.join(here, 't1.mha'), 'rb').read()
-start = raw.index(b'ElementDataFile = LOCAL\n') + len(b'ElementDataFile = LOCAL\n')
-t1 = np.frombuffer(zlib.decompress(raw[start:]), dtype=np.uint8).reshape(180, 217, 181).transpose(2, 1, 0).astype(np.float32)
-labels = np.asarray(nib.load(os.path.join(here, 'labels_crisp.nii.gz')).dataobj).astype(np.uint8)
-mask = (np.asarray(nib.load(os.path.join(here, 'brain_mask.nii.gz')).dataobj) > 0).astype(np.uint8)
-base = nib.load(os.path.join(here, 'labels_crisp.nii.gz')).affine
+t1, labels, mask, base = brainweb_data.load()
 n = np.array(t1.shape, float)
 rng = np.random.default_rng(54)
 def rician(a, s): return np.sqrt((a + rng.normal(0, s, a.shape))**2 + rng.normal(0, s, a.shape)**2)

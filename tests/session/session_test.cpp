@@ -91,6 +91,23 @@ SessionOptions options() {
     return o;
 }
 
+// Steps the session until it converges: the same number of steps as `o`, and its φ and statuses
+// bit for bit.
+void expect_converges_as(Session& s, const SegmentOutcome& o) {
+    ASSERT_EQ(o.result.reason, StopReason::kConverged);
+    int steps = 0;
+    while (!s.segment_status().converged && steps < 2000) {
+        s.segment_step();
+        ++steps;
+    }
+    EXPECT_EQ(steps, o.result.iterations);
+    for (std::size_t i = 0; i < o.field->phi().size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        ASSERT_EQ(std::bit_cast<std::uint32_t>(s.field().phi()[p]), std::bit_cast<std::uint32_t>(o.field->phi()[p])) << i;
+        ASSERT_EQ(s.field().status()[p], o.field->status()[p]) << i;
+    }
+}
+
 TEST(Session, SegmentsFromSeedsExactlyAsLivesetSegment) {
     const Phantom& ph = phantom64();
     Session s(ph.image, options());
@@ -100,21 +117,10 @@ TEST(Session, SegmentsFromSeedsExactlyAsLivesetSegment) {
         req.seeds.push_back({c.cast<double>(), 2.0});
         s.add_seed({c.cast<double>(), 2.0});
     }
-    int steps = 0;
-    while (!s.segment_status().converged && steps < 2000) {
-        s.segment_step();
-        ++steps;
-    }
     const SegmentOutcome o = segment_image(ph.image, req);
-    ASSERT_EQ(o.result.reason, StopReason::kConverged);
-    EXPECT_EQ(steps, o.result.iterations);
+    expect_converges_as(s, o);
     EXPECT_DOUBLE_EQ(s.params().mu, o.params.mu);
     EXPECT_DOUBLE_EQ(s.params().epsilon, o.params.epsilon);
-    for (std::size_t i = 0; i < o.field->phi().size(); ++i) {
-        const auto p = static_cast<PointIndex>(i);
-        ASSERT_EQ(std::bit_cast<std::uint32_t>(s.field().phi()[p]), std::bit_cast<std::uint32_t>(o.field->phi()[p])) << i;
-        ASSERT_EQ(s.field().status()[p], o.field->status()[p]) << i;
-    }
     const Grid<std::uint8_t> mask = s.mask();
     EXPECT_TRUE(std::equal(mask.values().begin(), mask.values().end(), o.mask.values().begin(), o.mask.values().end()));
     expect_mesh_is_whole_volume_mesh(s);
@@ -133,21 +139,11 @@ TEST(Session, SegmentsANoisyScanWithTheAutomaticBlurExactlyAsLivesetSegment) {
         req.seeds.push_back({c.cast<double>(), 2.0});
         s.add_seed({c.cast<double>(), 2.0});
     }
-    int steps = 0;
-    while (!s.segment_status().converged && steps < 2000) {
-        s.segment_step();
-        ++steps;
-    }
     const SegmentOutcome o = segment_image(noisy.image, req);
-    ASSERT_EQ(o.result.reason, StopReason::kConverged);
     ASSERT_GT(o.params.smooth_mm, 0.0);
+    expect_converges_as(s, o);
     EXPECT_EQ(s.params().smooth_mm, o.params.smooth_mm);
     EXPECT_EQ(s.params().alpha, o.params.alpha);
-    EXPECT_EQ(steps, o.result.iterations);
-    for (std::size_t i = 0; i < o.field->phi().size(); ++i) {
-        const auto p = static_cast<PointIndex>(i);
-        ASSERT_EQ(std::bit_cast<std::uint32_t>(s.field().phi()[p]), std::bit_cast<std::uint32_t>(o.field->phi()[p])) << i;
-    }
     const Grid<float> blurred = gaussian_smooth(s.unit_image(), o.params.smooth_mm);
     EXPECT_TRUE(std::equal(blurred.values().begin(), blurred.values().end(), s.speed_image().values().begin()));
     // Without the blur (a given α and σ 0) the front ends elsewhere: the blur is what made the match.
