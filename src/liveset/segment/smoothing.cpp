@@ -65,13 +65,15 @@ void convolve_axis(const Grid<float>& in, Grid<float>& out, int axis, const std:
 
 }  // namespace
 
+void check_smooth_mm(double sigma_mm) {
+    if (std::isfinite(sigma_mm) && sigma_mm >= 0.0 && sigma_mm <= kMaxSmoothMm) return;
+    std::ostringstream os;
+    os << "the smoothing sigma must be in [0, " << kMaxSmoothMm << "] mm, not " << sigma_mm;
+    throw std::invalid_argument(os.str());
+}
+
 Grid<float> gaussian_smooth(const Grid<float>& image, double sigma_mm) {
-    if (!std::isfinite(sigma_mm) || sigma_mm < 0.0 || sigma_mm > kMaxSmoothMm)
-    {
-        std::ostringstream os;
-        os << "the smoothing sigma must be in [0, " << kMaxSmoothMm << "] mm, not " << sigma_mm;
-        throw std::invalid_argument(os.str());
-    }
+    check_smooth_mm(sigma_mm);
     Grid<float> out = image;
     if (sigma_mm == 0.0) return out;
     Grid<float> tmp(image.lattice());

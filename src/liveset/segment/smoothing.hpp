@@ -25,4 +25,8 @@ inline constexpr double kMaxSmoothVoxels = 50.0;
 inline constexpr double kNegligibleSigma = 0.15;
 Grid<float> gaussian_smooth(const Grid<float>& image, double sigma_mm);
 
+// Throws std::invalid_argument "the smoothing sigma must be in [0, 10] mm, not S" for σ outside
+// [0, kMaxSmoothMm] or not finite (gaussian_smooth's and ThresholdParams' one range check).
+void check_smooth_mm(double sigma_mm);
+
 }  // namespace liveset

@@ -21,11 +21,7 @@ void validate(const ThresholdParams& p) {
     if (!std::isfinite(p.epsilon) || p.epsilon <= 0.0) fail("epsilon must be positive");
     if (!std::isfinite(p.n) || p.n <= 0.0 || p.n > 100.0) fail("n must be in (0, 100]");
     if (!std::isfinite(p.alpha) || p.alpha < 0.0 || p.alpha >= 1.0) fail("alpha must be in [0, 1)");
-    if (!std::isfinite(p.smooth_mm) || p.smooth_mm < 0.0 || p.smooth_mm > kMaxSmoothMm) {
-        std::ostringstream os;
-        os << "the smoothing sigma must be in [0, " << kMaxSmoothMm << "] mm";
-        fail(os.str());
-    }
+    check_smooth_mm(p.smooth_mm);
 }
 
 double threshold_term(double intensity, const ThresholdParams& p) {
