@@ -67,6 +67,8 @@ TEST(RoiAutoCli, WritesTheAutomaticBrainMaskAndSegmentsInsideIt) {
     EXPECT_EQ(j["roi"]["voxels"].get<std::size_t>(), expected.mask_voxels);
     EXPECT_NEAR(j["roi"]["volume_mm3"].get<double>(), expected.mask_volume_mm3, 1e-6);
     EXPECT_FALSE(j["roi"]["auto"]["skull_stripped"].get<bool>());
+    EXPECT_EQ(j["roi"]["auto"]["background_noise"].get<double>(), expected.background_noise);
+    EXPECT_EQ(j["roi"]["auto"]["head_threshold"].get<double>(), expected.head_threshold);
     EXPECT_EQ(j["outputs"]["roi"], roi.string());
 }
 

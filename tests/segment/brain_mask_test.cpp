@@ -50,7 +50,7 @@ Grid<T> every_other(const Grid<T>& g) {
     return out;
 }
 
-enum class Variant { kPlain, kScaled, kBias, kNoise, kHeavyNoise, kStripped };
+enum class Variant { kPlain, kScaled, kBias, kNoise, kHeavyNoise, kRician, kStripped };
 
 // A variant of an image (the same truth holds for each); kStripped multiplies by `brain`.
 Grid<float> make_variant(const Grid<float>& t1, const Mask& brain, Variant v) {
@@ -59,6 +59,7 @@ Grid<float> make_variant(const Grid<float>& t1, const Mask& brain, Variant v) {
     std::mt19937 rng(12345);
     std::normal_distribution<float> noise(0.0f, 8.0f);  // ~6 % of white matter
     std::normal_distribution<float> heavy(0.0f, 12.0f);  // ~9 % of white matter: BrainWeb's noisiest
+    std::normal_distribution<float> rician(0.0f, 14.0f);  // beyond it: the air's noise crosses the head threshold
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
             for (int x = 0; x < d.x; ++x) {
@@ -72,6 +73,7 @@ Grid<float> make_variant(const Grid<float>& t1, const Mask& brain, Variant v) {
                         break;
                     case Variant::kNoise: o += noise(rng); break;
                     case Variant::kHeavyNoise: o = std::abs(o + heavy(rng)); break;  // magnitude
+                    case Variant::kRician: o = std::hypot(o + rician(rng), rician(rng)); break;
                     case Variant::kStripped: o = brain({x, y, z}) != 0 ? o : 0.0f; break;
                 }
             }
@@ -126,9 +128,10 @@ double dice(const Mask& a, const Mask& b) {
 // the mask must then cover whole. `leak_bound`: the share of non-brain voxels in the GM window
 // allowed inside (noisy images: more, as the smoothed tissue test lets the mask follow the cortex).
 TruthCheck run_variant(const char* name, const Grid<float>& image, const Mask& labels, const Mask* stripped_with = nullptr,
-                       double leak_bound = 0.015) {
+                       double leak_bound = 0.015, BrainMaskReport* report = nullptr) {
     const bool expect_stripped = stripped_with != nullptr;
-    BrainMaskReport r;
+    BrainMaskReport local;
+    BrainMaskReport& r = report != nullptr ? *report : local;
     const auto t0 = std::chrono::steady_clock::now();
     const Mask mask = auto_brain_mask(image, {}, &r);
     const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -176,6 +179,22 @@ TEST(BrainMask, HeavyNoiseKeepsTheCortexInside) {
     run_variant("noise12", make_variant(bw.t1, bw.brain_mask, Variant::kHeavyNoise), bw.labels, nullptr, 0.025);
 }
 
+// Rician noise σ 14 (BrainWeb's own ~4 on top: 14.6 in all): a third of the air lies above the head
+// threshold p2 + 10 % (p98 − p2), which without the background's noise level made the whole field of
+// view "head" and the brain mask a 5 % fragment ("no brain found"); at floor + 2σ it is the head.
+TEST(BrainMask, HeavyRicianNoiseRaisesTheHeadThresholdToTheAirsNoise) {
+    const BrainWeb& bw = brainweb();
+    const Grid<float> noisy = make_variant(bw.t1, bw.brain_mask, Variant::kRician);
+    BrainMaskReport r;
+    run_variant("rician14", noisy, bw.labels, nullptr, 0.03, &r);
+    EXPECT_NEAR(r.background_noise, std::hypot(14.0, 4.0), 0.07 * 14.6);
+    EXPECT_GE(r.head_threshold, 2 * r.background_noise);
+    EXPECT_GT(r.head_threshold, r.background_threshold);
+    BrainMaskOptions without;
+    without.noise_multiple = 0;
+    EXPECT_THROW(auto_brain_mask(noisy, without), std::invalid_argument);
+}
+
 TEST(BrainMask, BrainWebVariantsAt2mm) {
     const BrainWeb& bw = brainweb();
     const Grid<float> t1 = every_other(bw.t1);
@@ -203,6 +222,12 @@ namespace {
 // An analytic head on a lattice of `spacing` (mm), centred: white matter (r < 18 mm, 130), grey matter
 // (< 27, 95), CSF (< 29, 45), dark skull (< 35, 8), bright scalp (< 42, 160), air (0); Gaussian
 // noise σ 3 (absolute value, like magnitude MR). The brain is r < 29 mm.
+float head_value(double r) { return r < 18 ? 130.0f : r < 27 ? 95.0f : r < 29 ? 45.0f : r < 35 ? 8.0f : r < 42 ? 160.0f : 0.0f; }
+
+double radius(Vec3i p, Vec3i d, Vec3d spacing) {
+    return norm(Vec3d{(p.x - (d.x - 1) / 2.0) * spacing.x, (p.y - (d.y - 1) / 2.0) * spacing.y, (p.z - (d.z - 1) / 2.0) * spacing.z});
+}
+
 Grid<float> sphere_head(Vec3d spacing, Mask* brain) {
     const Vec3i d{static_cast<int>(100 / spacing.x), static_cast<int>(100 / spacing.y), static_cast<int>(100 / spacing.z)};
     Grid<float> g(Lattice(d, spacing));
@@ -212,12 +237,24 @@ Grid<float> sphere_head(Vec3d spacing, Mask* brain) {
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
             for (int x = 0; x < d.x; ++x) {
-                const double r = norm(Vec3d{(x - (d.x - 1) / 2.0) * spacing.x, (y - (d.y - 1) / 2.0) * spacing.y,
-                                            (z - (d.z - 1) / 2.0) * spacing.z});
-                const float v = r < 18 ? 130.0f : r < 27 ? 95.0f : r < 29 ? 45.0f : r < 35 ? 8.0f : r < 42 ? 160.0f : 0.0f;
-                g({x, y, z}) = std::abs(v + noise(rng));
+                const double r = radius({x, y, z}, d, spacing);
+                g({x, y, z}) = std::abs(head_value(r) + noise(rng));
                 (*brain)({x, y, z}) = r < 29;
             }
+    return g;
+}
+
+// The same head (1 mm, `side` mm wide: under 84 there is no air) as a magnitude image with Rician
+// noise σ: the air is Rayleigh distributed with mode σ.
+Grid<float> rician_head(double sigma, int side) {
+    const Vec3i d{side, side, side};
+    Grid<float> g{Lattice(d)};
+    std::mt19937 rng(11);
+    std::normal_distribution<double> noise(0.0, sigma);
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x)
+                g({x, y, z}) = static_cast<float>(std::hypot(head_value(radius({x, y, z}, d, {1, 1, 1})) + noise(rng), noise(rng)));
     return g;
 }
 
@@ -260,6 +297,34 @@ TEST(BrainMask, AnalyticHeadGivesTheBrainSphereWithinAVoxel) {
         EXPECT_EQ(differences_beyond_a_voxel(mask, brain), 0u) << spacing;
         EXPECT_EQ(differences_beyond_a_voxel(brain, mask), 0u) << spacing;
     }
+}
+
+// The air's noise level is the Rayleigh σ (its mode), within a few %, from SNR 40 to 6; a background
+// without a mode above its floor (the folded Gaussian of sphere_head) or no air at all (a 60 mm crop
+// of the head) gives none, and the head threshold is then p2 + 10 % (p98 − p2) alone.
+TEST(BrainMask, TheAirsNoiseIsTheRayleighSigmaOrNone) {
+    for (const double sigma : {3.0, 8.0, 14.0, 22.0}) {
+        BrainMaskReport r;
+        const Mask mask = auto_brain_mask(rician_head(sigma, 100), {}, &r);
+        std::printf("Rician sigma %.0f: noise %.2f, background threshold %.2f, head threshold %.2f, head %zu voxels\n", sigma,
+                    r.background_noise, r.background_threshold, r.head_threshold, r.head_voxels);
+        EXPECT_NEAR(r.background_noise, sigma, 0.05 * sigma + 0.2);
+        EXPECT_GE(r.head_threshold, 2 * r.background_noise);  // above the floor, itself ≥ 0
+        EXPECT_LE(r.head_threshold, std::max(r.background_threshold, 2 * r.background_noise + 0.1 * sigma));
+        EXPECT_NEAR(double(r.head_voxels), 4.0 / 3.0 * 3.14159265 * 42 * 42 * 42, 0.05 * 310000);  // the head, not the box
+    }
+    Mask brain;
+    BrainMaskReport folded, cropped, plain;
+    BrainMaskOptions no_raise;
+    no_raise.noise_multiple = 0;
+    auto_brain_mask(sphere_head({1, 1, 1}, &brain), {}, &folded);
+    auto_brain_mask(sphere_head({1, 1, 1}, &brain), no_raise, &plain);
+    EXPECT_EQ(folded.background_noise, 0.0);
+    EXPECT_EQ(folded.head_threshold, plain.head_threshold);
+    EXPECT_EQ(folded.head_threshold, folded.background_threshold);
+    auto_brain_mask(rician_head(8.0, 40), {}, &cropped);
+    EXPECT_EQ(cropped.background_noise, 0.0);
+    EXPECT_GT(cropped.mask_voxels, 0u);
 }
 
 TEST(BrainMask, AnalyticSkullStrippedHeadIsTheWholeForeground) {
@@ -333,6 +398,16 @@ TEST(BrainMask, BadInputThrowsOneLine) {
     bad = {};
     bad.background_fraction = 1.5;
     EXPECT_THROW(auto_brain_mask(shell, bad), std::invalid_argument);
+    for (double m : {-0.5, 10.5, std::nan("")}) {
+        bad = {};
+        bad.noise_multiple = m;
+        EXPECT_THROW(validate(bad), std::invalid_argument) << m;
+    }
+    for (double share : {0.0, 1.0, std::nan("")}) {
+        bad = {};
+        bad.noise_min_share = share;
+        EXPECT_THROW(validate(bad), std::invalid_argument) << share;
+    }
     for (double s : {-1.0, 11.0, std::nan("")}) {
         bad = {};
         bad.smoothing_mm = s;

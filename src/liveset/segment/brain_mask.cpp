@@ -96,15 +96,56 @@ void check_image(const Grid<float>& image) {
     if (!(hi > lo)) throw std::invalid_argument("brain mask: the image is constant (every voxel is " + std::to_string(lo) + ")");
 }
 
-// The head threshold: p2 + fraction·(p98 − p2), with p98 taken over the voxels above p2 so that a
-// small head in a large empty field still has a range.
-double head_threshold(const Grid<float>& image, double fraction) {
+// The background's noise level (Sijbers et al. 2007; Brummer et al. 1993): the air around a head in
+// a magnitude image is Rayleigh distributed, its histogram's mode lying σ above the floor. Returns σ
+// (image units above `floor`), or 0 when the histogram over [floor, top] (bins of 1/64 of
+// base − floor, smoothed over 2 bins) has no such mode: its first bin that is the highest up to
+// three times its own distance from the floor, if it falls to half its height within that reach
+// and holds `min_share` of all voxels within twice its distance; σ is then the middle of the bins
+// around it at ≥ 90 % of its height (Rayleigh: 0.69σ..1.35σ, so 1.02σ; one noisy bin does not move it). A noise-free background is a spike
+// at the floor (σ 0); a cropped scan's first peak (its CSF) is outgrown by grey and white matter.
+double background_noise(const Grid<float>& image, double floor, double base, double top, double min_share) {
+    if (!(base > floor) || !(top > base)) return 0.0;
+    const double width = (base - floor) / 64;
+    const int bins = static_cast<int>(std::min(1024.0, std::ceil((top - floor) / width)));
+    std::vector<double> c(static_cast<std::size_t>(bins), 0.0);
+    for (float v : image.values()) {
+        const double k = (v - floor) / width;
+        if (k >= 0 && k < bins) c[static_cast<std::size_t>(k)] += 1.0;
+    }
+    const std::vector<double> s = smoothed(c, 2.0);
+    const auto at = [&](int i) { return s[static_cast<std::size_t>(i)]; };
+    for (int peak = 1; 3 * peak + 1 < bins; ++peak) {
+        const int reach = 3 * peak + 1;
+        bool highest = true;
+        for (int i = 0; i <= reach && highest; ++i) highest = i == peak || at(i) < at(peak) || (i > peak && at(i) == at(peak));
+        if (!highest) continue;
+        double lowest_after = at(peak), near = 0;
+        for (int i = peak; i <= reach; ++i) lowest_after = std::min(lowest_after, at(i));
+        for (int i = 0; i <= 2 * peak + 1; ++i) near += c[static_cast<std::size_t>(i)];
+        if (lowest_after > 0.5 * at(peak) || near < min_share * static_cast<double>(image.size())) return 0.0;
+        int lo = peak, hi = peak;  // the mode: the middle of the top (≥ 90 %), not its noisiest bin
+        while (lo > 0 && at(lo - 1) >= 0.9 * at(peak)) --lo;
+        while (hi < reach && at(hi + 1) >= 0.9 * at(peak)) ++hi;
+        return 0.5 * (lo + hi + 1) * width;
+    }
+    return 0.0;
+}
+
+// The background threshold p2 + fraction·(p98 − p2), with p98 taken over the voxels above p2 so
+// that a small head in a large empty field still has a range; and the head threshold: the same,
+// raised to floor + noise_multiple·σ when the air is noisy enough to cross it (floor: the 0.1st
+// percentile; σ: background_noise).
+void thresholds(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport& r) {
     std::vector<float> all(image.values().begin(), image.values().end());
+    const double floor = percentile(all, 0.001);
     const double p2 = percentile(all, 0.02);
     std::vector<float> above = values_above(image, nullptr, p2);
     if (above.empty()) throw std::invalid_argument("brain mask: no head found (98% of the voxels share the lowest value)");
     const double p98 = percentile(above, 0.98);
-    return p2 + fraction * (p98 - p2);
+    r.background_threshold = p2 + o.background_fraction * (p98 - p2);
+    r.background_noise = o.noise_multiple > 0 ? background_noise(image, floor, r.background_threshold, p98, o.noise_min_share) : 0.0;
+    r.head_threshold = std::max(r.background_threshold, floor + o.noise_multiple * r.background_noise);
 }
 
 double max_spacing(const Lattice& l) { return std::max({l.spacing().x, l.spacing().y, l.spacing().z}); }
@@ -216,6 +257,8 @@ void validate(const BrainMaskOptions& o) {
     };
     require(std::isfinite(o.background_fraction) && o.background_fraction > 0 && o.background_fraction < 1,
             "background_fraction must lie in (0, 1)");
+    require(std::isfinite(o.noise_multiple) && o.noise_multiple >= 0 && o.noise_multiple <= 10, "noise_multiple must lie in [0, 10]");
+    require(std::isfinite(o.noise_min_share) && o.noise_min_share > 0 && o.noise_min_share < 1, "noise_min_share must lie in (0, 1)");
     require(std::isfinite(o.min_head_share) && o.min_head_share >= 0 && o.min_head_share < 1, "min_head_share must lie in [0, 1)");
     require(std::isfinite(o.smoothing_mm) && o.smoothing_mm >= 0 && o.smoothing_mm <= 10, "smoothing_mm must lie in [0, 10]");
     require(std::isfinite(o.erosion_mm) && o.erosion_mm > 0 && o.erosion_mm <= 50, "erosion_mm must lie in (0, 50]");
@@ -231,8 +274,8 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     validate(o);
     check_image(image);
     BrainMaskReport r;
-    r.background_threshold = head_threshold(image, o.background_fraction);
-    const Mask head = fill_holes(close_mm(head_foreground(image, r.background_threshold), o.head_closing_mm));
+    thresholds(image, o, r);
+    const Mask head = fill_holes(close_mm(head_foreground(image, r.head_threshold), o.head_closing_mm));
     r.head_voxels = count(head);
     const Grid<float> depth = depth_mm(head);
     const Grid<float> smooth = gaussian_smooth(image, o.smoothing_mm);
@@ -243,7 +286,7 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     Mask brain = extract_brain(image, smooth, head, o, r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
     r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
-    if (r.skull_stripped) brain = stripped_foreground(image, r.background_threshold);
+    if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);
     r.mask_voxels = count(brain);
     if (r.mask_voxels == 0) throw std::invalid_argument("brain mask: the mask is empty");
     const double share = static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1));

@@ -14,8 +14,17 @@ namespace liveset {
 // Radii are in millimetres (the lattice spacing), so 2 mm scans and anisotropic voxels behave.
 // The defaults are meant to work untuned on adult human T1 scans.
 struct BrainMaskOptions {
-    // Head threshold: p2 + fraction·(p98 − p2) of the intensities (FSL BET's robust 10 %).
+    // Background threshold: p2 + fraction·(p98 − p2) of the intensities (FSL BET's robust 10 %):
+    // inside the head, what lies below it is background (skull, air, dark CSF).
     double background_fraction = 0.1;
+    // The head threshold, which separates the head from the air around it, is the background
+    // threshold or, when the air's histogram shows a noise mode σ above its floor (a noisy
+    // magnitude image: Rayleigh, 13.5 % of it above 2σ, too sparse to connect 6-neighbours),
+    // floor + noise_multiple·σ if higher, so heavy noise does not make the whole field of view
+    // "head". The mode counts only with noise_min_share of the voxels within 2σ of the floor (air,
+    // not a cropped scan's dark tissue). 0: no such raise.
+    double noise_multiple = 2.0;
+    double noise_min_share = 0.05;
     // A voxel is brain tissue when the image blurred by a Gaussian of this σ (mm; gaussian_smooth,
     // smoothing.hpp) lies in the tissue window (the window itself comes from the image as it is), so
     // noise does not punch the cortex out of the mask: BrainWeb + noise σ 12, 86.7 % → 99.6 % of GM
@@ -28,7 +37,7 @@ struct BrainMaskOptions {
     double regrow_margin_mm = 1.0;
     // Closing that takes in the sulcal CSF and the cortex's outer partial-volume layer.
     double closing_mm = 6.0;
-    // Final growth into voxels brighter than the head threshold (extracerebral CSF, dark cortex).
+    // Final growth into voxels brighter than the background threshold (extracerebral CSF, dark cortex).
     double rim_mm = 2.0;
     // Closing of the head foreground that bridges the dark skull, giving a solid head whose surface
     // the skull-stripping test measures from.
@@ -50,7 +59,9 @@ void validate(const BrainMaskOptions& options);
 
 // What the method found.
 struct BrainMaskReport {
-    double background_threshold = 0;  // head threshold (image units)
+    double background_threshold = 0;  // background threshold (image units)
+    double background_noise = 0;      // the air's noise σ (its mode above the floor) when found, else 0
+    double head_threshold = 0;        // head threshold: background, raised above the air's noise
     double wm_peak = 0;               // white-matter peak of the deep head's histogram
     double wm_sigma = 0;              // its width (upper half-width at half maximum / 1.1774)
     double tissue_low = 0;            // brain-tissue window (image units)
