@@ -100,22 +100,30 @@ TEST(GaussianSmooth, OneAndTwoThreadsGiveTheSameBits) {
 }
 
 // The speed with smooth_mm tabulates D of the blurred image: the same bits as the speed of the
-// image blurred beforehand; a σ outside [0, kMaxSmoothMm] is refused by validate().
+// image blurred beforehand, and as the speed handed that blurred image (a session's kept blur; a
+// blurred image is ignored without smooth_mm, refused with other dimensions); a σ outside
+// [0, kMaxSmoothMm] is refused by validate().
 TEST(GaussianSmooth, TheThresholdSpeedReadsTheBlurredImage) {
     const Grid<float> g = random_grid({20, 18, 16}, {1.0, 1.0, 1.0}, 11);
     ThresholdParams p{0.5, 0.2, 4.0, 0.1, 0.5};
     const ThresholdSpeed smoothed(g, p);
     ThresholdParams plain = p;
     plain.smooth_mm = 0.0;
-    const ThresholdSpeed before(gaussian_smooth(g, 0.5), plain), raw(g, plain);
+    const Grid<float> blurred = gaussian_smooth(g, 0.5);
+    const ThresholdSpeed before(blurred, plain), raw(g, plain), kept(g, p, nullptr, &blurred), unused(g, plain, nullptr, &blurred);
+    const auto bits = [](const ThresholdSpeed& s, Vec3i q) { return std::bit_cast<std::uint32_t>(s.propagation(q)); };
     int differ = 0;
     for (int z = 0; z < 16; ++z)
         for (int y = 0; y < 18; ++y)
             for (int x = 0; x < 20; ++x) {
-                ASSERT_EQ(std::bit_cast<std::uint32_t>(smoothed.propagation({x, y, z})), std::bit_cast<std::uint32_t>(before.propagation({x, y, z})));
+                ASSERT_EQ(bits(smoothed, {x, y, z}), bits(before, {x, y, z}));
+                ASSERT_EQ(bits(kept, {x, y, z}), bits(before, {x, y, z}));
+                ASSERT_EQ(bits(unused, {x, y, z}), bits(raw, {x, y, z}));
                 differ += smoothed.propagation({x, y, z}) != raw.propagation({x, y, z});
             }
     EXPECT_GT(differ, 20 * 18 * 16 / 2);  // the blur changed most of D
+    const Grid<float> other = random_grid({20, 18, 15}, {1.0, 1.0, 1.0}, 12);
+    EXPECT_THROW(ThresholdSpeed(g, p, nullptr, &other), std::invalid_argument);
     p.smooth_mm = -1.0;
     EXPECT_THROW(validate(p), std::invalid_argument);
     p.smooth_mm = kMaxSmoothMm * 2.0;

@@ -33,18 +33,23 @@ double threshold_term(double intensity, const ThresholdParams& p) {
     return (r - 1.0) / (r + 1.0);
 }
 
-ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi)
+ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi,
+                               const Grid<float>* blurred)
     : params_(params), propagation_(unit_image.lattice()), roi_(roi) {
     validate(params);
-    if (roi && !(roi->dims() == unit_image.dims())) {
-        std::ostringstream os;
-        os << "region-of-interest mask " << roi->dims() << " does not match the image " << unit_image.dims();
-        throw std::invalid_argument(os.str());
-    }
+    for (const auto& [what, dims] : {std::pair{"region-of-interest mask", roi ? roi->dims() : unit_image.dims()},
+                                     std::pair{"blurred image", blurred ? blurred->dims() : unit_image.dims()}})
+        if (!(dims == unit_image.dims())) {
+            std::ostringstream os;
+            os << what << " " << dims << " does not match the image " << unit_image.dims();
+            throw std::invalid_argument(os.str());
+        }
     const double w = 0.5 * (1.0 - params.alpha);
     std::optional<Grid<float>> smoothed;
-    if (params.smooth_mm > 0.0) smoothed = gaussian_smooth(unit_image, params.smooth_mm);
-    const std::span<const float> img = smoothed ? smoothed->values() : unit_image.values();
+    if (params.smooth_mm > 0.0 && blurred == nullptr) smoothed = gaussian_smooth(unit_image, params.smooth_mm);
+    const std::span<const float> img = params.smooth_mm <= 0.0 ? unit_image.values()
+                                       : smoothed               ? smoothed->values()
+                                                                : blurred->values();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, img.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const auto pi = static_cast<PointIndex>(i);

@@ -37,8 +37,11 @@ class ThresholdSpeed final : public Speed {
 public:
     // `unit_image` (normalised to [0, 1]) and `roi` (optional, non-zero = allowed) must outlive
     // the speed and match each other's dimensions; D is tabulated per voxel at construction (of the
-    // image blurred by params.smooth_mm when it is positive).
-    ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi = nullptr);
+    // image blurred by params.smooth_mm when it is positive). A caller that keeps that blurred image
+    // (gaussian_smooth(unit_image, params.smooth_mm), e.g. a session whose window changes) passes
+    // it as `blurred`, which is then read instead of blurring again (ignored when smooth_mm is 0).
+    ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi = nullptr,
+                   const Grid<float>* blurred = nullptr);
 
     SpeedSample at(const Grid<float>& phi, Vec3i p) const override;
     void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;

@@ -276,7 +276,7 @@ SessionUpdate Session::segment_step() {
             // A level set loaded with no seed nor set window since: α for the window as it stands,
             // within the action (the same value set_params and the seeds' refresh give elsewhere).
             if (marks_.alpha_automatic) take_automatic(marks_.params, automatic_alpha_choice());
-            speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi());
+            speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi(), &speed_image());  // the blur kept
         }
         StepResult step = field_.step(*speed_, options_.segmentation.step);
         segment_.flips = convergence_->record_step(field_.phi(), step.changed.points);
