@@ -102,8 +102,9 @@ void check_image(const Grid<float>& image) {
 // base − floor, smoothed over 2 bins) has no such mode: its first bin that is the highest up to
 // three times its own distance from the floor, if it falls to half its height within that reach
 // and holds `min_share` of all voxels within twice its distance; σ is then the middle of the bins
-// around it at ≥ 90 % of its height (Rayleigh: 0.69σ..1.35σ, so 1.02σ; one noisy bin does not move it). A noise-free background is a spike
-// at the floor (σ 0); a cropped scan's first peak (its CSF) is outgrown by grey and white matter.
+// around it at ≥ 90 % of its height (Rayleigh: 0.69σ..1.35σ, so 1.02σ; one noisy bin does not
+// move it). A noise-free background is a spike at the floor (σ 0); a cropped scan's first peak
+// (its CSF) is outgrown by grey and white matter.
 double background_noise(const Grid<float>& image, double floor, double base, double top, double min_share) {
     if (!(base > floor) || !(top > base)) return 0.0;
     const double width = (base - floor) / 64;
