@@ -299,13 +299,20 @@ TEST(BrainMask, AnalyticHeadGivesTheBrainSphereWithinAVoxel) {
     }
 }
 
-// The air's noise level is the Rayleigh σ (its mode), within a few %, from SNR 40 to 6; a background
-// without a mode above its floor (the folded Gaussian of sphere_head) or no air at all (a 60 mm crop
-// of the head) gives none, and the head threshold is then p2 + 10 % (p98 − p2) alone.
+// The air's noise level is the Rayleigh σ (its mode), within a few %, from SNR 40 to 6.5, also with
+// zeros around the field of view (a resampled scan's outside: left out of the noise's histogram); a
+// background without a mode above its floor (the folded Gaussian of sphere_head) or no air at all
+// (a 40 mm crop of the head) gives none, and the head threshold is then p2 + 10 % (p98 − p2) alone.
 TEST(BrainMask, TheAirsNoiseIsTheRayleighSigmaOrNone) {
-    for (const double sigma : {3.0, 8.0, 14.0, 22.0}) {
+    for (const double sigma : {3.0, 8.0, 14.0, 20.0}) {
+        Grid<float> head = rician_head(sigma, 100);
+        if (sigma == 14.0)  // zeros beyond 45 mm from the centre along x and y: 34 % of the lattice
+            for (int z = 0; z < 100; ++z)
+                for (int y = 0; y < 100; ++y)
+                    for (int x = 0; x < 100; ++x)
+                        if (std::abs(x - 49.5) > 40 || std::abs(y - 49.5) > 40) head({x, y, z}) = 0.0f;
         BrainMaskReport r;
-        const Mask mask = auto_brain_mask(rician_head(sigma, 100), {}, &r);
+        const Mask mask = auto_brain_mask(head, {}, &r);
         std::printf("Rician sigma %.0f: noise %.2f, background threshold %.2f, head threshold %.2f, head %zu voxels\n", sigma,
                     r.background_noise, r.background_threshold, r.head_threshold, r.head_voxels);
         EXPECT_NEAR(r.background_noise, sigma, 0.05 * sigma + 0.2);
@@ -335,6 +342,8 @@ TEST(BrainMask, AnalyticSkullStrippedHeadIsTheWholeForeground) {
     BrainMaskReport r;
     const Mask mask = auto_brain_mask(head, {}, &r);
     EXPECT_TRUE(r.skull_stripped);
+    EXPECT_EQ(r.background_noise, 0.0);  // the zeros are a constant fill, the brain no noise mode
+    EXPECT_EQ(r.head_threshold, r.background_threshold);
     for (std::size_t i = 0; i < mask.size(); ++i) ASSERT_EQ(mask[static_cast<PointIndex>(i)], brain[static_cast<PointIndex>(i)]) << i;
 }
 

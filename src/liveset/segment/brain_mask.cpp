@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -96,12 +97,22 @@ void check_image(const Grid<float>& image) {
     if (!(hi > lo)) throw std::invalid_argument("brain mask: the image is constant (every voxel is " + std::to_string(lo) + ")");
 }
 
+// The image's lowest value when it fills at least 2 % of the voxels, as masking or resampling
+// leaves the outside (a skull-stripped background, zeros beyond a resampled field of view).
+std::optional<float> constant_fill(const Grid<float>& image) {
+    const float lowest = *std::min_element(image.values().begin(), image.values().end());
+    std::size_t at_lowest = 0;
+    for (float v : image.values()) at_lowest += v == lowest;
+    if (static_cast<double>(at_lowest) < 0.02 * static_cast<double>(image.size())) return std::nullopt;
+    return lowest;
+}
+
 // The background's noise level (Sijbers et al. 2007; Brummer et al. 1993): the air around a head in
 // a magnitude image is Rayleigh distributed, its histogram's mode lying σ above the floor. Returns σ
 // (image units above `floor`), or 0 when the histogram over [floor, top] (bins of 1/64 of
-// base − floor, smoothed over 2 bins) has no such mode: its first bin that is the highest up to
-// three times its own distance from the floor, if it falls to half its height within that reach
-// and holds `min_share` of all voxels within twice its distance; σ is then the middle of the bins
+// base − floor, smoothed over 2 bins) has no such mode below `base`: its first bin that is the
+// highest up to three times its own distance from the floor, if it falls to half its height within
+// that reach and holds `min_share` of all voxels within twice its distance; σ is then the middle of the bins
 // around it at ≥ 90 % of its height (Rayleigh: 0.69σ..1.35σ, so 1.02σ; one noisy bin does not
 // move it). A noise-free background is a spike at the floor (σ 0); a cropped scan's first peak
 // (its CSF) is outgrown by grey and white matter.
@@ -116,7 +127,7 @@ double background_noise(const Grid<float>& image, double floor, double base, dou
     }
     const std::vector<double> s = smoothed(c, 2.0);
     const auto at = [&](int i) { return s[static_cast<std::size_t>(i)]; };
-    for (int peak = 1; 3 * peak + 1 < bins; ++peak) {
+    for (int peak = 1; peak < 64 && 3 * peak + 1 < bins; ++peak) {  // a mode above `base` is no background
         const int reach = 3 * peak + 1;
         bool highest = true;
         for (int i = 0; i <= reach && highest; ++i) highest = i == peak || at(i) < at(peak) || (i > peak && at(i) == at(peak));
@@ -136,17 +147,20 @@ double background_noise(const Grid<float>& image, double floor, double base, dou
 // The background threshold p2 + fraction·(p98 − p2), with p98 taken over the voxels above p2 so
 // that a small head in a large empty field still has a range; and the head threshold: the same,
 // raised to floor + noise_multiple·σ when the air is noisy enough to cross it (floor: the 0.1st
-// percentile; σ: background_noise).
+// percentile, a constant fill left out; σ: background_noise).
 void thresholds(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport& r) {
     std::vector<float> all(image.values().begin(), image.values().end());
-    const double floor = percentile(all, 0.001);
+    const std::optional<float> fill = constant_fill(image);
+    std::vector<float> measured = fill ? values_above(image, nullptr, *fill) : all;
+    const double floor = measured.empty() ? 0.0 : percentile(measured, 0.001);
     const double p2 = percentile(all, 0.02);
     std::vector<float> above = values_above(image, nullptr, p2);
     if (above.empty()) throw std::invalid_argument("brain mask: no head found (98% of the voxels share the lowest value)");
     const double p98 = percentile(above, 0.98);
     r.background_threshold = p2 + o.background_fraction * (p98 - p2);
     r.background_noise = o.noise_multiple > 0 ? background_noise(image, floor, r.background_threshold, p98, o.noise_min_share) : 0.0;
-    r.head_threshold = std::max(r.background_threshold, floor + o.noise_multiple * r.background_noise);
+    r.head_threshold = r.background_noise > 0 ? std::max(r.background_threshold, floor + o.noise_multiple * r.background_noise)
+                                               : r.background_threshold;
 }
 
 double max_spacing(const Lattice& l) { return std::max({l.spacing().x, l.spacing().y, l.spacing().z}); }
@@ -212,10 +226,8 @@ double surface_contact(const Mask& mask, const Grid<float>& head_depth, double n
 // A skull-stripped input: the filled largest component of everything above the background (the
 // lowest value when it fills at least 2 % of the image, as masking leaves it; else the head threshold).
 Mask stripped_foreground(const Grid<float>& image, double threshold) {
-    const float lowest = *std::min_element(image.values().begin(), image.values().end());
-    std::size_t at_lowest = 0;
-    for (float v : image.values()) at_lowest += v == lowest;
-    const double floor = static_cast<double>(at_lowest) >= 0.02 * static_cast<double>(image.size()) ? lowest : threshold;
+    const std::optional<float> fill = constant_fill(image);
+    const double floor = fill ? *fill : threshold;
     Mask f(image.lattice());
     for (std::size_t i = 0; i < f.size(); ++i) f[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > floor;
     return fill_holes(largest_component(f));
