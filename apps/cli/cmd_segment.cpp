@@ -141,7 +141,7 @@ int run_segment(const SegmentArgs& a, int threads) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
         print_segmentation_summary(j);
-        if (roi) print_roi_summary(j["roi"]);
+        if (roi) print_roi_summary(*roi);
         fmt::print("  wrote        {}{}{}{}{}\n", a.out_mask, a.out_phi.empty() ? "" : ", " + a.out_phi,
                    a.out_mesh.empty() ? "" : ", " + a.out_mesh, a.out_roi.empty() ? "" : ", " + a.out_roi,
                    a.out_corrected.empty() ? "" : ", " + a.out_corrected);

@@ -141,12 +141,17 @@ nlohmann::json roi_report(const Roi& roi) {
     return j;
 }
 
-void print_roi_summary(const nlohmann::json& j) {
-    std::string how = j["source"].get<std::string>();
-    if (j.contains("auto"))
-        how = fmt::format("auto brain mask ({}, tissue window {:.1f}..{:.1f})",
-                          j["auto"]["skull_stripped"].get<bool>() ? "skull-stripped input" : "full head",
-                          j["auto"]["tissue_low"].get<double>(), j["auto"]["tissue_high"].get<double>());
+std::string brain_mask_summary(const BrainMaskReport& b) {
+    std::string s = fmt::format("{}, tissue window {:.1f}..{:.1f}", b.skull_stripped ? "skull-stripped input" : "full head",
+                                b.tissue_low, b.tissue_high);
+    if (b.head_threshold > b.background_threshold)
+        s += fmt::format(", noisy air σ {:.1f}: head threshold {:.1f}", b.background_noise, b.head_threshold);
+    return s;
+}
+
+void print_roi_summary(const Roi& roi) {
+    const nlohmann::json j = roi_report(roi);
+    const std::string how = roi.brain_mask ? "auto brain mask (" + brain_mask_summary(*roi.brain_mask) + ")" : roi.source;
     fmt::print("  roi          {}: {} voxels, {:.1f} ml\n", how, j["voxels"].get<std::size_t>(), j["volume_mm3"].get<double>() / 1000.0);
 }
 

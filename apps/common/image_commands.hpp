@@ -38,8 +38,11 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
 std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image);
 // {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".
 nlohmann::json roi_report(const Roi& roi);
-// One line: "  roi          auto brain mask: N voxels, V ml (...)".
-void print_roi_summary(const nlohmann::json& roi);
+// One line: "  roi          auto brain mask (...): N voxels, V ml".
+void print_roi_summary(const Roi& roi);
+// What the automatic brain mask found, for people: "full head, tissue window 65.1..171.4" and,
+// where the air's noise raised the head threshold, ", noisy air σ 14.8: head threshold 30.5".
+std::string brain_mask_summary(const BrainMaskReport& report);
 
 // Whether N4 runs before a segmentation (segment, view, the Python module): on by default, where a
 // failure (an image too small for its grid, a mask that leaves no sample) skips it with a warning;

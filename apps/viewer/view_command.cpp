@@ -76,8 +76,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     std::optional<Grid<std::uint8_t>> roi;
     if (std::optional<Roi> r = load_roi(a.roi, image, "--roi")) {  // a mask file, or "auto" as `segment --roi auto`
         if (const auto& b = r->brain_mask)
-            fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({}, tissue window {:.1f}..{:.1f})\n", b->mask_voxels,
-                       b->skull_stripped ? "skull-stripped input" : "full head", b->tissue_low, b->tissue_high);
+            fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({})\n", b->mask_voxels, brain_mask_summary(*b));
         roi = std::move(r->mask);
     }
     // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for (or a

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -164,4 +165,34 @@ TEST(RoiAutoCli, WithoutARoiALeakOutOfTheBrainIsWarnedAbout) {
         ASSERT_EQ(r.rc, 0) << r.err;
         EXPECT_EQ(leak_warnings(nlohmann::json::parse(r.out)), 0u) << args << ": " << r.out;
     }
+}
+
+// The analytic head under Rician noise σ 14 (its air a Rayleigh of mode 14): the report gives the
+// air's noise and the head threshold it raised, in the JSON (as the library's report) and in the
+// summary line; the segmentation stays inside the mask.
+TEST(RoiAutoCli, NoisyAirIsMeasuredAndReported) {
+    Grid<float> head = liveset::testing::analytic_head(false);
+    std::mt19937 rng(14);
+    std::normal_distribution<double> noise(0.0, 14.0);
+    for (float& v : head.values()) v = static_cast<float>(std::hypot(v + noise(rng), noise(rng)));
+    const fs::path image = work_dir() / "noisy_head.nii.gz";
+    write_image(head, image.string());
+    const Grid<float> read = read_image(image.string());
+    BrainMaskReport expected;
+    auto_brain_mask(read, {}, &expected);
+    EXPECT_NEAR(expected.background_noise, 14.0, 1.0);
+    EXPECT_GT(expected.head_threshold, expected.background_threshold);
+    const std::string args = "segment " + image.string() + " --roi auto --seed 32,32,32:3 --mu-raw 112 --epsilon-raw 40 --iterations 30 --out-mask " +
+                             (work_dir() / "noisy_seg.nii.gz").string();
+    const auto r = run_cli(args + " --json");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["roi"]["auto"]["background_noise"].get<double>(), expected.background_noise);
+    EXPECT_EQ(j["roi"]["auto"]["head_threshold"].get<double>(), expected.head_threshold);
+    EXPECT_EQ(j["roi"]["voxels"].get<std::size_t>(), expected.mask_voxels);
+    const auto text = run_cli(args);
+    ASSERT_EQ(text.rc, 0) << text.err;
+    char line[96];
+    std::snprintf(line, sizeof line, "noisy air σ %.1f: head threshold %.1f", expected.background_noise, expected.head_threshold);
+    EXPECT_NE(text.out.find(line), std::string::npos) << text.out;
 }
