@@ -136,7 +136,8 @@ nlohmann::json roi_report(const Roi& roi) {
     nlohmann::json j{{"source", roi.source}, {"voxels", voxels}, {"volume_mm3", static_cast<double>(voxels) * s.x * s.y * s.z}};
     if (const auto& b = roi.brain_mask)
         j["auto"] = {{"skull_stripped", b->skull_stripped}, {"background_threshold", b->background_threshold},
-                     {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold}, {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
+                     {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold},
+                     {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
                      {"surface_contact", b->surface_contact}};
     return j;
 }

@@ -112,9 +112,9 @@ std::optional<float> constant_fill(const Grid<float>& image) {
 // (image units above `floor`), or 0 when the histogram over [floor, top] (bins of 1/64 of
 // base − floor, smoothed over 2 bins) has no such mode below `base`: its first bin that is the
 // highest up to three times its own distance from the floor, if it falls to half its height within
-// that reach and holds `min_share` of all voxels within twice its distance; σ is then the middle of the bins
-// around it at ≥ 90 % of its height (Rayleigh: 0.69σ..1.35σ, so 1.02σ; one noisy bin does not
-// move it). A noise-free background is a spike at the floor (σ 0); a cropped scan's first peak
+// that reach and holds `min_share` of all voxels within twice its distance; σ is then the middle of
+// the bins around it at ≥ 90 % of its height (Rayleigh: 0.69σ..1.35σ, so 1.02σ; one noisy bin does
+// not move it). A noise-free background is a spike at the floor (σ 0); a cropped scan's first peak
 // (its CSF) is outgrown by grey and white matter.
 double background_noise(const Grid<float>& image, double floor, double base, double top, double min_share) {
     if (!(base > floor) || !(top > base)) return 0.0;
@@ -150,9 +150,13 @@ double background_noise(const Grid<float>& image, double floor, double base, dou
 // percentile, a constant fill left out; σ: background_noise).
 void thresholds(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport& r) {
     std::vector<float> all(image.values().begin(), image.values().end());
-    const std::optional<float> fill = constant_fill(image);
-    std::vector<float> measured = fill ? values_above(image, nullptr, *fill) : all;
-    const double floor = measured.empty() ? 0.0 : percentile(measured, 0.001);
+    double floor = 0.0;
+    if (const std::optional<float> fill = constant_fill(image)) {
+        std::vector<float> rest = values_above(image, nullptr, *fill);
+        if (!rest.empty()) floor = percentile(rest, 0.001);
+    } else {
+        floor = percentile(all, 0.001);
+    }
     const double p2 = percentile(all, 0.02);
     std::vector<float> above = values_above(image, nullptr, p2);
     if (above.empty()) throw std::invalid_argument("brain mask: no head found (98% of the voxels share the lowest value)");

@@ -37,19 +37,19 @@ ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdPar
                                const Grid<float>* blurred)
     : params_(params), propagation_(unit_image.lattice()), roi_(roi) {
     validate(params);
-    for (const auto& [what, dims] : {std::pair{"region-of-interest mask", roi ? roi->dims() : unit_image.dims()},
-                                     std::pair{"blurred image", blurred ? blurred->dims() : unit_image.dims()}})
-        if (!(dims == unit_image.dims())) {
-            std::ostringstream os;
-            os << what << " " << dims << " does not match the image " << unit_image.dims();
-            throw std::invalid_argument(os.str());
-        }
+    const auto check_dims = [&](const char* what, Vec3i dims) {
+        if (dims == unit_image.dims()) return;
+        std::ostringstream os;
+        os << what << " " << dims << " does not match the image " << unit_image.dims();
+        throw std::invalid_argument(os.str());
+    };
+    if (roi) check_dims("region-of-interest mask", roi->dims());
+    if (blurred) check_dims("blurred image", blurred->dims());
     const double w = 0.5 * (1.0 - params.alpha);
-    std::optional<Grid<float>> smoothed;
-    if (params.smooth_mm > 0.0 && blurred == nullptr) smoothed = gaussian_smooth(unit_image, params.smooth_mm);
-    const std::span<const float> img = params.smooth_mm <= 0.0 ? unit_image.values()
-                                       : smoothed               ? smoothed->values()
-                                                                : blurred->values();
+    std::optional<Grid<float>> own;  // the blur, when the caller keeps none
+    const Grid<float>* source = &unit_image;
+    if (params.smooth_mm > 0.0) source = blurred ? blurred : &own.emplace(gaussian_smooth(unit_image, params.smooth_mm));
+    const std::span<const float> img = source->values();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, img.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const auto pi = static_cast<PointIndex>(i);
