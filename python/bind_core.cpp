@@ -97,18 +97,19 @@ cli::BiasCorrection bias_mode(const std::optional<bool>& bias_correct) {
 pyb::dict segment(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a, const pyb::object& progress) {
     Grid<float> image = grid_from_array(values, lattice);
     SegmentRequest req = request_for(a, lattice);
-    const std::optional<cli::Roi> roi = roi_of(a.roi, image);
+    std::optional<cli::Roi> roi = roi_of(a.roi, image);
     std::optional<Grid<std::uint8_t>> init;
     if (!a.init_mask.is_none()) init = mask_from_array(a.init_mask.cast<pyb::array>(), lattice);
     Interrupt interrupt;
     interrupt.callback = progress;
-    const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const cli::BiasCorrection mode = bias_mode(a.bias_correct);
     cli::PreparedImage prepared;
     std::optional<SegmentOutcome> out;
+    const Grid<std::uint8_t>* roi_mask = nullptr;
     {
         pyb::gil_scoped_release nogil;
-        prepared = cli::prepare_image(image, roi_mask, mode, &interrupt.flag());
+        prepared = cli::prepare_image(image, roi, mode, &interrupt.flag());
+        roi_mask = roi ? &roi->mask : nullptr;
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
         if (roi) req.roi = &roi->mask;
         if (init) req.initial_mask = &*init;
@@ -140,18 +141,18 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
 // The image a Session works on, prepared as `liveset view` prepares it (prepare_image: N4 per
 // `bias_correct`, fitted in the ROI, else the automatic brain mask): the corrected image when N4
 // ran, the ROI (a mask array, or "auto": the automatic brain mask, as segment), the region the
-// tissue model is fitted in (the brain mask found before N4; none with a ROI) and the report's
+// tissue model is fitted in (the automatic brain mask; none with a ROI) and the report's
 // bias_correction / warnings / roi.
 pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice, const pyb::object& roi_arg,
                                 const std::optional<bool>& bias_correct) {
     Grid<float> image = grid_from_array(values, lattice);
-    const std::optional<cli::Roi> roi = roi_of(roi_arg, image);  // "auto": from the image before N4, as segment
-    const Grid<std::uint8_t>* r = roi ? &roi->mask : nullptr;
+    std::optional<cli::Roi> roi = roi_of(roi_arg, image);  // "auto": as segment's
     cli::PreparedImage prepared;
     {
         pyb::gil_scoped_release nogil;
-        prepared = cli::prepare_image(image, r, bias_mode(bias_correct));
+        prepared = cli::prepare_image(image, roi, bias_mode(bias_correct));
     }
+    const Grid<std::uint8_t>* r = roi ? &roi->mask : nullptr;
     nlohmann::json j = nlohmann::json::object();
     cli::add_bias_report(j, prepared, r);
     if (roi) j["roi"] = cli::roi_report(*roi);
@@ -167,10 +168,10 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
 std::string tissue_model(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a) {
     Grid<float> image = grid_from_array(values, lattice);
     SegmentRequest req = request_for(a, lattice, false);
-    const std::optional<cli::Roi> roi = roi_of(a.roi, image);
+    std::optional<cli::Roi> roi = roi_of(a.roi, image);
     pyb::gil_scoped_release nogil;
+    const cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct));  // as segment
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
-    const cli::PreparedImage prepared = cli::prepare_image(image, roi_mask, bias_mode(a.bias_correct));  // as segment
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
     const IntensityScale scale = robust_scale(image, roi_mask, req.scale);
     std::vector<std::string> warnings;

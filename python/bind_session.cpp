@@ -22,7 +22,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     std::optional<Grid<std::uint8_t>> r;
     if (!roi.is_none()) r = mask_from_array(roi.cast<pyb::array>(), l);
     SessionOptions o;
-    // Where the tissue model is fitted (the brain mask prepare_image found before N4, as the viewer).
+    // Where the tissue model is fitted (the automatic brain mask prepare_image found, as the viewer).
     if (!model_region.is_none()) o.model_region = mask_from_array(model_region.cast<pyb::array>(), l);
     o.layers = layers;
     o.fragment_size = fragment_size;

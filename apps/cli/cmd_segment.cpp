@@ -92,12 +92,12 @@ int run_segment(const SegmentArgs& a, int threads) {
 
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> init;
-    const std::optional<Roi> roi = load_roi(a.roi, image);
+    std::optional<Roi> roi = load_roi(a.roi, image);
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.
-    const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const BiasCorrection mode = bias_mode(a.bias_correct, a.bias_given || !a.out_corrected.empty());
-    const PreparedImage prepared = prepare_image(image, roi_mask, mode, &interrupt.flag());
+    const PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag());
+    const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     if (prepared.bias && prepared.bias->interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
         return 130;

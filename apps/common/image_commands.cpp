@@ -67,26 +67,25 @@ double negative_share(const Grid<float>& image, const Grid<std::uint8_t>* region
 
 }  // namespace
 
-PreparedImage prepare_image(Grid<float>& image, const Grid<std::uint8_t>* roi, BiasCorrection mode,
-                            const std::atomic<bool>* interrupt) {
-    PreparedImage out;
-    if (roi == nullptr) out.fit_region = try_auto_brain_mask(image);
-    if (mode == BiasCorrection::kOff) return out;
+namespace {
+
+// N4 per `mode` on `image`, fitted in `fit` (null: Otsu's foreground), as prepare_image.
+void correct_for(Grid<float>& image, const Grid<std::uint8_t>* fit, BiasCorrection mode, const std::atomic<bool>* interrupt,
+                 PreparedImage& out) {
     const auto skip = [&](const std::string& why) {
         out.bias_skipped = "bias correction skipped: " + why + "; the uncorrected image is used";
-        return out;
     };
     BiasCorrectionReport report;
     try {
         if (mode == BiasCorrection::kDefault) {
             // N4 models a multiplicative field on magnitude data. Negative values where it would fit
             // (an offset, a z-scored image) are outside that model: the default leaves such an image alone.
-            const double negative = negative_share(image, out.fit(roi));
+            const double negative = negative_share(image, fit);
             if (negative > 0.01)
                 return skip(fmt::format("{:.1f} % of the voxels it would fit are negative (an offset or a z-scored image?), outside N4's "
                                         "multiplicative model", 100.0 * negative));
         }
-        image = correct_bias(image, out.fit(roi), {}, &report, interrupt);
+        image = correct_bias(image, fit, {}, &report, interrupt);
     } catch (const std::invalid_argument& e) {  // the input N4 cannot take
         if (mode == BiasCorrection::kRequired) throw;
         return skip(e.what());
@@ -95,6 +94,27 @@ PreparedImage prepare_image(Grid<float>& image, const Grid<std::uint8_t>* roi, B
         return skip(e.what());
     }
     out.bias = std::move(report);
+}
+
+}  // namespace
+
+PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt) {
+    PreparedImage out;
+    if (!roi) out.fit_region = try_auto_brain_mask(image);
+    if (mode == BiasCorrection::kOff) return out;
+    correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
+    if (!out.bias || out.bias->interrupted) return out;
+    // The automatic brain mask again, on the corrected image.
+    Grid<std::uint8_t>* automatic = roi ? (roi->brain_mask ? &roi->mask : nullptr) : out.fit_region ? &*out.fit_region : nullptr;
+    if (automatic == nullptr) return out;
+    BrainMaskReport report;
+    try {
+        *automatic = auto_brain_mask(image, {}, &report);
+    } catch (const std::invalid_argument&) {
+        return out;  // none found there: the first stays
+    }
+    if (roi) roi->brain_mask = report;
+    out.brain_mask_after_n4 = report.mask_voxels;
     return out;
 }
 
@@ -102,6 +122,7 @@ void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, cons
     if (prepared.bias) {
         report["bias_correction"] = bias_correction_report(*prepared.bias);
         report["bias_correction"]["mask"] = prepared.fit_name(roi);
+        if (prepared.brain_mask_after_n4) report["bias_correction"]["brain_mask_after_voxels"] = prepared.brain_mask_after_n4;
     }
     if (!prepared.bias_skipped.empty()) report["warnings"].push_back(prepared.bias_skipped);
 }

@@ -61,6 +61,9 @@ struct PreparedImage {
     std::optional<Grid<std::uint8_t>> fit_region;
     std::optional<BiasCorrectionReport> bias;  // N4's report when it ran
     std::string bias_skipped;                  // why the default correction did not run (a warning)
+    // Voxels of the automatic brain mask found again on the corrected image (prepare_image), which
+    // replaced the one N4 was fitted in; 0 when it was not.
+    std::size_t brain_mask_after_n4 = 0;
     // The region N4 and the tissue model are fitted in: the ROI, else fit_region, else none (N4
     // then takes Otsu's foreground).
     const Grid<std::uint8_t>* fit(const Grid<std::uint8_t>* roi) const { return roi ? roi : fit_region ? &*fit_region : nullptr; }
@@ -70,7 +73,11 @@ struct PreparedImage {
 // N4 (BiasCorrectionOptions' defaults) on `image` per `mode`, fitted inside the ROI, else the
 // automatic brain mask, else Otsu's foreground. `interrupt`: Ctrl-C (the report then says
 // interrupted and the image is unchanged). Throws std::invalid_argument (kRequired) as correct_bias.
-PreparedImage prepare_image(Grid<float>& image, const Grid<std::uint8_t>* roi, BiasCorrection mode,
+// An automatic brain mask (`roi` "auto", or the fit region without a ROI) is found again on the
+// corrected image once N4 ran, and replaces the first (kept when none is found there): a strong
+// field drags the first mask's tissue window off (BrainWeb × a ±40 % field: brain mask Dice 0.904,
+// found again 0.943; docs/BENCHMARKS.md, session 56).
+PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode,
                             const std::atomic<bool>* interrupt = nullptr);
 // The report's "bias_correction" object (bias_correction_report and where it was fitted), or, when
 // the default correction was skipped, its warning appended to the report's "warnings".

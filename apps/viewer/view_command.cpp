@@ -73,25 +73,24 @@ SessionOptions session_options(const ViewArgs& a) {
 
 std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
-    std::optional<Grid<std::uint8_t>> roi;
-    if (std::optional<Roi> r = load_roi(a.roi, image, "--roi")) {  // a mask file, or "auto" as `segment --roi auto`
-        if (const auto& b = r->brain_mask)
-            fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({})\n", b->mask_voxels, brain_mask_summary(*b));
-        roi = std::move(r->mask);
-    }
+    std::optional<Roi> r = load_roi(a.roi, image, "--roi");  // a mask file, or "auto" as `segment --roi auto`
     // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for (or a
     // continued workspace's image was corrected: then it must be again).
     const BiasCorrection mode = bias_mode(a.workspace_bias.value_or(a.bias_correct), a.bias_given || a.workspace_bias);
     PreparedImage prepared;
     try {
-        prepared = prepare_image(image, roi ? &*roi : nullptr, mode);
+        prepared = prepare_image(image, r, mode);
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{}: {}", a.image, e.what()));
     }
     if (!prepared.bias_skipped.empty()) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
+    if (r && r->brain_mask)
+        fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({})\n", r->brain_mask->mask_voxels, brain_mask_summary(*r->brain_mask));
+    std::optional<Grid<std::uint8_t>> roi;
+    if (r) roi = std::move(r->mask);
     a.image_corrected = prepared.bias.has_value();
     SessionOptions so = session_options(a);
-    so.model_region = std::move(prepared.fit_region);  // as `segment`: the brain mask found before N4 (none with a ROI)
+    so.model_region = std::move(prepared.fit_region);  // as `segment`: the automatic brain mask (none with a ROI)
     try {
         return std::make_unique<Session>(std::move(image), so, std::move(roi));
     } catch (const std::invalid_argument& e) {

@@ -46,7 +46,8 @@ bool Viewer::open_image(const std::string& path) {
             auto out = std::make_shared<Opened>();
             Grid<float> image = read_image(path);
             if (cancel->load()) return out;
-            cli::PreparedImage prepared = cli::prepare_image(image, nullptr, mode, cancel.get());
+            std::optional<cli::Roi> no_roi;
+            cli::PreparedImage prepared = cli::prepare_image(image, no_roi, mode, cancel.get());
             if (cancel->load()) return out;
             out->corrected = prepared.bias.has_value();
             out->bias_skipped = prepared.bias_skipped;

@@ -16,7 +16,7 @@ FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "smooth_mm", "
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
 CHOICES = {"window_from": ("model", "seeds")}
 BOOLS = ("bias_correct",)
-DEFAULTS_EPOCH = 54  # see Subject.fingerprint
+DEFAULTS_EPOCH = 56  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -45,7 +45,8 @@ class Subject:
         stats = [(p, os.stat(p).st_size, os.stat(p).st_mtime_ns) for p in files]
         # DEFAULTS_EPOCH: bumped when a default that changes the outputs changes (session 48: N4 by
         # default; 49: the curvature per mm, which changes every scan not at 1 mm; 50: α chosen from
-        # the image unless given; 54: noisy scans pre-smoothed unless α is given), so a resumed
+        # the image unless given; 54: noisy scans pre-smoothed unless α is given; 56: the automatic
+        # brain mask raised above noisy air (55) and found again after N4), so a resumed
         # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)

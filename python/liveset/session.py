@@ -30,7 +30,7 @@ class Session:
     with a warning where it cannot run (an image too small for its grid); True requires it
     (ValueError where it cannot run); False takes the image as given (pass False for an image that
     is already corrected, e.g. ``segment(...).corrected``). Without a ROI the tissue model is
-    fitted in the brain mask found before N4, as ``segment`` fits it, so the same seeds give
+    fitted in the automatic brain mask (found again on the corrected image), as ``segment`` fits it, so the same seeds give
     ``segment``'s mask. ``roi``: None, a mask (Image, nibabel image or array) the front may not
     leave, or ``"auto"``: the automatic brain mask, as ``segment(roi="auto")``. ``image`` is the
     image the session works on (the corrected one when N4 ran), ``corrected`` True when N4 ran,

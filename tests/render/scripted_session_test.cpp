@@ -369,7 +369,7 @@ ClickedPhantom clicked_phantom(const std::string& name) {
 
 
 // With bias correction (the default) and no ROI, `view` fits the tissue model where `segment` does:
-// in the brain mask found before N4 (it once took the corrected image's: 43 voxels of this mask
+// in prepare_image's automatic brain mask (it once computed its own: 43 voxels of this mask
 // differed), so seeds placed in the viewer still give segment's mask.
 TEST(ScriptedSession, WithBiasCorrectionAndNoRoiTheViewerFitsTheModelWhereSegmentDoes) {
     const ClickedPhantom ph = clicked_phantom("n4");

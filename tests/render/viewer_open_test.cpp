@@ -61,7 +61,8 @@ TEST(ViewerOpen, AnImageOpensOnAWorkerAndAFrameSwapsItIn) {
     ASSERT_NE(v.session(), nullptr) << v.message();
     EXPECT_EQ(v.message(), "opened " + image_path());
     Grid<float> expected = read_image(image_path());
-    const cli::PreparedImage prepared = cli::prepare_image(expected, nullptr, cli::BiasCorrection::kDefault);
+    std::optional<cli::Roi> no_roi;
+    const cli::PreparedImage prepared = cli::prepare_image(expected, no_roi, cli::BiasCorrection::kDefault);
     ASSERT_TRUE(prepared.bias.has_value());
     EXPECT_EQ(image_checksum(v.session()->image()), image_checksum(expected));  // corrected as `view` corrects it
     EXPECT_NE(image_checksum(v.session()->image()), image_checksum(read_image(image_path())));

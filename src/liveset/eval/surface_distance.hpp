@@ -3,6 +3,8 @@
 // built on an exact separable Euclidean distance transform with anisotropic voxel spacing.
 #pragma once
 
+#include <limits>
+
 #include <cstdint>
 #include <vector>
 
@@ -19,8 +21,11 @@ std::vector<PointIndex> boundary_voxels(const Grid<std::uint8_t>& mask);
 // parabolas, one separable pass per axis, O(volume)). +infinity everywhere when there is no feature.
 // Direction cosines are ignored: distances in an orthonormal frame do not depend on them.
 // Lines run in parallel (oneTBB); every line is computed independently, so the result does not
-// depend on the thread count.
-Grid<double> squared_distance_transform_mm(const Grid<std::uint8_t>& features);
+// depend on the thread count. With `max_mm2`, a value above it is only known to be above it
+// (+infinity or a larger distance): morphology by a ball of radius r needs no more than r², and
+// the passes then skip the sites beyond it.
+Grid<double> squared_distance_transform_mm(const Grid<std::uint8_t>& features,
+                                           double max_mm2 = std::numeric_limits<double>::infinity());
 
 struct SurfaceDistance {
     // max over both directions of the largest boundary-voxel distance to the other boundary.

@@ -26,8 +26,8 @@ Grid<std::uint8_t> complement(const Grid<std::uint8_t>& mask) {
 // 1 where the squared distance (mm²) to the features is above r² (above == true) or at most r².
 // Distances equal to r up to rounding count as r: a 4 mm ball at 1 mm spacing holds (0, 0, 4).
 Grid<std::uint8_t> threshold_distance(const Grid<std::uint8_t>& features, double r, bool above) {
-    const Grid<double> d2 = squared_distance_transform_mm(features);
     const double r2 = r * r * (1 + 1e-9);
+    const Grid<double> d2 = squared_distance_transform_mm(features, r2);
     Grid<std::uint8_t> out(features.lattice());
     for (std::size_t i = 0; i < out.size(); ++i) {
         const double v = d2[static_cast<PointIndex>(i)];
