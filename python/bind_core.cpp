@@ -114,6 +114,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
         if (roi) req.roi = &roi->mask;
         if (init) req.initial_mask = &*init;
         req.model_region = fit;
+        req.model_region_is_brain = prepared.fit_is_brain(roi);
         const SegmentationHook hook = [&](const SegmentationProgress& p, const ChangedPoints&) {
             return interrupt.poll_with([&]() -> pyb::object {
                 return pyb::dict(pyb::arg("iteration") = p.iteration, pyb::arg("zero_layer") = p.zero_layer,
@@ -160,6 +161,7 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
     d["report"] = j.dump();
     d["roi"] = roi ? pyb::object(array_from_grid(Grid<std::uint8_t>(roi->mask))) : pyb::object(pyb::none());
     d["image"] = prepared.bias ? pyb::object(array_from_grid(std::move(image))) : pyb::object(pyb::none());
+    d["region_is_brain"] = prepared.fit_is_brain(roi);
     d["model_region"] = prepared.fit_region ? pyb::object(array_from_grid(std::move(*prepared.fit_region))) : pyb::object(pyb::none());
     return d;
 }
@@ -175,8 +177,10 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
     const IntensityScale scale = robust_scale(image, roi_mask, req.scale);
     std::vector<std::string> warnings;
-    const Grid<std::uint8_t> region = model_region(image, fit, roi_mask, a.classes);
-    const std::optional<TissueModel> model = fit_window_model(image, region, req.window.model, warnings);
+    bool automatic = false;
+    const Grid<std::uint8_t> region = model_region(image, fit, roi_mask, a.classes, &automatic);
+    const std::optional<TissueModel> model =
+        fit_window_model(image, region, req.window.model, warnings, automatic || prepared.fit_is_brain(roi));
     nlohmann::json j;
     j["intensity_scale"] = {{"low", scale.low}, {"high", scale.high}};
     if (!req.seeds.empty()) {

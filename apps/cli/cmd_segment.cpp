@@ -57,13 +57,14 @@ void check_segment_args(const SegmentArgs& a) {
 
 // The segmentation request the options describe (seeds parsed and checked inside the image).
 SegmentRequest segment_request(const SegmentArgs& a, const Lattice& lattice, const std::optional<Roi>& roi,
-                               const std::optional<Grid<std::uint8_t>>& init, const Grid<std::uint8_t>* fit) {
+                               const std::optional<Grid<std::uint8_t>>& init, const Grid<std::uint8_t>* fit, bool fit_is_brain) {
     SegmentRequest req;
     fill_segment_request(req, a, lattice);
     req.loop.step = step_options(a);
     if (roi) req.roi = &roi->mask;
     if (init) req.initial_mask = &*init;
     req.model_region = fit;
+    req.model_region_is_brain = fit_is_brain;
     return req;
 }
 
@@ -105,7 +106,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!prepared.bias_skipped.empty() && !a.quiet) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
 
-    const SegmentRequest req = segment_request(a, image.lattice(), roi, init, fit);
+    const SegmentRequest req = segment_request(a, image.lattice(), roi, init, fit, prepared.fit_is_brain(roi));
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} iterations; nothing written\n", run.outcome.result.iterations);

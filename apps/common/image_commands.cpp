@@ -260,6 +260,7 @@ nlohmann::json tissue_model_report(const TissueModel& m, const ModelWindow* w) {
     nlohmann::json j{{"classes", classes}, {"partial_volume", m.mixed}, {"voxels", m.voxels},
                      {"iterations", m.iterations}, {"converged", m.converged}, {"usable", m.usable()}};
     if (!m.usable()) j["degenerate"] = m.degenerate;
+    if (m.smooth_mm > 0) j["fitted_smooth_mm"] = m.smooth_mm;  // fitted on the image blurred by this σ
     if (w) j["seed_class"] = {{"name", tissue_class_name(m, w->seed_class)}, {"index", w->seed_class}, {"share", w->seed_class_share}};
     return j;
 }

@@ -69,6 +69,8 @@ struct PreparedImage {
     const Grid<std::uint8_t>* fit(const Grid<std::uint8_t>* roi) const { return roi ? roi : fit_region ? &*fit_region : nullptr; }
     // "roi", "auto brain mask" or "otsu": where N4 was fitted (the report's bias_correction.mask).
     std::string fit_name(const Grid<std::uint8_t>* roi) const { return roi ? "roi" : fit_region ? "auto brain mask" : "otsu"; }
+    // That region is an automatic brain mask (ROI "auto", or fit_region): SegmentRequest::model_region_is_brain.
+    bool fit_is_brain(const std::optional<Roi>& roi) const { return roi ? roi->brain_mask.has_value() : fit_region.has_value(); }
 };
 // N4 (BiasCorrectionOptions' defaults) on `image` per `mode`, fitted inside the ROI, else the
 // automatic brain mask, else Otsu's foreground. `interrupt`: Ctrl-C (the report then says

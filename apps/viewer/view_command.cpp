@@ -86,10 +86,11 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     if (!prepared.bias_skipped.empty()) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
     if (r && r->brain_mask)
         fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({})\n", r->brain_mask->mask_voxels, brain_mask_summary(*r->brain_mask));
+    SessionOptions so = session_options(a);
+    so.model_region_is_brain = prepared.fit_is_brain(r);
     std::optional<Grid<std::uint8_t>> roi;
     if (r) roi = std::move(r->mask);
     a.image_corrected = prepared.bias.has_value();
-    SessionOptions so = session_options(a);
     so.model_region = std::move(prepared.fit_region);  // as `segment`: the automatic brain mask (none with a ROI)
     try {
         return std::make_unique<Session>(std::move(image), so, std::move(roi));

@@ -52,6 +52,7 @@ bool Viewer::open_image(const std::string& path) {
             out->corrected = prepared.bias.has_value();
             out->bias_skipped = prepared.bias_skipped;
             SessionOptions with_region = options;
+            with_region.model_region_is_brain = prepared.fit_is_brain(no_roi);
             with_region.model_region = std::move(prepared.fit_region);  // as `segment` (view_command.cpp)
             out->session = std::make_unique<Session>(std::move(image), with_region);
             return out;

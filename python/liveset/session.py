@@ -60,7 +60,8 @@ class Session:
         self.image = img.like(prepared["image"]) if self.corrected else img
         self.roi = None if prepared["roi"] is None else img.like(prepared["roi"])
         self.report = json.loads(prepared["report"])
-        self._s = _liveset._Session(self.image.array, img.geometry, prepared["roi"], prepared["model_region"], float(n),
+        self._s = _liveset._Session(self.image.array, img.geometry, prepared["roi"], prepared["model_region"],
+                                    bool(prepared["region_is_brain"]), float(n),
                                     None if alpha is None else float(alpha),
                                     None if smooth_mm is None else float(smooth_mm), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),

@@ -439,3 +439,25 @@ def test_repair_cut_removes_a_handle_and_nothing_else():
         liveset.repair(img.like(mask.astype(np.uint8)), img, [(c, c, c)], decision="maybe")
     with pytest.raises(ValueError):
         liveset.repair(img.like(mask.astype(np.uint8)), img, [(c, c, c)], decision="cut", edit_range=0)
+
+
+def test_noise_that_hides_a_tissue_is_seen_through_the_blur_as_segment_sees_it():
+    # BrainWeb under Rician noise σ 18 with roi="auto" (a whole brain): segment, tissue_model and
+    # the Session all fit the tissue model on the blurred image (grey and white matter overlap on
+    # the image itself) and choose the same window, α and blur.
+    here = os.path.dirname(os.path.abspath(__file__))
+    t1 = liveset.read(os.path.join(here, "..", "..", "data", "brainweb", "t1.mha"))
+    rng = np.random.default_rng(57)
+    a = t1.array.astype(np.float64)
+    img = t1.like(np.hypot(a + rng.normal(0, 18, a.shape), rng.normal(0, 18, a.shape)).astype(np.float32))
+    seed = (35, 83, 113)
+    seg = liveset.segment(img, [seed], roi="auto", iterations=1)
+    tm = seg.report["tissue_model"]
+    assert len(tm["classes"]) == 3 and tm["fitted_smooth_mm"] == 0.5 and seg.report["smooth_mm"] == 0.5
+    assert any("noise hid a tissue" in w for w in seg.report["warnings"])
+    model = liveset.tissue_model(img, [seed], roi="auto")
+    assert model["tissue_model"]["fitted_smooth_mm"] == 0.5 and model["window"]["mu"] == seg.report["mu"]
+    s = liveset.Session(img, roi="auto")
+    s.add_seed(seed)
+    p = s.params
+    assert (p["mu"], p["epsilon"], p["alpha"], p["smooth_mm"]) == (seg.report["mu"], seg.report["epsilon"], seg.report["alpha"], 0.5)

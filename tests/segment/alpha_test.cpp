@@ -112,3 +112,18 @@ TEST(AutomaticAlpha, ThePreSmoothingIsHalfTheFinestVoxelAboveTheNoiseFloor) {
     EXPECT_DOUBLE_EQ(automatic_alpha(&loud, 91.0, {2, 2, 2}).smooth_mm, 1.0);
     EXPECT_EQ(automatic_alpha(nullptr, 91.0, {1, 1, 1}).smooth_mm, 0.0);  // the fallback α measures no noise
 }
+
+// A model fitted on the blurred image (window.cpp, noise hiding a tissue) keeps its blur for D
+// whatever its own (narrowed) noise ratio says; an unusable one does not count.
+TEST(AutomaticAlpha, AModelFittedOnTheBlurredImageKeepsItsBlur) {
+    TissueModel quiet = three_classes(5.7);
+    quiet.smooth_mm = 0.5;
+    const AlphaChoice a = automatic_alpha(&quiet, 91.0, {1, 1, 1});
+    EXPECT_EQ(a.alpha, 0.0);  // under the noise floor
+    EXPECT_DOUBLE_EQ(a.smooth_mm, 0.5);
+    TissueModel loud = three_classes(13.1);
+    loud.smooth_mm = 0.25;  // the rule's own blur is larger: it stays
+    EXPECT_DOUBLE_EQ(automatic_alpha(&loud, 91.0, {1, 1, 1}).smooth_mm, 0.5);
+    quiet.degenerate = "tissue classes 1 and 2 overlap";
+    EXPECT_EQ(automatic_alpha(&quiet, 91.0, {1, 1, 1}).smooth_mm, 0.0);
+}

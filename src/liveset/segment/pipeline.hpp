@@ -33,6 +33,9 @@ struct SegmentRequest {
     // Where the tissue model is fitted: this region, else the ROI, else the image's foreground
     // (voxels above the Otsu threshold between background and the rest).
     const Grid<std::uint8_t>* model_region = nullptr;
+    // That region (model_region, else the ROI) is a whole brain - the automatic brain mask - so the
+    // model may be fitted through noise that hides a tissue (fit_window_model, window.hpp).
+    bool model_region_is_brain = false;
     double n = 4.0;
     // The curvature weight; absent: automatic_alpha() (alpha.hpp) from the tissue model's noise
     // ratio of the window's class and the voxel shape (the fallback 0.1 without a usable model).

@@ -61,6 +61,9 @@ struct TissueModel {
     // when it is sound.
     std::string degenerate;
     std::string note;  // e.g. the partial-volume fit failed and the plain mixture is used
+    // σ (mm) of the Gaussian blur (smoothing.hpp) of the image the model was fitted on: 0 for the
+    // image itself (fit_window_model, window.hpp, may fit the blurred image when noise hides a class).
+    double smooth_mm = 0.0;
 
     bool usable() const { return degenerate.empty(); }
     // Index of the pure class with the largest posterior at `value` (mixed classes ignored).

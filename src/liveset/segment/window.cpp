@@ -2,6 +2,7 @@
 #include "liveset/segment/window.hpp"
 
 #include "liveset/segment/brain_mask.hpp"
+#include "liveset/segment/smoothing.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -27,7 +28,8 @@ void WindowOptions::validate() const {
 }
 
 Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_t>* region, const Grid<std::uint8_t>* roi,
-                                int classes) {
+                                int classes, bool* whole_brain) {
+    if (whole_brain) *whole_brain = false;
     for (const Grid<std::uint8_t>* m : {region, roi})
         if (m && !(m->dims() == image.dims())) {
             std::ostringstream os;
@@ -37,7 +39,9 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
     if (region) return *region;
     if (roi) return *roi;
     try {  // a head (or a skull-stripped brain, or the phantom): the automatic brain mask
-        return auto_brain_mask(image);
+        Grid<std::uint8_t> brain = auto_brain_mask(image);
+        if (whole_brain) *whole_brain = true;
+        return brain;
     } catch (const std::invalid_argument&) {  // not a head: the foreground
     }
     // Background and the tissue classes: the lowest threshold separates the background.
@@ -74,12 +78,52 @@ void thin_class_warnings(const TissueModel& m, std::vector<std::string>& warning
     }
 }
 
+// Noise that hides a tissue (docs/ARCHITECTURE.md; docs/BENCHMARKS.md, session 57): at BrainWeb +
+// Rician σ 18 grey and white matter lie under two spreads apart, so the classes asked for
+// "overlap" and a class fewer merges them (GM+WM as one, the seeds' window spanning both: GM Dice
+// 0.685). The threshold term reads such a scan blurred (alpha.hpp: σ = kSmoothVoxels finest voxel
+// sides), where they stand apart. Only in a whole brain, where the classes are known to be there:
+// in a region holding fewer tissues (a grey + white matter ROI fitted for three classes) the
+// blurred fit can split one tissue in two. A blur narrows each tissue's spread but does not move
+// its mean, so the blurred fit is taken only when it is sound and finds the same classes: each
+// mean within the plain fit's spread of that class.
+std::optional<TissueModel> fit_through_noise(const Grid<float>& image, const Grid<std::uint8_t>& region,
+                                             const TissueModelOptions& options, const TissueModel& plain) {
+    if (plain.classes.size() != static_cast<std::size_t>(options.classes)) return std::nullopt;
+    for (const TissueClass& c : plain.classes)  // an overlap, not a class without voxels
+        if (!(c.weight >= 0.01) || !std::isfinite(c.mean) || !std::isfinite(c.sigma)) return std::nullopt;
+    const Vec3f h = image.lattice().spacing_float();
+    const double sigma_mm = std::min(kSmoothVoxels * std::min({h.x, h.y, h.z}), kMaxSmoothMm);
+    TissueModel blurred;
+    try {
+        blurred = fit_tissue_model(gaussian_smooth(image, sigma_mm), &region, options);
+    } catch (const std::invalid_argument&) {
+        return std::nullopt;
+    }
+    if (!blurred.usable() || blurred.classes.size() != plain.classes.size()) return std::nullopt;
+    for (std::size_t k = 0; k < plain.classes.size(); ++k)
+        if (!(std::abs(blurred.classes[k].mean - plain.classes[k].mean) <= plain.classes[k].sigma)) return std::nullopt;
+    blurred.smooth_mm = sigma_mm;
+    return blurred;
+}
+
 }  // namespace
 
 std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid<std::uint8_t>& region,
-                                            const TissueModelOptions& options, std::vector<std::string>& warnings) {
+                                            const TissueModelOptions& options, std::vector<std::string>& warnings,
+                                            bool whole_brain) {
     try {
         TissueModel m = fit_tissue_model(image, &region, options);
+        if (!m.usable() && whole_brain)
+            if (std::optional<TissueModel> b = fit_through_noise(image, region, options, m)) {
+                std::ostringstream os;
+                os.precision(3);
+                os << "tissue model: on the image " << m.degenerate << "; blurred by " << b->smooth_mm
+                   << " mm, as the threshold term reads a noisy scan, the " << options.classes
+                   << " classes fit with the same means: noise hid a tissue, and the blurred fit is used";
+                warnings.push_back(os.str());
+                m = std::move(*b);
+            }
         // Fewer tissues in the region than classes asked for (a tight mask with next to no CSF: a
         // class under 1 %, or one tissue split in two): one class fewer, down to two.
         for (TissueModelOptions fewer = options; !m.usable() && fewer.classes > 2;) {
@@ -92,9 +136,12 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
             m = std::move(next);
         }
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
-        // (On BrainWeb only its shaded variants fail the partial-volume fit: say so.)
+        // (On BrainWeb only its shaded variants fail the partial-volume fit: say so. Fitted through
+        // noise that hid a tissue, the noise is the likelier cause.)
         if (!m.note.empty())
-            warnings.push_back("tissue model: " + m.note + " (a bias field can do this; " + kShadingHint + ")");
+            warnings.push_back("tissue model: " + m.note +
+                               (m.smooth_mm > 0 ? std::string(" (heavy noise can do this)")
+                                                : " (a bias field can do this; " + std::string(kShadingHint) + ")"));
         if (m.usable() && !m.converged)
             warnings.push_back("tissue model: EM stopped at its limit of " + std::to_string(options.max_iterations) +
                                " iterations before converging (the class means still drift slowly)");
@@ -160,8 +207,9 @@ std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std
         warnings.push_back("the segmentation is empty: no sheet to find holes in");
         return std::nullopt;
     }
-    const Grid<std::uint8_t> region = model_region(image, nullptr, roi, options.classes);
-    const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings);
+    bool whole_brain = false;
+    const Grid<std::uint8_t> region = model_region(image, nullptr, roi, options.classes, &whole_brain);
+    const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings, whole_brain);
     if (!m || !m->usable()) return std::nullopt;
     if (model) *model = *m;
     return model_window(*m, values);

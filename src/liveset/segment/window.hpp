@@ -38,14 +38,19 @@ struct WindowEstimate {
 // The region the tissue model is fitted in: `region` when given, else `roi`, else the automatic
 // brain mask (brain_mask.hpp; full-head scans must not mix scalp and muscle into the classes),
 // else, when that finds no head, the image's foreground (voxels above the lowest of the Otsu
-// thresholds that split the image into background and `classes` tissue classes).
+// thresholds that split the image into background and `classes` tissue classes). `whole_brain`
+// (optional) is set when the region is that automatic brain mask, else cleared.
 Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_t>* region,
-                                const Grid<std::uint8_t>* roi, int classes);
+                                const Grid<std::uint8_t>* roi, int classes, bool* whole_brain = nullptr);
 
 // Fits the model for estimate_window(). Never throws on data the model cannot describe: returns
-// nullopt (or a degenerate model) and says why in `warnings`.
+// nullopt (or a degenerate model) and says why in `warnings`. `whole_brain`: the region is a whole
+// brain (the automatic brain mask), so every class asked for is in it; when noise makes two of
+// them overlap on the image, the model is fitted on the image blurred as the threshold term reads
+// it (TissueModel::smooth_mm; docs/ARCHITECTURE.md, "Noise that hides a tissue").
 std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid<std::uint8_t>& region,
-                                            const TissueModelOptions& options, std::vector<std::string>& warnings);
+                                            const TissueModelOptions& options, std::vector<std::string>& warnings,
+                                            bool whole_brain = false);
 
 // The window for `seeds` on the raw `image` (normalised by `scale`): the model's when `model` is
 // usable and options.estimate is kModel, else the seeds' statistics (with a warning saying why).

@@ -198,7 +198,9 @@ const std::optional<TissueModel>& Session::tissue_model() const {
     if (!model_) {
         std::vector<std::string> ignored;  // window_estimate() reports an unusable model
         const Grid<std::uint8_t>* region = options_.model_region ? &*options_.model_region : nullptr;
-        model_ = fit_window_model(image_, model_region(image_, region, roi(), options_.window.model.classes), options_.window.model, ignored);
+        bool automatic = false;
+        const Grid<std::uint8_t> fit = model_region(image_, region, roi(), options_.window.model.classes, &automatic);
+        model_ = fit_window_model(image_, fit, options_.window.model, ignored, automatic || options_.model_region_is_brain);
     }
     return *model_;
 }
