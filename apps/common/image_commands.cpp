@@ -159,7 +159,8 @@ nlohmann::json roi_report(const Roi& roi) {
         j["auto"] = {{"skull_stripped", b->skull_stripped}, {"background_threshold", b->background_threshold},
                      {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold},
                      {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
-                     {"surface_contact", b->surface_contact}};
+                     {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
+                     {"below_head_voxels", b->below_voxels}};
     return j;
 }
 
@@ -168,6 +169,9 @@ std::string brain_mask_summary(const BrainMaskReport& b) {
                                 b.tissue_low, b.tissue_high);
     if (b.head_threshold > b.background_threshold)
         s += fmt::format(", noisy air σ {:.1f}: head threshold {:.1f}", b.background_noise, b.head_threshold);
+    if (b.below_voxels > 0 && !b.skull_stripped)
+        s += fmt::format(", {:.0f} ml of neck left out", static_cast<double>(b.below_voxels) * b.mask_volume_mm3 /
+                                                              static_cast<double>(std::max<std::size_t>(b.mask_voxels, 1)) / 1000.0);
     return s;
 }
 

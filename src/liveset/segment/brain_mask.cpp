@@ -237,6 +237,32 @@ Mask stripped_foreground(const Grid<float>& image, double threshold) {
     return fill_holes(largest_component(f));
 }
 
+// The head within `extent_mm` of its highest voxel along the world's superior axis (LPS z; the
+// lattice's direction cosines included); `below` counts what is left out. 0: the whole head.
+Mask cranial(const Mask& head, double extent_mm, std::size_t& below) {
+    below = 0;
+    if (extent_mm <= 0) return head;
+    const Lattice& lat = head.lattice();
+    const Vec3i d = lat.dims();
+    const double z0 = lat.to_world({0, 0, 0}).z;
+    const double gx = lat.to_world({1, 0, 0}).z - z0, gy = lat.to_world({0, 1, 0}).z - z0, gz = lat.to_world({0, 0, 1}).z - z0;
+    const auto height = [&](int x, int y, int z) { return z0 + gx * x + gy * y + gz * z; };
+    double top = -std::numeric_limits<double>::infinity();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x)
+                if (head({x, y, z}) != 0) top = std::max(top, height(x, y, z));
+    Mask out = head;
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x)
+                if (out({x, y, z}) != 0 && height(x, y, z) < top - extent_mm) {
+                    out({x, y, z}) = 0;
+                    ++below;
+                }
+    return out;
+}
+
 Mask intersect(Mask a, const Mask& b) {
     for (std::size_t i = 0; i < a.size(); ++i) a[static_cast<PointIndex>(i)] &= b[static_cast<PointIndex>(i)] != 0;
     return a;
@@ -283,6 +309,8 @@ void validate(const BrainMaskOptions& o) {
     require(std::isfinite(o.closing_mm) && o.closing_mm >= 0 && o.closing_mm <= 50, "closing_mm must lie in [0, 50]");
     require(std::isfinite(o.rim_mm) && o.rim_mm >= 0 && o.rim_mm <= 50, "rim_mm must lie in [0, 50]");
     require(std::isfinite(o.head_closing_mm) && o.head_closing_mm >= 0 && o.head_closing_mm <= 50, "head_closing_mm must lie in [0, 50]");
+    require(std::isfinite(o.brain_extent_mm) && (o.brain_extent_mm == 0 || (o.brain_extent_mm >= 100 && o.brain_extent_mm <= 1000)),
+            "brain_extent_mm must be 0 (the whole head) or lie in [100, 1000]");
     require(std::isfinite(o.stripped_near_mm) && o.stripped_near_mm > 0 && o.stripped_near_mm <= 50, "stripped_near_mm must lie in (0, 50]");
     require(std::isfinite(o.stripped_fraction) && o.stripped_fraction > 0 && o.stripped_fraction <= 1, "stripped_fraction must lie in (0, 1]");
 }
@@ -292,9 +320,10 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     check_image(image);
     BrainMaskReport r;
     thresholds(image, o, r);
-    const Mask head = fill_holes(close_mm(head_foreground(image, r.head_threshold), o.head_closing_mm));
+    const Mask whole_head = fill_holes(close_mm(head_foreground(image, r.head_threshold), o.head_closing_mm));
+    const Grid<float> depth = depth_mm(whole_head);
+    const Mask head = cranial(whole_head, o.brain_extent_mm, r.below_voxels);
     r.head_voxels = count(head);
-    const Grid<float> depth = depth_mm(head);
     const Grid<float> smooth = gaussian_smooth(image, o.smoothing_mm);
     white_matter_peak(image, head, depth, r);
     const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);

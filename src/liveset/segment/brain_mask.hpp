@@ -42,6 +42,11 @@ struct BrainMaskOptions {
     // Closing of the head foreground that bridges the dark skull, giving a solid head whose surface
     // the skull-stripping test measures from.
     double head_closing_mm = 5.0;
+    // Only the head within this distance (mm) of its top along the world's superior axis (LPS +z)
+    // holds the brain: below it lie neck and shoulders, whose deep muscle would otherwise be read
+    // as the deep head's white matter (FSL's robustfov keeps 170 mm from the top of the head too).
+    // The depth is still measured from the whole head's surface. 0: the whole head.
+    double brain_extent_mm = 170.0;
     // Skull-stripped input: at least `stripped_fraction` of the mask's boundary lies within
     // `stripped_near_mm` of the head's surface (a full head has scalp and skull in between). The
     // mask is then the filled non-background foreground. Set detect_skull_stripped false to skip.
@@ -66,7 +71,8 @@ struct BrainMaskReport {
     double wm_sigma = 0;              // its width (upper half-width at half maximum / 1.1774)
     double tissue_low = 0;            // brain-tissue window (image units)
     double tissue_high = 0;
-    std::size_t head_voxels = 0;      // solid head (filled, closed foreground)
+    std::size_t head_voxels = 0;      // solid head (filled, closed foreground) within brain_extent_mm of its top
+    std::size_t below_voxels = 0;     // solid head further below its top (neck, shoulders), left out
     std::size_t tissue_voxels = 0;    // head voxels in the tissue window
     std::size_t core_voxels = 0;      // largest component after the erosion
     double surface_contact = 0;       // fraction of the mask boundary near the head surface
