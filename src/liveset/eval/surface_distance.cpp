@@ -19,23 +19,21 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // Scratch for one 1D transform of a line of n samples.
 struct LineScratch {
-    std::vector<double> f, d, z;
+    std::vector<double> d, z;
     std::vector<int> v;
     void resize(int n) {
         const auto un = static_cast<std::size_t>(n);
-        f.resize(un);
         d.resize(un);
         v.resize(un);
         z.resize(un + 1);
     }
 };
 
-// 1D squared distance transform (Felzenszwalb & Huttenlocher 2012) on samples at positions q·step:
-// d[q] = min_p (step·(q-p))² + f[p]. Samples with f = +inf or above `cutoff` are not sites; with
+// 1D squared distance transform (Felzenszwalb & Huttenlocher 2012) on samples f at positions q·step:
+// s.d[q] = min_p (step·(q-p))² + f[p]. Samples with f = +inf or above `cutoff` are not sites; with
 // no site, d = +inf. Inside a run of zeros only the run's two ends are sites: an interior zero is
 // never the nearest site of a point outside the run, and inside it d is 0 (as the full envelope gives).
-void transform_line(LineScratch& s, int n, double step, double cutoff) {
-    const double* f = s.f.data();
+void transform_line(const double* f, LineScratch& s, int n, double step, double cutoff) {
     double* d = s.d.data();
     int* v = s.v.data();
     double* z = s.z.data();
@@ -110,8 +108,7 @@ void transform_axis(Grid<double>& grid, int axis, double cutoff) {
                         block[static_cast<std::size_t>(l * n + q)] = first[static_cast<std::size_t>(q) * stride + static_cast<std::size_t>(l)];
                 for (int l = 0; l < w; ++l) {
                     double* line = block.data() + static_cast<std::size_t>(l * n);
-                    std::copy(line, line + n, s.f.begin());
-                    transform_line(s, n, step, cutoff);
+                    transform_line(line, s, n, step, cutoff);
                     std::copy(s.d.begin(), s.d.begin() + n, line);
                 }
                 for (int q = 0; q < n; ++q)

@@ -3,9 +3,8 @@
 // built on an exact separable Euclidean distance transform with anisotropic voxel spacing.
 #pragma once
 
-#include <limits>
-
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
