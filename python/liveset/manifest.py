@@ -46,7 +46,8 @@ class Subject:
         # DEFAULTS_EPOCH: bumped when a default that changes the outputs changes (session 48: N4 by
         # default; 49: the curvature per mm, which changes every scan not at 1 mm; 50: α chosen from
         # the image unless given; 54: noisy scans pre-smoothed unless α is given; 56: the automatic
-        # brain mask raised above noisy air (55) and found again after N4), so a resumed
+        # brain mask raised above noisy air (55) and found again after N4; 57: the tissue model fitted
+        # through noise that hides a tissue, the brain looked for within 170 mm of the head's top), so a resumed
         # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)

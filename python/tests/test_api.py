@@ -442,9 +442,9 @@ def test_repair_cut_removes_a_handle_and_nothing_else():
 
 
 def test_noise_that_hides_a_tissue_is_seen_through_the_blur_as_segment_sees_it():
-    # BrainWeb under Rician noise σ 18 with roi="auto" (a whole brain): segment, tissue_model and
-    # the Session all fit the tissue model on the blurred image (grey and white matter overlap on
-    # the image itself) and choose the same window, α and blur.
+    # BrainWeb under Rician noise σ 18 with roi="auto" (a whole brain) and without a ROI: segment,
+    # tissue_model and the Session all fit the tissue model on the blurred image (grey and white
+    # matter overlap on the image itself) and choose the same window, α and blur.
     here = os.path.dirname(os.path.abspath(__file__))
     t1 = liveset.read(os.path.join(here, "..", "..", "data", "brainweb", "t1.mha"))
     rng = np.random.default_rng(57)
@@ -458,6 +458,13 @@ def test_noise_that_hides_a_tissue_is_seen_through_the_blur_as_segment_sees_it()
     model = liveset.tissue_model(img, [seed], roi="auto")
     assert model["tissue_model"]["fitted_smooth_mm"] == 0.5 and model["window"]["mu"] == seg.report["mu"]
     s = liveset.Session(img, roi="auto")
+    s.add_seed(seed)
+    p = s.params
+    assert (p["mu"], p["epsilon"], p["alpha"], p["smooth_mm"]) == (seg.report["mu"], seg.report["epsilon"], seg.report["alpha"], 0.5)
+    # without a ROI the automatic brain mask is the fit region: the same again
+    seg = liveset.segment(img, [seed], iterations=1)
+    assert seg.report["tissue_model"]["fitted_smooth_mm"] == 0.5
+    s = liveset.Session(img)
     s.add_seed(seed)
     p = s.params
     assert (p["mu"], p["epsilon"], p["alpha"], p["smooth_mm"]) == (seg.report["mu"], seg.report["epsilon"], seg.report["alpha"], 0.5)

@@ -251,8 +251,10 @@ TEST(RoiAutoCli, AStrongBiasFieldIsCorrectedBeforeTheMaskIsFoundAgain) {
 // Noise that hides a tissue (window.cpp): BrainWeb under Rician noise σ 18, bias-corrected (the
 // default). With `--roi auto` the region is known to be a whole brain, so the model is fitted on
 // the blurred image when three classes overlap on the image: three classes, the blur reported,
-// and the grey-matter seed's window ends below the white matter's mean. The same mask given as a file is not known to be a
-// whole brain: two classes on the image, GM and WM merged, the window past the white matter.
+// the seed voting for grey matter (on the blurred image), and its window ending below the white
+// matter's mean. Without a ROI the same (the automatic mask is the fit region). The same mask
+// given as a file is not known to be a whole brain: two classes on the image, GM and WM merged,
+// the window past the white matter.
 TEST(RoiAutoCli, NoiseThatHidesATissueIsSeenThroughTheBlurInAnAutomaticBrainMask) {
     const fs::path data = fs::path(LIVESET_DATA_DIR) / "brainweb";
     Grid<float> t1 = read_image((data / "t1.mha").string());
@@ -272,6 +274,13 @@ TEST(RoiAutoCli, NoiseThatHidesATissueIsSeenThroughTheBlurInAnAutomaticBrainMask
     EXPECT_GT(j["window"]["upper_raw"].get<double>(), gm);
     EXPECT_LT(j["window"]["upper_raw"].get<double>(), wm);
     EXPECT_NE(j["warnings"].dump().find("noise hid a tissue"), std::string::npos) << j["warnings"].dump();
+    EXPECT_EQ(j["tissue_model"]["seed_class"]["name"], "GM");
+    EXPECT_GE(j["tissue_model"]["seed_class"]["share"].get<double>(), 0.7);
+    const auto none = run_cli("segment " + image.string() + common);
+    ASSERT_EQ(none.rc, 0) << none.err;
+    const nlohmann::json n = nlohmann::json::parse(none.out);
+    EXPECT_EQ(n["tissue_model"]["classes"].size(), 3u) << n["tissue_model"].dump();
+    EXPECT_EQ(n["tissue_model"]["fitted_smooth_mm"].get<double>(), 0.5);
     const auto b = run_cli("segment " + image.string() + " --roi " + roi.string() + common);
     ASSERT_EQ(b.rc, 0) << b.err;
     const nlohmann::json k = nlohmann::json::parse(b.out);

@@ -186,7 +186,10 @@ TEST(BrainWeb, NoiseThatHidesATissueIsSeenThroughTheBlur) {
         }
     }
     const double gm = sum[2] / n[2], wm = sum[3] / n[3];
-    const ModelWindow w = model_window(*m, seed_values(blurred, s.seeds, &s.brain));
+    // The production path: the seeds vote on the blurred image, the window from the model's means.
+    const WindowEstimate e = estimate_window(loud, robust_scale(loud, &s.brain), s.seeds, &s.brain, &*m, WindowOptions{});
+    ASSERT_TRUE(e.model_window.has_value());
+    const ModelWindow& w = *e.model_window;
     std::printf("sigma 18 slab: GM %.1f WM %.1f (blurred truth), window %.1f .. %.1f\n", gm, wm, w.lower, w.upper);
     EXPECT_EQ(w.seed_class, 1);
     EXPECT_LT(w.lower, gm);

@@ -48,7 +48,7 @@ AlphaChoice automatic_alpha(const TissueModel* model, double window_centre_raw, 
     const double h_max = std::max({spacing.x, spacing.y, spacing.z});
     a.anisotropy = h_max / h_min;
     a.alpha = base / (a.anisotropy * a.anisotropy * a.anisotropy);
-    if (a.noise_ratio > kAlphaNoiseFloor) a.smooth_mm = std::min(kSmoothVoxels * h_min, kMaxSmoothMm);  // NaN compares false
+    if (a.noise_ratio > kAlphaNoiseFloor) a.smooth_mm = presmoothing_mm(spacing);  // NaN compares false
     // A model fitted on the blurred image (window.cpp): its window holds on that image, so D reads it.
     if (model && model->usable()) a.smooth_mm = std::max(a.smooth_mm, model->smooth_mm);
     return a;

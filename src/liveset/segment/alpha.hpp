@@ -21,7 +21,9 @@ struct AlphaChoice {
     int tissue_class = -1;   // the window's class (see automatic_alpha); -1 without a ratio
     double anisotropy = 1.0;  // longest over shortest voxel side
     // σ (mm) of the pre-smoothing (ThresholdParams::smooth_mm): kSmoothVoxels × the finest voxel
-    // side when the noise ratio exceeds kAlphaNoiseFloor, else 0 (also without a ratio).
+    // side when the noise ratio exceeds kAlphaNoiseFloor, else 0 (also without a ratio); at least
+    // the model's own smooth_mm when it was fitted on the blurred image (window.hpp: the noise ratio
+    // and α then come from that model's narrower spreads).
     double smooth_mm = 0.0;
 };
 

@@ -65,6 +65,11 @@ void convolve_axis(const Grid<float>& in, Grid<float>& out, int axis, const std:
 
 }  // namespace
 
+double presmoothing_mm(Vec3f spacing) {
+    const double h_min = std::min({spacing.x, spacing.y, spacing.z});  // float -> double: exact
+    return std::min(kSmoothVoxels * h_min, kMaxSmoothMm);
+}
+
 void check_smooth_mm(double sigma_mm) {
     if (std::isfinite(sigma_mm) && sigma_mm >= 0.0 && sigma_mm <= kMaxSmoothMm) return;
     std::ostringstream os;

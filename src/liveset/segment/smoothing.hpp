@@ -29,4 +29,8 @@ Grid<float> gaussian_smooth(const Grid<float>& image, double sigma_mm);
 // [0, kMaxSmoothMm] or not finite (gaussian_smooth's and ThresholdParams' one range check).
 void check_smooth_mm(double sigma_mm);
 
+// The automatic pre-smoothing's σ (mm) for voxels of `spacing` (as float, Lattice::spacing_float()):
+// kSmoothVoxels × the finest side, at most kMaxSmoothMm.
+double presmoothing_mm(Vec3f spacing);
+
 }  // namespace liveset

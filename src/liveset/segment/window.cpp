@@ -84,16 +84,16 @@ void thin_class_warnings(const TissueModel& m, std::vector<std::string>& warning
 // 0.685). The threshold term reads such a scan blurred (alpha.hpp: σ = kSmoothVoxels finest voxel
 // sides), where they stand apart. Only in a whole brain, where the classes are known to be there:
 // in a region holding fewer tissues (a grey + white matter ROI fitted for three classes) the
-// blurred fit can split one tissue in two. A blur narrows each tissue's spread but does not move
-// its mean, so the blurred fit is taken only when it is sound and finds the same classes: each
-// mean within the plain fit's spread of that class.
+// blurred fit can split one tissue in two. A blur narrows each tissue's spread and hardly moves its
+// mean (partial volume at thin cortex a little), so the blurred fit is taken only when it is sound
+// and finds the same classes: each mean within the plain fit's spread of that class, each spread
+// no wider than there.
 std::optional<TissueModel> fit_through_noise(const Grid<float>& image, const Grid<std::uint8_t>& region,
                                              const TissueModelOptions& options, const TissueModel& plain) {
     if (plain.classes.size() != static_cast<std::size_t>(options.classes)) return std::nullopt;
     for (const TissueClass& c : plain.classes)  // an overlap, not a class without voxels
         if (!(c.weight >= 0.01) || !std::isfinite(c.mean) || !std::isfinite(c.sigma)) return std::nullopt;
-    const Vec3f h = image.lattice().spacing_float();
-    const double sigma_mm = std::min(kSmoothVoxels * std::min({h.x, h.y, h.z}), kMaxSmoothMm);
+    const double sigma_mm = presmoothing_mm(image.lattice().spacing_float());
     TissueModel blurred;
     try {
         blurred = fit_tissue_model(gaussian_smooth(image, sigma_mm), &region, options);
@@ -101,8 +101,10 @@ std::optional<TissueModel> fit_through_noise(const Grid<float>& image, const Gri
         return std::nullopt;
     }
     if (!blurred.usable() || blurred.classes.size() != plain.classes.size()) return std::nullopt;
-    for (std::size_t k = 0; k < plain.classes.size(); ++k)
-        if (!(std::abs(blurred.classes[k].mean - plain.classes[k].mean) <= plain.classes[k].sigma)) return std::nullopt;
+    for (std::size_t k = 0; k < plain.classes.size(); ++k) {
+        const TissueClass &b = blurred.classes[k], &p = plain.classes[k];
+        if (!(std::abs(b.mean - p.mean) <= p.sigma) || !(b.sigma <= p.sigma)) return std::nullopt;
+    }
     blurred.smooth_mm = sigma_mm;
     return blurred;
 }
@@ -120,7 +122,7 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
                 os.precision(3);
                 os << "tissue model: on the image " << m.degenerate << "; blurred by " << b->smooth_mm
                    << " mm, as the threshold term reads a noisy scan, the " << options.classes
-                   << " classes fit with the same means: noise hid a tissue, and the blurred fit is used";
+                   << " classes fit, each mean within its spread on the image: noise hid a tissue, and the blurred fit is used";
                 warnings.push_back(os.str());
                 m = std::move(*b);
             }
@@ -170,7 +172,10 @@ std::vector<std::string> window_warnings(const TissueModel& model, double lower,
 WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& scale, std::span<const SeedBall> seeds,
                                const Grid<std::uint8_t>* roi, const TissueModel* model, const WindowOptions& options) {
     options.validate();
-    const std::vector<float> raw = seed_values(image, seeds, roi);
+    // The seeds vote on the image the model was fitted on (blurred when noise hid a tissue).
+    std::optional<Grid<float>> smooth;
+    if (model && model->usable() && model->smooth_mm > 0) smooth = gaussian_smooth(image, model->smooth_mm);
+    const std::vector<float> raw = seed_values(smooth ? *smooth : image, seeds, roi);
     WindowEstimate w;
     if (options.estimate == WindowSource::kModel && model && model->usable()) {
         w.model_window = liveset::model_window(*model, raw);
@@ -212,6 +217,12 @@ std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std
     const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings, whole_brain);
     if (!m || !m->usable()) return std::nullopt;
     if (model) *model = *m;
+    if (m->smooth_mm > 0) {  // the voxels vote on the image the model was fitted on
+        const Grid<float> smooth = gaussian_smooth(image, m->smooth_mm);
+        values.clear();
+        for (PointIndex i = 0; i < mask.size(); ++i)
+            if (mask[i] && (!roi || (*roi)[i])) values.push_back(smooth[i]);
+    }
     return model_window(*m, values);
 }
 
