@@ -205,10 +205,10 @@ std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std
                                         std::vector<std::string>& warnings, TissueModel* model) {
     if (!(mask.dims() == image.dims()) || (roi && !(roi->dims() == image.dims())))
         throw std::invalid_argument("sheet window: image, mask and ROI differ in size");
-    std::vector<float> values;
-    for (PointIndex i = 0; i < mask.size(); ++i)
-        if (mask[i] && (!roi || (*roi)[i])) values.push_back(image[i]);
-    if (values.empty()) {
+    const auto inside = [&](PointIndex i) { return mask[i] && (!roi || (*roi)[i]); };
+    bool any = false;
+    for (PointIndex i = 0; i < mask.size() && !any; ++i) any = inside(i);
+    if (!any) {
         warnings.push_back("the segmentation is empty: no sheet to find holes in");
         return std::nullopt;
     }
@@ -217,12 +217,13 @@ std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std
     const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings, whole_brain);
     if (!m || !m->usable()) return std::nullopt;
     if (model) *model = *m;
-    if (m->smooth_mm > 0) {  // the voxels vote on the image the model was fitted on
-        const Grid<float> smooth = gaussian_smooth(image, m->smooth_mm);
-        values.clear();
-        for (PointIndex i = 0; i < mask.size(); ++i)
-            if (mask[i] && (!roi || (*roi)[i])) values.push_back(smooth[i]);
-    }
+    // The voxels vote on the image the model was fitted on (blurred when noise hid a tissue).
+    std::optional<Grid<float>> smooth;
+    if (m->smooth_mm > 0) smooth = gaussian_smooth(image, m->smooth_mm);
+    const Grid<float>& fitted = smooth ? *smooth : image;
+    std::vector<float> values;
+    for (PointIndex i = 0; i < mask.size(); ++i)
+        if (inside(i)) values.push_back(fitted[i]);
     return model_window(*m, values);
 }
 
