@@ -155,7 +155,7 @@ TEST(Holes, FindsThePhantomsPerforationsWithoutTruth) {
         missed[i] = ph.truth[i] && !o.mask[i];
     }
     const auto truth = find_perforations(o.mask, ph.truth, white);
-    const std::vector<std::uint32_t> region = label_components(missed, 6, nullptr);
+    const ComponentLabels region = label_components(missed, 6, nullptr);
     std::vector<std::string> warnings;
     const auto w = sheet_window(ph.image, o.mask, nullptr, TissueModelOptions{}, warnings);
     ASSERT_TRUE(w.has_value());

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <vector>
 
 #include "eval/mask_shapes.hpp"
@@ -221,11 +222,11 @@ TEST(LabelComponents, ConnectivityDecidesDiagonalContacts) {
     m({2, 2, 2}) = 1;
     m({3, 3, 3}) = 1;
     std::size_t count = 0;
-    std::vector<std::uint32_t> six = label_components(m, 6, &count);
+    ComponentLabels six = label_components(m, 6, &count);
     EXPECT_EQ(count, 2u);
     EXPECT_EQ(six[m.lattice().index({2, 2, 2})], 1u);
     EXPECT_EQ(six[m.lattice().index({3, 3, 3})], 2u);
-    std::vector<std::uint32_t> all = label_components(m, 26, &count);
+    ComponentLabels all = label_components(m, 26, &count);
     EXPECT_EQ(count, 1u);
     EXPECT_EQ(all[m.lattice().index({3, 3, 3})], 1u);
     EXPECT_EQ(all[m.lattice().index({0, 0, 0})], 0u);
@@ -238,7 +239,7 @@ TEST(LabelComponents, LabelsFollowScanOrderOfFirstVoxel) {
     paint_box(m, {0, 4, 0}, {3, 6, 6});  // first voxel (0,4,0): label 2
     paint_box(m, {5, 3, 2}, {9, 6, 6});  // first voxel (5,3,2): label 3 (6-separated from the others)
     std::size_t count = 0;
-    const std::vector<std::uint32_t> labels = label_components(m, 6, &count);
+    const ComponentLabels labels = label_components(m, 6, &count);
     ASSERT_EQ(count, 3u);
     const Lattice& lat = m.lattice();
     EXPECT_EQ(labels[lat.index({8, 1, 1})], 1u);
@@ -265,7 +266,7 @@ TEST(LabelComponents, MergedBranchesGetOneCompactLabel) {
     paint_box(m, {7, 1, 0}, {8, 2, 5});  // separate pillar
     for (int connectivity : {6, 26}) {
         std::size_t count = 0;
-        const std::vector<std::uint32_t> labels = label_components(m, connectivity, &count);
+        const ComponentLabels labels = label_components(m, connectivity, &count);
         EXPECT_EQ(count, 2u);
         const Lattice& lat = m.lattice();
         EXPECT_EQ(labels[lat.index({1, 1, 0})], 1u);
@@ -274,6 +275,51 @@ TEST(LabelComponents, MergedBranchesGetOneCompactLabel) {
         EXPECT_EQ(labels[lat.index({7, 1, 0})], 2u);
         EXPECT_EQ(labels[lat.index({7, 1, 4})], 2u);
         EXPECT_EQ(*std::max_element(labels.begin(), labels.end()), 2u);
+    }
+}
+
+// Labels by breadth-first flood fill from each unlabelled voxel in scan order: the definition the
+// run-length labelling must reproduce exactly (numbers included).
+ComponentLabels flood_labels(const Mask& m, int connectivity, std::size_t& count) {
+    const Lattice& lat = m.lattice();
+    ComponentLabels label(m.size(), 0);
+    count = 0;
+    std::vector<PointIndex> queue;
+    for (PointIndex s = 0; s < m.size(); ++s) {
+        if (m[s] == 0 || label[s] != 0) continue;
+        label[s] = static_cast<std::uint32_t>(++count);
+        queue.assign(1, s);
+        while (!queue.empty()) {
+            const Vec3i p = lat.coord(queue.back());
+            queue.pop_back();
+            for (int dz = -1; dz <= 1; ++dz)
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int steps = std::abs(dx) + std::abs(dy) + std::abs(dz);
+                        if (steps == 0 || (connectivity == 6 && steps > 1)) continue;
+                        const Vec3i q{p.x + dx, p.y + dy, p.z + dz};
+                        if (!lat.contains(q) || m(q) == 0 || label[lat.index(q)] != 0) continue;
+                        label[lat.index(q)] = static_cast<std::uint32_t>(count);
+                        queue.push_back(lat.index(q));
+                    }
+        }
+    }
+    return label;
+}
+
+TEST(LabelComponents, MatchesAFloodFillOnRandomMasks) {
+    std::mt19937 rng(7);
+    for (double density : {0.2, 0.45, 0.6}) {
+        Mask m(Lattice({17, 11, 9}));
+        std::bernoulli_distribution on(density);
+        for (std::uint8_t& v : m.values()) v = on(rng) ? 1 : 0;
+        for (int connectivity : {6, 26}) {
+            std::size_t count = 0, expected_count = 0;
+            const ComponentLabels labels = label_components(m, connectivity, &count);
+            const ComponentLabels expected = flood_labels(m, connectivity, expected_count);
+            EXPECT_EQ(count, expected_count) << density << " " << connectivity;
+            EXPECT_TRUE(labels == expected) << density << " " << connectivity;
+        }
     }
 }
 

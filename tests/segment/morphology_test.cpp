@@ -2,6 +2,8 @@
 // closing, largest component and hole filling on small grids; the Gaussian blur in mm.
 #include <gtest/gtest.h>
 
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -70,6 +72,32 @@ TEST(Morphology, ErodeAndDilateMatchBruteForceBallsWithAnisotropicSpacing) {
             const Mask c = close_mm(m, r), ce = erode_mm(g, r);
             for (std::size_t i = 0; i < m.size(); ++i)
                 EXPECT_EQ(c[static_cast<PointIndex>(i)] != 0, m[static_cast<PointIndex>(i)] != 0 || ce[static_cast<PointIndex>(i)] != 0);
+        }
+    }
+}
+
+// A small blob away from the border (the work is cropped to its box grown by the ball), balls from
+// a few voxels to wider than the chord path takes (the distance transform then), and the thread
+// count varied: always the brute force.
+TEST(Morphology, ErodeAndDilateMatchBruteForceWhateverTheBallAndThreads) {
+    const Lattice lat({11, 24, 22}, {1.0, 0.15, 0.15});
+    Mask m(lat);
+    for (int z = 7; z < 15; ++z)
+        for (int y = 8; y < 16; ++y)
+            for (int x = 3; x < 7; ++x) m({x, y, z}) = (x + 2 * y + 3 * z) % 7 != 0;
+    for (double r : {0.4, 1.1, 3.3}) {  // 3.3 mm: 22 + 21 voxels along y and z, past the chord path's 40
+        for (int threads : {1, 3}) {
+            tbb::task_arena arena(threads);
+            Mask e, g;
+            arena.execute([&] {
+                e = erode_mm(m, r);
+                g = dilate_mm(m, r);
+            });
+            for (PointIndex i = 0; i < m.size(); ++i) {
+                const Vec3i p = lat.coord(i);
+                ASSERT_EQ(e[i] != 0, m[i] != 0 && !any_within(m, p, r, 0)) << "r " << r << " threads " << threads << " at " << p;
+                ASSERT_EQ(g[i] != 0, any_within(m, p, r, 1)) << "r " << r << " threads " << threads << " at " << p;
+            }
         }
     }
 }

@@ -93,7 +93,7 @@ TEST(HandleCut, FinderListsTheInnerHandlesAndNothingElse) {
         Grid<std::uint8_t> taken(c.mask.lattice(), 0);
         for (PointIndex i = 0; i < taken.size(); ++i) taken[i] = c.mask[i] && c.inner[i];
         std::size_t count = 0;
-        const std::vector<std::uint32_t> label = label_components(taken, 26, &count);
+        const ComponentLabels label = label_components(taken, 26, &count);
         std::vector<std::vector<PointIndex>> region(count + 1);
         for (PointIndex i = 0; i < taken.size(); ++i) region[label[i]].push_back(i);
         std::size_t expected = 0;

@@ -21,7 +21,7 @@ bool seals_by_labelling(const Grid<std::uint8_t>& inside, const std::vector<Vec3
     const Lattice& lat = inside.lattice();
     Grid<std::uint8_t> outside(lat, 0);
     for (PointIndex i = 0; i < lat.size(); ++i) outside[i] = inside[i] ? 0 : 1;
-    const std::vector<std::uint32_t> label = label_components(outside, 6, nullptr);
+    const ComponentLabels label = label_components(outside, 6, nullptr);
     std::map<std::uint32_t, std::size_t> size;
     std::set<std::uint32_t> on_border;
     const Vec3i d = lat.dims();

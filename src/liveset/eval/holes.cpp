@@ -59,7 +59,7 @@ std::vector<std::uint8_t> classify(const Grid<std::uint8_t>& mask, const Grid<fl
 }
 
 struct Labelled {
-    std::vector<std::uint32_t> label;  // gap components
+    ComponentLabels label;  // gap components
     std::vector<std::uint8_t> keep;    // per label: touches inner and outside
     std::vector<std::uint8_t> rim;     // per voxel: a gap voxel touching inner or outside
     std::vector<std::size_t> size, sheet;  // per label: voxels, voxels touching the mask

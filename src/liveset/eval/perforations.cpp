@@ -14,7 +14,7 @@ namespace {
 
 // Fills each region's `nearest` (its voxel nearest its centroid; slot maps a component label to
 // its index in `out`) and sorts the regions largest first, ties by centroid (deterministic).
-void locate_nearest(const Lattice& lat, const std::vector<std::uint32_t>& label, const std::vector<std::size_t>& slot,
+void locate_nearest(const Lattice& lat, const ComponentLabels& label, const std::vector<std::size_t>& slot,
                     std::vector<Perforation>& out) {
     std::vector<double> best(out.size(), 1e300);
     for (PointIndex i = 0; i < lat.size(); ++i) {
@@ -35,7 +35,7 @@ void locate_nearest(const Lattice& lat, const std::vector<std::uint32_t>& label,
 }
 
 // The 6-connected components of the truth the mask missed (labels 1..count, 0 elsewhere).
-std::vector<std::uint32_t> label_missed(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, std::size_t& count) {
+ComponentLabels label_missed(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth, std::size_t& count) {
     Grid<std::uint8_t> missed(mask.lattice(), 0);
     for (PointIndex i = 0; i < missed.size(); ++i) missed[i] = truth[i] && !mask[i];
     count = 0;
@@ -50,7 +50,7 @@ struct RegionBoxes {
     Vec3d centroid(std::uint32_t k) const { return sum[k] / static_cast<double>(size[k]); }
 };
 
-RegionBoxes region_boxes(const Lattice& lat, const std::vector<std::uint32_t>& label, std::size_t count) {
+RegionBoxes region_boxes(const Lattice& lat, const ComponentLabels& label, std::size_t count) {
     RegionBoxes r{std::vector<std::size_t>(count + 1, 0), std::vector<Vec3d>(count + 1, Vec3d{0, 0, 0}),
                   std::vector<Vec3i>(count + 1, lat.dims()), std::vector<Vec3i>(count + 1, Vec3i{-1, -1, -1})};
     for (PointIndex i = 0; i < lat.size(); ++i) {
@@ -73,7 +73,7 @@ std::vector<Perforation> find_perforations(const Grid<std::uint8_t>& mask, const
         throw std::invalid_argument("find_perforations: mask, truth and inner differ in size");
     const Lattice& lat = mask.lattice();
     std::size_t count = 0;
-    const std::vector<std::uint32_t> label = label_missed(mask, truth, count);
+    const ComponentLabels label = label_missed(mask, truth, count);
     std::vector<std::size_t> size(count + 1, 0);
     std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
     std::vector<std::uint8_t> touches_inner(count + 1, 0), touches_outer(count + 1, 0);
@@ -115,7 +115,7 @@ std::vector<Perforation> find_cavities(const Grid<std::uint8_t>& mask, const Gri
     Grid<std::uint8_t> outside(lat, 0);
     for (PointIndex i = 0; i < lat.size(); ++i) outside[i] = !mask[i];
     std::size_t count = 0;
-    const std::vector<std::uint32_t> label = label_components(outside, 6, &count);
+    const ComponentLabels label = label_components(outside, 6, &count);
     std::vector<std::size_t> size(count + 1, 0);
     std::vector<Vec3d> sum(count + 1, Vec3d{0, 0, 0});
     std::vector<std::uint8_t> open(count + 1, 0);  // touches the border or the inner core
@@ -142,7 +142,7 @@ std::vector<Perforation> find_missed_tunnels(const Grid<std::uint8_t>& mask, con
     if (!(mask.dims() == truth.dims())) throw std::invalid_argument("find_missed_tunnels: mask and truth differ in size");
     const Lattice& lat = mask.lattice();
     std::size_t count = 0;
-    const std::vector<std::uint32_t> label = label_missed(mask, truth, count);
+    const ComponentLabels label = label_missed(mask, truth, count);
     const RegionBoxes r = region_boxes(lat, label, count);
     std::vector<Perforation> out;
     std::vector<std::size_t> slot(count + 1, SIZE_MAX);
@@ -166,7 +166,7 @@ std::vector<Perforation> find_inner_handles(const Grid<std::uint8_t>& mask, cons
     Grid<std::uint8_t> taken(lat, 0);
     for (PointIndex i = 0; i < lat.size(); ++i) taken[i] = mask[i] && inner[i];
     std::size_t count = 0;
-    const std::vector<std::uint32_t> label = label_components(taken, 26, &count);
+    const ComponentLabels label = label_components(taken, 26, &count);
     const RegionBoxes r = region_boxes(lat, label, count);
     // Whether a region has a face neighbour outside the mask (or the lattice): one without is
     // enclosed by the mask, and removing it opens a cavity (no handle cut; skipped before the

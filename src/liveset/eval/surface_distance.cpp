@@ -166,14 +166,37 @@ std::vector<PointIndex> boundary_voxels(const Grid<std::uint8_t>& mask) {
     return out;
 }
 
+// The transform along x of one row of binary features: (x·s − p·s)² to the nearest feature p of the
+// row (the left one on a tie), +infinity without one.
+void feature_row(const std::uint8_t* f, double* d, int n, double step) {
+    int last = -1;
+    for (int x = 0; x < n; ++x) {
+        if (f[x] != 0) last = x;
+        d[x] = last < 0 ? kInf : x * step - last * step;
+    }
+    int next = -1;
+    for (int x = n - 1; x >= 0; --x) {
+        if (f[x] != 0) next = x;
+        const double left = d[x];
+        const double right = next < 0 ? kInf : next * step - x * step;
+        const double nearest = right < left ? right : left;
+        d[x] = nearest * nearest;
+    }
+}
+
 Grid<double> squared_distance_transform_mm(const Grid<std::uint8_t>& features, double max_mm2) {
-    Grid<double> dist(features.lattice(), kInf);
-    const auto fv = features.values();
-    auto dv = dist.values();
-    for (std::size_t i = 0; i < fv.size(); ++i)
-        if (fv[i] != 0) dv[i] = 0.0;
+    Grid<double> dist(features.lattice());
     if (dist.size() == 0) return dist;
-    for (int axis = 0; axis < 3; ++axis) transform_axis(dist, axis, max_mm2);
+    const Vec3i d = features.dims();
+    const double step = features.lattice().spacing().x;
+    tbb::parallel_for(tbb::blocked_range<int>(0, d.z), [&](const tbb::blocked_range<int>& zs) {
+        for (int z = zs.begin(); z < zs.end(); ++z)
+            for (int y = 0; y < d.y; ++y) {
+                const std::size_t row = features.lattice().index({0, y, z});
+                feature_row(features.values().data() + row, dist.values().data() + row, d.x, step);
+            }
+    });
+    for (int axis = 1; axis < 3; ++axis) transform_axis(dist, axis, max_mm2);
     return dist;
 }
 

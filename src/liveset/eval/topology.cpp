@@ -8,6 +8,8 @@
 #include <array>
 #include <cstdlib>
 #include <initializer_list>
+#include <numeric>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -41,63 +43,88 @@ struct LabelForest {
     }
 };
 
-// Two-pass raster-scan labelling of the voxels whose foreground-ness equals `foreground`: the first
-// pass links each voxel to its already-scanned neighbours (3 for 6-connectivity, 13 for 26), the
-// second renumbers the sets in scan order of their first voxel.
-std::vector<std::uint32_t> label_voxels(const Grid<std::uint8_t>& mask, int connectivity, bool foreground,
-                                        std::size_t* count) {
+// A run of voxels along x in one row: [x0, x1).
+struct Run {
+    int x0, x1;
+};
+
+// Unites every run of `row` with each run of `prev` it touches: overlapping x ranges, widened by
+// `reach` voxels (0: a face neighbour row; 1: an edge or corner neighbour row under 26-connectivity).
+void link_rows(std::span<const Run> row, std::size_t row_first, std::span<const Run> prev, std::size_t prev_first, int reach,
+               LabelForest& forest) {
+    std::size_t j = 0;
+    for (std::size_t i = 0; i < row.size(); ++i) {
+        const int lo = row[i].x0 - reach, hi = row[i].x1 + reach;
+        while (j < prev.size() && prev[j].x1 <= lo) ++j;
+        for (std::size_t k = j; k < prev.size() && prev[k].x0 < hi; ++k)
+            forest.unite(static_cast<std::uint32_t>(row_first + i + 1), static_cast<std::uint32_t>(prev_first + k + 1));
+    }
+}
+
+// Run-length labelling of the voxels whose foreground-ness equals `foreground`: the runs of each
+// row (x fastest) are united with the touching runs of the rows before it (2 rows for
+// 6-connectivity, 4 for 26), and the sets renumbered in scan order of their first run, whose first
+// voxel is the component's first voxel.
+ComponentLabels label_voxels(const Grid<std::uint8_t>& mask, int connectivity, bool foreground, std::size_t* count) {
     if (connectivity != 6 && connectivity != 26) {
         throw std::invalid_argument("label_components: connectivity must be 6 or 26, got " +
                                     std::to_string(connectivity));
     }
     const Lattice& lat = mask.lattice();
     const Vec3i d = lat.dims();
-    struct Backward {
-        Vec3i offset;
-        std::ptrdiff_t delta;
-    };
-    std::vector<Backward> backward;  // neighbours that precede a voxel in scan order
-    for (int dz = -1; dz <= 0; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-            for (int dx = -1; dx <= 1; ++dx) {
-                const bool before = dz < 0 || dy < 0 || (dy == 0 && dx < 0);
-                const int manhattan = std::abs(dx) + std::abs(dy) + std::abs(dz);
-                if (!before || (connectivity == 6 && manhattan > 1)) continue;
-                backward.push_back({{dx, dy, dz},
-                                    dx + dy * static_cast<std::ptrdiff_t>(lat.stride_y()) +
-                                        dz * static_cast<std::ptrdiff_t>(lat.stride_z())});
-            }
-
     const std::uint8_t* in = mask.values().data();
-    std::vector<std::uint32_t> labels(mask.size(), 0);
-    LabelForest forest;
-    for (int z = 0; z < d.z; ++z) {
+    std::vector<Run> runs;
+    std::vector<std::size_t> row_begin(static_cast<std::size_t>(d.y) * static_cast<std::size_t>(d.z) + 1, 0);
+    for (std::size_t r = 0; r + 1 < row_begin.size(); ++r) {
+        const std::uint8_t* row = in + r * static_cast<std::size_t>(d.x);
+        for (int x = 0; x < d.x;) {
+            if ((row[x] != 0) != foreground) {
+                ++x;
+                continue;
+            }
+            const int x0 = x;
+            while (x < d.x && (row[x] != 0) == foreground) ++x;
+            runs.push_back({x0, x});
+        }
+        row_begin[r + 1] = runs.size();
+    }
+    LabelForest forest;  // run k is label k + 1
+    std::vector<std::uint32_t> parent(runs.size() + 1);
+    std::iota(parent.begin(), parent.end(), std::uint32_t{0});
+    forest.parent = std::move(parent);
+    const auto row_runs = [&](int y, int z) {
+        const std::size_t r = static_cast<std::size_t>(z) * static_cast<std::size_t>(d.y) + static_cast<std::size_t>(y);
+        return std::pair{std::span<const Run>(runs.data() + row_begin[r], runs.data() + row_begin[r + 1]), row_begin[r]};
+    };
+    for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y) {
-            const std::size_t row = lat.index({0, y, z});
-            for (int x = 0; x < d.x; ++x) {
-                const std::size_t i = row + static_cast<std::size_t>(x);
-                if ((in[i] != 0) != foreground) continue;
-                std::uint32_t label = 0;
-                for (const Backward& b : backward) {
-                    const int nx = x + b.offset.x, ny = y + b.offset.y, nz = z + b.offset.z;
-                    if (nx < 0 || nx >= d.x || ny < 0 || ny >= d.y || nz < 0) continue;
-                    const std::uint32_t n = labels[static_cast<std::size_t>(static_cast<std::ptrdiff_t>(i) + b.delta)];
-                    if (n == 0 || n == label) continue;
-                    label = label == 0 ? n : forest.unite(label, n);
-                }
-                labels[i] = label != 0 ? label : forest.make();
+            const auto [row, first] = row_runs(y, z);
+            if (row.empty()) continue;
+            const auto link = [&](int py, int pz, int reach) {
+                if (py < 0 || py >= d.y || pz < 0) return;
+                const auto [prev, prev_first] = row_runs(py, pz);
+                link_rows(row, first, prev, prev_first, reach, forest);
+            };
+            const int diagonal = connectivity == 26 ? 1 : 0;
+            link(y - 1, z, diagonal);
+            link(y, z - 1, diagonal);
+            if (connectivity == 26) {
+                link(y - 1, z - 1, 1);
+                link(y + 1, z - 1, 1);
             }
         }
-    }
 
     std::vector<std::uint32_t> final_label(forest.parent.size(), 0);
     std::uint32_t next = 0;
-    for (std::uint32_t& l : labels) {
-        if (l == 0) continue;
-        const std::uint32_t root = forest.find(l);
-        if (final_label[root] == 0) final_label[root] = ++next;
-        l = final_label[root];
-    }
+    ComponentLabels labels(mask.size(), 0);
+    for (std::size_t r = 0; r + 1 < row_begin.size(); ++r)
+        for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) {
+            const std::uint32_t root = forest.find(static_cast<std::uint32_t>(k + 1));
+            if (final_label[root] == 0) final_label[root] = ++next;
+            std::fill(labels.begin() + static_cast<std::ptrdiff_t>(r * static_cast<std::size_t>(d.x) + static_cast<std::size_t>(runs[k].x0)),
+                      labels.begin() + static_cast<std::ptrdiff_t>(r * static_cast<std::size_t>(d.x) + static_cast<std::size_t>(runs[k].x1)),
+                      final_label[root]);
+        }
     if (count) *count = next;
     return labels;
 }
@@ -172,7 +199,7 @@ long euler_characteristic(const Grid<std::uint8_t>& mask) {
 // Background 6-components that touch no image border face.
 std::size_t count_cavities(const Grid<std::uint8_t>& mask) {
     std::size_t background = 0;
-    const std::vector<std::uint32_t> labels = label_voxels(mask, 6, false, &background);
+    const ComponentLabels labels = label_voxels(mask, 6, false, &background);
     if (background == 0) return 0;
     std::vector<std::uint8_t> touches_border(background + 1, 0);
     const Lattice& lat = mask.lattice();
@@ -194,7 +221,7 @@ std::size_t count_cavities(const Grid<std::uint8_t>& mask) {
 
 }  // namespace
 
-std::vector<std::uint32_t> label_components(const Grid<std::uint8_t>& mask, int connectivity,
+ComponentLabels label_components(const Grid<std::uint8_t>& mask, int connectivity,
                                             std::size_t* count) {
     return label_voxels(mask, connectivity, true, count);
 }

@@ -16,7 +16,8 @@ namespace liveset {
 // (face, edge and corner neighbours); anything else throws std::invalid_argument. Returns one label
 // per voxel (linear index): 0 for background, 1..count for foreground, numbered in scan order
 // (x fastest) of each component's first voxel, so the result is deterministic. `count` may be null.
-std::vector<std::uint32_t> label_components(const Grid<std::uint8_t>& mask, int connectivity,
+using ComponentLabels = LargeVector<std::uint32_t>;
+ComponentLabels label_components(const Grid<std::uint8_t>& mask, int connectivity,
                                             std::size_t* count);
 
 // The mask's foreground is read as the union of its closed unit voxel cubes; everything outside the

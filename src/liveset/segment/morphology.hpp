@@ -1,5 +1,6 @@
 // Binary morphology in millimetres on a lattice with (possibly anisotropic) spacing: erosion,
-// dilation and closing by a Euclidean ball (through the exact distance transform), the largest
+// dilation and closing by a Euclidean ball (exact: by the ball's chords within the mask's box, or
+// through the distance transform for a ball over 40 voxels wide along y and z together), the largest
 // connected component and hole filling — the building blocks of the automatic brain mask.
 #pragma once
 

@@ -114,7 +114,7 @@ Grid<std::uint8_t> with_walled_inner(const Grid<std::uint8_t>& mask, const Grid<
     Grid<std::uint8_t> open(mask.lattice(), 0);
     for (PointIndex i = 0; i < open.size(); ++i) open[i] = inner[i] && !mask[i];
     std::size_t count = 0;
-    const std::vector<std::uint32_t> label = label_components(open, 6, &count);
+    const ComponentLabels label = label_components(open, 6, &count);
     std::vector<std::size_t> size(count + 1, 0);
     for (const std::uint32_t k : label) ++size[k];
     size[0] = 0;
