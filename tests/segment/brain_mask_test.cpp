@@ -197,6 +197,28 @@ TEST(BrainMask, HeavyRicianNoiseRaisesTheHeadThresholdToTheAirsNoise) {
     EXPECT_THROW(auto_brain_mask(noisy, without), std::invalid_argument);
 }
 
+// The background threshold is p2 + 10 % (p98 − p2) of the voxels' values, p98 taken among those
+// above p2, each the element at floor(q·(n − 1)) of the sorted values (the selection by a histogram
+// of the values' bits must give exactly that element), on BrainWeb and on its 2 mm version with
+// negative values and ties (an offset, then rounding to integers) and with hardly any tie.
+TEST(BrainMask, BackgroundThresholdIsTheDocumentedPercentileRule) {
+    const Grid<float> t1 = every_other(brainweb().t1);
+    Grid<float> rounded = t1, distinct = t1;
+    for (float& v : rounded.values()) v = std::round(v - 20.0f);
+    for (std::size_t i = 0; i < distinct.size(); ++i) distinct[static_cast<PointIndex>(i)] += static_cast<float>(i % 9973) * 1e-4f;
+    for (const Grid<float>* image : {&brainweb().t1, &t1, static_cast<const Grid<float>*>(&rounded), static_cast<const Grid<float>*>(&distinct)}) {
+        std::vector<float> sorted(image->values().begin(), image->values().end());
+        std::sort(sorted.begin(), sorted.end());
+        const auto at = [](const std::vector<float>& v, double q) { return v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))]; };
+        const double p2 = at(sorted, 0.02);
+        const std::vector<float> above(std::upper_bound(sorted.begin(), sorted.end(), static_cast<float>(p2)), sorted.end());
+        const double p98 = at(above, 0.98);
+        BrainMaskReport r;
+        auto_brain_mask(*image, {}, &r);
+        EXPECT_DOUBLE_EQ(r.background_threshold, p2 + 0.1 * (p98 - p2));
+    }
+}
+
 TEST(BrainMask, BrainWebVariantsAt2mm) {
     const BrainWeb& bw = brainweb();
     const Grid<float> t1 = every_other(bw.t1);

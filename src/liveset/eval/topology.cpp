@@ -43,14 +43,9 @@ struct LabelForest {
     }
 };
 
-// A run of voxels along x in one row: [x0, x1).
-struct Run {
-    int x0, x1;
-};
-
 // Unites every run of `row` with each run of `prev` it touches: overlapping x ranges, widened by
 // `reach` voxels (0: a face neighbour row; 1: an edge or corner neighbour row under 26-connectivity).
-void link_rows(std::span<const Run> row, std::size_t row_first, std::span<const Run> prev, std::size_t prev_first, int reach,
+void link_rows(std::span<const VoxelRun> row, std::size_t row_first, std::span<const VoxelRun> prev, std::size_t prev_first, int reach,
                LabelForest& forest) {
     std::size_t j = 0;
     for (std::size_t i = 0; i < row.size(); ++i) {
@@ -61,71 +56,15 @@ void link_rows(std::span<const Run> row, std::size_t row_first, std::span<const 
     }
 }
 
-// Run-length labelling of the voxels whose foreground-ness equals `foreground`: the runs of each
-// row (x fastest) are united with the touching runs of the rows before it (2 rows for
-// 6-connectivity, 4 for 26), and the sets renumbered in scan order of their first run, whose first
-// voxel is the component's first voxel.
 ComponentLabels label_voxels(const Grid<std::uint8_t>& mask, int connectivity, bool foreground, std::size_t* count) {
-    if (connectivity != 6 && connectivity != 26) {
-        throw std::invalid_argument("label_components: connectivity must be 6 or 26, got " +
-                                    std::to_string(connectivity));
-    }
-    const Lattice& lat = mask.lattice();
-    const Vec3i d = lat.dims();
-    const std::uint8_t* in = mask.values().data();
-    std::vector<Run> runs;
-    std::vector<std::size_t> row_begin(static_cast<std::size_t>(d.y) * static_cast<std::size_t>(d.z) + 1, 0);
-    for (std::size_t r = 0; r + 1 < row_begin.size(); ++r) {
-        const std::uint8_t* row = in + r * static_cast<std::size_t>(d.x);
-        for (int x = 0; x < d.x;) {
-            if ((row[x] != 0) != foreground) {
-                ++x;
-                continue;
-            }
-            const int x0 = x;
-            while (x < d.x && (row[x] != 0) == foreground) ++x;
-            runs.push_back({x0, x});
-        }
-        row_begin[r + 1] = runs.size();
-    }
-    LabelForest forest;  // run k is label k + 1
-    std::vector<std::uint32_t> parent(runs.size() + 1);
-    std::iota(parent.begin(), parent.end(), std::uint32_t{0});
-    forest.parent = std::move(parent);
-    const auto row_runs = [&](int y, int z) {
-        const std::size_t r = static_cast<std::size_t>(z) * static_cast<std::size_t>(d.y) + static_cast<std::size_t>(y);
-        return std::pair{std::span<const Run>(runs.data() + row_begin[r], runs.data() + row_begin[r + 1]), row_begin[r]};
-    };
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y) {
-            const auto [row, first] = row_runs(y, z);
-            if (row.empty()) continue;
-            const auto link = [&](int py, int pz, int reach) {
-                if (py < 0 || py >= d.y || pz < 0) return;
-                const auto [prev, prev_first] = row_runs(py, pz);
-                link_rows(row, first, prev, prev_first, reach, forest);
-            };
-            const int diagonal = connectivity == 26 ? 1 : 0;
-            link(y - 1, z, diagonal);
-            link(y, z - 1, diagonal);
-            if (connectivity == 26) {
-                link(y - 1, z - 1, 1);
-                link(y + 1, z - 1, 1);
-            }
-        }
-
-    std::vector<std::uint32_t> final_label(forest.parent.size(), 0);
-    std::uint32_t next = 0;
+    const RunComponents c = component_runs(mask, connectivity, foreground);
     ComponentLabels labels(mask.size(), 0);
-    for (std::size_t r = 0; r + 1 < row_begin.size(); ++r)
-        for (std::size_t k = row_begin[r]; k < row_begin[r + 1]; ++k) {
-            const std::uint32_t root = forest.find(static_cast<std::uint32_t>(k + 1));
-            if (final_label[root] == 0) final_label[root] = ++next;
-            std::fill(labels.begin() + static_cast<std::ptrdiff_t>(r * static_cast<std::size_t>(d.x) + static_cast<std::size_t>(runs[k].x0)),
-                      labels.begin() + static_cast<std::ptrdiff_t>(r * static_cast<std::size_t>(d.x) + static_cast<std::size_t>(runs[k].x1)),
-                      final_label[root]);
-        }
-    if (count) *count = next;
+    const std::size_t nx = static_cast<std::size_t>(mask.dims().x);
+    for (std::size_t r = 0; r + 1 < c.row_begin.size(); ++r)
+        for (std::size_t k = c.row_begin[r]; k < c.row_begin[r + 1]; ++k)
+            std::fill(labels.begin() + static_cast<std::ptrdiff_t>(r * nx + static_cast<std::size_t>(c.runs[k].x0)),
+                      labels.begin() + static_cast<std::ptrdiff_t>(r * nx + static_cast<std::size_t>(c.runs[k].x1)), c.label[k]);
+    if (count) *count = c.count;
     return labels;
 }
 
@@ -198,28 +137,83 @@ long euler_characteristic(const Grid<std::uint8_t>& mask) {
 
 // Background 6-components that touch no image border face.
 std::size_t count_cavities(const Grid<std::uint8_t>& mask) {
-    std::size_t background = 0;
-    const ComponentLabels labels = label_voxels(mask, 6, false, &background);
-    if (background == 0) return 0;
-    std::vector<std::uint8_t> touches_border(background + 1, 0);
-    const Lattice& lat = mask.lattice();
-    const Vec3i d = lat.dims();
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y) {
-            const bool face = z == 0 || y == 0 || z == d.z - 1 || y == d.y - 1;
-            if (face) {
-                for (int x = 0; x < d.x; ++x) touches_border[labels[lat.index({x, y, z})]] = 1;
-            } else {
-                touches_border[labels[lat.index({0, y, z})]] = 1;
-                touches_border[labels[lat.index({d.x - 1, y, z})]] = 1;
-            }
-        }
-    std::size_t cavities = 0;
-    for (std::size_t l = 1; l <= background; ++l) cavities += touches_border[l] == 0;
-    return cavities;
+    const RunComponents c = component_runs(mask, 6, false);
+    const std::vector<std::uint8_t> touches = border_components(c, mask.dims());
+    return static_cast<std::size_t>(std::count(touches.begin() + 1, touches.end(), std::uint8_t{0}));
 }
 
 }  // namespace
+
+RunComponents component_runs(const Grid<std::uint8_t>& mask, int connectivity, bool foreground) {
+    if (connectivity != 6 && connectivity != 26) {
+        throw std::invalid_argument("label_components: connectivity must be 6 or 26, got " +
+                                    std::to_string(connectivity));
+    }
+    const Vec3i d = mask.dims();
+    const std::uint8_t* in = mask.values().data();
+    RunComponents c;
+    c.row_begin.assign(static_cast<std::size_t>(d.y) * static_cast<std::size_t>(d.z) + 1, 0);
+    for (std::size_t r = 0; r + 1 < c.row_begin.size(); ++r) {
+        const std::uint8_t* row = in + r * static_cast<std::size_t>(d.x);
+        for (int x = 0; x < d.x;) {
+            if ((row[x] != 0) != foreground) {
+                ++x;
+                continue;
+            }
+            const int x0 = x;
+            while (x < d.x && (row[x] != 0) == foreground) ++x;
+            c.runs.push_back({x0, x});
+        }
+        c.row_begin[r + 1] = c.runs.size();
+    }
+    LabelForest forest;  // run k is label k + 1
+    std::vector<std::uint32_t> parent(c.runs.size() + 1);
+    std::iota(parent.begin(), parent.end(), std::uint32_t{0});
+    forest.parent = std::move(parent);
+    const auto row_runs = [&](int y, int z) {
+        const std::size_t r = static_cast<std::size_t>(z) * static_cast<std::size_t>(d.y) + static_cast<std::size_t>(y);
+        return std::pair{std::span<const VoxelRun>(c.runs.data() + c.row_begin[r], c.runs.data() + c.row_begin[r + 1]), c.row_begin[r]};
+    };
+    const int diagonal = connectivity == 26 ? 1 : 0;
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y) {
+            const auto [row, first] = row_runs(y, z);
+            if (row.empty()) continue;
+            const auto link = [&](int py, int pz, int reach) {
+                if (py < 0 || py >= d.y || pz < 0) return;
+                const auto [prev, prev_first] = row_runs(py, pz);
+                link_rows(row, first, prev, prev_first, reach, forest);
+            };
+            link(y - 1, z, diagonal);
+            link(y, z - 1, diagonal);
+            if (connectivity == 26) {
+                link(y - 1, z - 1, 1);
+                link(y + 1, z - 1, 1);
+            }
+        }
+    std::vector<std::uint32_t> final_label(forest.parent.size(), 0);
+    c.label.resize(c.runs.size());
+    std::uint32_t next = 0;
+    for (std::size_t k = 0; k < c.runs.size(); ++k) {  // runs are in scan order
+        const std::uint32_t root = forest.find(static_cast<std::uint32_t>(k + 1));
+        if (final_label[root] == 0) final_label[root] = ++next;
+        c.label[k] = final_label[root];
+    }
+    c.count = next;
+    return c;
+}
+
+std::vector<std::uint8_t> border_components(const RunComponents& c, Vec3i dims) {
+    std::vector<std::uint8_t> touches(c.count + 1, 0);
+    for (int z = 0; z < dims.z; ++z)
+        for (int y = 0; y < dims.y; ++y) {
+            const std::size_t r = static_cast<std::size_t>(z) * static_cast<std::size_t>(dims.y) + static_cast<std::size_t>(y);
+            const bool face = z == 0 || y == 0 || z == dims.z - 1 || y == dims.y - 1;
+            for (std::size_t k = c.row_begin[r]; k < c.row_begin[r + 1]; ++k)
+                if (face || c.runs[k].x0 == 0 || c.runs[k].x1 == dims.x) touches[c.label[k]] = 1;
+        }
+    return touches;
+}
 
 ComponentLabels label_components(const Grid<std::uint8_t>& mask, int connectivity,
                                             std::size_t* count) {
@@ -228,7 +222,7 @@ ComponentLabels label_components(const Grid<std::uint8_t>& mask, int connectivit
 
 Topology mask_topology(const Grid<std::uint8_t>& mask) {
     Topology t;
-    label_voxels(mask, 26, true, &t.components);
+    t.components = component_runs(mask, 26).count;
     t.cavities = count_cavities(mask);
     t.euler_solid = euler_characteristic(mask);
     t.euler = 2 * t.euler_solid;

@@ -17,6 +17,23 @@ namespace liveset {
 // per voxel (linear index): 0 for background, 1..count for foreground, numbered in scan order
 // (x fastest) of each component's first voxel, so the result is deterministic. `count` may be null.
 using ComponentLabels = LargeVector<std::uint32_t>;
+
+// The same components as runs: each row's (x fastest, row r = y + z·dims.y) maximal runs
+// [x0, x1) of voxels whose nonzero-ness equals `foreground`, runs[row_begin[r] .. row_begin[r+1]),
+// in scan order, with their component's label (1..count, numbered as label_components numbers
+// them). For work per component (sizes, selection, fills) without a label per voxel.
+struct VoxelRun {
+    int x0, x1;
+};
+struct RunComponents {
+    std::vector<VoxelRun> runs;
+    std::vector<std::size_t> row_begin;
+    std::vector<std::uint32_t> label;
+    std::size_t count = 0;
+};
+RunComponents component_runs(const Grid<std::uint8_t>& mask, int connectivity, bool foreground = true);
+// Per label (index 0 unused): 1 when one of its runs lies on the lattice's border.
+std::vector<std::uint8_t> border_components(const RunComponents& components, Vec3i dims);
 ComponentLabels label_components(const Grid<std::uint8_t>& mask, int connectivity,
                                             std::size_t* count);
 

@@ -4,6 +4,7 @@
 #include "liveset/segment/tissue_model.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -22,6 +23,7 @@ namespace {
 using Mask = Grid<std::uint8_t>;
 
 constexpr int kBins = 128;
+constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::size_t count(const Mask& m) {
     std::size_t n = 0;
@@ -29,21 +31,34 @@ std::size_t count(const Mask& m) {
     return n;
 }
 
-// q in [0, 1]; reorders `v`, which must not be empty.
-double percentile(std::vector<float>& v, double q) {
-    const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(v.size() - 1));
-    std::nth_element(v.begin(), v.begin() + k, v.end());
-    return v[static_cast<std::size_t>(k)];
-}
-
-// Values of `image` inside `mask` (all voxels when null) that lie above `above`.
-std::vector<float> values_above(const Grid<float>& image, const Mask* mask, double above) {
-    std::vector<float> out;
-    for (std::size_t i = 0; i < image.size(); ++i) {
-        const float v = image[static_cast<PointIndex>(i)];
-        if ((mask == nullptr || (*mask)[static_cast<PointIndex>(i)] != 0) && v > above) out.push_back(v);
-    }
-    return out;
+// The value at fraction q in [0, 1] of the sorted values of `image` inside `mask` (all voxels when
+// null) that lie above `above` — element floor(q·(n − 1)), as std::nth_element places it — or
+// nullopt when there is none. By a histogram of the values' order-preserving bit patterns (their
+// top 16 bits) and a selection among the values of the one bin that holds the element: two passes
+// and no copy of the image.
+std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, double above, double q) {
+    const auto key = [](float v) {
+        const auto u = std::bit_cast<std::uint32_t>(v);
+        return (u & 0x80000000u) != 0 ? ~u : (u | 0x80000000u);
+    };
+    const auto kept = [&](std::size_t i) { return (mask == nullptr || (*mask)[static_cast<PointIndex>(i)] != 0) && image[static_cast<PointIndex>(i)] > above; };
+    std::vector<std::size_t> bins(std::size_t{1} << 16, 0);
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < image.size(); ++i)
+        if (kept(i)) {
+            ++bins[key(image[static_cast<PointIndex>(i)]) >> 16];
+            ++n;
+        }
+    if (n == 0) return std::nullopt;
+    auto k = static_cast<std::size_t>(q * static_cast<double>(n - 1));
+    std::size_t bin = 0;
+    while (k >= bins[bin]) k -= bins[bin++];
+    std::vector<float> in_bin;
+    in_bin.reserve(bins[bin]);
+    for (std::size_t i = 0; i < image.size(); ++i)
+        if (kept(i) && key(image[static_cast<PointIndex>(i)]) >> 16 == bin) in_bin.push_back(image[static_cast<PointIndex>(i)]);
+    std::nth_element(in_bin.begin(), in_bin.begin() + static_cast<std::ptrdiff_t>(k), in_bin.end());
+    return in_bin[k];
 }
 
 // A kBins-bin histogram over [lo, hi] of the image's voxels inside `mask` (values outside the range
@@ -149,20 +164,17 @@ double background_noise(const Grid<float>& image, double floor, double base, dou
 // raised to floor + noise_multiple·σ when the air is noisy enough to cross it (floor: the 0.1st
 // percentile, a constant fill left out; σ: background_noise).
 void thresholds(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport& r) {
-    std::vector<float> all(image.values().begin(), image.values().end());
     double floor = 0.0;
     if (const std::optional<float> fill = constant_fill(image)) {
-        std::vector<float> rest = values_above(image, nullptr, *fill);
-        if (!rest.empty()) floor = percentile(rest, 0.001);
+        floor = quantile_above(image, nullptr, *fill, 0.001).value_or(0.0f);
     } else {
-        floor = percentile(all, 0.001);
+        floor = *quantile_above(image, nullptr, -kInf, 0.001);
     }
-    const double p2 = percentile(all, 0.02);
-    std::vector<float> above = values_above(image, nullptr, p2);
-    if (above.empty()) throw std::invalid_argument("brain mask: no head found (98% of the voxels share the lowest value)");
-    const double p98 = percentile(above, 0.98);
-    r.background_threshold = p2 + o.background_fraction * (p98 - p2);
-    r.background_noise = o.noise_multiple > 0 ? background_noise(image, floor, r.background_threshold, p98, o.noise_min_share) : 0.0;
+    const double p2 = *quantile_above(image, nullptr, -kInf, 0.02);
+    const std::optional<float> p98 = quantile_above(image, nullptr, p2, 0.98);
+    if (!p98) throw std::invalid_argument("brain mask: no head found (98% of the voxels share the lowest value)");
+    r.background_threshold = p2 + o.background_fraction * (*p98 - p2);
+    r.background_noise = o.noise_multiple > 0 ? background_noise(image, floor, r.background_threshold, *p98, o.noise_min_share) : 0.0;
     r.head_threshold = r.background_noise > 0 ? std::max(r.background_threshold, floor + o.noise_multiple * r.background_noise)
                                                : r.background_threshold;
 }
@@ -191,9 +203,9 @@ void white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<fl
     Mask deep(head.lattice());
     for (std::size_t i = 0; i < head.size(); ++i)
         deep[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && depth[static_cast<PointIndex>(i)] >= 0.5f * deepest;
-    std::vector<float> in_head = values_above(image, &head, r.background_threshold);
-    if (in_head.empty()) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
-    const double top = percentile(in_head, 0.995);
+    const std::optional<float> in_head_top = quantile_above(image, &head, r.background_threshold, 0.995);
+    if (!in_head_top) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
+    const double top = *in_head_top;
     if (!(top > r.background_threshold)) throw std::invalid_argument("brain mask: no brain tissue found (the head has no contrast)");
     const Histogram h = histogram(image, deep, r.background_threshold, top);
     const std::vector<double> s = smoothed(h.counts, 2.0);

@@ -224,53 +224,55 @@ Grid<std::uint8_t> close_mm(const Grid<std::uint8_t>& mask, double radius_mm) {
     return out;
 }
 
+namespace {
+
+// Per label (index 0 unused): its voxel count.
+std::vector<std::size_t> component_sizes(const RunComponents& c) {
+    std::vector<std::size_t> sizes(c.count + 1, 0);
+    for (std::size_t k = 0; k < c.runs.size(); ++k) sizes[c.label[k]] += static_cast<std::size_t>(c.runs[k].x1 - c.runs[k].x0);
+    return sizes;
+}
+
+// `out` with the runs whose component `keep` accepts set to 1.
+template <class Keep>
+void paint_runs(const RunComponents& c, Keep keep, Grid<std::uint8_t>& out) {
+    const std::size_t nx = static_cast<std::size_t>(out.dims().x);
+    std::uint8_t* v = out.values().data();
+    for (std::size_t r = 0; r + 1 < c.row_begin.size(); ++r)
+        for (std::size_t k = c.row_begin[r]; k < c.row_begin[r + 1]; ++k)
+            if (keep(c.label[k])) std::fill(v + r * nx + static_cast<std::size_t>(c.runs[k].x0), v + r * nx + static_cast<std::size_t>(c.runs[k].x1), 1);
+}
+
+}  // namespace
+
 Grid<std::uint8_t> largest_component(const Grid<std::uint8_t>& mask) {
-    std::size_t count = 0;
-    const ComponentLabels labels = label_components(mask, 6, &count);
+    const RunComponents c = component_runs(mask, 6);
     Grid<std::uint8_t> out(mask.lattice());
-    if (count == 0) return out;
-    std::vector<std::size_t> sizes(count + 1, 0);
-    for (std::uint32_t l : labels) ++sizes[l];
+    if (c.count == 0) return out;
+    const std::vector<std::size_t> sizes = component_sizes(c);
     std::uint32_t best = 1;
-    for (std::uint32_t l = 2; l <= count; ++l)
+    for (std::uint32_t l = 2; l <= c.count; ++l)
         if (sizes[l] > sizes[best]) best = l;  // labels follow scan order: strict > keeps the first on ties
-    for (std::size_t i = 0; i < out.size(); ++i) out[static_cast<PointIndex>(i)] = labels[i] == best;
+    paint_runs(c, [&](std::uint32_t l) { return l == best; }, out);
     return out;
 }
 
 Grid<std::uint8_t> large_components(const Grid<std::uint8_t>& mask, double fraction) {
     if (!(fraction > 0 && fraction <= 1)) throw std::invalid_argument("large_components: fraction must lie in (0, 1]");
-    std::size_t count = 0;
-    const ComponentLabels labels = label_components(mask, 6, &count);
-    std::vector<std::size_t> sizes(count + 1, 0);
-    for (std::uint32_t l : labels) ++sizes[l];
-    sizes[0] = 0;
-    const double largest = static_cast<double>(*std::max_element(sizes.begin(), sizes.end()));
+    const RunComponents c = component_runs(mask, 6);
     Grid<std::uint8_t> out(mask.lattice());
-    for (std::size_t i = 0; i < out.size(); ++i)
-        out[static_cast<PointIndex>(i)] = labels[i] != 0 && static_cast<double>(sizes[labels[i]]) >= fraction * largest;
+    if (c.count == 0) return out;
+    const std::vector<std::size_t> sizes = component_sizes(c);
+    const double largest = static_cast<double>(*std::max_element(sizes.begin(), sizes.end()));
+    paint_runs(c, [&](std::uint32_t l) { return static_cast<double>(sizes[l]) >= fraction * largest; }, out);
     return out;
 }
 
 Grid<std::uint8_t> fill_holes(const Grid<std::uint8_t>& mask) {
-    const Grid<std::uint8_t> outside = complement(mask);
-    std::size_t count = 0;
-    const ComponentLabels labels = label_components(outside, 6, &count);
-    std::vector<std::uint8_t> open(count + 1, 0);  // outside components that reach the border
-    const Lattice& lat = mask.lattice();
-    const Vec3i d = lat.dims();
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y) {
-            const std::size_t row = lat.index({0, y, z});
-            if (z == 0 || y == 0 || z == d.z - 1 || y == d.y - 1) {
-                for (int x = 0; x < d.x; ++x) open[labels[row + static_cast<std::size_t>(x)]] = 1;
-            } else {
-                open[labels[row]] = 1;
-                open[labels[row + static_cast<std::size_t>(d.x - 1)]] = 1;
-            }
-        }
-    Grid<std::uint8_t> out(lat);
-    for (std::size_t i = 0; i < out.size(); ++i) out[static_cast<PointIndex>(i)] = labels[i] == 0 || !open[labels[i]];
+    const RunComponents outside = component_runs(mask, 6, false);
+    const std::vector<std::uint8_t> open = border_components(outside, mask.dims());  // reach the border
+    Grid<std::uint8_t> out = binarised(mask);
+    paint_runs(outside, [&](std::uint32_t l) { return open[l] == 0; }, out);
     return out;
 }
 
