@@ -43,10 +43,12 @@ bool HoleTool::start(const Session& session, const HoleScanOptions& options) {
     job_sites_ = aimed_;
     job_revision_ = session.revision();
     started_ = std::chrono::steady_clock::now();
-    job_ = std::async(std::launch::async, [image = image_, roi = roi_, mask = std::move(mask), options, before, sites = job_sites_]() mutable {
+    HoleScanOptions o = options;
+    o.roi_is_brain = session.options().model_region_is_brain;  // an automatic brain mask as the ROI: a whole brain
+    job_ = std::async(std::launch::async, [image = image_, roi = roi_, mask = std::move(mask), o, before, sites = job_sites_]() mutable {
         Result r;
         try {
-            r.scan = scan_holes(std::move(mask), *image, roi.get(), options);
+            r.scan = scan_holes(std::move(mask), *image, roi.get(), o);
             if (before && !sites.empty()) {
                 const std::vector<HoleVerdict> v = hole_verdicts(sites, *before, *r.scan, *image, roi.get());
                 for (std::size_t k = 0; k < sites.size(); ++k) r.verdicts.push_back({sites[k], v[k]});

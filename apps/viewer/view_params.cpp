@@ -17,7 +17,8 @@ namespace {
 // inside voxels fall in (as the hole finder picks the sheet's class).
 std::string model_window_for_level_set(const Session& s, ThresholdParams& p, bool& from_seeds) {
     std::vector<std::string> warnings;
-    const std::optional<ModelWindow> w = sheet_window(s.image(), s.mask(), s.roi(), TissueModelOptions{}, warnings);
+    const std::optional<ModelWindow> w = sheet_window(s.image(), s.mask(), s.roi(), TissueModelOptions{}, warnings, nullptr,
+                                                              s.options().model_region_is_brain);
     const IntensityScale& sc = s.scale();
     if (!w) {
         return fmt::format("µ, ε: no usable tissue model ({}); µ {:.4g}, ε {:.4g} (raw) are defaults: set them (panel or --mu-raw/--epsilon-raw)",

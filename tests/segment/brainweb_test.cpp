@@ -196,7 +196,22 @@ TEST(BrainWeb, NoiseThatHidesATissueIsSeenThroughTheBlur) {
     EXPECT_GT(w.upper, gm + 0.25 * (wm - gm));
     EXPECT_LT(w.upper, wm - 0.25 * (wm - gm));
 
+    // The hole finder's band for a grey-matter sheet inside that brain mask given as the ROI: the
+    // grey matter's when the ROI is known to be an automatic brain mask, the merged class's when not.
+    Grid<std::uint8_t> sheet(s.t1.lattice(), 0);
+    for (PointIndex p = 0; p < labels.size(); ++p) sheet[p] = labels[p] == 2;
     std::vector<std::string> ignored;
+    TissueModel sheet_model;
+    const std::optional<ModelWindow> band = sheet_window(loud, sheet, &s.brain, options, ignored, &sheet_model, true);
+    ASSERT_TRUE(band.has_value());
+    EXPECT_EQ(sheet_model.classes.size(), 3u);
+    EXPECT_EQ(band->seed_class, 1);
+    EXPECT_LT(band->upper, wm - 0.25 * (wm - gm));
+    const std::optional<ModelWindow> merged_band = sheet_window(loud, sheet, &s.brain, options, ignored, &sheet_model);
+    ASSERT_TRUE(merged_band.has_value());
+    EXPECT_EQ(sheet_model.classes.size(), 2u);
+    EXPECT_GT(merged_band->upper, wm - 0.25 * (wm - gm));
+
     const std::optional<TissueModel> merged = fit_window_model(loud, s.brain, options, ignored, false);
     ASSERT_TRUE(merged && merged->usable());
     EXPECT_EQ(merged->classes.size(), 2u);

@@ -202,7 +202,7 @@ WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& s
 
 std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                         const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
-                                        std::vector<std::string>& warnings, TissueModel* model) {
+                                        std::vector<std::string>& warnings, TissueModel* model, bool roi_is_brain) {
     if (!(mask.dims() == image.dims()) || (roi && !(roi->dims() == image.dims())))
         throw std::invalid_argument("sheet window: image, mask and ROI differ in size");
     const auto inside = [&](PointIndex i) { return mask[i] && (!roi || (*roi)[i]); };
@@ -214,7 +214,7 @@ std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std
     }
     bool whole_brain = false;
     const Grid<std::uint8_t> region = model_region(image, nullptr, roi, options.classes, &whole_brain);
-    const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings, whole_brain);
+    const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings, whole_brain || (roi && roi_is_brain));
     if (!m || !m->usable()) return std::nullopt;
     if (model) *model = *m;
     // The voxels vote on the image the model was fitted on (blurred when noise hid a tissue).

@@ -66,9 +66,11 @@ std::vector<std::string> window_warnings(const TissueModel& model, double lower,
 // repair rule): the model window (model_window) of the class most of the mask's voxels fall in,
 // from the tissue model fitted in model_region(image, nullptr, roi, classes). nullopt, with the
 // reason in `warnings`, when the model cannot be used or the mask is empty. `model` (optional)
-// receives the fitted model. Throws std::invalid_argument when the sizes differ.
+// receives the fitted model. `roi_is_brain`: the ROI is an automatic brain mask (`--roi auto`), a
+// whole brain to fit_window_model as the mask model_region finds itself without a ROI. Throws
+// std::invalid_argument when the sizes differ.
 std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                         const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
-                                        std::vector<std::string>& warnings, TissueModel* model = nullptr);
+                                        std::vector<std::string>& warnings, TissueModel* model = nullptr, bool roi_is_brain = false);
 
 }  // namespace liveset

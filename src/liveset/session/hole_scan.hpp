@@ -26,6 +26,7 @@ struct HoleScanOptions {
     // The sheet's band [lower, upper) in raw units; both absent: the tissue model's window for the
     // class most of the mask's voxels are in (sheet_window).
     std::optional<double> sheet_lower, sheet_upper;
+    bool roi_is_brain = false;  // the ROI is an automatic brain mask (sheet_window; SessionOptions::model_region_is_brain)
     void validate() const;  // std::invalid_argument with a one-line message
 };
 
