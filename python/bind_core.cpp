@@ -60,7 +60,7 @@ std::optional<cli::Roi> roi_of(const pyb::object& roi, const Grid<float>& image)
         pyb::gil_scoped_release nogil;
         return cli::load_roi("auto", image, "roi");
     }
-    return cli::Roi{mask_from_array(roi.cast<pyb::array>(), image.lattice()), "array", std::nullopt};
+    return cli::Roi{mask_from_array(roi.cast<pyb::array>(), image.lattice()), "array", std::nullopt, nullptr};
 }
 
 struct SegmentArgs {

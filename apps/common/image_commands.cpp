@@ -31,19 +31,20 @@ Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& refere
 
 std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option) {
     if (arg.empty()) return std::nullopt;
-    if (arg != "auto") return Roi{load_mask_like(arg, image.lattice(), option), arg, std::nullopt};
+    if (arg != "auto") return Roi{load_mask_like(arg, image.lattice(), option), arg, std::nullopt, nullptr};
     BrainMaskReport report;
+    auto head = std::make_shared<BrainMaskHead>();
     try {
-        Grid<std::uint8_t> mask = auto_brain_mask(image, {}, &report);
-        return Roi{std::move(mask), arg, report};
+        Grid<std::uint8_t> mask = auto_brain_mask(image, {}, &report, head.get());
+        return Roi{std::move(mask), arg, report, std::move(head)};
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{} auto: {}", option, e.what()));
     }
 }
 
-std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image) {
+std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head) {
     try {
-        return auto_brain_mask(image);
+        return auto_brain_mask(image, {}, nullptr, head);
     } catch (const std::invalid_argument&) {
         return std::nullopt;
     }
@@ -99,23 +100,35 @@ void correct_for(Grid<float>& image, const Grid<std::uint8_t>* fit, BiasCorrecti
 
 }  // namespace
 
-PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt) {
-    PreparedImage out;
-    if (!roi) out.fit_region = try_auto_brain_mask(image);
-    if (mode == BiasCorrection::kOff) return out;
-    correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
-    if (!out.bias || out.bias->interrupted) return out;
-    // The automatic brain mask again, on the corrected image.
+namespace {
+
+// The automatic brain mask (ROI "auto", or the fit region without a ROI) found again on the corrected
+// image, in the head it was first found in (`head`; null: the head is found again too).
+void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMaskHead* head, PreparedImage& out) {
     Grid<std::uint8_t>* automatic = roi ? (roi->brain_mask ? &roi->mask : nullptr) : out.fit_region ? &*out.fit_region : nullptr;
-    if (automatic == nullptr) return out;
+    if (automatic == nullptr) return;
     BrainMaskReport report;
+    BrainMaskHead anew;
     try {
-        *automatic = auto_brain_mask(image, {}, &report);
+        *automatic = auto_brain_mask(image, {}, &report, head ? head : &anew);
     } catch (const std::invalid_argument&) {
-        return out;  // none found there: the first stays
+        return;  // none found there: the first stays
     }
     if (roi) roi->brain_mask = report;
     out.brain_mask_after_n4 = report.mask_voxels;
+}
+
+}  // namespace
+
+PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt) {
+    PreparedImage out;
+    BrainMaskHead fit_head;  // the fit region's head, without a ROI
+    if (!roi) out.fit_region = try_auto_brain_mask(image, &fit_head);
+    if (mode != BiasCorrection::kOff) {
+        correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
+        if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : &fit_head, out);
+    }
+    if (roi) roi->head.reset();  // only needed here
     return out;
 }
 

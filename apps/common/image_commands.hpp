@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <atomic>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -29,13 +30,14 @@ struct Roi {
     Grid<std::uint8_t> mask;
     std::string source;                          // the file, or "auto"
     std::optional<BrainMaskReport> brain_mask;   // what auto_brain_mask found (auto only)
+    std::shared_ptr<BrainMaskHead> head;         // the head it was found in (auto only): prepare_image looks again there
 };
 // `arg` empty: no ROI. "auto": auto_brain_mask(image) (UsageError "<option> auto: ..." when it
 // fails: constant image, no head, empty mask). Otherwise a mask file overlaying the image
 // (load_mask_like); a file named "auto" can be given as ./auto.
 std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option = "--roi");
-// auto_brain_mask(image), or nullopt when the image does not look like a head (no error).
-std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image);
+// auto_brain_mask(image, {}, nullptr, head), or nullopt when the image does not look like a head (no error).
+std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head = nullptr);
 // {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".
 nlohmann::json roi_report(const Roi& roi);
 // One line: "  roi          auto brain mask (...): N voxels, V ml".
@@ -76,7 +78,8 @@ struct PreparedImage {
 // automatic brain mask, else Otsu's foreground. `interrupt`: Ctrl-C (the report then says
 // interrupted and the image is unchanged). Throws std::invalid_argument (kRequired) as correct_bias.
 // An automatic brain mask (`roi` "auto", or the fit region without a ROI) is found again on the
-// corrected image once N4 ran, and replaces the first (kept when none is found there): a strong
+// corrected image once N4 ran, inside the head the first was found in (Roi::head, released here),
+// and replaces the first (kept when none is found there): a strong
 // field drags the first mask's tissue window off (BrainWeb × a ±40 % field: brain mask Dice 0.904,
 // found again 0.943; docs/BENCHMARKS.md, session 56).
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode,

@@ -16,7 +16,7 @@ FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "smooth_mm", "
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
 CHOICES = {"window_from": ("model", "seeds")}
 BOOLS = ("bias_correct",)
-DEFAULTS_EPOCH = 57  # see Subject.fingerprint
+DEFAULTS_EPOCH = 58  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -47,7 +47,8 @@ class Subject:
         # default; 49: the curvature per mm, which changes every scan not at 1 mm; 50: α chosen from
         # the image unless given; 54: noisy scans pre-smoothed unless α is given; 56: the automatic
         # brain mask raised above noisy air (55) and found again after N4; 57: the tissue model fitted
-        # through noise that hides a tissue, the brain looked for within 170 mm of the head's top), so a resumed
+        # through noise that hides a tissue, the brain looked for within 170 mm of the head's top; 58: the
+        # mask after N4 looked for in the head found before it), so a resumed
         # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)

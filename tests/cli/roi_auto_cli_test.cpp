@@ -170,7 +170,7 @@ TEST(RoiAutoCli, WithoutARoiALeakOutOfTheBrainIsWarnedAbout) {
 
 // The analytic head under Rician noise σ 14 (its air a Rayleigh of mode 14): the report gives the
 // air's noise and the head threshold it raised, in the JSON (as the library's report of the
-// corrected image, where the mask is found again) and in the summary line.
+// corrected image, where the mask is found again in the head found first) and in the summary line.
 TEST(RoiAutoCli, NoisyAirIsMeasuredAndReported) {
     Grid<float> head = liveset::testing::analytic_head(false);
     std::mt19937 rng(14);
@@ -179,7 +179,8 @@ TEST(RoiAutoCli, NoisyAirIsMeasuredAndReported) {
     const fs::path image = work_dir() / "noisy_head.nii.gz";
     write_image(head, image.string());
     BrainMaskReport first;
-    auto_brain_mask(read_image(image.string()), {}, &first);
+    BrainMaskHead first_head;
+    auto_brain_mask(read_image(image.string()), {}, &first, &first_head);
     EXPECT_NEAR(first.background_noise, 14.0, 1.0);
     EXPECT_GT(first.head_threshold, first.background_threshold);
     const fs::path corrected = work_dir() / "noisy_corrected.nii.gz";
@@ -188,7 +189,7 @@ TEST(RoiAutoCli, NoisyAirIsMeasuredAndReported) {
     const auto r = run_cli(args + " --json");
     ASSERT_EQ(r.rc, 0) << r.err;
     BrainMaskReport expected;
-    auto_brain_mask(read_image(corrected.string()), {}, &expected);
+    auto_brain_mask(read_image(corrected.string()), {}, &expected, &first_head);
     EXPECT_GT(expected.background_noise, 0.0);
     EXPECT_GT(expected.head_threshold, expected.background_threshold);
     const nlohmann::json j = nlohmann::json::parse(r.out);
@@ -205,8 +206,8 @@ TEST(RoiAutoCli, NoisyAirIsMeasuredAndReported) {
 // A strong bias field drags the first brain mask's tissue window off: BrainWeb times a ramp of
 // 0.63..1.6 along z (a receive coil's) gives a first mask (the library's on the image as read) well off the
 // shipped brain mask. With N4 (the default) the mask is found again on the corrected image: the
-// written ROI is the library's mask of the corrected image, close to the shipped mask, and N4's
-// report counts both masks.
+// written ROI is the library's mask of the corrected image in the head found first, close to the
+// shipped mask, and N4's report counts both masks.
 TEST(RoiAutoCli, AStrongBiasFieldIsCorrectedBeforeTheMaskIsFoundAgain) {
     const fs::path data = fs::path(LIVESET_DATA_DIR) / "brainweb";
     Grid<float> t1 = read_image((data / "t1.mha").string());
@@ -233,8 +234,9 @@ TEST(RoiAutoCli, AStrongBiasFieldIsCorrectedBeforeTheMaskIsFoundAgain) {
         return 2.0 * static_cast<double>(both) / static_cast<double>(a + b);
     };
     BrainMaskReport first_report, again_report;
-    const Grid<std::uint8_t> first = auto_brain_mask(read_image(image.string()), {}, &first_report);
-    const Grid<std::uint8_t> again = auto_brain_mask(read_image(corrected.string()), {}, &again_report);
+    BrainMaskHead head;
+    const Grid<std::uint8_t> first = auto_brain_mask(read_image(image.string()), {}, &first_report, &head);
+    const Grid<std::uint8_t> again = auto_brain_mask(read_image(corrected.string()), {}, &again_report, &head);
     const Grid<std::uint8_t> written = read_label_image(roi.string());
     EXPECT_TRUE(std::equal(written.values().begin(), written.values().end(), again.values().begin()));
     std::printf("brain mask Dice: first %.4f, found again after N4 %.4f\n", dice(first), dice(written));

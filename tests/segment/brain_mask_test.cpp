@@ -230,6 +230,50 @@ TEST(BrainMask, BrainWebVariantsAt2mm) {
     run_variant("strip2mm", make_variant(t1, brain, Variant::kStripped), labels, &brain);
 }
 
+// The head a mask was found in, given back: the same mask on the same image (nothing else is
+// reused); on that image under a ±20 % field, the brain found in the given head is a brain mask as
+// good against the truth as the one found from scratch, and the head's depth is the one that
+// image's own head has; a head of another size is refused.
+TEST(BrainMask, FoundAgainInTheHeadItWasFirstFoundIn) {
+    const BrainWeb& bw = brainweb();
+    const Grid<float> t1 = every_other(bw.t1);
+    const Mask labels = every_other(bw.labels), brain = every_other(bw.brain_mask);
+    BrainMaskHead head;
+    BrainMaskReport first;
+    const Mask plain = auto_brain_mask(t1, {}, &first, &head);
+    ASSERT_TRUE(head.solid.dims() == t1.dims());
+    ASSERT_TRUE(head.depth.dims() == t1.dims());
+    EXPECT_EQ(static_cast<std::size_t>(std::count(head.solid.values().begin(), head.solid.values().end(), 1)),
+              first.head_voxels + first.below_voxels);
+    const BrainMaskHead kept = head;
+    BrainMaskReport again;
+    const Mask same = auto_brain_mask(t1, {}, &again, &head);
+    EXPECT_TRUE(std::equal(plain.values().begin(), plain.values().end(), same.values().begin()));
+    EXPECT_TRUE(std::equal(head.solid.values().begin(), head.solid.values().end(), kept.solid.values().begin()));  // not replaced
+    EXPECT_EQ(again.head_voxels, first.head_voxels);
+
+    const Grid<float> shaded = make_variant(t1, brain, Variant::kBias);
+    BrainMaskHead own;
+    const Mask scratch = auto_brain_mask(shaded, {}, nullptr, &own);
+    const Mask reused = auto_brain_mask(shaded, {}, nullptr, &head);
+    const auto dice = [&](const Mask& m) {
+        std::size_t a = 0, b = 0, both = 0;
+        for (PointIndex i = 0; i < m.size(); ++i) {
+            const bool t = brain_label(labels[i]);
+            a += m[i] != 0, b += t, both += m[i] != 0 && t;
+        }
+        return 2.0 * static_cast<double>(both) / static_cast<double>(a + b);
+    };
+    std::printf("±20 %% field: brain Dice from scratch %.4f, in the first head %.4f\n", dice(scratch), dice(reused));
+    EXPECT_GT(dice(reused), dice(scratch) - 0.002);
+    std::size_t differ = 0;
+    for (PointIndex i = 0; i < own.solid.size(); ++i) differ += own.solid[i] != head.solid[i];
+    EXPECT_LT(static_cast<double>(differ), 0.005 * static_cast<double>(first.head_voxels));
+
+    BrainMaskHead wrong{Mask(Lattice({3, 3, 3})), Grid<float>(Lattice({3, 3, 3}))};
+    EXPECT_THROW(auto_brain_mask(t1, {}, nullptr, &wrong), std::invalid_argument);
+}
+
 TEST(BrainMask, SameMaskWhateverTheThreadCount) {
     const Grid<float> t1 = every_other(brainweb().t1);
     const Mask many = auto_brain_mask(t1);

@@ -327,13 +327,21 @@ void validate(const BrainMaskOptions& o) {
     require(std::isfinite(o.stripped_fraction) && o.stripped_fraction > 0 && o.stripped_fraction <= 1, "stripped_fraction must lie in (0, 1]");
 }
 
-Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport* report) {
+Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport* report, BrainMaskHead* known) {
     validate(o);
     check_image(image);
+    const bool reuse = known != nullptr && known->solid.size() > 0;
+    if (reuse && (!(known->solid.dims() == image.dims()) || !(known->depth.dims() == image.dims())))
+        throw std::invalid_argument("brain mask: the head given is not of the image's size");
     BrainMaskReport r;
     thresholds(image, o, r);
-    const Mask whole_head = fill_holes(close_mm(head_foreground(image, r.head_threshold), o.head_closing_mm));
-    const Grid<float> depth = depth_mm(whole_head);
+    BrainMaskHead found;
+    if (!reuse) {
+        found.solid = fill_holes(close_mm(head_foreground(image, r.head_threshold), o.head_closing_mm));
+        found.depth = depth_mm(found.solid);
+    }
+    const Mask& whole_head = reuse ? known->solid : found.solid;
+    const Grid<float>& depth = reuse ? known->depth : found.depth;
     const Mask head = cranial(whole_head, o.brain_extent_mm, r.below_voxels);
     r.head_voxels = count(head);
     const Grid<float> smooth = gaussian_smooth(image, o.smoothing_mm);
@@ -357,6 +365,7 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     const Vec3d s = image.lattice().spacing();
     r.mask_volume_mm3 = static_cast<double>(r.mask_voxels) * s.x * s.y * s.z;
     if (report != nullptr) *report = r;
+    if (known != nullptr && !reuse) *known = std::move(found);
     return brain;
 }
 

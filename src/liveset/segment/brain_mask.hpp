@@ -81,11 +81,23 @@ struct BrainMaskReport {
     double mask_volume_mm3 = 0;
 };
 
+// The head a brain mask was found in: the solid head (the closed, filled foreground above the head
+// threshold, neck included) and each voxel's depth in it (mm). A smooth multiplicative correction of
+// the intensities (N4) does not move the head's surface against the dark air around it, so the brain
+// can be found again on the corrected image inside the same head (prepare_image, apps/common).
+struct BrainMaskHead {
+    Grid<std::uint8_t> solid;
+    Grid<float> depth;
+};
+
 // The brain mask (0/1) on the image's lattice. Deterministic for any thread count.
+// `head` (optional, in and out): when it holds a head of the image's size, the brain is looked for
+// in that head (the head step is skipped; every threshold is still read off this image); when it is
+// empty, it receives the head found here.
 // Throws std::invalid_argument with a one-line message on bad options, an empty image, non-finite
-// voxels, a constant image, an image with no head (no solid foreground: e.g. pure noise), or when no
-// brain tissue survives the erosion (mask empty).
+// voxels, a constant image, an image with no head (no solid foreground: e.g. pure noise), a given
+// head of another size, or when no brain tissue survives the erosion (mask empty).
 Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& options = {},
-                                   BrainMaskReport* report = nullptr);
+                                   BrainMaskReport* report = nullptr, BrainMaskHead* head = nullptr);
 
 }  // namespace liveset
