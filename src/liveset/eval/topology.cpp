@@ -177,7 +177,9 @@ RunComponents component_runs(const Grid<std::uint8_t>& mask, int connectivity, b
     const int diagonal = connectivity == 26 ? 1 : 0;
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y) {
-            const auto [row, first] = row_runs(y, z);
+            const auto here = row_runs(y, z);  // (runs, index of the first); no structured binding: captured below
+            const std::span<const VoxelRun> row = here.first;
+            const std::size_t first = here.second;
             if (row.empty()) continue;
             const auto link = [&](int py, int pz, int reach) {
                 if (py < 0 || py >= d.y || pz < 0) return;
