@@ -56,17 +56,6 @@ void link_rows(std::span<const VoxelRun> row, std::size_t row_first, std::span<c
     }
 }
 
-ComponentLabels label_voxels(const Grid<std::uint8_t>& mask, int connectivity, bool foreground, std::size_t* count) {
-    const RunComponents c = component_runs(mask, connectivity, foreground);
-    ComponentLabels labels(mask.size(), 0);
-    const std::size_t nx = static_cast<std::size_t>(mask.dims().x);
-    for (std::size_t r = 0; r + 1 < c.row_begin.size(); ++r)
-        for (std::size_t k = c.row_begin[r]; k < c.row_begin[r + 1]; ++k)
-            std::fill(labels.begin() + static_cast<std::ptrdiff_t>(r * nx + static_cast<std::size_t>(c.runs[k].x0)),
-                      labels.begin() + static_cast<std::ptrdiff_t>(r * nx + static_cast<std::size_t>(c.runs[k].x1)), c.label[k]);
-    if (count) *count = c.count;
-    return labels;
-}
 
 // Contribution to V - E + F - C of the cells "owned" by one lattice vertex: the vertex itself, the
 // three edges, three faces and one cube that leave it in the +x/+y/+z directions. A cell belongs to
@@ -219,7 +208,11 @@ std::vector<std::uint8_t> border_components(const RunComponents& c, Vec3i dims) 
 
 ComponentLabels label_components(const Grid<std::uint8_t>& mask, int connectivity,
                                             std::size_t* count) {
-    return label_voxels(mask, connectivity, true, count);
+    const RunComponents c = component_runs(mask, connectivity);
+    ComponentLabels labels(mask.size(), 0);
+    write_runs(c, static_cast<std::size_t>(mask.dims().x), [](std::uint32_t l) { return l; }, std::span<std::uint32_t>(labels));
+    if (count) *count = c.count;
+    return labels;
 }
 
 Topology mask_topology(const Grid<std::uint8_t>& mask) {

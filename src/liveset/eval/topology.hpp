@@ -4,8 +4,10 @@
 // labelling.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
@@ -34,6 +36,16 @@ struct RunComponents {
 RunComponents component_runs(const Grid<std::uint8_t>& mask, int connectivity, bool foreground = true);
 // Per label (index 0 unused): 1 when one of its runs lies on the lattice's border.
 std::vector<std::uint8_t> border_components(const RunComponents& components, Vec3i dims);
+// Writes value(label) over every run of `components` into `out` (a lattice's values, x fastest, rows
+// of `nx`); voxels outside the runs are left as they are.
+template <class T, class Value>
+void write_runs(const RunComponents& components, std::size_t nx, Value value, std::span<T> out) {
+    for (std::size_t r = 0; r + 1 < components.row_begin.size(); ++r)
+        for (std::size_t k = components.row_begin[r]; k < components.row_begin[r + 1]; ++k)
+            std::fill(out.begin() + static_cast<std::ptrdiff_t>(r * nx + static_cast<std::size_t>(components.runs[k].x0)),
+                      out.begin() + static_cast<std::ptrdiff_t>(r * nx + static_cast<std::size_t>(components.runs[k].x1)),
+                      static_cast<T>(value(components.label[k])));
+}
 ComponentLabels label_components(const Grid<std::uint8_t>& mask, int connectivity,
                                             std::size_t* count);
 

@@ -1,4 +1,4 @@
-// Binary morphology in mm through eval's exact separable distance transform (see morphology.hpp).
+// Binary morphology in mm: exact balls by their chords or eval's distance transform, components as runs (see morphology.hpp).
 #include "liveset/segment/morphology.hpp"
 
 #include <tbb/blocked_range.h>
@@ -233,16 +233,6 @@ std::vector<std::size_t> component_sizes(const RunComponents& c) {
     return sizes;
 }
 
-// `out` with the runs whose component `keep` accepts set to 1.
-template <class Keep>
-void paint_runs(const RunComponents& c, Keep keep, Grid<std::uint8_t>& out) {
-    const std::size_t nx = static_cast<std::size_t>(out.dims().x);
-    std::uint8_t* v = out.values().data();
-    for (std::size_t r = 0; r + 1 < c.row_begin.size(); ++r)
-        for (std::size_t k = c.row_begin[r]; k < c.row_begin[r + 1]; ++k)
-            if (keep(c.label[k])) std::fill(v + r * nx + static_cast<std::size_t>(c.runs[k].x0), v + r * nx + static_cast<std::size_t>(c.runs[k].x1), 1);
-}
-
 }  // namespace
 
 Grid<std::uint8_t> largest_component(const Grid<std::uint8_t>& mask) {
@@ -253,7 +243,7 @@ Grid<std::uint8_t> largest_component(const Grid<std::uint8_t>& mask) {
     std::uint32_t best = 1;
     for (std::uint32_t l = 2; l <= c.count; ++l)
         if (sizes[l] > sizes[best]) best = l;  // labels follow scan order: strict > keeps the first on ties
-    paint_runs(c, [&](std::uint32_t l) { return l == best; }, out);
+    write_runs(c, static_cast<std::size_t>(out.dims().x), [&](std::uint32_t l) { return l == best; }, out.values());
     return out;
 }
 
@@ -264,7 +254,8 @@ Grid<std::uint8_t> large_components(const Grid<std::uint8_t>& mask, double fract
     if (c.count == 0) return out;
     const std::vector<std::size_t> sizes = component_sizes(c);
     const double largest = static_cast<double>(*std::max_element(sizes.begin(), sizes.end()));
-    paint_runs(c, [&](std::uint32_t l) { return static_cast<double>(sizes[l]) >= fraction * largest; }, out);
+    write_runs(c, static_cast<std::size_t>(out.dims().x), [&](std::uint32_t l) { return static_cast<double>(sizes[l]) >= fraction * largest; },
+               out.values());
     return out;
 }
 
@@ -272,7 +263,7 @@ Grid<std::uint8_t> fill_holes(const Grid<std::uint8_t>& mask) {
     const RunComponents outside = component_runs(mask, 6, false);
     const std::vector<std::uint8_t> open = border_components(outside, mask.dims());  // reach the border
     Grid<std::uint8_t> out = binarised(mask);
-    paint_runs(outside, [&](std::uint32_t l) { return open[l] == 0; }, out);
+    write_runs(outside, static_cast<std::size_t>(out.dims().x), [&](std::uint32_t l) { return open[l] == 0; }, out.values());  // outside: 0 or filled
     return out;
 }
 
