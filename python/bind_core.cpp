@@ -51,14 +51,14 @@ void write(const pyb::array& values, const Lattice& lattice, const std::string& 
     }
 }
 
-// The ROI as `liveset segment --roi` takes it: None, "auto" (the automatic brain mask) or a mask array.
+// The ROI as `liveset segment --roi` takes it: None (the default: the automatic brain mask on a head,
+// else none), "auto" (the automatic brain mask), "none" or a mask array.
 std::optional<cli::Roi> roi_of(const pyb::object& roi, const Grid<float>& image) {
-    if (roi.is_none()) return std::nullopt;
-    if (pyb::isinstance<pyb::str>(roi)) {
-        const std::string s = roi.cast<std::string>();
-        if (s != "auto") throw std::invalid_argument("roi must be None, 'auto' or a mask array, not '" + s + "'");
+    if (roi.is_none() || pyb::isinstance<pyb::str>(roi)) {
+        const std::string s = roi.is_none() ? std::string() : roi.cast<std::string>();
+        if (s != "auto" && s != "none" && !s.empty()) throw std::invalid_argument("roi must be None, 'auto', 'none' or a mask array, not '" + s + "'");
         pyb::gil_scoped_release nogil;
-        return cli::load_roi("auto", image, "roi");
+        return cli::load_roi(s, image, "roi");
     }
     return cli::Roi{mask_from_array(roi.cast<pyb::array>(), image.lattice()), "array", std::nullopt, nullptr};
 }
@@ -106,10 +106,12 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     cli::PreparedImage prepared;
     std::optional<SegmentOutcome> out;
     const Grid<std::uint8_t>* roi_mask = nullptr;
+    std::vector<std::string> left_out;  // seeds outside the ROI
     {
         pyb::gil_scoped_release nogil;
         prepared = cli::prepare_image(image, roi, mode, &interrupt.flag());
         roi_mask = roi ? &roi->mask : nullptr;
+        left_out = cli::drop_seeds_outside_roi(roi, req.seeds, "roi='none'");
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
         if (roi) req.roi = &roi->mask;
         if (init) req.initial_mask = &*init;
@@ -129,12 +131,13 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     nlohmann::json j = cli::segmentation_report(*out, lattice);
     cli::add_bias_report(j, prepared, roi_mask);
     if (const std::string w = cli::leak_warning(out->mask, prepared.fit(nullptr), "roi='auto'"); !w.empty()) j["warnings"].push_back(w);
+    for (const std::string& w : left_out) j["warnings"].push_back(w);
     if (roi) j["roi"] = cli::roi_report(*roi);
     pyb::dict r;
     r["phi"] = array_from_grid(Grid<float>(out->field->phi()));
     r["mask"] = array_from_grid(std::move(out->mask));
     r["report"] = j.dump();
-    if (roi && pyb::isinstance<pyb::str>(a.roi)) r["roi"] = array_from_grid(Grid<std::uint8_t>(roi->mask));
+    if (roi && roi->source == "auto") r["roi"] = array_from_grid(Grid<std::uint8_t>(roi->mask));
     if (prepared.bias) r["corrected"] = array_from_grid(std::move(image));
     return r;
 }
@@ -173,6 +176,7 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
     std::optional<cli::Roi> roi = roi_of(a.roi, image);
     pyb::gil_scoped_release nogil;
     const cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct));  // as segment
+    const std::vector<std::string> left_out = cli::drop_seeds_outside_roi(roi, req.seeds, "roi='none'");
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
     const IntensityScale scale = robust_scale(image, roi_mask, req.scale);
@@ -189,6 +193,7 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
                        {"epsilon_raw", scale.raw_length(w.epsilon)}, {"lower_raw", scale.to_raw(w.mu - w.epsilon)},
                        {"upper_raw", scale.to_raw(w.mu + w.epsilon)}, {"source", to_string(w.source)}};
         for (const std::string& s : w.warnings) warnings.push_back(s);
+        for (const std::string& s : left_out) warnings.push_back(s);
         if (model) j["tissue_model"] = cli::tissue_model_report(*model, w.model_window ? &*w.model_window : nullptr);
     } else if (model) {
         j["tissue_model"] = cli::tissue_model_report(*model, nullptr);

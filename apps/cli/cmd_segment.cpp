@@ -47,7 +47,7 @@ void check_segment_args(const SegmentArgs& a) {
     if (!a.out_mesh.empty()) check_output_path(a.out_mesh, OutputKind::kMesh, "--out-mesh");
     if (!a.log.empty()) check_output_path(a.log, OutputKind::kText, "--log");
     if (!a.out_roi.empty()) check_output_path(a.out_roi, OutputKind::kImage, "--out-roi");
-    if (!a.out_roi.empty() && a.roi.empty()) throw UsageError("--out-roi needs --roi (a mask or auto)");
+    if (!a.out_roi.empty() && a.roi == "none") throw UsageError("--out-roi needs a ROI (a mask, auto, or the default on a head), not --roi none");
     if (!a.out_corrected.empty() && !a.bias_correct) throw UsageError("--out-corrected needs the bias correction (drop --no-bias-correct)");
     if (!a.out_corrected.empty()) check_output_path(a.out_corrected, OutputKind::kImage, "--out-corrected");
     check_threshold_args(a);
@@ -56,16 +56,20 @@ void check_segment_args(const SegmentArgs& a) {
 }
 
 // The segmentation request the options describe (seeds parsed and checked inside the image).
-SegmentRequest segment_request(const SegmentArgs& a, const Lattice& lattice, const std::optional<Roi>& roi,
-                               const std::optional<Grid<std::uint8_t>>& init, const Grid<std::uint8_t>* fit, bool fit_is_brain) {
+SegmentRequest segment_request(const SegmentArgs& a, const Lattice& lattice) {
     SegmentRequest req;
     fill_segment_request(req, a, lattice);
     req.loop.step = step_options(a);
+    return req;
+}
+
+// The request's regions: the ROI, the initial mask and where the tissue model is fitted.
+void add_regions(SegmentRequest& req, const std::optional<Roi>& roi, const std::optional<Grid<std::uint8_t>>& init,
+                 const Grid<std::uint8_t>* fit, bool fit_is_brain) {
     if (roi) req.roi = &roi->mask;
     if (init) req.initial_mask = &*init;
     req.model_region = fit;
     req.model_region_is_brain = fit_is_brain;
-    return req;
 }
 
 // The report: the segmentation's, the bias correction's, the ROI and what was written.
@@ -94,6 +98,8 @@ int run_segment(const SegmentArgs& a, int threads) {
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> init;
     std::optional<Roi> roi = load_roi(a.roi, image);
+    if (!a.out_roi.empty() && !roi) throw UsageError("--out-roi: no ROI to write (the image does not look like a head: give --roi MASK)");
+    SegmentRequest req = segment_request(a, image.lattice());
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.
     const BiasCorrection mode = bias_mode(a.bias_correct, a.bias_given || !a.out_corrected.empty());
@@ -105,8 +111,11 @@ int run_segment(const SegmentArgs& a, int threads) {
     }
     if (!prepared.bias_skipped.empty() && !a.quiet) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
+    const std::vector<std::string> left_out = drop_seeds_outside_roi(roi, req.seeds, "--roi none");
+    if (!a.quiet)
+        for (const std::string& w : left_out) fmt::print(stderr, "liveset: warning: {}\n", w);
 
-    const SegmentRequest req = segment_request(a, image.lattice(), roi, init, fit, prepared.fit_is_brain(roi));
+    add_regions(req, roi, init, fit, prepared.fit_is_brain(roi));
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} iterations; nothing written\n", run.outcome.result.iterations);
@@ -125,6 +134,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     }
 
     nlohmann::json j = segment_report(a, o, image.lattice(), roi, prepared, triangles);
+    for (const std::string& w : left_out) j["warnings"].push_back(w);
     // The default limit reached before convergence: the mask is a front still moving (a grid whose
     // fine voxels keep the time step small, docs/BENCHMARKS.md session 49, or a very large image).
     if (o.result.reason == StopReason::kIterationLimit && !a.iterations_given) {
@@ -202,7 +212,8 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     seg->add_option("--seed-mm", sa.seeds_mm, "seed X,Y,Z[:R] in physical LPS mm (radius in mm); repeatable");
     seg->add_option("--seed-radius", sa.seed_radius, "default seed radius")->check(finite_number() & CLI::Range(0.5, 100.0))->capture_default_str();
     seg->add_option("--init-mask", sa.init_mask, "start from this mask instead of seeds (needs --mu/--epsilon)");
-    seg->add_option("--roi", sa.roi, "region-of-interest mask the front may not leave (e.g. a brain mask), or 'auto': a brain mask computed from the T1");
+    seg->add_option("--roi", sa.roi, "region-of-interest mask the front may not leave (e.g. a brain mask); 'auto': a brain mask computed from the T1; "
+                    "'none': the whole image. Default: the automatic brain mask when the image is a head, else none");
     add_threshold_options(*seg, sa);  // --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
     seg->add_option("--window-from", sa.window_from, "estimate the window from the tissue model of the image (the seeds pick the class) or from the seeds' statistics")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     seg->add_option("--classes", sa.classes, "tissue classes of the model (T1 brain: CSF, GM, WM)")->check(CLI::Range(2, 6))->capture_default_str();

@@ -30,16 +30,66 @@ Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& refere
 }
 
 std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option) {
-    if (arg.empty()) return std::nullopt;
-    if (arg != "auto") return Roi{load_mask_like(arg, image.lattice(), option), arg, std::nullopt, nullptr};
+    if (arg == "none") return std::nullopt;
+    if (!arg.empty() && arg != "auto") return Roi{load_mask_like(arg, image.lattice(), option), arg, std::nullopt, nullptr};
     BrainMaskReport report;
     auto head = std::make_shared<BrainMaskHead>();
     try {
         Grid<std::uint8_t> mask = auto_brain_mask(image, {}, &report, head.get());
-        return Roi{std::move(mask), arg, report, std::move(head)};
+        // By default only a full head: a skull-stripped brain (or a phantom) has no scalp to leak into.
+        if (arg.empty() && report.skull_stripped) return std::nullopt;
+        return Roi{std::move(mask), "auto", report, std::move(head), arg.empty()};
     } catch (const std::invalid_argument& e) {
+        if (arg.empty()) return std::nullopt;  // not a head: the default is no ROI
         throw UsageError(fmt::format("{} auto: {}", option, e.what()));
     }
+}
+
+namespace {
+
+// Whether a voxel of the seed's ball (as seed_values reads it: within max(radius, 0.5) of the
+// centre, index space) lies in `mask`.
+bool ball_touches(const Grid<std::uint8_t>& mask, const SeedBall& s) {
+    const Vec3i d = mask.dims();
+    const double r = std::max(s.radius, 0.5);
+    Vec3i lo, hi;
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = std::max(0, static_cast<int>(std::floor(s.center[a] - r)));
+        hi[a] = std::min(d[a] - 1, static_cast<int>(std::ceil(s.center[a] + r)));
+    }
+    for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x)
+                if (mask({x, y, z}) != 0 && norm(Vec3d{double(x), double(y), double(z)} - s.center) <= r) return true;
+    return false;
+}
+
+}  // namespace
+
+std::vector<std::string> drop_seeds_outside_roi(const std::optional<Roi>& roi, std::vector<SeedBall>& seeds, std::string_view none_hint) {
+    std::vector<std::string> warnings;
+    if (!roi || seeds.empty()) return warnings;
+    const std::string what = roi->by_default ? "the automatic brain mask (the default ROI of a head)"
+                             : roi->brain_mask ? "the automatic brain mask (--roi auto)"
+                                               : "the ROI " + roi->source;
+    const std::string hint = roi->by_default ? fmt::format("; pass {} to segment outside the brain", none_hint) : std::string();
+    std::vector<Vec3i> outside;
+    std::vector<SeedBall> kept;
+    for (const SeedBall& s : seeds) {
+        if (ball_touches(roi->mask, s)) {
+            kept.push_back(s);
+            continue;
+        }
+        outside.push_back({static_cast<int>(std::lround(s.center.x)), static_cast<int>(std::lround(s.center.y)),
+                           static_cast<int>(std::lround(s.center.z))});
+    }
+    if (kept.empty())
+        throw UsageError(fmt::format("every seed lies outside {}, the first at ({}, {}, {}){}", what, outside[0].x, outside[0].y,
+                                     outside[0].z, hint));
+    for (const Vec3i& c : outside)
+        warnings.push_back(fmt::format("the seed at ({}, {}, {}) lies outside {}: it is left out{}", c.x, c.y, c.z, what, hint));
+    seeds = std::move(kept);
+    return warnings;
 }
 
 std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head) {
@@ -168,7 +218,8 @@ nlohmann::json roi_report(const Roi& roi) {
     const Vec3d s = roi.mask.lattice().spacing();
     std::size_t voxels = 0;
     for (std::uint8_t v : roi.mask.values()) voxels += v != 0;
-    nlohmann::json j{{"source", roi.source}, {"voxels", voxels}, {"volume_mm3", static_cast<double>(voxels) * s.x * s.y * s.z}};
+    nlohmann::json j{{"source", roi.source}, {"voxels", voxels}, {"volume_mm3", static_cast<double>(voxels) * s.x * s.y * s.z},
+                     {"default", roi.by_default}};
     if (const auto& b = roi.brain_mask)
         j["auto"] = {{"skull_stripped", b->skull_stripped}, {"background_threshold", b->background_threshold},
                      {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold},
@@ -191,7 +242,9 @@ std::string brain_mask_summary(const BrainMaskReport& b) {
 
 void print_roi_summary(const Roi& roi) {
     const nlohmann::json j = roi_report(roi);
-    const std::string how = roi.brain_mask ? "auto brain mask (" + brain_mask_summary(*roi.brain_mask) + ")" : roi.source;
+    const std::string how = roi.brain_mask ? fmt::format("auto brain mask{} ({})", roi.by_default ? " by default, --roi none for the whole image" : "",
+                                                         brain_mask_summary(*roi.brain_mask))
+                                           : roi.source;
     fmt::print("  roi          {}: {} voxels, {:.1f} ml\n", how, j["voxels"].get<std::size_t>(), j["volume_mm3"].get<double>() / 1000.0);
 }
 

@@ -25,17 +25,29 @@ namespace liveset::cli {
 // and direction within tolerance); UsageError naming `option` otherwise. Non-zero -> 1.
 Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& reference, const std::string& option);
 
-// A region of interest given as `--roi MASK` or `--roi auto` (the automatic brain mask of the image).
+// A region of interest given as `--roi MASK` or `--roi auto` (the automatic brain mask of the image),
+// or the automatic brain mask chosen by default (no `--roi`, the image a head).
 struct Roi {
     Grid<std::uint8_t> mask;
     std::string source;                          // the file, or "auto"
     std::optional<BrainMaskReport> brain_mask;   // what auto_brain_mask found (auto only)
     std::shared_ptr<BrainMaskHead> head;         // the head it was found in (auto only): prepare_image looks again there
+    bool by_default = false;                     // "auto" chosen by default, not asked for
 };
-// `arg` empty: no ROI. "auto": auto_brain_mask(image) (UsageError "<option> auto: ..." when it
+// `arg` empty, the default: the automatic brain mask when the image is a full head (Roi::by_default),
+// else no ROI (a skull-stripped brain has no scalp, muscle or eyes to leak into). "none": no ROI. "auto": auto_brain_mask(image) (UsageError "<option> auto: ..." when it
 // fails: constant image, no head, empty mask). Otherwise a mask file overlaying the image
-// (load_mask_like); a file named "auto" can be given as ./auto.
+// (load_mask_like); files named "auto" or "none" can be given as ./auto, ./none.
 std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option = "--roi");
+// What a seed refused by a ROI chosen by default is told (after the session's own message).
+inline constexpr const char* kDefaultRoiHint =
+    ": the automatic brain mask bounds the front by default on a head; open the image with --roi none to segment outside the brain";
+// Removes the seeds whose whole ball lies outside the ROI (no voxel of it in the mask; a seed astride
+// its edge is clipped, as ever) and returns one warning each ("the seed at (i, j, k) lies outside <the
+// ROI>: it is left out"); a UsageError, changing nothing, when every seed does. With a ROI chosen by default both add "; pass
+// <none_hint> to segment outside the brain". Called with the ROI the segmentation uses (after
+// prepare_image found it again).
+std::vector<std::string> drop_seeds_outside_roi(const std::optional<Roi>& roi, std::vector<SeedBall>& seeds, std::string_view none_hint);
 // auto_brain_mask(image, {}, nullptr, head), or nullopt when the image does not look like a head (no error).
 std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head = nullptr);
 // {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".

@@ -41,6 +41,7 @@ struct ViewArgs : ThresholdArgs {
     std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
     std::string workspace_warning;      // the workspace was refused, or its ROI is not the one it was saved with
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
+    bool roi_by_default = false;        // set by load_session: no --roi, and the automatic brain mask found
 };
 
 void parse_size(const std::string& text, int& w, int& h) {
@@ -73,7 +74,11 @@ SessionOptions session_options(const ViewArgs& a) {
 
 std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
-    std::optional<Roi> r = load_roi(a.roi, image, "--roi");  // a mask file, or "auto" as `segment --roi auto`
+    std::optional<Roi> r = load_roi(a.roi, image, "--roi");  // a mask file, "auto", "none" or the default, as `segment`
+    if (a.roi.empty()) {  // the default's choice, kept as such (workspaces, a second load)
+        a.roi_by_default = r.has_value();
+        a.roi = r ? "auto" : "none";
+    }
     // N4 first, as `segment`: skipped with a warning where it cannot run, unless asked for (or a
     // continued workspace's image was corrected: then it must be again).
     const BiasCorrection mode = bias_mode(a.workspace_bias.value_or(a.bias_correct), a.bias_given || a.workspace_bias);
@@ -85,7 +90,9 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     }
     if (!prepared.bias_skipped.empty()) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
     if (r && r->brain_mask)
-        fmt::print(stderr, "liveset: note: --roi auto: brain mask of {} voxels ({})\n", r->brain_mask->mask_voxels, brain_mask_summary(*r->brain_mask));
+        fmt::print(stderr, "liveset: note: {}: brain mask of {} voxels ({})\n",
+                   a.roi_by_default ? "the front stays in the automatic brain mask by default (--roi none: the whole image)" : "--roi auto",
+                   r->brain_mask->mask_voxels, brain_mask_summary(*r->brain_mask));
     SessionOptions so = session_options(a);
     so.model_region_is_brain = prepared.fit_is_brain(r);
     std::optional<Grid<std::uint8_t>> roi;
@@ -121,7 +128,7 @@ void load_inputs(Session& s, const ViewArgs& a) {
         try {
             s.add_seed(b);
         } catch (const std::invalid_argument& e) {
-            throw UsageError(fmt::format("seed {}: {}", given_as, e.what()));
+            throw UsageError(fmt::format("seed {}: {}{}", given_as, e.what(), a.roi_by_default ? kDefaultRoiHint : ""));
         }
     }
     s.end_action();
@@ -215,6 +222,7 @@ int run_view(ViewArgs& a, int threads) {
     config.session = session_options(a);  // images opened from the panel start as the command line's
     config.image_path = a.image;
     config.roi_path = a.roi;
+    config.roi_by_default = a.roi_by_default;
     config.bias_correct = a.bias_correct;
     config.image_corrected = a.image_corrected;
     config.params_note = note;

@@ -388,7 +388,7 @@ bool Viewer::add_seed(Vec3d index, double radius) {
     try {
         account(session_->add_seed({index, radius}));
     } catch (const std::invalid_argument& e) {
-        return fail(e.what());
+        return fail(std::string(e.what()) + (config_.roi_by_default && session_->roi() ? cli::kDefaultRoiHint : ""));
     }
     message_ = fmt::format("seed {} at ({:.0f}, {:.0f}, {:.0f})", session_->seeds().size(), index.x, index.y, index.z);
     message_is_error_ = false;

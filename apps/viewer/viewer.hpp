@@ -86,7 +86,8 @@ struct ViewerConfig {
     FrameBudgetOptions budget;  // steps per frame, redraw pacing and level of detail
     std::string image_path;  // the session's image as given (the key of its recovery file)
     AutosaveConfig autosave;  // recovery files (dir empty: none)
-    std::string roi_path;     // the session's ROI as given (saved in workspaces)
+    std::string roi_path;     // the session's ROI as given, or as the default chose it: "auto" or "none" (saved in workspaces)
+    bool roi_by_default = false;  // the automatic brain mask bounds the front by default (a seed outside: say --roi none)
     // N4 first for images opened from the panel (as `view` and `segment` by default; skipped with a
     // message where it cannot run), and whether the session's image is N4-corrected (saved in
     // workspaces: a continued workspace corrects its image again, or not).

@@ -22,6 +22,7 @@ constexpr int kOpenPollMs = 40;  // a frame waits this long for the worker (the 
 struct Viewer::Opened {
     std::unique_ptr<Session> session;
     bool corrected = false;    // N4 ran
+    bool brain_roi = false;    // the automatic brain mask bounds the front (the default on a head)
     std::string bias_skipped;  // the default correction's warning, when it did not run
     std::string error;         // the image could not be opened
 };
@@ -46,15 +47,19 @@ bool Viewer::open_image(const std::string& path) {
             auto out = std::make_shared<Opened>();
             Grid<float> image = read_image(path);
             if (cancel->load()) return out;
-            std::optional<cli::Roi> no_roi;
-            cli::PreparedImage prepared = cli::prepare_image(image, no_roi, mode, cancel.get());
+            std::optional<cli::Roi> roi = cli::load_roi("", image);  // the default, as `segment` (view_command.cpp)
+            if (cancel->load()) return out;
+            cli::PreparedImage prepared = cli::prepare_image(image, roi, mode, cancel.get());
             if (cancel->load()) return out;
             out->corrected = prepared.bias.has_value();
             out->bias_skipped = prepared.bias_skipped;
+            out->brain_roi = roi.has_value();
             SessionOptions with_region = options;
-            with_region.model_region_is_brain = prepared.fit_is_brain(no_roi);
-            with_region.model_region = std::move(prepared.fit_region);  // as `segment` (view_command.cpp)
-            out->session = std::make_unique<Session>(std::move(image), with_region);
+            with_region.model_region_is_brain = prepared.fit_is_brain(roi);
+            with_region.model_region = std::move(prepared.fit_region);
+            std::optional<Grid<std::uint8_t>> roi_mask;
+            if (roi) roi_mask = std::move(roi->mask);
+            out->session = std::make_unique<Session>(std::move(image), with_region, std::move(roi_mask));
             return out;
         } catch (const std::exception& e) {
             return failed(e.what());
@@ -111,13 +116,15 @@ void Viewer::poll_open(bool wait) {
     report_autosave();
     session_ = std::move(opened->session);
     image_path_ = path;
-    config_.roi_path.clear();  // an image opened here has no ROI
+    config_.roi_path = opened->brain_roi ? "auto" : "none";  // the default's choice
+    config_.roi_by_default = opened->brain_roi;
     config_.image_corrected = opened->corrected;
     image_name_ = std::filesystem::path(path).filename().string();
     attach_session();
-    message_ = "opened " + path + (opened->bias_skipped.empty() ? "" : " (" + opened->bias_skipped + ")");
+    message_ = "opened " + path + (opened->brain_roi ? ", the front bounded by the automatic brain mask" : "") +
+               (opened->bias_skipped.empty() ? "" : " (" + opened->bias_skipped + ")");
     message_is_error_ = false;
-    log_.add("open", {{"path", path}, {"bias_corrected", opened->corrected}});
+    log_.add("open", {{"path", path}, {"bias_corrected", opened->corrected}, {"roi", config_.roi_path}});
 }
 
 }  // namespace liveset::viewer

@@ -162,6 +162,7 @@ Workspace parse_workspace(const json& j) {
     Workspace ws;
     ws.image = field(j, "image").get<std::string>();
     ws.roi = field(j, "roi").get<std::string>();
+    if (ws.roi.empty()) ws.roi = "none";  // older workspaces saved "" without a ROI (now the default: auto on a head)
     if (j.contains("bias_corrected")) {
         if (!j["bias_corrected"].is_boolean()) throw std::runtime_error("field 'bias_corrected' is not true or false");
         ws.bias_corrected = j["bias_corrected"].get<bool>();
@@ -255,7 +256,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
     for (const SeedBall& s : m.seeds) seeds.push_back({s.center.x, s.center.y, s.center.z, s.radius});
     json j{{"liveset_workspace", kWorkspaceVersion},
            {"image", image.empty() ? std::string() : fs::absolute(image).string()},
-           {"roi", roi.empty() || roi == "auto" ? roi : fs::absolute(roi).string()},  // "auto": computed again on reading
+           {"roi", roi.empty() || roi == "auto" || roi == "none" ? roi : fs::absolute(roi).string()},  // "auto": computed again on reading
            {"bias_corrected", bias_corrected},
            {"geometry", {{"dims", {l.dims().x, l.dims().y, l.dims().z}}, {"spacing", vec(l.spacing())}, {"origin", vec(l.origin())},
                          {"direction", l.direction()}}},

@@ -27,7 +27,7 @@ struct WorkspaceView {
 };
 
 struct Workspace {
-    std::string image, roi;          // absolute paths (roi empty: none; "auto": the automatic brain mask, computed again)
+    std::string image, roi;          // absolute paths (roi "none" or, in older files, empty: none; "auto": the automatic brain mask, computed again)
     bool bias_corrected = false;     // the session's image was the N4-corrected one (absent in older files: no)
     Lattice lattice;                 // the image's geometry when saved
     std::uint64_t image_checksum = 0;  // image_checksum() of its voxels

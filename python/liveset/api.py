@@ -73,8 +73,10 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
     image: a liveset.Image, a nibabel image or (array, RAS affine).
     seeds: voxel indices ``(i, j, k)``, ``(i, j, k, radius)`` or the CLI's ``"I,J,K[:R]"``
         strings (0-based, radius in voxels); seeds_mm: LPS mm ``"X,Y,Z[:R]"`` (radius in mm).
-    roi: None, ``"auto"`` (the automatic brain mask) or a mask (Image/nibabel/array) the front
-        may not leave. init_mask: start from this region instead of seeds.
+    roi: None (the default: the automatic brain mask when the image is a head, else none; a seed
+        outside it is a ValueError naming ``roi="none"``), ``"auto"`` (the automatic brain mask,
+        an error when none is found), ``"none"`` (the whole image) or a mask (Image/nibabel/array)
+        the front may not leave. init_mask: start from this region instead of seeds.
     mu/epsilon: the window in normalised units, or mu_raw/epsilon_raw in the image's own; by
         default the tissue model's window for the seeds' class (``window_from="seeds"``: their
         statistics). n, alpha, iterations, classes: as the CLI (alpha None: chosen
@@ -108,9 +110,9 @@ def _mask_arg(mask, img: Image, what: str, allow_auto: bool = False):
     if mask is None:
         return None
     if isinstance(mask, str):
-        if allow_auto and mask == "auto":
+        if allow_auto and mask in ("auto", "none"):
             return mask
-        raise ValueError(f"{what} must be {'auto, ' if allow_auto else ''}a mask image or array, not {mask!r}")
+        raise ValueError(f"{what} must be {'auto, none, ' if allow_auto else ''}a mask image or array, not {mask!r}")
     if isinstance(mask, np.ndarray):
         arr = mask
     else:

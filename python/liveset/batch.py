@@ -57,7 +57,7 @@ def process_subject(s: Subject, out: str, fingerprint: str, threads: int = 0, wr
         os.makedirs(tmp)
         liveset.set_threads(threads)
         image = liveset.read(s.image)
-        roi = s.roi if s.roi in (None, "auto") else liveset.read(s.roi, labels=True)
+        roi = s.roi if s.roi in (None, "auto", "none") else liveset.read(s.roi, labels=True)
         init = None if not s.init_mask else liveset.read(s.init_mask, labels=True)
         seg = liveset.segment(image, s.seeds, seeds_mm=s.seeds_mm, roi=roi, init_mask=init, **s.options)
         report = {"status": "ok", "subject": s.subject, "fingerprint": fingerprint, "image": s.image,

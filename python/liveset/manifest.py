@@ -16,7 +16,7 @@ FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "smooth_mm", "
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
 CHOICES = {"window_from": ("model", "seeds")}
 BOOLS = ("bias_correct",)
-DEFAULTS_EPOCH = 58  # see Subject.fingerprint
+DEFAULTS_EPOCH = 59  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -33,7 +33,7 @@ class Subject:
     image: str
     seeds: list                   # ["I,J,K[:R]", ...] as the CLI's --seed
     seeds_mm: list = field(default_factory=list)
-    roi: str | None = None        # a file, "auto" or None
+    roi: str | None = None        # a file, "auto", "none" or None (the default: auto on a head)
     truth: str | None = None
     label: int | None = None
     init_mask: str | None = None
@@ -41,14 +41,15 @@ class Subject:
 
     def fingerprint(self) -> str:
         """Changes when anything that affects the outputs changes (inputs' paths, sizes, times, options)."""
-        files = [p for p in (self.image, self.roi, self.truth, self.init_mask) if p and p != "auto"]
+        files = [p for p in (self.image, self.roi, self.truth, self.init_mask) if p and p not in ("auto", "none")]
         stats = [(p, os.stat(p).st_size, os.stat(p).st_mtime_ns) for p in files]
         # DEFAULTS_EPOCH: bumped when a default that changes the outputs changes (session 48: N4 by
         # default; 49: the curvature per mm, which changes every scan not at 1 mm; 50: α chosen from
         # the image unless given; 54: noisy scans pre-smoothed unless α is given; 56: the automatic
         # brain mask raised above noisy air (55) and found again after N4; 57: the tissue model fitted
         # through noise that hides a tissue, the brain looked for within 170 mm of the head's top; 58: the
-        # mask after N4 looked for in the head found before it), so a resumed
+        # mask after N4 looked for in the head found before it; 59: the automatic brain mask the
+        # default ROI of a head), so a resumed
         # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)
@@ -122,8 +123,8 @@ def _subject(row: dict, line: int, base: str, where: str) -> Subject:
         s.seeds_mm = parse_seeds(row["seeds_mm"], where)
     for column in FILES:
         value = row.get(column) or ""
-        if value == "auto" and column == "roi":
-            s.roi = "auto"
+        if value in ("auto", "none") and column == "roi":
+            s.roi = value
         elif value:
             setattr(s, column, _path(value, base, where, column))
     for column, value in row.items():

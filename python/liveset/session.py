@@ -31,8 +31,9 @@ class Session:
     (ValueError where it cannot run); False takes the image as given (pass False for an image that
     is already corrected, e.g. ``segment(...).corrected``). Without a ROI the tissue model is
     fitted in the automatic brain mask (found again on the corrected image), as ``segment`` fits it, so the same seeds give
-    ``segment``'s mask. ``roi``: None, a mask (Image, nibabel image or array) the front may not
-    leave, or ``"auto"``: the automatic brain mask, as ``segment(roi="auto")``. ``image`` is the
+    ``segment``'s mask. ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
+    a head, else none), ``"auto"``, ``"none"`` or a mask (Image, nibabel image or array) the front
+    may not leave. ``image`` is the
     image the session works on (the corrected one when N4 ran), ``corrected`` True when N4 ran,
     ``roi`` the ROI as an Image (None without one), ``report`` the ``bias_correction`` (or
     ``warnings``) and ``roi`` entries of ``segment``'s report.
@@ -71,7 +72,13 @@ class Session:
     # seeds and parameters
     def add_seed(self, ijk: Sequence[float], radius: float = 2.0) -> None:
         """Add a seed ball (undoable); the window follows the seeds unless set_params fixed it."""
-        self._s.add_seed([float(v) for v in ijk], float(radius))
+        try:
+            self._s.add_seed([float(v) for v in ijk], float(radius))
+        except ValueError as e:
+            if self.report.get("roi", {}).get("default"):
+                raise ValueError(f"{e}: the automatic brain mask bounds the front by default on a head; "
+                                 "pass roi='none' to segment outside the brain") from None
+            raise
 
     def remove_seed(self, index: int) -> None:
         self._s.remove_seed(int(index))

@@ -324,20 +324,27 @@ def _bridged_head():
 def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
     img = _bridged_head()
     kw = dict(mu_raw=130, epsilon_raw=40, iterations=400, bias_correct=False)
-    leaked = liveset.segment(img, [(32, 32, 32, 3)], **kw)
+    leaked = liveset.segment(img, [(32, 32, 32, 3)], roi="none", **kw)
     warned = [w for w in leaked.report["warnings"] if "outside the automatic brain mask" in w]
-    assert len(warned) == 1 and "roi='auto'" in warned[0]
+    assert len(warned) == 1 and "roi='auto'" in warned[0] and "roi" not in leaked.report
     inside = liveset.segment(img, [(32, 32, 32, 3)], roi="auto", **kw)
     assert not any("outside the automatic brain mask" in w for w in inside.report["warnings"])
     assert int(inside.mask.array.sum()) < int(leaked.mask.array.sum())
+    # The default on a full head is the automatic brain mask: roi="auto"'s voxels, marked as the default.
+    by_default = liveset.segment(img, [(32, 32, 32, 3)], **kw)
+    assert np.array_equal(by_default.mask.array, inside.mask.array)
+    assert by_default.report["roi"]["default"] and not inside.report["roi"]["default"]
+    assert np.array_equal(by_default.roi.array, inside.roi.array)
+    with pytest.raises(ValueError, match="outside the automatic brain mask.*roi='none'"):
+        liveset.segment(img, [(2, 2, 2)], **kw)  # air: outside the default ROI
 
 
 def test_session_warns_as_segment_when_its_front_leaks_out_of_the_brain():
     img = _bridged_head()
-    seg = liveset.segment(img, [(32, 32, 32, 3)], mu_raw=130, epsilon_raw=40, iterations=1000, bias_correct=False)
+    seg = liveset.segment(img, [(32, 32, 32, 3)], roi="none", mu_raw=130, epsilon_raw=40, iterations=1000, bias_correct=False)
     expected = [w for w in seg.report["warnings"] if "outside the automatic brain mask" in w]
     assert len(expected) == 1
-    for roi in (None, "auto"):
+    for roi in ("none", "auto", None):
         s = liveset.Session(img, roi=roi, bias_correct=False)
         s.add_seed((32, 32, 32), 3)
         p = s.params  # the window segment was given, in the session's normalised units
@@ -348,12 +355,16 @@ def test_session_warns_as_segment_when_its_front_leaks_out_of_the_brain():
             warnings.simplefilter("always")
             status = s.run(1000)
         assert status["converged"]
-        if roi is None:  # the same front as segment's, the same warning, also as a Python warning
+        if roi == "none":  # the same front as segment's, the same warning, also as a Python warning
             assert np.array_equal(s.mask().array, seg.mask.array)
             assert status["warnings"] == expected and [str(w.message) for w in caught] == expected
-        else:
+        else:  # "auto", and the default on a full head
             assert status["warnings"] == [] and not caught
             assert int(s.mask().array.sum()) < int(seg.mask.array.sum())
+            assert s.report["roi"]["default"] == (roi is None)
+    s = liveset.Session(img, bias_correct=False)
+    with pytest.raises(ValueError, match="outside the region of interest.*roi='none'"):
+        s.add_seed((2, 2, 2))
 
 
 def test_docs_example_runs(tmp_path):

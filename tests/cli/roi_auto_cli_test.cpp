@@ -89,7 +89,11 @@ TEST(RoiAutoCli, BadInputIsOneLineAndWritesNothing) {
     };
     for (const Case& c : std::vector<Case>{{"segment " + flat.string() + " --roi auto --out-roi " + roi.string() + o, "constant"},
                                            {"segment " + noise.string() + " --roi auto --out-roi " + roi.string() + o, "no head"},
-                                           {"segment " + head_image().string() + " --out-roi " + roi.string() + o, "--out-roi needs --roi"}}) {
+                                           {"segment " + head_image().string() + " --roi none --out-roi " + roi.string() + o, "--out-roi needs a ROI"},
+                                           {"segment " + noise.string() + " --out-roi " + roi.string() + o, "no ROI to write"},
+                                           // (5, 5, 5) is air: outside the brain mask a head gets by default
+                                           {"segment " + head_image().string() + o,
+                                            "every seed lies outside the automatic brain mask (the default ROI of a head), the first at (5, 5, 5); pass --roi none"}}) {
         const auto r = run_cli(c.args);
         EXPECT_NE(r.rc, 0) << c.args;
         EXPECT_EQ(lines(r.err), 1) << r.err;
@@ -141,13 +145,13 @@ TEST(RoiAutoCli, AMaskIsItsNonZeroRealValues) {
     EXPECT_FALSE(fs::exists(out));
 }
 
-// Without a ROI, a segmentation of which more than 5 % lies outside the automatic brain mask (the
+// With --roi none, a segmentation of which more than 5 % lies outside the automatic brain mask (the
 // front leaked into the scalp) is warned about, with the count against the library's mask; none
 // when it stays inside, none with --roi auto.
-TEST(RoiAutoCli, WithoutARoiALeakOutOfTheBrainIsWarnedAbout) {
+TEST(RoiAutoCli, WithRoiNoneALeakOutOfTheBrainIsWarnedAbout) {
     const fs::path seg = work_dir() / "leak.nii.gz";
     const std::string o = " --seed 32,32,32:3 --mu-raw 130 --epsilon-raw 40 --iterations 400 --no-bias-correct --json --out-mask " + seg.string();
-    const auto leaked = run_cli("segment " + head_image(true).string() + o);
+    const auto leaked = run_cli("segment " + head_image(true).string() + " --roi none" + o);
     ASSERT_EQ(leaked.rc, 0) << leaked.err;
     const nlohmann::json j = nlohmann::json::parse(leaked.out);
     ASSERT_EQ(leak_warnings(j), 1u) << j["warnings"].dump();
@@ -161,11 +165,61 @@ TEST(RoiAutoCli, WithoutARoiALeakOutOfTheBrainIsWarnedAbout) {
     EXPECT_GT(static_cast<double>(outside), 0.05 * static_cast<double>(inside));
     std::string counts = std::to_string(outside) + " of " + std::to_string(inside);
     EXPECT_NE(j["warnings"].dump().find(counts), std::string::npos) << j["warnings"].dump() << " expected " << counts;
-    for (const std::string& args : {"segment " + head_image().string() + o, "segment " + head_image(true).string() + " --roi auto" + o}) {
+    for (const std::string& args : {"segment " + head_image().string() + " --roi none" + o, "segment " + head_image(true).string() + " --roi auto" + o}) {
         const auto r = run_cli(args);
         ASSERT_EQ(r.rc, 0) << r.err;
         EXPECT_EQ(leak_warnings(nlohmann::json::parse(r.out)), 0u) << args << ": " << r.out;
     }
+}
+
+// Without --roi, a full head is segmented in its automatic brain mask: the same voxels as --roi auto
+// (where --roi none leaks along the bridge), the report's ROI marked as the default; a skull-stripped
+// brain (no scalp to leak into) gets no ROI: the same voxels as --roi none.
+TEST(RoiAutoCli, AFullHeadIsSegmentedInItsBrainMaskByDefault) {
+    const std::string o = " --seed 32,32,32:3 --mu-raw 130 --epsilon-raw 40 --iterations 400 --no-bias-correct --json --out-mask ";
+    const auto run = [&](const fs::path& image, const std::string& roi, const std::string& name) {
+        const fs::path seg = work_dir() / (name + ".nii.gz");
+        const auto r = run_cli("--threads 2 segment " + image.string() + roi + o + seg.string());
+        EXPECT_EQ(r.rc, 0) << r.err;
+        return std::pair{read_label_image(seg.string()), nlohmann::json::parse(r.out.empty() ? "{}" : r.out)};
+    };
+    const auto differ = [](const Grid<std::uint8_t>& a, const Grid<std::uint8_t>& b) {
+        std::size_t n = 0;
+        for (PointIndex i = 0; i < a.size(); ++i) n += a[i] != b[i];
+        return n;
+    };
+    const auto [by_default, jd] = run(head_image(true), "", "default_head");
+    const auto [asked, ja] = run(head_image(true), " --roi auto", "auto_head");
+    const auto [none, jn] = run(head_image(true), " --roi none", "none_head");
+    EXPECT_EQ(differ(by_default, asked), 0u);
+    EXPECT_GT(differ(by_default, none), 1000u);  // the leak along the bridge
+    EXPECT_EQ(jd["roi"]["source"], "auto");
+    EXPECT_TRUE(jd["roi"]["default"].get<bool>());
+    EXPECT_FALSE(ja["roi"]["default"].get<bool>());
+    EXPECT_EQ(jd["roi"]["voxels"], ja["roi"]["voxels"]);
+    EXPECT_FALSE(jn.contains("roi"));
+    // A seed in the air beside one in the brain: left out with a warning naming --roi none (the
+    // same voxels as without it); alone, it is an error (BadInputIsOneLineAndWritesNothing).
+    const auto [with_air, jw] = run(head_image(true), " --seed 2,2,2", "air_seed_head");
+    EXPECT_EQ(differ(with_air, by_default), 0u);
+    std::size_t said = 0;
+    for (const auto& w : jw["warnings"])
+        said += w.get<std::string>() == "the seed at (2, 2, 2) lies outside the automatic brain mask (the default ROI of a head): it is left "
+                                        "out; pass --roi none to segment outside the brain";
+    EXPECT_EQ(said, 1u) << jw["warnings"].dump();
+
+    Grid<float> stripped = liveset::testing::analytic_head(false);  // brain and CSF only, air around
+    for (int z = 0; z < 64; ++z)
+        for (int y = 0; y < 64; ++y)
+            for (int x = 0; x < 64; ++x)
+                if (1.5 * norm(Vec3d{x - 31.5, y - 31.5, z - 31.5}) >= 29) stripped({x, y, z}) = 0.0f;
+    const fs::path path = work_dir() / "stripped.nii.gz";
+    write_image(stripped, path.string());
+    ASSERT_TRUE(auto_brain_mask(stripped).lattice().same_geometry(stripped.lattice()));  // a brain is found there...
+    const auto [s_default, sd] = run(path, "", "default_stripped");
+    const auto [s_none, sn] = run(path, " --roi none", "none_stripped");
+    EXPECT_FALSE(sd.contains("roi")) << sd.dump();  // ...but not imposed
+    EXPECT_EQ(differ(s_default, s_none), 0u);
 }
 
 // The analytic head under Rician noise σ 14 (its air a Rayleigh of mode 14): the report gives the

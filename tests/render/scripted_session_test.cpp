@@ -402,8 +402,15 @@ TEST(ScriptedSession, RoiAutoIsSegmentsBrainMaskAndTheWorkspaceKeepsIt) {
     EXPECT_NE(view.err.find("--roi auto: brain mask of"), std::string::npos) << view.err;
     EXPECT_EQ(differing_voxels(view_mask, seg_mask), 0u);
     const std::string leaked = (dir / "auto_leaked.nii.gz").string();  // the same run without the ROI differs
-    ASSERT_EQ(run_cli("segment " + path + o + " --out-mask " + leaked).rc, 0);
+    ASSERT_EQ(run_cli("segment " + path + o + " --roi none --out-mask " + leaked).rc, 0);
     EXPECT_GT(differing_voxels(leaked, seg_mask), 1000u);
+    // Without --roi, a head: the automatic brain mask by default, in the viewer as in `segment`.
+    const std::string by_default = (dir / "auto_default.nii.gz").string();
+    write_text(dir / "default.json", R"([{"segment": "converge"}, {"save_mask": ")" + by_default + R"("}])");
+    const CliResult dv = run_cli("view " + path + o + " --headless --no-autosave --script " + (dir / "default.json").string());
+    ASSERT_EQ(dv.rc, 0) << dv.err;
+    EXPECT_NE(dv.err.find("the front stays in the automatic brain mask by default"), std::string::npos) << dv.err;
+    EXPECT_EQ(differing_voxels(by_default, seg_mask), 0u);
     std::ifstream in(ws);
     const nlohmann::json j = nlohmann::json::parse(in);
     EXPECT_EQ(j["roi"], "auto");
@@ -414,8 +421,9 @@ TEST(ScriptedSession, RoiAutoIsSegmentsBrainMaskAndTheWorkspaceKeepsIt) {
     EXPECT_EQ(differing_voxels(again, view_mask), 0u);
 }
 
-// As `segment`: without a ROI on a head, a front that leaked out of the automatic brain mask is
-// warned about when it converges (stderr when headless, the event log); with --roi auto it is not.
+// As `segment`: with --roi none on a head, a front that leaked out of the automatic brain mask is
+// warned about when it converges (stderr when headless, the event log); with --roi auto or the
+// default (the same mask on a head) it is not.
 TEST(ScriptedSession, AFrontThatLeaksOutOfTheBrainWithoutARoiIsWarnedAbout) {
     const fs::path dir = scripts_dir();
     const std::string path = (dir / "bridged_head.nii.gz").string(), events = (dir / "leak_events.jsonl").string();
@@ -423,7 +431,7 @@ TEST(ScriptedSession, AFrontThatLeaksOutOfTheBrainWithoutARoiIsWarnedAbout) {
     write_text(dir / "leak.json", R"([{"segment": "converge"}])");
     const std::string common = " --seed 32,32,32:3 --mu-raw 130 --epsilon-raw 40 --no-bias-correct --headless --no-autosave --script " +
                                (dir / "leak.json").string();
-    const CliResult leaked = run_cli("view " + path + common + " --log-events " + events);
+    const CliResult leaked = run_cli("view " + path + " --roi none" + common + " --log-events " + events);
     ASSERT_EQ(leaked.rc, 0) << leaked.err;
     EXPECT_NE(leaked.err.find("outside the automatic brain mask"), std::string::npos) << leaked.err;
     std::ifstream in(events);
@@ -433,9 +441,11 @@ TEST(ScriptedSession, AFrontThatLeaksOutOfTheBrainWithoutARoiIsWarnedAbout) {
         logged += e.value("type", "") == "warning" && e["message"].get<std::string>().find("outside the automatic brain mask") != std::string::npos;
     }
     EXPECT_EQ(logged, 1u);
-    const CliResult inside = run_cli("view " + path + " --roi auto" + common);
-    ASSERT_EQ(inside.rc, 0) << inside.err;
-    EXPECT_EQ(inside.err.find("outside the automatic brain mask"), std::string::npos) << inside.err;
+    for (const std::string roi : {" --roi auto", ""}) {
+        const CliResult inside = run_cli("view " + path + roi + common);
+        ASSERT_EQ(inside.rc, 0) << inside.err;
+        EXPECT_EQ(inside.err.find("outside the automatic brain mask"), std::string::npos) << roi << ": " << inside.err;
+    }
 }
 
 }  // namespace

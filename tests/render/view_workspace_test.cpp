@@ -13,6 +13,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "analytic_head.hpp"
 #include "cli/cli_run.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
@@ -224,6 +225,23 @@ TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
     EXPECT_NE(r.rc, 0);
     EXPECT_NE(r.err.find("entry 2 (\"seed\")"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("outside the region of interest"), std::string::npos) << r.err;
+
+    // A full head without --roi: its automatic brain mask by default, and a seed in the air is told
+    // how to segment outside it, on the command line and when clicked (a script's seed).
+    const std::string head = (f.dir / "head.nii.gz").string();
+    write_image(testing::analytic_head(false), head);
+    const std::string hint = "the automatic brain mask bounds the front by default on a head; open the image with --roi none";
+    r = run_cli(fmt::format("view {} --no-bias-correct --seed 2,2,2 --headless --script {}", head, script("h.json", "[]")));
+    EXPECT_NE(r.rc, 0);
+    EXPECT_EQ(lines(r.err), 2u) << r.err;  // the note naming the default ROI, then the error
+    EXPECT_NE(r.err.find("seed --seed 2,2,2: the seed at (2, 2, 2) lies outside the region of interest"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(hint), std::string::npos) << r.err;
+    r = run_cli(fmt::format("view {} --no-bias-correct --headless --script {}", head, script("i.json", R"([{"seed": [32, 32, 32]}, {"seed": [2, 2, 2]}])")));
+    EXPECT_NE(r.rc, 0);
+    EXPECT_NE(r.err.find("entry 2 (\"seed\")"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(hint), std::string::npos) << r.err;
+    r = run_cli(fmt::format("view {} --no-bias-correct --roi none --seed 2,2,2 --headless --script {}", head, script("n.json", "[]")));
+    EXPECT_EQ(r.rc, 0) << r.err;
 }
 
 // A workspace records its ROI's checksum. Without N4: reopened with the ROI unchanged it says

@@ -1,12 +1,14 @@
 // Opening an image from the viewer's panel: the read and N4 run on a worker thread while frames go
 // on, and a frame swaps the new session in - the image the command line's `view` would give
 // (prepare_image: N4 by default); a second open waits its turn; Cancel keeps the current session;
-// a file that cannot be read fails in one line and keeps it too.
+// a file that cannot be read fails in one line and keeps it too. A full head opens in its automatic
+// brain mask, as `view IMAGE` opens it.
 #include <gtest/gtest.h>
 
 #include <filesystem>
 #include <string>
 
+#include "analytic_head.hpp"
 #include "image_commands.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/phantom/phantom.hpp"
@@ -66,6 +68,30 @@ TEST(ViewerOpen, AnImageOpensOnAWorkerAndAFrameSwapsItIn) {
     ASSERT_TRUE(prepared.bias.has_value());
     EXPECT_EQ(image_checksum(v.session()->image()), image_checksum(expected));  // corrected as `view` corrects it
     EXPECT_NE(image_checksum(v.session()->image()), image_checksum(read_image(image_path())));
+}
+
+TEST(ViewerOpen, AHeadOpensInItsAutomaticBrainMaskAsViewDoes) {
+    render::HeadlessContext context;
+    render::Framebuffer fb(640, 480);
+    const std::string head = (testing::scratch_dir("viewer_open_test") / "head.nii.gz").string();
+    write_image(testing::analytic_head(false), head);
+    Viewer v(nullptr, "", headless());
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+    ASSERT_TRUE(v.open_image(head));
+    ASSERT_TRUE(frames_until_opened(v, fb));
+    ASSERT_NE(v.session(), nullptr) << v.message();
+    EXPECT_EQ(v.message(), "opened " + head + ", the front bounded by the automatic brain mask");
+    Grid<float> image = read_image(head);
+    std::optional<cli::Roi> roi = cli::load_roi("", image);  // `view IMAGE`'s default
+    cli::prepare_image(image, roi, cli::BiasCorrection::kDefault);
+    ASSERT_TRUE(roi.has_value() && roi->by_default);
+    ASSERT_NE(v.session()->roi(), nullptr);
+    EXPECT_EQ(mask_checksum(*v.session()->roi()), mask_checksum(roi->mask));
+    EXPECT_EQ(image_checksum(v.session()->image()), image_checksum(image));
+    EXPECT_FALSE(v.add_seed({2, 2, 2}, 2.0));  // the air: refused, and told how to segment outside the brain
+    EXPECT_NE(v.message().find("lies outside the region of interest"), std::string::npos) << v.message();
+    EXPECT_NE(v.message().find("open the image with --roi none"), std::string::npos) << v.message();
+    EXPECT_TRUE(v.add_seed({32, 32, 32}, 2.0)) << v.message();
 }
 
 TEST(ViewerOpen, CancelAndAnUnreadableFileKeepTheCurrentSession) {
