@@ -292,7 +292,8 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("image", va.image, "image to open (NIfTI, MetaImage, NRRD, MINC, DICOM folder)");
     v->add_option("--mask", va.mask, "start from this segmentation mask (non-zero inside)");
     v->add_option("--phi", va.phi, "start from this level set (< 0 inside)");
-    v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave, or 'auto': a brain mask computed from the T1 (as segment --roi auto)");
+    v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave; 'auto': a brain mask computed from the T1; 'none': the whole image. "
+                    "Default, as segment: the automatic brain mask when the image is a full head, else none");
     v->add_option("--seed", va.seeds, "seed I,J,K[:R] (voxels); repeatable");
     v->add_option("--window-from", va.window_from, "estimate the window from the tissue model (the seeds pick the class) or from the seeds' statistics, as `segment`")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     auto* bias = v->add_flag("--bias-correct,!--no-bias-correct", va.bias_correct, "correct the intensity non-uniformity first (N4), as `segment`. Default: on, skipped with a warning where it cannot run (asked for: an error); a continued workspace keeps its own setting");
