@@ -110,8 +110,8 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     {
         pyb::gil_scoped_release nogil;
         prepared = cli::prepare_image(image, roi, mode, &interrupt.flag());
+        left_out = cli::fit_seeds_to_roi(roi, prepared, req.seeds, "roi='none'");
         roi_mask = roi ? &roi->mask : nullptr;
-        left_out = cli::drop_seeds_outside_roi(roi, req.seeds, "roi='none'");
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
         if (roi) req.roi = &roi->mask;
         if (init) req.initial_mask = &*init;
@@ -175,8 +175,8 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
     SegmentRequest req = request_for(a, lattice, false);
     std::optional<cli::Roi> roi = roi_of(a.roi, image);
     pyb::gil_scoped_release nogil;
-    const cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct));  // as segment
-    const std::vector<std::string> left_out = cli::drop_seeds_outside_roi(roi, req.seeds, "roi='none'");
+    cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct));  // as segment
+    const std::vector<std::string> left_out = cli::fit_seeds_to_roi(roi, prepared, req.seeds, "roi='none'");
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
     const IntensityScale scale = robust_scale(image, roi_mask, req.scale);

@@ -103,17 +103,18 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.
     const BiasCorrection mode = bias_mode(a.bias_correct, a.bias_given || !a.out_corrected.empty());
-    const PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag());
-    const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
+    PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag());
     if (prepared.bias && prepared.bias->interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
         return 130;
     }
     if (!prepared.bias_skipped.empty() && !a.quiet) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
-    const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
-    const std::vector<std::string> left_out = drop_seeds_outside_roi(roi, req.seeds, "--roi none");
+    const std::vector<std::string> left_out = fit_seeds_to_roi(roi, prepared, req.seeds, "--roi none");
     if (!a.quiet)
         for (const std::string& w : left_out) fmt::print(stderr, "liveset: warning: {}\n", w);
+    if (!a.out_roi.empty() && !roi) throw UsageError("--out-roi: no ROI to write (every seed lies outside the automatic brain mask)");
+    const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
+    const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
 
     add_regions(req, roi, init, fit, prepared.fit_is_brain(roi));
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);

@@ -45,53 +45,6 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
     }
 }
 
-namespace {
-
-// Whether a voxel of the seed's ball (as seed_values reads it: within max(radius, 0.5) of the
-// centre, index space) lies in `mask`.
-bool ball_touches(const Grid<std::uint8_t>& mask, const SeedBall& s) {
-    const Vec3i d = mask.dims();
-    const double r = std::max(s.radius, 0.5);
-    Vec3i lo, hi;
-    for (int a = 0; a < 3; ++a) {
-        lo[a] = std::max(0, static_cast<int>(std::floor(s.center[a] - r)));
-        hi[a] = std::min(d[a] - 1, static_cast<int>(std::ceil(s.center[a] + r)));
-    }
-    for (int z = lo.z; z <= hi.z; ++z)
-        for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x)
-                if (mask({x, y, z}) != 0 && norm(Vec3d{double(x), double(y), double(z)} - s.center) <= r) return true;
-    return false;
-}
-
-}  // namespace
-
-std::vector<std::string> drop_seeds_outside_roi(const std::optional<Roi>& roi, std::vector<SeedBall>& seeds, std::string_view none_hint) {
-    std::vector<std::string> warnings;
-    if (!roi || seeds.empty()) return warnings;
-    const std::string what = roi->by_default ? "the automatic brain mask (the default ROI of a head)"
-                             : roi->brain_mask ? "the automatic brain mask (--roi auto)"
-                                               : "the ROI " + roi->source;
-    const std::string hint = roi->by_default ? fmt::format("; pass {} to segment outside the brain", none_hint) : std::string();
-    std::vector<Vec3i> outside;
-    std::vector<SeedBall> kept;
-    for (const SeedBall& s : seeds) {
-        if (ball_touches(roi->mask, s)) {
-            kept.push_back(s);
-            continue;
-        }
-        outside.push_back({static_cast<int>(std::lround(s.center.x)), static_cast<int>(std::lround(s.center.y)),
-                           static_cast<int>(std::lround(s.center.z))});
-    }
-    if (kept.empty())
-        throw UsageError(fmt::format("every seed lies outside {}, the first at ({}, {}, {}){}", what, outside[0].x, outside[0].y,
-                                     outside[0].z, hint));
-    for (const Vec3i& c : outside)
-        warnings.push_back(fmt::format("the seed at ({}, {}, {}) lies outside {}: it is left out{}", c.x, c.y, c.z, what, hint));
-    seeds = std::move(kept);
-    return warnings;
-}
-
 std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head) {
     try {
         return auto_brain_mask(image, {}, nullptr, head);
@@ -180,6 +133,61 @@ PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCor
     }
     if (roi) roi->head.reset();  // only needed here
     return out;
+}
+
+namespace {
+
+// Whether a voxel of the seed's ball (as seed_values reads it: within max(radius, 0.5) of the
+// centre, index space) lies in `mask`.
+bool ball_touches(const Grid<std::uint8_t>& mask, const SeedBall& s) {
+    const Vec3i d = mask.dims();
+    const double r = std::max(s.radius, 0.5);
+    Vec3i lo, hi;
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = std::max(0, static_cast<int>(std::floor(s.center[a] - r)));
+        hi[a] = std::min(d[a] - 1, static_cast<int>(std::ceil(s.center[a] + r)));
+    }
+    for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x)
+                if (mask({x, y, z}) != 0 && norm(Vec3d{double(x), double(y), double(z)} - s.center) <= r) return true;
+    return false;
+}
+
+}  // namespace
+
+std::vector<std::string> fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage& prepared, std::vector<SeedBall>& seeds,
+                                          std::string_view none_hint) {
+    std::vector<std::string> warnings;
+    if (!roi || seeds.empty()) return warnings;
+    const std::string what = roi->by_default ? "the automatic brain mask (the default ROI of a head)"
+                             : roi->brain_mask ? "the automatic brain mask (--roi auto)"
+                                               : "the ROI " + roi->source;
+    const std::string hint = roi->by_default ? fmt::format("; pass {} to segment outside the brain", none_hint) : std::string();
+    std::vector<Vec3i> outside;
+    std::vector<SeedBall> kept;
+    for (const SeedBall& s : seeds) {
+        if (ball_touches(roi->mask, s)) {
+            kept.push_back(s);
+            continue;
+        }
+        outside.push_back({static_cast<int>(std::lround(s.center.x)), static_cast<int>(std::lround(s.center.y)),
+                           static_cast<int>(std::lround(s.center.z))});
+    }
+    if (kept.empty() && !roi->by_default)
+        throw UsageError(fmt::format("every seed lies outside {}, the first at ({}, {}, {})", what, outside[0].x, outside[0].y, outside[0].z));
+    if (kept.empty()) {  // the default's guess does not fit these seeds: the whole image, as without a ROI
+        warnings.push_back(fmt::format("every seed lies outside the automatic brain mask (a T1 brain's), the first at ({}, {}, {}): the "
+                                       "whole image is segmented, as with {}",
+                                       outside[0].x, outside[0].y, outside[0].z, none_hint));
+        prepared.fit_region = std::move(roi->mask);  // N4 was fitted there, as it is without a ROI
+        roi.reset();
+        return warnings;
+    }
+    for (const Vec3i& c : outside)
+        warnings.push_back(fmt::format("the seed at ({}, {}, {}) lies outside {}: it is left out{}", c.x, c.y, c.z, what, hint));
+    seeds = std::move(kept);
+    return warnings;
 }
 
 void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi) {

@@ -42,12 +42,6 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
 // What a seed refused by a ROI chosen by default is told (after the session's own message).
 inline constexpr const char* kDefaultRoiHint =
     ": the automatic brain mask bounds the front by default on a head; open the image with --roi none to segment outside the brain";
-// Removes the seeds whose whole ball lies outside the ROI (no voxel of it in the mask; a seed astride
-// its edge is clipped, as ever) and returns one warning each ("the seed at (i, j, k) lies outside <the
-// ROI>: it is left out"); a UsageError, changing nothing, when every seed does. With a ROI chosen by default both add "; pass
-// <none_hint> to segment outside the brain". Called with the ROI the segmentation uses (after
-// prepare_image found it again).
-std::vector<std::string> drop_seeds_outside_roi(const std::optional<Roi>& roi, std::vector<SeedBall>& seeds, std::string_view none_hint);
 // auto_brain_mask(image, {}, nullptr, head), or nullopt when the image does not look like a head (no error).
 std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head = nullptr);
 // {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".
@@ -96,6 +90,15 @@ struct PreparedImage {
 // found again 0.943; docs/BENCHMARKS.md, session 56).
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode,
                             const std::atomic<bool>* interrupt = nullptr);
+// The seeds against the ROI prepare_image left (call it next). Seeds whose whole ball lies outside
+// it (no voxel of it in the mask; a seed astride its edge is clipped, as ever) are removed, one
+// warning each ("the seed at (i, j, k) lies outside <the ROI>: it is left out", and with a ROI
+// chosen by default "; pass <none_hint> to segment outside the brain"). When every seed does: a
+// UsageError for a ROI asked for; a ROI chosen by default is dropped instead (its mask becomes
+// prepared.fit_region, so the run is <none_hint>'s bit for bit) with a warning - the seeds ask for
+// something else than a T1 brain (the eyes, the scalp; or the image is no T1 and the mask is wrong).
+std::vector<std::string> fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage& prepared, std::vector<SeedBall>& seeds,
+                                          std::string_view none_hint);
 // The report's "bias_correction" object (bias_correction_report and where it was fitted), or, when
 // the default correction was skipped, its warning appended to the report's "warnings".
 void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi);

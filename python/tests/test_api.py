@@ -335,8 +335,18 @@ def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
     assert np.array_equal(by_default.mask.array, inside.mask.array)
     assert by_default.report["roi"]["default"] and not inside.report["roi"]["default"]
     assert np.array_equal(by_default.roi.array, inside.roi.array)
-    with pytest.raises(ValueError, match="outside the automatic brain mask.*roi='none'"):
-        liveset.segment(img, [(2, 2, 2)], **kw)  # air: outside the default ROI
+    # A seed in the air beside one in the brain is left out (named); alone, it asks for something else
+    # than the brain: the default ROI is dropped, with a warning, and the run is roi="none"'s.
+    both = liveset.segment(img, [(32, 32, 32, 3), (2, 2, 2)], **kw)
+    assert np.array_equal(both.mask.array, inside.mask.array)
+    assert any("the seed at (2, 2, 2) lies outside" in w and "roi='none'" in w for w in both.report["warnings"])
+    air = dict(mu_raw=8, epsilon_raw=6, iterations=50, bias_correct=False)
+    alone = liveset.segment(img, [(2, 2, 2)], **air)
+    assert np.array_equal(alone.mask.array, liveset.segment(img, [(2, 2, 2)], roi="none", **air).mask.array)
+    assert "roi" not in alone.report and alone.roi is None
+    assert any("every seed lies outside" in w for w in alone.report["warnings"])
+    with pytest.raises(ValueError, match="every seed lies outside the automatic brain mask"):
+        liveset.segment(img, [(2, 2, 2)], roi="auto", **air)
 
 
 def test_session_warns_as_segment_when_its_front_leaks_out_of_the_brain():

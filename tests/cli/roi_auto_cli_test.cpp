@@ -91,9 +91,9 @@ TEST(RoiAutoCli, BadInputIsOneLineAndWritesNothing) {
                                            {"segment " + noise.string() + " --roi auto --out-roi " + roi.string() + o, "no head"},
                                            {"segment " + head_image().string() + " --roi none --out-roi " + roi.string() + o, "--out-roi needs a ROI"},
                                            {"segment " + noise.string() + " --out-roi " + roi.string() + o, "no ROI to write"},
-                                           // (5, 5, 5) is air: outside the brain mask a head gets by default
-                                           {"segment " + head_image().string() + o,
-                                            "every seed lies outside the automatic brain mask (the default ROI of a head), the first at (5, 5, 5); pass --roi none"}}) {
+                                           // (5, 5, 5) is air: outside the brain mask asked for
+                                           {"segment " + head_image().string() + " --roi auto" + o,
+                                            "every seed lies outside the automatic brain mask (--roi auto), the first at (5, 5, 5)"}}) {
         const auto r = run_cli(c.args);
         EXPECT_NE(r.rc, 0) << c.args;
         EXPECT_EQ(lines(r.err), 1) << r.err;
@@ -199,7 +199,9 @@ TEST(RoiAutoCli, AFullHeadIsSegmentedInItsBrainMaskByDefault) {
     EXPECT_EQ(jd["roi"]["voxels"], ja["roi"]["voxels"]);
     EXPECT_FALSE(jn.contains("roi"));
     // A seed in the air beside one in the brain: left out with a warning naming --roi none (the
-    // same voxels as without it); alone, it is an error (BadInputIsOneLineAndWritesNothing).
+    // same voxels as without it). Alone, it asks for something else than the brain: the default ROI
+    // is dropped, with a warning, and the run is --roi none's voxel for voxel (with --roi auto it is
+    // an error: BadInputIsOneLineAndWritesNothing).
     const auto [with_air, jw] = run(head_image(true), " --seed 2,2,2", "air_seed_head");
     EXPECT_EQ(differ(with_air, by_default), 0u);
     std::size_t said = 0;
@@ -207,6 +209,17 @@ TEST(RoiAutoCli, AFullHeadIsSegmentedInItsBrainMaskByDefault) {
         said += w.get<std::string>() == "the seed at (2, 2, 2) lies outside the automatic brain mask (the default ROI of a head): it is left "
                                         "out; pass --roi none to segment outside the brain";
     EXPECT_EQ(said, 1u) << jw["warnings"].dump();
+    const std::string air_only = " --seed 2,2,2 --mu-raw 8 --epsilon-raw 6 --iterations 50 --no-bias-correct --json --out-mask ";
+    const fs::path a1 = work_dir() / "air_default.nii.gz", a2 = work_dir() / "air_none.nii.gz";
+    const auto r1 = run_cli("--threads 2 segment " + head_image(true).string() + air_only + a1.string());
+    const auto r2 = run_cli("--threads 2 segment " + head_image(true).string() + " --roi none" + air_only + a2.string());
+    ASSERT_EQ(r1.rc, 0) << r1.err;
+    ASSERT_EQ(r2.rc, 0) << r2.err;
+    EXPECT_EQ(differ(read_label_image(a1.string()), read_label_image(a2.string())), 0u);
+    const nlohmann::json j1 = nlohmann::json::parse(r1.out);
+    EXPECT_FALSE(j1.contains("roi"));
+    EXPECT_NE(j1["warnings"].dump().find("every seed lies outside the automatic brain mask (a T1 brain's), the first at (2, 2, 2): the whole "
+                                         "image is segmented, as with --roi none"), std::string::npos) << j1["warnings"].dump();
 
     Grid<float> stripped = liveset::testing::analytic_head(false);  // brain and CSF only, air around
     for (int z = 0; z < 64; ++z)
