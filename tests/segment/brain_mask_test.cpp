@@ -168,6 +168,36 @@ TEST(BrainMask, BrainWebFullHeadMatchesBrainTissue) {
     run_variant("1mm", bw.t1, bw.labels);
 }
 
+// BrainWeb defaced as public datasets are (pydeface, mri_deface): everything but the brain and 3 mm
+// around it zeroed in a wedge in front of and below the frontal lobe - eyes, nose, mouth, chin. The
+// cut exposes 9-12 % of the brain's boundary within 4 mm of the surface, which a skull-stripped
+// detection at 10 % took for a stripped brain (mask Dice 0.50 against the brain, GM 0.54): it is a
+// full head, masked as one.
+TEST(BrainMask, ADefacedHeadIsAFullHead) {
+    const BrainWeb& bw = brainweb();
+    const Lattice& l = bw.t1.lattice();
+    Mask brain(l);
+    double y_front = 1e300, z_low = 1e300, z_high = -1e300;
+    for (PointIndex i = 0; i < brain.size(); ++i) {
+        brain[i] = brain_label(bw.labels[i]);
+        if (!brain[i]) continue;
+        const Vec3d w = l.to_world(l.coord(i).cast<double>());
+        y_front = std::min(y_front, w.y), z_low = std::min(z_low, w.z), z_high = std::max(z_high, w.z);
+    }
+    const Mask kept = dilate_mm(brain, 3.0);
+    const double z_cut = z_low + 0.35 * (z_high - z_low) + 10.0;  // LPS: anterior is -y, inferior -z
+    Grid<float> defaced = bw.t1;
+    std::size_t cut = 0;
+    for (PointIndex i = 0; i < defaced.size(); ++i) {
+        const Vec3d w = l.to_world(l.coord(i).cast<double>());
+        if (!kept[i] && w.z < z_cut && w.y < y_front + 1.2 * (z_cut - w.z)) defaced[i] = 0.0f, ++cut;
+    }
+    ASSERT_GT(cut, 300000u);  // the face is gone (BrainWeb: 0.63 M voxels)
+    BrainMaskReport r;
+    run_variant("defaced", defaced, bw.labels, nullptr, 0.015, &r);
+    EXPECT_GT(r.surface_contact, 0.05);  // the cut does reach the brain
+}
+
 TEST(BrainMask, BrainWebSkullStrippedPassesThrough) {
     const BrainWeb& bw = brainweb();
     run_variant("stripped", make_variant(bw.t1, bw.brain_mask, Variant::kStripped), bw.labels, &bw.brain_mask);
