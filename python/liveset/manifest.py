@@ -49,7 +49,7 @@ class Subject:
         # brain mask raised above noisy air (55) and found again after N4; 57: the tissue model fitted
         # through noise that hides a tissue, the brain looked for within 170 mm of the head's top; 58: the
         # mask after N4 looked for in the head found before it; 59: the automatic brain mask the
-        # default ROI of a head), so a resumed
+        # default ROI of a head, and a defaced head no longer taken for a stripped brain), so a resumed
         # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)
