@@ -106,11 +106,11 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     cli::PreparedImage prepared;
     std::optional<SegmentOutcome> out;
     const Grid<std::uint8_t>* roi_mask = nullptr;
-    std::vector<std::string> left_out;  // seeds outside the ROI
+    cli::SeedFit seed_fit;  // seeds outside the ROI
     {
         pyb::gil_scoped_release nogil;
         prepared = cli::prepare_image(image, roi, mode, &interrupt.flag());
-        left_out = cli::fit_seeds_to_roi(roi, prepared, req.seeds, "roi='none'");
+        seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, init ? &*init : nullptr, "roi='none'");
         roi_mask = roi ? &roi->mask : nullptr;
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
         if (roi) req.roi = &roi->mask;
@@ -130,8 +130,9 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     if (!out || out->result.reason == StopReason::kInterrupted) throw pyb::error_already_set();  // a pending KeyboardInterrupt
     nlohmann::json j = cli::segmentation_report(*out, lattice);
     cli::add_bias_report(j, prepared, roi_mask);
-    if (const std::string w = cli::leak_warning(out->mask, prepared.fit(nullptr), "roi='auto'"); !w.empty()) j["warnings"].push_back(w);
-    for (const std::string& w : left_out) j["warnings"].push_back(w);
+    for (const std::string& w : seed_fit.warnings) j["warnings"].push_back(w);
+    const Grid<std::uint8_t>* brain = seed_fit.default_dropped ? nullptr : prepared.fit(nullptr);  // given up: the user's choice
+    if (const std::string w = cli::leak_warning(out->mask, brain, "roi='auto'"); !w.empty()) j["warnings"].push_back(w);
     if (roi) j["roi"] = cli::roi_report(*roi);
     pyb::dict r;
     r["phi"] = array_from_grid(Grid<float>(out->field->phi()));
@@ -176,7 +177,7 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
     std::optional<cli::Roi> roi = roi_of(a.roi, image);
     pyb::gil_scoped_release nogil;
     cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct));  // as segment
-    const std::vector<std::string> left_out = cli::fit_seeds_to_roi(roi, prepared, req.seeds, "roi='none'");
+    const cli::SeedFit seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, nullptr, "roi='none'");
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
     const IntensityScale scale = robust_scale(image, roi_mask, req.scale);
@@ -193,7 +194,7 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
                        {"epsilon_raw", scale.raw_length(w.epsilon)}, {"lower_raw", scale.to_raw(w.mu - w.epsilon)},
                        {"upper_raw", scale.to_raw(w.mu + w.epsilon)}, {"source", to_string(w.source)}};
         for (const std::string& s : w.warnings) warnings.push_back(s);
-        for (const std::string& s : left_out) warnings.push_back(s);
+        for (const std::string& s : seed_fit.warnings) warnings.push_back(s);
         if (model) j["tissue_model"] = cli::tissue_model_report(*model, w.model_window ? &*w.model_window : nullptr);
     } else if (model) {
         j["tissue_model"] = cli::tissue_model_report(*model, nullptr);

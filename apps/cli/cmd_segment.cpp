@@ -98,7 +98,9 @@ int run_segment(const SegmentArgs& a, int threads) {
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> init;
     std::optional<Roi> roi = load_roi(a.roi, image);
-    if (!a.out_roi.empty() && !roi) throw UsageError("--out-roi: no ROI to write (the image does not look like a head: give --roi MASK)");
+    if (!a.out_roi.empty() && !roi)
+        throw UsageError("--out-roi: no ROI to write (a skull-stripped brain, or an image where no head is found, gets none by default: give "
+                         "--roi auto or a mask)");
     SegmentRequest req = segment_request(a, image.lattice());
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.
@@ -109,10 +111,10 @@ int run_segment(const SegmentArgs& a, int threads) {
         return 130;
     }
     if (!prepared.bias_skipped.empty() && !a.quiet) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
-    const std::vector<std::string> left_out = fit_seeds_to_roi(roi, prepared, req.seeds, "--roi none");
+    const SeedFit seed_fit = fit_seeds_to_roi(roi, prepared, req.seeds, init ? &*init : nullptr, "--roi none");
     if (!a.quiet)
-        for (const std::string& w : left_out) fmt::print(stderr, "liveset: warning: {}\n", w);
-    if (!a.out_roi.empty() && !roi) throw UsageError("--out-roi: no ROI to write (every seed lies outside the automatic brain mask)");
+        for (const std::string& w : seed_fit.warnings) fmt::print(stderr, "liveset: warning: {}\n", w);
+    if (!a.out_roi.empty() && !roi) throw UsageError("--out-roi: no ROI to write (the default ROI was given up for the whole image)");
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
 
@@ -135,7 +137,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     }
 
     nlohmann::json j = segment_report(a, o, image.lattice(), roi, prepared, triangles);
-    for (const std::string& w : left_out) j["warnings"].push_back(w);
+    for (const std::string& w : seed_fit.warnings) j["warnings"].push_back(w);
     // The default limit reached before convergence: the mask is a front still moving (a grid whose
     // fine voxels keep the time step small, docs/BENCHMARKS.md session 49, or a very large image).
     if (o.result.reason == StopReason::kIterationLimit && !a.iterations_given) {
@@ -145,7 +147,8 @@ int run_segment(const SegmentArgs& a, int threads) {
         if (!a.quiet) fmt::print(stderr, "liveset: warning: {}\n", w);
         j["warnings"].push_back(w);
     }
-    if (const std::string w = leak_warning(o.mask, prepared.fit(nullptr), "--roi auto"); !w.empty()) {
+    const Grid<std::uint8_t>* brain = seed_fit.default_dropped ? nullptr : prepared.fit(nullptr);  // given up: the user's choice
+    if (const std::string w = leak_warning(o.mask, brain, "--roi auto"); !w.empty()) {
         if (!a.quiet) fmt::print(stderr, "liveset: warning: {}\n", w);
         j["warnings"].push_back(w);
     }

@@ -156,10 +156,39 @@ bool ball_touches(const Grid<std::uint8_t>& mask, const SeedBall& s) {
 
 }  // namespace
 
-std::vector<std::string> fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage& prepared, std::vector<SeedBall>& seeds,
-                                          std::string_view none_hint) {
-    std::vector<std::string> warnings;
-    if (!roi || seeds.empty()) return warnings;
+namespace {
+
+// The default ROI given up for the whole image (its mask becomes the fit region, where N4 was
+// fitted, as without a ROI), with the warning saying why.
+void drop_default_roi(std::optional<Roi>& roi, PreparedImage& prepared, SeedFit& out, std::string why, std::string_view none_hint) {
+    out.warnings.push_back(fmt::format("{}: the whole image is segmented, as with {}", why, none_hint));
+    out.default_dropped = true;
+    prepared.fit_region = std::move(roi->mask);
+    roi.reset();
+}
+
+}  // namespace
+
+SeedFit fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage& prepared, std::vector<SeedBall>& seeds, const Grid<std::uint8_t>* init,
+                         std::string_view none_hint) {
+    SeedFit out;
+    if (!roi) return out;
+    if (init != nullptr && roi->by_default) {  // a region to start from, mostly outside the brain: not the brain's
+        std::size_t inside = 0, outside = 0;
+        for (std::size_t i = 0; i < init->size(); ++i) {
+            const auto p = static_cast<PointIndex>(i);
+            if ((*init)[p] == 0) continue;
+            (roi->mask[p] != 0 ? inside : outside) += 1;
+        }
+        const double share = inside + outside > 0 ? static_cast<double>(outside) / static_cast<double>(inside + outside) : 0.0;
+        if (share > kLeakShare) {
+            drop_default_roi(roi, prepared, out,
+                             fmt::format("{:.0f} % of the initial mask lies outside the automatic brain mask (a T1 brain's)", 100.0 * share),
+                             none_hint);
+            return out;
+        }
+    }
+    if (seeds.empty()) return out;
     const std::string what = roi->by_default ? "the automatic brain mask (the default ROI of a head)"
                              : roi->brain_mask ? "the automatic brain mask (--roi auto)"
                                                : "the ROI " + roi->source;
@@ -175,19 +204,18 @@ std::vector<std::string> fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage
                            static_cast<int>(std::lround(s.center.z))});
     }
     if (kept.empty() && !roi->by_default)
-        throw UsageError(fmt::format("every seed lies outside {}, the first at ({}, {}, {})", what, outside[0].x, outside[0].y, outside[0].z));
-    if (kept.empty()) {  // the default's guess does not fit these seeds: the whole image, as without a ROI
-        warnings.push_back(fmt::format("every seed lies outside the automatic brain mask (a T1 brain's), the first at ({}, {}, {}): the "
-                                       "whole image is segmented, as with {}",
-                                       outside[0].x, outside[0].y, outside[0].z, none_hint));
-        prepared.fit_region = std::move(roi->mask);  // N4 was fitted there, as it is without a ROI
-        roi.reset();
-        return warnings;
+        throw UsageError(fmt::format("every seed lies outside {}, the first at voxel ({}, {}, {})", what, outside[0].x, outside[0].y, outside[0].z));
+    if (kept.empty()) {  // the default's guess does not fit these seeds
+        drop_default_roi(roi, prepared, out,
+                         fmt::format("every seed lies outside the automatic brain mask (a T1 brain's), the first at voxel ({}, {}, {})",
+                                     outside[0].x, outside[0].y, outside[0].z),
+                         none_hint);
+        return out;
     }
     for (const Vec3i& c : outside)
-        warnings.push_back(fmt::format("the seed at ({}, {}, {}) lies outside {}: it is left out{}", c.x, c.y, c.z, what, hint));
+        out.warnings.push_back(fmt::format("the seed at voxel ({}, {}, {}) lies outside {}: it is left out{}", c.x, c.y, c.z, what, hint));
     seeds = std::move(kept);
-    return warnings;
+    return out;
 }
 
 void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi) {

@@ -90,15 +90,21 @@ struct PreparedImage {
 // found again 0.943; docs/BENCHMARKS.md, session 56).
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode,
                             const std::atomic<bool>* interrupt = nullptr);
-// The seeds against the ROI prepare_image left (call it next). Seeds whose whole ball lies outside
-// it (no voxel of it in the mask; a seed astride its edge is clipped, as ever) are removed, one
-// warning each ("the seed at (i, j, k) lies outside <the ROI>: it is left out", and with a ROI
-// chosen by default "; pass <none_hint> to segment outside the brain"). When every seed does: a
-// UsageError for a ROI asked for; a ROI chosen by default is dropped instead (its mask becomes
-// prepared.fit_region, so the run is <none_hint>'s bit for bit) with a warning - the seeds ask for
-// something else than a T1 brain (the eyes, the scalp; or the image is no T1 and the mask is wrong).
-std::vector<std::string> fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage& prepared, std::vector<SeedBall>& seeds,
-                                          std::string_view none_hint);
+// What fit_seeds_to_roi said and did.
+struct SeedFit {
+    std::vector<std::string> warnings;
+    bool default_dropped = false;  // the ROI chosen by default was given up: the run is `--roi none`'s
+};
+// The seeds (and the initial mask, `init`, may be null) against the ROI prepare_image left (call it
+// next). Seeds whose whole ball lies outside it (no voxel of it in the mask; a seed astride its edge
+// is clipped, as ever) are removed, one warning each ("the seed at voxel (i, j, k) lies outside <the
+// ROI>: it is left out", and with a ROI chosen by default "; pass <none_hint> to segment outside the
+// brain"). When every seed does: a UsageError for a ROI asked for; a ROI chosen by default is
+// dropped instead (its mask becomes prepared.fit_region, so the run is <none_hint>'s bit for bit)
+// with a warning - the seeds ask for something else than a T1 brain (the eyes, the scalp; or the
+// image is no T1 and the mask is wrong). So is it when over kLeakShare of `init` lies outside it.
+SeedFit fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage& prepared, std::vector<SeedBall>& seeds, const Grid<std::uint8_t>* init,
+                         std::string_view none_hint);
 // The report's "bias_correction" object (bias_correction_report and where it was fitted), or, when
 // the default correction was skipped, its warning appended to the report's "warnings".
 void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi);

@@ -74,6 +74,8 @@ SessionOptions session_options(const ViewArgs& a) {
 
 std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
+    // A level set to continue (--mask, --phi) may come from another tool: no default ROI to clip it.
+    if (a.roi.empty() && (!a.mask.empty() || !a.phi.empty())) a.roi = "none";
     std::optional<Roi> r = load_roi(a.roi, image, "--roi");  // a mask file, "auto", "none" or the default, as `segment`
     if (a.roi.empty()) {  // the default's choice, kept as such (workspaces, a second load)
         a.roi_by_default = r.has_value();
@@ -214,6 +216,7 @@ int run_view(ViewArgs& a, int threads) {
 
     std::unique_ptr<Session> session;
     std::string note;
+    const bool roi_none = a.roi == "none";  // as asked (open_session records the default's choice in a.roi)
     if (!a.image.empty()) session = open_session(a, ws, note);
     std::optional<viewer::Script> script;
     if (!a.script.empty()) script = viewer::parse_script(a.script, session->lattice());
@@ -223,6 +226,7 @@ int run_view(ViewArgs& a, int threads) {
     config.image_path = a.image;
     config.roi_path = a.roi;
     config.roi_by_default = a.roi_by_default;
+    config.roi_none = roi_none;
     config.bias_correct = a.bias_correct;
     config.image_corrected = a.image_corrected;
     config.params_note = note;

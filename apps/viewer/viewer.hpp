@@ -88,6 +88,7 @@ struct ViewerConfig {
     AutosaveConfig autosave;  // recovery files (dir empty: none)
     std::string roi_path;     // the session's ROI as given, or as the default chose it: "auto" or "none" (saved in workspaces)
     bool roi_by_default = false;  // the automatic brain mask bounds the front by default (a seed outside: say --roi none)
+    bool roi_none = false;        // --roi none on the command line: images opened from the panel get no ROI either
     // N4 first for images opened from the panel (as `view` and `segment` by default; skipped with a
     // message where it cannot run), and whether the session's image is N4-corrected (saved in
     // workspaces: a continued workspace corrects its image again, or not).

@@ -33,6 +33,7 @@ bool Viewer::open_image(const std::string& path) {
     const auto cancel = open_cancel_;
     const cli::BiasCorrection mode = cli::bias_mode(config_.bias_correct, false);
     const SessionOptions options = config_.session;
+    const std::string roi_arg = config_.roi_none ? "none" : "";  // the command line's --roi none, else the default
     const auto failed = [](std::string why) noexcept -> std::shared_ptr<Opened> {
         try {
             auto out = std::make_shared<Opened>();
@@ -42,12 +43,12 @@ bool Viewer::open_image(const std::string& path) {
             return nullptr;  // out of memory: poll_open says so
         }
     };
-    const auto work = [path, cancel, mode, options, failed]() -> std::shared_ptr<Opened> {
+    const auto work = [path, cancel, mode, options, roi_arg, failed]() -> std::shared_ptr<Opened> {
         try {
             auto out = std::make_shared<Opened>();
             Grid<float> image = read_image(path);
             if (cancel->load()) return out;
-            std::optional<cli::Roi> roi = cli::load_roi("", image);  // the default, as `segment` (view_command.cpp)
+            std::optional<cli::Roi> roi = cli::load_roi(roi_arg, image);  // as `view IMAGE [--roi none]` (view_command.cpp)
             if (cancel->load()) return out;
             cli::PreparedImage prepared = cli::prepare_image(image, roi, mode, cancel.get());
             if (cancel->load()) return out;
@@ -116,7 +117,7 @@ void Viewer::poll_open(bool wait) {
     report_autosave();
     session_ = std::move(opened->session);
     image_path_ = path;
-    config_.roi_path = opened->brain_roi ? "auto" : "none";  // the default's choice
+    config_.roi_path = opened->brain_roi ? "auto" : "none";  // the default's choice, or --roi none
     config_.roi_by_default = opened->brain_roi;
     config_.image_corrected = opened->corrected;
     image_name_ = std::filesystem::path(path).filename().string();

@@ -73,10 +73,13 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
     image: a liveset.Image, a nibabel image or (array, RAS affine).
     seeds: voxel indices ``(i, j, k)``, ``(i, j, k, radius)`` or the CLI's ``"I,J,K[:R]"``
         strings (0-based, radius in voxels); seeds_mm: LPS mm ``"X,Y,Z[:R]"`` (radius in mm).
-    roi: None (the default: the automatic brain mask when the image is a head, else none; a seed
-        outside it is a ValueError naming ``roi="none"``), ``"auto"`` (the automatic brain mask,
-        an error when none is found), ``"none"`` (the whole image) or a mask (Image/nibabel/array)
-        the front may not leave. init_mask: start from this region instead of seeds.
+    roi: None (the default: the automatic brain mask when the image is a full head, else none; a
+        seed whose ball lies wholly outside it is left out with a warning naming ``roi="none"``,
+        and when every seed does - or over 5 % of ``init_mask`` lies outside - the whole image is
+        segmented, warned), ``"auto"`` (the automatic brain mask, an error when none is found),
+        ``"none"`` (the whole image) or a mask (Image/nibabel/array) the front may not leave. Any
+        ROI leaves out seeds wholly outside it (warned); all of them outside is a ValueError.
+        init_mask: start from this region instead of seeds.
     mu/epsilon: the window in normalised units, or mu_raw/epsilon_raw in the image's own; by
         default the tissue model's window for the seeds' class (``window_from="seeds"``: their
         statistics). n, alpha, iterations, classes: as the CLI (alpha None: chosen

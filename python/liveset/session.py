@@ -123,9 +123,10 @@ class Session:
 
     def run(self, max_steps: int = 2000) -> dict:
         """Segmentation steps until the front converges (or vanishes), at most max_steps; returns
-        the status and ``warnings``: without a ROI, a converged front with more than 5 % of its
-        voxels outside the automatic brain mask is warned about as ``segment`` warns (also issued
-        as a Python ``UserWarning``); pass ``roi="auto"`` for brain tissue."""
+        the status and ``warnings``: with ``roi="none"`` on a head, a converged front with more
+        than 5 % of its voxels outside the automatic brain mask is warned about as ``segment`` warns
+        (also issued as a Python ``UserWarning``); the default ROI (or ``roi="auto"``) keeps brain
+        tissue in."""
         return _warned(self._s.segment_steps(int(max_steps), True))
 
     @property
@@ -207,7 +208,7 @@ def repair(phi_or_mask, image, targets: Sequence[Sequence[float]], *, steps: int
     voxels by default), as ``liveset repair --decision``. Uses Session (exact step, not the CLI's
     ``liveset repair`` option set: no @STEP schedule, no log)."""
     img = as_image(image)
-    s = Session(img, roi=roi, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range,
+    s = Session(img, roi="none" if roi is None else roi, agents=agents, p=p, seed=seed, decision=decision, edit_range=edit_range,
                 bias_correct=False)  # the image as given, as `liveset repair --image`
     src = as_image(phi_or_mask, "phi_or_mask")
     a = np.asarray(src.array)

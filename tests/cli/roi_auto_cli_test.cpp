@@ -93,7 +93,7 @@ TEST(RoiAutoCli, BadInputIsOneLineAndWritesNothing) {
                                            {"segment " + noise.string() + " --out-roi " + roi.string() + o, "no ROI to write"},
                                            // (5, 5, 5) is air: outside the brain mask asked for
                                            {"segment " + head_image().string() + " --roi auto" + o,
-                                            "every seed lies outside the automatic brain mask (--roi auto), the first at (5, 5, 5)"}}) {
+                                            "every seed lies outside the automatic brain mask (--roi auto), the first at voxel (5, 5, 5)"}}) {
         const auto r = run_cli(c.args);
         EXPECT_NE(r.rc, 0) << c.args;
         EXPECT_EQ(lines(r.err), 1) << r.err;
@@ -206,8 +206,8 @@ TEST(RoiAutoCli, AFullHeadIsSegmentedInItsBrainMaskByDefault) {
     EXPECT_EQ(differ(with_air, by_default), 0u);
     std::size_t said = 0;
     for (const auto& w : jw["warnings"])
-        said += w.get<std::string>() == "the seed at (2, 2, 2) lies outside the automatic brain mask (the default ROI of a head): it is left "
-                                        "out; pass --roi none to segment outside the brain";
+        said += w.get<std::string>() == "the seed at voxel (2, 2, 2) lies outside the automatic brain mask (the default ROI of a head): it is "
+                                        "left out; pass --roi none to segment outside the brain";
     EXPECT_EQ(said, 1u) << jw["warnings"].dump();
     const std::string air_only = " --seed 2,2,2 --mu-raw 8 --epsilon-raw 6 --iterations 50 --no-bias-correct --json --out-mask ";
     const fs::path a1 = work_dir() / "air_default.nii.gz", a2 = work_dir() / "air_none.nii.gz";
@@ -218,8 +218,34 @@ TEST(RoiAutoCli, AFullHeadIsSegmentedInItsBrainMaskByDefault) {
     EXPECT_EQ(differ(read_label_image(a1.string()), read_label_image(a2.string())), 0u);
     const nlohmann::json j1 = nlohmann::json::parse(r1.out);
     EXPECT_FALSE(j1.contains("roi"));
-    EXPECT_NE(j1["warnings"].dump().find("every seed lies outside the automatic brain mask (a T1 brain's), the first at (2, 2, 2): the whole "
-                                         "image is segmented, as with --roi none"), std::string::npos) << j1["warnings"].dump();
+    EXPECT_NE(j1["warnings"].dump().find("every seed lies outside the automatic brain mask (a T1 brain's), the first at voxel (2, 2, 2): the "
+                                         "whole image is segmented, as with --roi none"), std::string::npos) << j1["warnings"].dump();
+    EXPECT_EQ(j1["warnings"].dump().find("may have leaked"), std::string::npos);  // the whole image was their choice: no advice
+    // An initial mask: in the brain (a WM ball) the default ROI stays; in the scalp it is given up
+    // as the seeds in the air were (the run is --roi none's).
+    const Grid<float> head = read_image(head_image(true).string());
+    for (const bool scalp : {false, true}) {
+        Grid<std::uint8_t> init(head.lattice(), 0);
+        for (int z = 0; z < 64; ++z)
+            for (int y = 0; y < 64; ++y)
+                for (int x = 0; x < 64; ++x) {
+                    const double r = 1.5 * norm(Vec3d{x - 31.5, y - 31.5, z - 31.5});
+                    init({x, y, z}) = scalp ? (r > 36 && r < 41 && z > 40) : r < 9;
+                }
+        const std::string name = scalp ? "init_scalp" : "init_wm", path = (work_dir() / (name + ".nii.gz")).string();
+        write_label_image(init, path);
+        const std::string start = " --init-mask " + path + " --mu-raw 130 --epsilon-raw 40 --iterations 30 --no-bias-correct --json --out-mask ";
+        const auto d = run_cli("--threads 2 segment " + head_image(true).string() + start + (work_dir() / (name + "_d.nii.gz")).string());
+        const auto n = run_cli("--threads 2 segment " + head_image(true).string() + " --roi none" + start + (work_dir() / (name + "_n.nii.gz")).string());
+        ASSERT_EQ(d.rc, 0) << d.err;
+        ASSERT_EQ(n.rc, 0) << n.err;
+        const nlohmann::json jd2 = nlohmann::json::parse(d.out);
+        EXPECT_EQ(jd2.contains("roi"), !scalp) << name;
+        EXPECT_EQ(jd2["warnings"].dump().find("of the initial mask lies outside the automatic brain mask") != std::string::npos, scalp) << name;
+        if (scalp) {
+            EXPECT_EQ(differ(read_label_image((work_dir() / (name + "_d.nii.gz")).string()), read_label_image((work_dir() / (name + "_n.nii.gz")).string())), 0u);
+        }
+    }
 
     Grid<float> stripped = liveset::testing::analytic_head(false);  // brain and CSF only, air around
     for (int z = 0; z < 64; ++z)

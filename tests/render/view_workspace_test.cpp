@@ -242,6 +242,19 @@ TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
     EXPECT_NE(r.err.find(hint), std::string::npos) << r.err;
     r = run_cli(fmt::format("view {} --no-bias-correct --roi none --seed 2,2,2 --headless --script {}", head, script("n.json", "[]")));
     EXPECT_EQ(r.rc, 0) << r.err;
+    // A level set to continue keeps the whole image unless --roi says otherwise (it may come from
+    // another tool): no default ROI with --mask.
+    Grid<std::uint8_t> ball(read_image(head).lattice(), 0);
+    ball({32, 32, 32}) = ball({33, 32, 32}) = 1;
+    const std::string ball_path = (f.dir / "head_ball.nii.gz").string();
+    write_label_image(ball, ball_path);
+    r = run_cli(fmt::format("view {} --no-bias-correct --mask {} --headless --script {}", head, ball_path, script("m.json", "[]")));
+    EXPECT_EQ(r.rc, 0) << r.err;
+    EXPECT_EQ(r.err.find("by default"), std::string::npos) << r.err;
+    // A seed whose centre lies just outside the ROI but whose ball reaches into it is taken (and
+    // clipped), as `segment` takes it.
+    r = run_cli(fmt::format("view {} --roi {} --headless --script {}", f.image, roi_path, script("edge.json", R"([{"seed": [25, 24, 24], "radius": 2}])")));
+    EXPECT_EQ(r.rc, 0) << r.err;
 }
 
 // A workspace records its ROI's checksum. Without N4: reopened with the ROI unchanged it says
@@ -340,15 +353,15 @@ TEST(ViewCommand, ScriptsSaveAndLoadSeedFiles) {
     const Vec3i d = roi.dims();
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x <= s0.x + 2; ++x) roi({x, y, z}) = 1;  // the first seed inside, 5 voxels along x outside
+            for (int x = 0; x <= s0.x + 2; ++x) roi({x, y, z}) = 1;  // the first seed inside, 6 voxels along x outside
     const std::string roi_path = (f.dir / "slab.nii.gz").string();
     write_label_image(roi, roi_path);
     const std::string two = (f.dir / "two_seeds.txt").string();
-    std::ofstream(two) << fmt::format("{},{},{}\n{},{},{}:3\n", s0.x, s0.y, s0.z, s0.x + 5, s0.y, s0.z);
+    std::ofstream(two) << fmt::format("{},{},{}\n{},{},{}:3\n", s0.x, s0.y, s0.z, s0.x + 6, s0.y, s0.z);  // its ball 1 voxel off
     r = run_cli(fmt::format("view {} --roi {} --headless --script {}", f.image, roi_path, script("m.json", R"([{"load_seeds": ")" + two + R"("}])")));
     EXPECT_NE(r.rc, 0);
     EXPECT_NE(r.err.find("loaded 1 of 2 seed(s)"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find(fmt::format("refused {},{},{}:3", s0.x + 5, s0.y, s0.z)), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(fmt::format("refused {},{},{}:3", s0.x + 6, s0.y, s0.z)), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("outside the region of interest"), std::string::npos) << r.err;
 }
 

@@ -371,13 +371,15 @@ TEST(Session, RefusesASeedOutsideTheRoi) {
         for (int y = 0; y < d.y; ++y)
             for (int x = 0; x < d.x / 2; ++x) roi({x, y, z}) = 1;  // the ROI: the half with x < d.x / 2
     Session s(ph.image, options(), roi);
-    const Vec3d outside{d.x / 2.0, d.y / 2.0, d.z / 2.0}, inside{d.x / 2.0 - 1.0, d.y / 2.0, d.z / 2.0};
+    // outside: no voxel of its ball (radius 2) in the ROI; astride: its centre outside, part of its ball in
+    const Vec3d outside{d.x / 2.0 + 2.5, d.y / 2.0, d.z / 2.0}, inside{d.x / 2.0 - 1.0, d.y / 2.0, d.z / 2.0},
+        astride{d.x / 2.0 + 1.0, d.y / 2.0, d.z / 2.0};
     try {
         s.add_seed({outside, 2.0});
         FAIL() << "a seed outside the ROI was accepted";
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("outside the region of interest"), std::string::npos) << e.what();
-        EXPECT_NE(std::string(e.what()).find("(32, 32, 32)"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("(35, 32, 32)"), std::string::npos) << e.what();
     }
     EXPECT_TRUE(s.seeds().empty());
     EXPECT_FALSE(s.has_surface());
@@ -385,6 +387,8 @@ TEST(Session, RefusesASeedOutsideTheRoi) {
     s.add_seed({inside, 2.0});
     EXPECT_EQ(s.seeds().size(), 1u);
     EXPECT_TRUE(s.has_surface());
+    s.add_seed({astride, 2.0});  // clipped by the ROI, as `segment` clips it
+    EXPECT_EQ(s.seeds().size(), 2u);
     // Without a ROI the same voxel is fine.
     Session free(ph.image, options());
     EXPECT_NO_THROW(free.add_seed({outside, 2.0}));

@@ -114,10 +114,10 @@ public:
 
     // --- seeds (undoable) -------------------------------------------------------------------
     const std::vector<SeedBall>& seeds() const { return marks_.seeds; }
-    // Adds a seed ball (index space; centre inside the image and, with a ROI, on a ROI voxel) and
+    // Adds a seed ball (index space; centre inside the image and, with a ROI, a voxel of it in the ROI) and
     // unites it with the level set. Throws std::invalid_argument (changing nothing) otherwise.
     SessionUpdate add_seed(SeedBall seed);
-    // Throws std::invalid_argument when the seed's centre voxel lies outside the ROI (none: no-op).
+    // Throws std::invalid_argument when no voxel of the seed's ball lies in the ROI (none: no-op).
     void check_seed_in_roi(const SeedBall& seed) const;
     // Removes seed `index`. While the level set is still the union of the seeds (no step taken
     // since), it is re-initialised from the remaining ones; later, only the list (and the window
