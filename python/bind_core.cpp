@@ -53,12 +53,12 @@ void write(const pyb::array& values, const Lattice& lattice, const std::string& 
 
 // The ROI as `liveset segment --roi` takes it: None (the default: the automatic brain mask on a head,
 // else none), "auto" (the automatic brain mask), "none" or a mask array.
-std::optional<cli::Roi> roi_of(const pyb::object& roi, const Grid<float>& image) {
+std::optional<cli::Roi> roi_of(const pyb::object& roi, const Grid<float>& image, cli::BrainLookup* lookup) {
     if (roi.is_none() || pyb::isinstance<pyb::str>(roi)) {
         const std::string s = roi.is_none() ? std::string() : roi.cast<std::string>();
         if (s != "auto" && s != "none" && !s.empty()) throw std::invalid_argument("roi must be None, 'auto', 'none' or a mask array, not '" + s + "'");
         pyb::gil_scoped_release nogil;
-        return cli::load_roi(s, image, "roi");
+        return cli::load_roi(s, image, "roi", lookup);
     }
     return cli::Roi{mask_from_array(roi.cast<pyb::array>(), image.lattice()), "array", std::nullopt, nullptr};
 }
@@ -97,7 +97,8 @@ cli::BiasCorrection bias_mode(const std::optional<bool>& bias_correct) {
 pyb::dict segment(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a, const pyb::object& progress) {
     Grid<float> image = grid_from_array(values, lattice);
     SegmentRequest req = request_for(a, lattice);
-    std::optional<cli::Roi> roi = roi_of(a.roi, image);
+    cli::BrainLookup lookup;
+    std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
     std::optional<Grid<std::uint8_t>> init;
     if (!a.init_mask.is_none()) init = mask_from_array(a.init_mask.cast<pyb::array>(), lattice);
     Interrupt interrupt;
@@ -109,7 +110,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     cli::SeedFit seed_fit;  // seeds outside the ROI
     {
         pyb::gil_scoped_release nogil;
-        prepared = cli::prepare_image(image, roi, mode, &interrupt.flag());
+        prepared = cli::prepare_image(image, roi, mode, &interrupt.flag(), &lookup);
         seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, init ? &*init : nullptr, "roi='none'");
         roi_mask = roi ? &roi->mask : nullptr;
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
@@ -151,11 +152,12 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
 pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice, const pyb::object& roi_arg,
                                 const std::optional<bool>& bias_correct) {
     Grid<float> image = grid_from_array(values, lattice);
-    std::optional<cli::Roi> roi = roi_of(roi_arg, image);  // "auto": as segment's
+    cli::BrainLookup lookup;
+    std::optional<cli::Roi> roi = roi_of(roi_arg, image, &lookup);  // "auto": as segment's
     cli::PreparedImage prepared;
     {
         pyb::gil_scoped_release nogil;
-        prepared = cli::prepare_image(image, roi, bias_mode(bias_correct));
+        prepared = cli::prepare_image(image, roi, bias_mode(bias_correct), nullptr, &lookup);
     }
     const Grid<std::uint8_t>* r = roi ? &roi->mask : nullptr;
     nlohmann::json j = nlohmann::json::object();
@@ -174,9 +176,10 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
 std::string tissue_model(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a) {
     Grid<float> image = grid_from_array(values, lattice);
     SegmentRequest req = request_for(a, lattice, false);
-    std::optional<cli::Roi> roi = roi_of(a.roi, image);
+    cli::BrainLookup lookup;
+    std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
     pyb::gil_scoped_release nogil;
-    cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct));  // as segment
+    cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct), nullptr, &lookup);  // as segment
     const cli::SeedFit seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, nullptr, "roi='none'");
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);

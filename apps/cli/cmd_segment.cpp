@@ -97,7 +97,8 @@ int run_segment(const SegmentArgs& a, int threads) {
 
     Grid<float> image = read_image(a.image);
     std::optional<Grid<std::uint8_t>> init;
-    std::optional<Roi> roi = load_roi(a.roi, image);
+    BrainLookup lookup;
+    std::optional<Roi> roi = load_roi(a.roi, image, "--roi", &lookup);
     if (!a.out_roi.empty() && !roi)
         throw UsageError("--out-roi: no ROI to write (a skull-stripped brain, or an image where no head is found, gets none by default: give "
                          "--roi auto or a mask)");
@@ -105,7 +106,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.
     const BiasCorrection mode = bias_mode(a.bias_correct, a.bias_given || !a.out_corrected.empty());
-    PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag());
+    PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag(), &lookup);
     if (prepared.bias && prepared.bias->interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
         return 130;

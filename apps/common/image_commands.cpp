@@ -29,7 +29,7 @@ Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& refere
     return m;
 }
 
-std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option) {
+std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option, BrainLookup* lookup) {
     if (arg == "none") return std::nullopt;
     if (!arg.empty() && arg != "auto") return Roi{load_mask_like(arg, image.lattice(), option), arg, std::nullopt, nullptr};
     BrainMaskReport report;
@@ -37,10 +37,16 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
     try {
         Grid<std::uint8_t> mask = auto_brain_mask(image, {}, &report, head.get());
         // By default only a full head: a skull-stripped brain (or a phantom) has no scalp to leak into.
-        if (arg.empty() && report.skull_stripped) return std::nullopt;
+        if (arg.empty() && report.skull_stripped) {
+            if (lookup) *lookup = BrainLookup{true, std::move(mask), std::move(head)};
+            return std::nullopt;
+        }
         return Roi{std::move(mask), "auto", report, std::move(head), arg.empty()};
     } catch (const std::invalid_argument& e) {
-        if (arg.empty()) return std::nullopt;  // not a head: the default is no ROI
+        if (arg.empty()) {  // not a head: the default is no ROI
+            if (lookup) *lookup = BrainLookup{true, std::nullopt, nullptr};
+            return std::nullopt;
+        }
         throw UsageError(fmt::format("{} auto: {}", option, e.what()));
     }
 }
@@ -123,13 +129,20 @@ void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMa
 
 }  // namespace
 
-PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt) {
+PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt,
+                            BrainLookup* lookup) {
     PreparedImage out;
-    BrainMaskHead fit_head;  // the fit region's head, without a ROI
-    if (!roi) out.fit_region = try_auto_brain_mask(image, &fit_head);
+    BrainMaskHead own_head;  // the fit region's head, without a ROI
+    BrainMaskHead* fit_head = &own_head;
+    if (!roi && lookup && lookup->done) {  // the default looked already
+        out.fit_region = std::move(lookup->mask);
+        if (lookup->head) fit_head = lookup->head.get();
+    } else if (!roi) {
+        out.fit_region = try_auto_brain_mask(image, fit_head);
+    }
     if (mode != BiasCorrection::kOff) {
         correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
-        if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : &fit_head, out);
+        if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : fit_head, out);
     }
     if (roi) roi->head.reset();  // only needed here
     return out;

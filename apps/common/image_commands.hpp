@@ -38,7 +38,16 @@ struct Roi {
 // else no ROI (a skull-stripped brain has no scalp, muscle or eyes to leak into). "none": no ROI. "auto": auto_brain_mask(image) (UsageError "<option> auto: ..." when it
 // fails: constant image, no head, empty mask). Otherwise a mask file overlaying the image
 // (load_mask_like); files named "auto" or "none" can be given as ./auto, ./none.
-std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option = "--roi");
+// What the default learnt without keeping a ROI: that no head is there, or the automatic brain mask
+// of a skull-stripped brain. prepare_image takes it as the fit region instead of looking again
+// (the same mask, bit for bit).
+struct BrainLookup {
+    bool done = false;                       // the default looked and kept no ROI
+    std::optional<Grid<std::uint8_t>> mask;  // what it found (none: no head)
+    std::shared_ptr<BrainMaskHead> head;     // where it found it
+};
+std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option = "--roi",
+                            BrainLookup* lookup = nullptr);
 // What a seed refused by a ROI chosen by default is told (after the session's own message).
 inline constexpr const char* kDefaultRoiHint =
     ": the automatic brain mask bounds the front by default on a head; open the image with --roi none to segment outside the brain";
@@ -88,8 +97,9 @@ struct PreparedImage {
 // and replaces the first (kept when none is found there): a strong
 // field drags the first mask's tissue window off (BrainWeb × a ±40 % field: brain mask Dice 0.904,
 // found again 0.943; docs/BENCHMARKS.md, session 56).
+// `lookup`: load_roi's, so a default that kept no ROI is not looked for again.
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode,
-                            const std::atomic<bool>* interrupt = nullptr);
+                            const std::atomic<bool>* interrupt = nullptr, BrainLookup* lookup = nullptr);
 // What fit_seeds_to_roi said and did.
 struct SeedFit {
     std::vector<std::string> warnings;

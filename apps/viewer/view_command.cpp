@@ -76,7 +76,8 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     Grid<float> image = read_image(a.image);
     // A level set to continue (--mask, --phi) may come from another tool: no default ROI to clip it.
     if (a.roi.empty() && (!a.mask.empty() || !a.phi.empty())) a.roi = "none";
-    std::optional<Roi> r = load_roi(a.roi, image, "--roi");  // a mask file, "auto", "none" or the default, as `segment`
+    BrainLookup lookup;
+    std::optional<Roi> r = load_roi(a.roi, image, "--roi", &lookup);  // a mask file, "auto", "none" or the default, as `segment`
     if (a.roi.empty()) {  // the default's choice, kept as such (workspaces, a second load)
         a.roi_by_default = r.has_value();
         a.roi = r ? "auto" : "none";
@@ -86,7 +87,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     const BiasCorrection mode = bias_mode(a.workspace_bias.value_or(a.bias_correct), a.bias_given || a.workspace_bias);
     PreparedImage prepared;
     try {
-        prepared = prepare_image(image, r, mode);
+        prepared = prepare_image(image, r, mode, nullptr, &lookup);
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{}: {}", a.image, e.what()));
     }

@@ -48,9 +48,10 @@ bool Viewer::open_image(const std::string& path) {
             auto out = std::make_shared<Opened>();
             Grid<float> image = read_image(path);
             if (cancel->load()) return out;
-            std::optional<cli::Roi> roi = cli::load_roi(roi_arg, image);  // as `view IMAGE [--roi none]` (view_command.cpp)
+            cli::BrainLookup lookup;
+            std::optional<cli::Roi> roi = cli::load_roi(roi_arg, image, "--roi", &lookup);  // as `view IMAGE [--roi none]` (view_command.cpp)
             if (cancel->load()) return out;
-            cli::PreparedImage prepared = cli::prepare_image(image, roi, mode, cancel.get());
+            cli::PreparedImage prepared = cli::prepare_image(image, roi, mode, cancel.get(), &lookup);
             if (cancel->load()) return out;
             out->corrected = prepared.bias.has_value();
             out->bias_skipped = prepared.bias_skipped;
