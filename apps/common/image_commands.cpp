@@ -150,27 +150,6 @@ PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCor
 
 namespace {
 
-// Whether a voxel of the seed's ball (as seed_values reads it: within max(radius, 0.5) of the
-// centre, index space) lies in `mask`.
-bool ball_touches(const Grid<std::uint8_t>& mask, const SeedBall& s) {
-    const Vec3i d = mask.dims();
-    const double r = std::max(s.radius, 0.5);
-    Vec3i lo, hi;
-    for (int a = 0; a < 3; ++a) {
-        lo[a] = std::max(0, static_cast<int>(std::floor(s.center[a] - r)));
-        hi[a] = std::min(d[a] - 1, static_cast<int>(std::ceil(s.center[a] + r)));
-    }
-    for (int z = lo.z; z <= hi.z; ++z)
-        for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x)
-                if (mask({x, y, z}) != 0 && norm(Vec3d{double(x), double(y), double(z)} - s.center) <= r) return true;
-    return false;
-}
-
-}  // namespace
-
-namespace {
-
 // The default ROI given up for the whole image (its mask becomes the fit region, where N4 was
 // fitted, as without a ROI), with the warning saying why.
 void drop_default_roi(std::optional<Roi>& roi, PreparedImage& prepared, SeedFit& out, std::string why, std::string_view none_hint) {

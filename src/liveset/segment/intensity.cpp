@@ -75,6 +75,21 @@ Grid<float> normalise(const Grid<float>& image, const IntensityScale& scale) {
     return out;
 }
 
+bool ball_touches(const Grid<std::uint8_t>& mask, const SeedBall& s) {
+    const Vec3i d = mask.dims();
+    const double r = std::max(s.radius, 0.5);
+    Vec3i lo, hi;
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = std::max(0, static_cast<int>(std::floor(s.center[a] - r)));
+        hi[a] = std::min(d[a] - 1, static_cast<int>(std::ceil(s.center[a] + r)));
+    }
+    for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+            for (int x = lo.x; x <= hi.x; ++x)
+                if (mask({x, y, z}) != 0 && norm(Vec3d{double(x), double(y), double(z)} - s.center) <= r) return true;
+    return false;
+}
+
 std::vector<float> seed_values(const Grid<float>& image, std::span<const SeedBall> seeds, const Grid<std::uint8_t>* roi) {
     check_roi(image, roi);
     const Lattice& l = image.lattice();

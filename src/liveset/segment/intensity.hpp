@@ -57,6 +57,10 @@ struct SeedStatistics {
 std::vector<float> seed_values(const Grid<float>& image, std::span<const SeedBall> seeds,
                                const Grid<std::uint8_t>* roi = nullptr);
 
+// Whether a lattice point of the seed's ball, as seed_values reads it (within max(radius, 0.5) of
+// the centre, index space), lies in `mask` (non-zero).
+bool ball_touches(const Grid<std::uint8_t>& mask, const SeedBall& seed);
+
 // Statistics of seed_values().
 SeedStatistics seed_statistics(const Grid<float>& image, std::span<const SeedBall> seeds,
                                const Grid<std::uint8_t>* roi = nullptr);

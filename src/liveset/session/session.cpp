@@ -169,17 +169,7 @@ void Session::check_seed_in_roi(const SeedBall& seed) const {
     if (!roi_) return;
     const Vec3i c{static_cast<int>(std::lround(seed.center.x)), static_cast<int>(std::lround(seed.center.y)),
                   static_cast<int>(std::lround(seed.center.z))};
-    // Any voxel of the ball (as seed_values reads it) in the ROI will do: a seed astride its edge is clipped.
-    const double r = std::max(seed.radius, 0.5);
-    Vec3i lo, hi;
-    for (int a = 0; a < 3; ++a) {
-        lo[a] = std::max(0, static_cast<int>(std::floor(seed.center[a] - r)));
-        hi[a] = std::min(lattice().dims()[a] - 1, static_cast<int>(std::ceil(seed.center[a] + r)));
-    }
-    for (int z = lo.z; z <= hi.z; ++z)
-        for (int y = lo.y; y <= hi.y; ++y)
-            for (int x = lo.x; x <= hi.x; ++x)
-                if ((*roi_)({x, y, z}) != 0 && norm(Vec3d{double(x), double(y), double(z)} - seed.center) <= r) return;
+    if (ball_touches(*roi_, seed)) return;  // a seed astride the ROI's edge is clipped, as `segment` clips it
     throw std::invalid_argument("the seed at (" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z) +
                                 ") lies outside the region of interest (the front may not grow there)");
 }
