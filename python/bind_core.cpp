@@ -24,19 +24,17 @@ namespace {
 
 using cli::UsageError;
 
-pyb::tuple image_tuple(Grid<float>&& g) {
-    const Lattice l = g.lattice();
-    return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l));
-}
-
+// (array, geometry, oriented: the file gave an orientation).
 pyb::tuple read(const std::string& path, bool labels) {
+    ImageHeader h;
     if (labels) {
-        Grid<std::uint8_t> g = [&] { pyb::gil_scoped_release nogil; return read_label_image(path); }();
+        Grid<std::uint8_t> g = [&] { pyb::gil_scoped_release nogil; return read_label_image(path, kDefaultImageMemoryLimit, &h); }();
         const Lattice l = g.lattice();
-        return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l));
+        return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l), h.orientation_known);
     }
-    Grid<float> g = [&] { pyb::gil_scoped_release nogil; return read_image(path); }();
-    return image_tuple(std::move(g));
+    Grid<float> g = [&] { pyb::gil_scoped_release nogil; return read_image(path, kDefaultImageMemoryLimit, &h); }();
+    const Lattice l = g.lattice();
+    return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l), h.orientation_known);
 }
 
 void write(const pyb::array& values, const Lattice& lattice, const std::string& path, bool labels) {
@@ -74,7 +72,17 @@ struct SegmentArgs {
     std::optional<double> alpha;  // unset: automatic (alpha.hpp), as the CLI
     std::optional<double> smooth_mm;  // only with alpha (the automatic choice sets both), as --smooth
     std::optional<bool> bias_correct;  // unset: on, skipped with a warning where it cannot run (as the CLI's default)
+    bool oriented = true;  // Image.oriented: the file gave an orientation (BrainMaskOptions::superior_from_header)
 };
+
+// The automatic brain mask's lookup for an image whose file did (not) give an orientation, as the CLI's.
+cli::BrainLookup lookup_for(bool oriented) {
+    ImageHeader h;
+    h.orientation_known = oriented;
+    cli::BrainLookup lookup;
+    lookup.options = cli::brain_mask_options(h);
+    return lookup;
+}
 
 // The request `liveset segment` builds from its options (cmd_segment.cpp), on an image in memory.
 SegmentRequest request_for(const SegmentArgs& a, const Lattice& lattice, bool need_seeds = true) {
@@ -97,7 +105,7 @@ cli::BiasCorrection bias_mode(const std::optional<bool>& bias_correct) {
 pyb::dict segment(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a, const pyb::object& progress) {
     Grid<float> image = grid_from_array(values, lattice);
     SegmentRequest req = request_for(a, lattice);
-    cli::BrainLookup lookup;
+    cli::BrainLookup lookup = lookup_for(a.oriented);
     std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
     std::optional<Grid<std::uint8_t>> init;
     if (!a.init_mask.is_none()) init = mask_from_array(a.init_mask.cast<pyb::array>(), lattice);
@@ -150,9 +158,9 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
 // tissue model is fitted in (the automatic brain mask; none with a ROI) and the report's
 // bias_correction / warnings / roi.
 pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice, const pyb::object& roi_arg,
-                                const std::optional<bool>& bias_correct) {
+                                const std::optional<bool>& bias_correct, bool oriented) {
     Grid<float> image = grid_from_array(values, lattice);
-    cli::BrainLookup lookup;
+    cli::BrainLookup lookup = lookup_for(oriented);
     std::optional<cli::Roi> roi = roi_of(roi_arg, image, &lookup);  // "auto": as segment's
     cli::PreparedImage prepared;
     {
@@ -176,7 +184,7 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
 std::string tissue_model(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a) {
     Grid<float> image = grid_from_array(values, lattice);
     SegmentRequest req = request_for(a, lattice, false);
-    cli::BrainLookup lookup;
+    cli::BrainLookup lookup = lookup_for(a.oriented);
     std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
     pyb::gil_scoped_release nogil;
     cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct), nullptr, &lookup);  // as segment
@@ -354,6 +362,7 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
         else if (k == "alpha") a.alpha = value.cast<std::optional<double>>();
         else if (k == "smooth_mm") a.smooth_mm = value.cast<std::optional<double>>();
         else if (k == "bias_correct") a.bias_correct = value.cast<std::optional<bool>>();
+        else if (k == "oriented") a.oriented = value.cast<bool>();
         else throw std::invalid_argument("unknown segment option '" + k + "'");
     }
     if (a.classes < 2 || a.classes > 6) throw UsageError("classes must be in 2..6");
@@ -374,6 +383,7 @@ void register_core(pyb::module_& m) {
         d["components"] = h.components;
         d["pixel_type"] = h.pixel_type;
         d["format"] = h.format;
+        d["oriented"] = h.orientation_known;
         return d;
     }, pyb::arg("path"));
     m.def("_read", &read, pyb::arg("path"), pyb::arg("labels") = false);
@@ -392,10 +402,11 @@ void register_core(pyb::module_& m) {
         SegmentArgs a = segment_args(kw);
         return tissue_model(v, l, a);
     });
-    m.def("_prepare_session_image", [](const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi, const std::optional<bool>& bias_correct) {
+    m.def("_prepare_session_image", [](const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi, const std::optional<bool>& bias_correct,
+                                       bool oriented) {
         if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
         const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
-        return prepare_session_image(v, l, roi, bias_correct);
+        return prepare_session_image(v, l, roi, bias_correct, oriented);
     });
     m.def("_mesh", [](const pyb::array& v, const pyb::tuple& geo, bool is_mask, const std::string& out) {
         if (v.ndim() != 3) throw std::invalid_argument("the input must be a 3D array");

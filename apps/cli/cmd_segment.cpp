@@ -95,9 +95,11 @@ int run_segment(const SegmentArgs& a, int threads) {
     const InterruptGuard interrupt;
     check_segment_args(a);
 
-    Grid<float> image = read_image(a.image);
+    ImageHeader header;
+    Grid<float> image = read_image(a.image, kDefaultImageMemoryLimit, &header);
     std::optional<Grid<std::uint8_t>> init;
     BrainLookup lookup;
+    lookup.options = brain_mask_options(header);
     std::optional<Roi> roi = load_roi(a.roi, image, "--roi", &lookup);
     if (!a.out_roi.empty() && !roi)
         throw UsageError("--out-roi: no ROI to write (a skull-stripped brain, or an image where no head is found, gets none by default: give "

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "cli_support.hpp"
@@ -29,31 +31,44 @@ Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& refere
     return m;
 }
 
+BrainMaskOptions brain_mask_options(const ImageHeader& header) {
+    BrainMaskOptions o;
+    o.superior_from_header = header.orientation_known;
+    return o;
+}
+
 std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option, BrainLookup* lookup) {
     if (arg == "none") return std::nullopt;
     if (!arg.empty() && arg != "auto") return Roi{load_mask_like(arg, image.lattice(), option), arg, std::nullopt, nullptr};
+    const BrainMaskOptions options = lookup ? lookup->options : BrainMaskOptions{};
     BrainMaskReport report;
     auto head = std::make_shared<BrainMaskHead>();
+    const auto learnt = [&](std::optional<Grid<std::uint8_t>> mask, std::shared_ptr<BrainMaskHead> where) {
+        if (lookup == nullptr) return;
+        lookup->done = true;
+        lookup->mask = std::move(mask);
+        lookup->head = std::move(where);
+    };
     try {
-        Grid<std::uint8_t> mask = auto_brain_mask(image, {}, &report, head.get());
+        Grid<std::uint8_t> mask = auto_brain_mask(image, options, &report, head.get());
         // By default only a full head: a skull-stripped brain (or a phantom) has no scalp to leak into.
         if (arg.empty() && report.skull_stripped) {
-            if (lookup) *lookup = BrainLookup{true, std::move(mask), std::move(head)};
+            learnt(std::move(mask), std::move(head));
             return std::nullopt;
         }
         return Roi{std::move(mask), "auto", report, std::move(head), arg.empty()};
     } catch (const std::invalid_argument& e) {
         if (arg.empty()) {  // not a head: the default is no ROI
-            if (lookup) *lookup = BrainLookup{true, std::nullopt, nullptr};
+            learnt(std::nullopt, nullptr);
             return std::nullopt;
         }
         throw UsageError(fmt::format("{} auto: {}", option, e.what()));
     }
 }
 
-std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head) {
+std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head, const BrainMaskOptions& options) {
     try {
-        return auto_brain_mask(image, {}, nullptr, head);
+        return auto_brain_mask(image, options, nullptr, head);
     } catch (const std::invalid_argument&) {
         return std::nullopt;
     }
@@ -80,6 +95,15 @@ double negative_share(const Grid<float>& image, const Grid<std::uint8_t>* region
 
 namespace {
 
+// The image's floor: its 0.1 % quantile (a z-scored head's air, a stripped brain's background),
+// robust to the few values ringing below it after a resampling.
+float image_floor(const Grid<float>& image) {
+    std::vector<float> v(image.values().begin(), image.values().end());
+    const auto k = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 1000);
+    std::nth_element(v.begin(), k, v.end());
+    return *k;
+}
+
 // N4 per `mode` on `image`, fitted in `fit` (null: Otsu's foreground), as prepare_image.
 void correct_for(Grid<float>& image, const Grid<std::uint8_t>* fit, BiasCorrection mode, const std::atomic<bool>* interrupt,
                  PreparedImage& out) {
@@ -88,15 +112,22 @@ void correct_for(Grid<float>& image, const Grid<std::uint8_t>* fit, BiasCorrecti
     };
     BiasCorrectionReport report;
     try {
-        if (mode == BiasCorrection::kDefault) {
-            // N4 models a multiplicative field on magnitude data. Negative values where it would fit
-            // (an offset, a z-scored image) are outside that model: the default leaves such an image alone.
-            const double negative = negative_share(image, fit);
-            if (negative > 0.01)
-                return skip(fmt::format("{:.1f} % of the voxels it would fit are negative (an offset or a z-scored image?), outside N4's "
-                                        "multiplicative model", 100.0 * negative));
+        // N4 models a multiplicative field on magnitude data, whose zero is the air's. Negative values
+        // where it would fit (an offset, a z-scored image) put that zero elsewhere: N4 then fits the
+        // image above its floor (the air's value), and the floor is added back.
+        const float offset = negative_share(image, fit) > 0.01 ? image_floor(image) : 0.0f;
+        if (offset == 0.0f) {
+            image = correct_bias(image, fit, {}, &report, interrupt);
+        } else {
+            Grid<float> shifted = image;
+            for (float& v : shifted.values()) v -= offset;
+            shifted = correct_bias(shifted, fit, {}, &report, interrupt);
+            if (!report.interrupted) {
+                for (float& v : shifted.values()) v += offset;
+                image = std::move(shifted);
+            }
+            out.bias_offset = offset;
         }
-        image = correct_bias(image, fit, {}, &report, interrupt);
     } catch (const std::invalid_argument& e) {  // the input N4 cannot take
         if (mode == BiasCorrection::kRequired) throw;
         return skip(e.what());
@@ -113,13 +144,14 @@ namespace {
 
 // The automatic brain mask (ROI "auto", or the fit region without a ROI) found again on the corrected
 // image, in the head it was first found in (`head`; null: the head is found again too).
-void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMaskHead* head, PreparedImage& out) {
+void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMaskHead* head, const BrainMaskOptions& options,
+                      PreparedImage& out) {
     Grid<std::uint8_t>* automatic = roi ? (roi->brain_mask ? &roi->mask : nullptr) : out.fit_region ? &*out.fit_region : nullptr;
     if (automatic == nullptr) return;
     BrainMaskReport report;
     BrainMaskHead anew;
     try {
-        *automatic = auto_brain_mask(image, {}, &report, head ? head : &anew);
+        *automatic = auto_brain_mask(image, options, &report, head ? head : &anew);
     } catch (const std::invalid_argument&) {
         return;  // none found there: the first stays
     }
@@ -132,17 +164,18 @@ void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMa
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt,
                             BrainLookup* lookup) {
     PreparedImage out;
+    const BrainMaskOptions options = lookup ? lookup->options : BrainMaskOptions{};
     BrainMaskHead own_head;  // the fit region's head, without a ROI
     BrainMaskHead* fit_head = &own_head;
     if (!roi && lookup && lookup->done) {  // the default looked already
         out.fit_region = std::move(lookup->mask);
         if (lookup->head) fit_head = lookup->head.get();
     } else if (!roi) {
-        out.fit_region = try_auto_brain_mask(image, fit_head);
+        out.fit_region = try_auto_brain_mask(image, fit_head, options);
     }
     if (mode != BiasCorrection::kOff) {
         correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
-        if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : fit_head, out);
+        if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : fit_head, options, out);
     }
     if (roi) roi->head.reset();  // only needed here
     return out;
@@ -215,6 +248,7 @@ void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, cons
         report["bias_correction"] = bias_correction_report(*prepared.bias);
         report["bias_correction"]["mask"] = prepared.fit_name(roi);
         if (prepared.brain_mask_after_n4) report["bias_correction"]["brain_mask_after_voxels"] = prepared.brain_mask_after_n4;
+        if (prepared.bias_offset != 0.0f) report["bias_correction"]["offset"] = prepared.bias_offset;
     }
     if (!prepared.bias_skipped.empty()) report["warnings"].push_back(prepared.bias_skipped);
 }
@@ -253,7 +287,8 @@ nlohmann::json roi_report(const Roi& roi) {
                      {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold},
                      {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
                      {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
-                     {"below_head_voxels", b->below_voxels}};
+                     {"below_head_voxels", b->below_voxels}, {"inferior_exit_mm2", b->inferior_exit_mm2},
+                     {"superior", b->superior_from_header ? "header" : "from the head"}};
     return j;
 }
 

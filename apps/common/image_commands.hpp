@@ -14,6 +14,7 @@
 #include "liveset/eval/overlap.hpp"
 #include "liveset/eval/surface_distance.hpp"
 #include "liveset/eval/topology.hpp"
+#include "liveset/io/image_io.hpp"
 #include "liveset/segment/brain_mask.hpp"
 #include "liveset/preprocess/bias_correction.hpp"
 #include "liveset/segment/pipeline.hpp"
@@ -41,18 +42,24 @@ struct Roi {
 // What the default learnt without keeping a ROI: that no head is there, or the automatic brain mask
 // of a skull-stripped brain. prepare_image takes it as the fit region instead of looking again
 // (the same mask, bit for bit).
+// `options` (in) say how to look at this image: brain_mask_options(its header).
 struct BrainLookup {
     bool done = false;                       // the default looked and kept no ROI
     std::optional<Grid<std::uint8_t>> mask;  // what it found (none: no head)
     std::shared_ptr<BrainMaskHead> head;     // where it found it
+    BrainMaskOptions options;
 };
+// The automatic brain mask's options for an image with this header: where the header gives no
+// orientation, the head's top is found from the head (BrainMaskOptions::superior_from_header).
+BrainMaskOptions brain_mask_options(const ImageHeader& header);
 std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, const std::string& option = "--roi",
                             BrainLookup* lookup = nullptr);
 // What a seed refused by a ROI chosen by default is told (after the session's own message).
 inline constexpr const char* kDefaultRoiHint =
     ": the automatic brain mask bounds the front by default on a head; open the image with --roi none to segment outside the brain";
-// auto_brain_mask(image, {}, nullptr, head), or nullopt when the image does not look like a head (no error).
-std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head = nullptr);
+// auto_brain_mask(image, options, nullptr, head), or nullopt when the image does not look like a head (no error).
+std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head = nullptr,
+                                                      const BrainMaskOptions& options = {});
 // {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".
 nlohmann::json roi_report(const Roi& roi);
 // One line: "  roi          auto brain mask (...): N voxels, V ml".
@@ -81,6 +88,9 @@ struct PreparedImage {
     // Voxels of the automatic brain mask found again on the corrected image (prepare_image), which
     // replaced the one N4 was fitted in; 0 when it was not.
     std::size_t brain_mask_after_n4 = 0;
+    // The floor N4 fitted the image above when it held negative values where N4 fits (an offset, a
+    // z-scored image), added back after; 0 when none.
+    float bias_offset = 0.0f;
     // The region N4 and the tissue model are fitted in: the ROI, else fit_region, else none (N4
     // then takes Otsu's foreground).
     const Grid<std::uint8_t>* fit(const Grid<std::uint8_t>* roi) const { return roi ? roi : fit_region ? &*fit_region : nullptr; }

@@ -73,10 +73,12 @@ SessionOptions session_options(const ViewArgs& a) {
 }
 
 std::unique_ptr<Session> load_session(ViewArgs& a) {
-    Grid<float> image = read_image(a.image);
+    ImageHeader header;
+    Grid<float> image = read_image(a.image, kDefaultImageMemoryLimit, &header);
     // A level set to continue (--mask, --phi) may come from another tool: no default ROI to clip it.
     if (a.roi.empty() && (!a.mask.empty() || !a.phi.empty())) a.roi = "none";
     BrainLookup lookup;
+    lookup.options = brain_mask_options(header);
     std::optional<Roi> r = load_roi(a.roi, image, "--roi", &lookup);  // a mask file, "auto", "none" or the default, as `segment`
     if (a.roi.empty()) {  // the default's choice, kept as such (workspaces, a second load)
         a.roi_by_default = r.has_value();

@@ -46,9 +46,11 @@ bool Viewer::open_image(const std::string& path) {
     const auto work = [path, cancel, mode, options, roi_arg, failed]() -> std::shared_ptr<Opened> {
         try {
             auto out = std::make_shared<Opened>();
-            Grid<float> image = read_image(path);
+            ImageHeader header;
+            Grid<float> image = read_image(path, kDefaultImageMemoryLimit, &header);
             if (cancel->load()) return out;
             cli::BrainLookup lookup;
+            lookup.options = cli::brain_mask_options(header);
             std::optional<cli::Roi> roi = cli::load_roi(roi_arg, image, "--roi", &lookup);  // as `view IMAGE [--roi none]` (view_command.cpp)
             if (cancel->load()) return out;
             cli::PreparedImage prepared = cli::prepare_image(image, roi, mode, cancel.get(), &lookup);

@@ -20,13 +20,14 @@ def read(path: str, labels: bool = False) -> Image:
     Returns float32 intensities, or uint8 labels with ``labels=True`` (values must be 0..255).
     Raises ImageIOError (an OSError) with a one-line message on missing, corrupt, 2D, RGB, ...
     files."""
-    array, (spacing, origin, direction) = _liveset._read(str(path), labels)
-    return Image(array, spacing, origin, direction)
+    array, (spacing, origin, direction), oriented = _liveset._read(str(path), labels)
+    return Image(array, spacing, origin, direction, oriented)
 
 
 def read_header(path: str) -> dict:
     """What an image file says about itself, without reading the voxels: dims, spacing, origin
-    (LPS), direction (9 numbers, row-major), dimension, components, pixel_type, format."""
+    (LPS), direction (9 numbers, row-major), dimension, components, pixel_type, format, oriented
+    (False: a NIfTI without qform and sform, or an Analyze file; see Image.oriented)."""
     return _liveset._read_header(str(path))
 
 
@@ -100,7 +101,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
               epsilon_raw=epsilon_raw, window_from=window_from, classes=int(classes), n=float(n),
               alpha=None if alpha is None else float(alpha),
               smooth_mm=None if smooth_mm is None else float(smooth_mm), iterations=int(iterations),
-              bias_correct=None if bias_correct is None else bool(bias_correct))
+              bias_correct=None if bias_correct is None else bool(bias_correct), oriented=bool(img.oriented))
     kw["roi"] = _mask_arg(roi, img, "roi", allow_auto=True)
     kw["init_mask"] = _mask_arg(init_mask, img, "init_mask")
     r = _liveset._segment(img.array, img.geometry, progress, **kw)
@@ -141,7 +142,7 @@ def tissue_model(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_r
     kw = dict(seeds=[_seed_text(s) for s in seeds], seeds_mm=[_seed_text(s) for s in seeds_mm],
               seed_radius=float(seed_radius), classes=int(classes), window_from=window_from,
               roi=_mask_arg(roi, img, "roi", allow_auto=True),
-              bias_correct=None if bias_correct is None else bool(bias_correct))
+              bias_correct=None if bias_correct is None else bool(bias_correct), oriented=bool(img.oriented))
     return json.loads(_liveset._tissue_model(img.array, img.geometry, **kw))
 
 

@@ -17,12 +17,17 @@ class Image:
     ``world = origin + direction @ (spacing * [i, j, k])``.
 
     ``direction`` is a 3x3 matrix whose columns are the axes in LPS world space. Arrays returned by
-    liveset are Fortran-ordered views on the C++ result (no copy)."""
+    liveset are Fortran-ordered views on the C++ result (no copy).
+
+    ``oriented`` is False when the file gave no orientation (a NIfTI with neither qform nor sform,
+    an Analyze file): its axes are then LPS identity, as ITK reads them, which may not say where the
+    head's top is; the automatic brain mask then finds it from the head (the neck)."""
 
     array: np.ndarray
     spacing: tuple = (1.0, 1.0, 1.0)
     origin: tuple = (0.0, 0.0, 0.0)
     direction: np.ndarray = field(default_factory=lambda: np.eye(3))
+    oriented: bool = True
 
     def __post_init__(self):
         self.array = np.asarray(self.array)
@@ -58,7 +63,7 @@ class Image:
 
     def like(self, array) -> "Image":
         """Another image on this one's geometry."""
-        return Image(array, self.spacing, self.origin, self.direction.copy())
+        return Image(array, self.spacing, self.origin, self.direction.copy(), self.oriented)
 
     def same_geometry(self, other: "Image", tol: float = 1e-4) -> bool:
         return (self.shape == other.shape and np.allclose(self.spacing, other.spacing, atol=tol)
@@ -84,7 +89,13 @@ class Image:
             data = data[..., 0]
         if not np.issubdtype(data.dtype, np.integer):
             data = np.asarray(data, dtype=np.float32)
-        return cls.from_affine(data, img.affine)
+        out = cls.from_affine(data, img.affine)
+        h = getattr(img, "header", None)
+        if h is not None and "qform_code" in h and "sform_code" in h:  # NIfTI; Analyze has neither: oriented by convention only
+            out.oriented = bool(int(h["qform_code"]) or int(h["sform_code"]))
+        elif type(img).__name__ in ("AnalyzeImage", "Spm99AnalyzeImage", "Spm2AnalyzeImage"):
+            out.oriented = False
+        return out
 
     def to_nibabel(self, dtype=None):
         """A nibabel Nifti1Image with this image's affine (RAS), qform and sform set."""

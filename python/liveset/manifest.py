@@ -16,7 +16,7 @@ FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "smooth_mm", "
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
 CHOICES = {"window_from": ("model", "seeds")}
 BOOLS = ("bias_correct",)
-DEFAULTS_EPOCH = 59  # see Subject.fingerprint
+DEFAULTS_EPOCH = 60  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -49,7 +49,9 @@ class Subject:
         # brain mask raised above noisy air (55) and found again after N4; 57: the tissue model fitted
         # through noise that hides a tissue, the brain looked for within 170 mm of the head's top; 58: the
         # mask after N4 looked for in the head found before it; 59: the automatic brain mask the
-        # default ROI of a head, and a defaced head no longer taken for a stripped brain), so a resumed
+        # default ROI of a head, and a defaced head no longer taken for a stripped brain; 60: N4 fitted
+        # above the floor of an image with negative values, the head's top found from the head where
+        # the header gives no orientation, and the neck cut only where a neck leaves the image), so a resumed
         # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)

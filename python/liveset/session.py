@@ -56,7 +56,7 @@ class Session:
         if smooth_mm is not None and alpha is None:
             raise ValueError("smooth_mm needs alpha: the automatic choice sets both")
         prepared = _liveset._prepare_session_image(img.array, img.geometry, _mask_arg(roi, img, "roi", allow_auto=True),
-                                                   None if bias_correct is None else bool(bias_correct))
+                                                   None if bias_correct is None else bool(bias_correct), bool(img.oriented))
         self.corrected = prepared["image"] is not None
         self.image = img.like(prepared["image"]) if self.corrected else img
         self.roi = None if prepared["roi"] is None else img.like(prepared["roi"])

@@ -86,8 +86,10 @@ def test_segment_equals_cli_bitwise(phantom, cli_segmentation):
 
 def test_bias_correction_is_the_default_and_false_turns_it_off(phantom, cli_segmentation):
     """N4 first by default (as ``liveset segment``, whose report the fixture holds), off with
-    bias_correct=False; the default skips it with a warning where N4's model does not apply
-    (negative intensities), where bias_correct=True refuses with a ValueError."""
+    bias_correct=False; the default skips it with a warning where N4 cannot run (a ROI between its
+    grid's samples), where bias_correct=True refuses with a ValueError. An image shifted below zero
+    (an offset) is fitted above its floor: the unshifted one's voxels, to within N4 fitted on the
+    air's own value."""
     img = liveset.Image.from_nibabel(nib.load(phantom["image"]))
     on = liveset.segment(img, phantom["seeds"], iterations=20)
     off = liveset.segment(img, phantom["seeds"], iterations=20, bias_correct=False)
@@ -97,11 +99,17 @@ def test_bias_correction_is_the_default_and_false_turns_it_off(phantom, cli_segm
     assert liveset.tissue_model(img, phantom["seeds"])["bias_correction"]["mask"] == on.report["bias_correction"]["mask"]
     shifted = liveset.Image.from_nibabel(nib.Nifti1Image(np.asarray(nib.load(phantom["image"]).dataobj, dtype=np.float32) - 5000.0,
                                                          nib.load(phantom["image"]).affine))
-    skipped = liveset.segment(shifted, phantom["seeds"], iterations=20)
+    offset = liveset.segment(shifted, phantom["seeds"], iterations=20)
+    assert -5000.0 <= offset.report["bias_correction"]["offset"] < -4990.0
+    a, b = offset.mask.array != 0, on.mask.array != 0  # to within N4 on the air's own value (1.3)
+    assert 2 * (a & b).sum() / (a.sum() + b.sum()) > 0.995
+    block = np.zeros(img.shape, np.uint8)
+    block[1:5, 1:5, 1:5] = 1
+    skipped = liveset.segment(img, [(2, 2, 2, 1)], roi=img.like(block), iterations=20)
     assert "bias_correction" not in skipped.report
-    assert any("negative" in w for w in skipped.report["warnings"]), skipped.report["warnings"]
-    with pytest.raises(ValueError, match="bias correction"):
-        liveset.segment(shifted, phantom["seeds"], iterations=20, bias_correct=True)
+    assert any("the uncorrected image is used" in w for w in skipped.report["warnings"]), skipped.report["warnings"]
+    with pytest.raises(ValueError, match="bias correction|no voxel"):
+        liveset.segment(img, [(2, 2, 2, 1)], roi=img.like(block), iterations=20, bias_correct=True)
 
 
 def test_evaluate_matches_brute_force_and_cli(phantom, cli_segmentation):
@@ -347,6 +355,30 @@ def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
     assert any("every seed lies outside" in w for w in alone.report["warnings"])
     with pytest.raises(ValueError, match="every seed lies outside the automatic brain mask"):
         liveset.segment(img, [(2, 2, 2)], roi="auto", **air)
+
+
+def test_a_file_without_orientation_reaches_the_brain_mask_as_such(tmp_path):
+    """A NIfTI with neither qform nor sform (as an Analyze file) is read as not oriented, by
+    liveset.read and from nibabel, and segment, tissue_model and Session find the head's top from
+    the head (the report's roi.auto.superior), as ``liveset segment`` does; a copy keeps the flag."""
+    img = _bridged_head()
+    plain, unoriented = str(tmp_path / "oriented.nii.gz"), str(tmp_path / "unoriented.nii.gz")
+    liveset.write(img, plain)
+    n = nib.Nifti1Image(img.array, None)
+    n.header.set_qform(None, code=0)
+    n.header.set_sform(None, code=0)
+    nib.save(n, unoriented)
+    assert liveset.read(plain).oriented and liveset.read_header(plain)["oriented"]
+    u = liveset.read(unoriented)
+    assert not u.oriented and not liveset.read_header(unoriented)["oriented"]
+    assert not liveset.Image.from_nibabel(nib.load(unoriented)).oriented
+    assert liveset.Image.from_nibabel(nib.load(plain)).oriented
+    assert not u.like(u.array).oriented and not liveset.read(unoriented, labels=False).oriented
+    kw = dict(mu_raw=130, epsilon_raw=40, iterations=5, bias_correct=False)
+    for image, superior in ((liveset.read(plain), "header"), (u, "from the head")):
+        assert liveset.segment(image, [(32, 32, 32, 3)], roi="auto", **kw).report["roi"]["auto"]["superior"] == superior
+        s = liveset.Session(image, roi="auto", bias_correct=False)
+        assert s.report["roi"]["auto"]["superior"] == superior
 
 
 def test_session_warns_as_segment_when_its_front_leaks_out_of_the_brain():

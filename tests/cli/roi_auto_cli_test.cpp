@@ -74,6 +74,29 @@ TEST(RoiAutoCli, WritesTheAutomaticBrainMaskAndSegmentsInsideIt) {
     EXPECT_EQ(j["outputs"]["roi"], roi.string());
 }
 
+// A NIfTI without orientation (qform and sform codes 0, as an Analyze file) reaches the automatic
+// brain mask as such: the head's top is found from the head (BrainMask.AHeaderWithoutOrientation…),
+// and the report says so; an oriented header is followed.
+TEST(RoiAutoCli, AHeaderWithoutOrientationHasItsTopFoundFromTheHead) {
+    const fs::path plain = work_dir() / "unoriented.nii";
+    write_image(read_image(head_image().string()), plain.string());
+    const auto superior = [](const fs::path& image) {
+        const auto r = run_cli("segment " + image.string() + " --roi auto --seed 32,32,32:3 --iterations 1 --json --out-mask " +
+                               (work_dir() / "unoriented_seg.nii.gz").string());
+        EXPECT_EQ(r.rc, 0) << r.err;
+        return r.rc == 0 ? nlohmann::json::parse(r.out)["roi"]["auto"]["superior"].get<std::string>() : std::string();
+    };
+    EXPECT_EQ(superior(plain), "header");
+    {
+        std::fstream f(plain, std::ios::in | std::ios::out | std::ios::binary);
+        const std::int16_t zero = 0;
+        f.seekp(252);
+        f.write(reinterpret_cast<const char*>(&zero), 2);  // qform_code
+        f.write(reinterpret_cast<const char*>(&zero), 2);  // sform_code
+    }
+    EXPECT_EQ(superior(plain), "from the head");
+}
+
 TEST(RoiAutoCli, BadInputIsOneLineAndWritesNothing) {
     const fs::path flat = work_dir() / "flat.nii.gz", noise = work_dir() / "noise.nii.gz";
     write_image(Grid<float>(Lattice({32, 32, 32}), 7.0f), flat.string());

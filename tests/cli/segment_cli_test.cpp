@@ -371,8 +371,8 @@ TEST(SegmentCli, BiasCorrectSegmentsTheCorrectedImageAndWritesIt) {
 
 // N4 runs by default (`--no-bias-correct` turns it off, the same mask as before the default
 // changed); where it cannot run and nobody asked for it, the segmentation goes on uncorrected with a
-// warning: a region holding no sample of N4's grid, or an image whose fit region is negative (an
-// offset: outside N4's multiplicative model).
+// warning (a region holding no sample of N4's grid); an image negative where N4 fits (an offset) is
+// fitted above its floor.
 TEST(SegmentCli, BiasCorrectionIsTheDefaultAndSkipsWithAWarningWhereItCannotRun) {
     const PhantomFiles& ph = phantom64();
     const std::string img = (ph.dir / "t1.nii.gz").string();
@@ -404,17 +404,36 @@ TEST(SegmentCli, BiasCorrectionIsTheDefaultAndSkipsWithAWarningWhereItCannotRun)
     EXPECT_TRUE(warned(skipped, "no voxel on the shrunk grid")) << skipped["warnings"];
     EXPECT_TRUE(warned(skipped, "the uncorrected image is used")) << skipped["warnings"];
 
-    // The phantom shifted below zero: the default leaves it alone, and segments it as the
-    // uncorrected phantom (the same mask: the model and the speed see intensities, not their sign).
+    // The phantom shifted below zero (an offset, as a z-scored image's): N4 fits it above its floor,
+    // the air's value, and adds the floor back, so the corrected image is the phantom's corrected
+    // image shifted (to within the air's own value, 1.3 of a range of 1 048) and the segmentation the
+    // unshifted one's.
     Grid<float> shifted = read_image(img);
     for (float& v : shifted.values()) v -= 5000.0f;
     const fs::path shifted_path = work_dir() / "shifted.nii.gz";
     write_image(shifted, shifted_path.string());
     const nlohmann::json negative = run_json(shifted_path.string() + ph.seeds);
-    EXPECT_FALSE(negative.contains("bias_correction"));
-    EXPECT_TRUE(warned(negative, "negative")) << negative["warnings"];
-    EXPECT_EQ(negative["voxels"], off["voxels"]);
-    EXPECT_EQ(negative["iterations"], off["iterations"]);
+    ASSERT_TRUE(negative.contains("bias_correction")) << negative;
+    const double offset = negative["bias_correction"]["offset"].get<double>();  // the phantom's air is dark, not 0
+    EXPECT_GE(offset, -5000.0);
+    EXPECT_LT(offset, -4990.0);
+    EXPECT_FALSE(on["bias_correction"].contains("offset"));
+    EXPECT_EQ(negative["voxels"], on["voxels"]);
+    const fs::path c_on = work_dir() / "shifted_c_on.nii.gz", c_neg = work_dir() / "shifted_c_neg.nii.gz";
+    for (const auto& [in, out] : {std::pair{img, c_on}, std::pair{shifted_path.string(), c_neg}}) {
+        const Result r = run_cli("segment " + in + ph.seeds + " --iterations 1 --out-mask " + mask.string() + " --out-corrected " + out.string());
+        ASSERT_EQ(r.rc, 0) << r.err;
+    }
+    const Grid<float> a = read_image(c_on.string()), b = read_image(c_neg.string());
+    const auto [lo, hi] = std::minmax_element(a.values().begin(), a.values().end());
+    double worst = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        worst = std::max(worst, std::abs(double(b[static_cast<PointIndex>(i)]) + 5000.0 - double(a[static_cast<PointIndex>(i)])));
+    EXPECT_LT(worst, 2e-3 * (*hi - *lo));
+    const Grid<float> shifted_in = read_image(shifted_path.string());
+    bool changed = false;  // N4 did correct something
+    for (std::size_t i = 0; i < b.size() && !changed; ++i) changed = b[static_cast<PointIndex>(i)] != shifted_in[static_cast<PointIndex>(i)];
+    EXPECT_TRUE(changed);
 }
 
 TEST(SegmentCli, DemoWritesItsOutputsAndAJsonReport) {

@@ -189,6 +189,54 @@ TEST_F(ImageIo, NiftiSformIsRasOfTheLpsGeometry) {
     }
 }
 
+// A NIfTI whose qform and sform codes are both 0 (NIFTI_XFORM_UNKNOWN; an Analyze file likewise)
+// carries no orientation: ITK reads its axes as LPS identity, and the header says they are not known.
+// Every header liveset writes, and the other formats, give one.
+TEST_F(ImageIo, AHeaderWithoutOrientationSaysSo) {
+    const Grid<float> image = test_image();
+    for (const std::string name : {"o.nii", "o.nii.gz", "o.mha", "o.nrrd", "o.mnc"}) {
+        write_image(image, path(name));
+        EXPECT_TRUE(read_image_header(path(name)).orientation_known) << name;
+    }
+    {
+        std::fstream f(path("o.nii"), std::ios::in | std::ios::out | std::ios::binary);
+        const std::int16_t zero = 0;
+        f.seekp(252);
+        f.write(reinterpret_cast<const char*>(&zero), 2);  // qform_code
+        f.write(reinterpret_cast<const char*>(&zero), 2);  // sform_code
+    }
+    ImageHeader h;
+    const Grid<float> read = read_image(path("o.nii"), kDefaultImageMemoryLimit, &h);
+    EXPECT_FALSE(h.orientation_known);
+    EXPECT_FALSE(read_image_header(path("o.nii")).orientation_known);
+    EXPECT_EQ(read.lattice().direction(), kIdentity3);
+    for (int a = 0; a < 3; ++a) EXPECT_NEAR(read.lattice().spacing()[a], image.lattice().spacing()[a], 1e-6) << a;
+    ASSERT_EQ(read.size(), image.size());
+    for (std::size_t i = 0; i < read.size(); ++i) ASSERT_EQ(read[static_cast<PointIndex>(i)], image[static_cast<PointIndex>(i)]) << i;
+
+    // The same voxels as an Analyze 7.5 pair (the NIfTI header without its magic, the data after
+    // it): no orientation either, and read without ITK's deprecation warning on stderr.
+    {
+        std::ifstream in(path("o.nii"), std::ios::binary);
+        std::string bytes((std::istreambuf_iterator<char>(in)), {});
+        float vox_offset;
+        std::memcpy(&vox_offset, bytes.data() + 108, 4);
+        std::string hdr = bytes.substr(0, 348);
+        std::fill(hdr.begin() + 344, hdr.end(), '\0');  // magic "n+1": gone
+        const float zero = 0.0f;  // the data start the .img
+        std::memcpy(hdr.data() + 108, &zero, 4);
+        std::ofstream(path("o.hdr"), std::ios::binary) << hdr;
+        std::ofstream(path("o.img"), std::ios::binary) << bytes.substr(static_cast<std::size_t>(vox_offset));
+    }
+    ::testing::internal::CaptureStderr();
+    ImageHeader ah;
+    const Grid<float> analyze = read_image(path("o.hdr"), kDefaultImageMemoryLimit, &ah);
+    EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+    EXPECT_FALSE(ah.orientation_known);
+    ASSERT_EQ(analyze.size(), image.size());
+    for (std::size_t i = 0; i < analyze.size(); ++i) ASSERT_EQ(analyze[static_cast<PointIndex>(i)], image[static_cast<PointIndex>(i)]) << i;
+}
+
 TEST_F(ImageIo, TwoFileFormatsGetFinalDataFileNames) {
     write_image(test_image(), path("vol.mhd"));
     write_image(test_image(), path("vol2.nhdr"));

@@ -408,6 +408,80 @@ TEST(BrainMask, ANeckBelowTheHeadIsLeftOut) {
     EXPECT_LT(static_cast<double>(moved), 0.001 * static_cast<double>(inside)) << moved << " of " << inside;
 }
 
+// A header without orientation (an Analyze file, a NIfTI with neither qform nor sform: read as
+// identity) of the same head with its 90 mm of neck stored as a coronal stack (array axes: left-right,
+// superior to inferior, posterior to anterior), as IBSR's scans are. Its "superior" axis is the
+// anterior one: no neck leaves the field of view there, so the header's cut takes nothing and the
+// neck's muscle wins ("no brain found"). Found from the head (superior_from_header false), the face
+// the neck leaves through is inferior, and the mask is the oriented head's, permuted.
+TEST(BrainMask, AHeaderWithoutOrientationFindsItsNeckFromTheHead) {
+    const BrainWeb& bw = brainweb();
+    Mask labels;
+    const Grid<float> oriented = every_other(with_neck(bw.t1, 90, &labels, bw.labels));
+    const Vec3i d = oriented.dims();
+    const Vec3d sp = oriented.lattice().spacing();
+    Grid<float> coronal(Lattice({d.x, d.z, d.y}, {sp.x, sp.z, sp.y}));  // identity direction, origin 0
+    for (int k = 0; k < d.y; ++k)
+        for (int j = 0; j < d.z; ++j)
+            for (int i = 0; i < d.x; ++i) coronal({i, j, k}) = oriented({i, k, d.z - 1 - j});
+    BrainMaskReport r;
+    const Mask a = auto_brain_mask(oriented, {}, &r);
+    EXPECT_GT(r.below_voxels, 0u);
+    BrainMaskOptions header;
+    bool header_wrong = true;  // the header's cut gives no brain, or another one
+    try {
+        const Mask m = auto_brain_mask(coronal, header);
+        std::size_t differ = 0;
+        for (int k = 0; k < d.y; ++k)
+            for (int j = 0; j < d.z; ++j)
+                for (int i = 0; i < d.x; ++i) differ += m({i, j, k}) != a({i, k, d.z - 1 - j});
+        header_wrong = static_cast<double>(differ) > 0.05 * static_cast<double>(r.mask_voxels);
+    } catch (const std::invalid_argument&) {
+    }
+    EXPECT_TRUE(header_wrong);
+    BrainMaskOptions from_head;
+    from_head.superior_from_header = false;
+    BrainMaskReport rc;
+    const Mask c = auto_brain_mask(coronal, from_head, &rc);
+    EXPECT_FALSE(rc.superior_from_header);
+    EXPECT_EQ(rc.below_voxels, r.below_voxels);
+    EXPECT_DOUBLE_EQ(rc.inferior_exit_mm2, r.inferior_exit_mm2);
+    std::size_t differ = 0;
+    for (int k = 0; k < d.y; ++k)
+        for (int j = 0; j < d.z; ++j)
+            for (int i = 0; i < d.x; ++i) differ += c({i, j, k}) != a({i, k, d.z - 1 - j});
+    EXPECT_LT(static_cast<double>(differ), 0.001 * static_cast<double>(r.mask_voxels)) << differ;
+    // The oriented head found from the head too: the same face, the same mask.
+    const Mask o = auto_brain_mask(oriented, from_head);
+    EXPECT_TRUE(std::equal(o.values().begin(), o.values().end(), a.values().begin()));
+}
+
+// A head that ends inside the field of view has no neck to cut: BrainWeb with 20 mm of air below
+// it (its lowest face then holds no head) keeps the whole head, and its mask is BrainWeb's.
+TEST(BrainMask, AHeadThatEndsInsideTheImageIsNotCut) {
+    const Grid<float> t1 = every_other(brainweb().t1);
+    const Lattice& l = t1.lattice();
+    const Vec3i d = l.dims();
+    Grid<float> padded(Lattice({d.x, d.y, d.z + 10}, l.spacing(), l.to_world({0.0, 0.0, -10.0}), l.direction()), 0.0f);
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) padded({x, y, z + 10}) = t1({x, y, z});
+    BrainMaskReport r, plain;
+    const Mask m = auto_brain_mask(padded, {}, &r);
+    const Mask a = auto_brain_mask(t1, {}, &plain);
+    EXPECT_GT(plain.inferior_exit_mm2, 1e4);  // BrainWeb's field of view ends in the lower head
+    EXPECT_LT(r.inferior_exit_mm2, 1000.0);
+    EXPECT_EQ(r.below_voxels, 0u);
+    std::size_t differ = 0, inside = 0;
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                differ += m({x, y, z + 10}) != a({x, y, z});
+                inside += a({x, y, z}) != 0;
+            }
+    EXPECT_LT(static_cast<double>(differ), 0.01 * static_cast<double>(inside)) << differ;
+}
+
 namespace {
 
 // An analytic head on a lattice of `spacing` (mm), centred: white matter (r < 18 mm, 130), grey matter

@@ -27,6 +27,8 @@
 #include <itkImageSeriesReader.h>
 #include <itkMINCImageIO.h>
 #include <itkMINCImageIOFactory.h>
+#include <itkMetaDataObject.h>
+#include <itkNiftiImageIO.h>
 #include <itkMetaImageIOFactory.h>
 #include <itkNiftiImageIOFactory.h>
 #include <itkNrrdImageIOFactory.h>
@@ -103,8 +105,21 @@ void keep_minc_world_as_stored(MincIO& io) {
     if constexpr (requires { io.SetRAStoLPS(false); }) io.SetRAStoLPS(false);
 }
 
-void prepare_minc_io(itk::ImageIOBase& io) {
+// False for a NIfTI (or Analyze) header whose qform and sform codes are both 0 (NIFTI_XFORM_UNKNOWN):
+// its axes carry no orientation, ITK reads them as LPS identity.
+bool orientation_known(const itk::ImageIOBase& io) {
+    if (std::string(io.GetNameOfClass()) != "NiftiImageIO") return true;
+    std::string q, s;
+    const itk::MetaDataDictionary& dict = io.GetMetaDataDictionary();
+    if (!itk::ExposeMetaData<std::string>(dict, "qform_code", q) || !itk::ExposeMetaData<std::string>(dict, "sform_code", s)) return true;
+    return !(q == "0" && s == "0");
+}
+
+void prepare_io(itk::ImageIOBase& io) {
     if (auto* minc = dynamic_cast<itk::MINCImageIO*>(&io)) keep_minc_world_as_stored(*minc);
+    // An Analyze file is read as ITK 4 read it (the axes as stored, no orientation: orientation_known
+    // false), without the default flavour's multi-line deprecation warning on stderr.
+    if (auto* nifti = dynamic_cast<itk::NiftiImageIO*>(&io)) nifti->SetLegacyAnalyze75Mode(itk::NiftiImageIOEnums::Analyze75Flavor::AnalyzeITK4);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -176,7 +191,7 @@ void open_file(Source& src) {
     }
     if (!io) fail_read(path, std::string("unknown image format or damaged header (") + kFormatsHint + ")");
     try {
-        prepare_minc_io(*io);
+        prepare_io(*io);
         io->SetFileName(path);
         io->ReadImageInformation();
     } catch (const itk::ExceptionObject& e) {
@@ -203,6 +218,7 @@ void open_file(Source& src) {
         src.header.pixel_type = itk::ImageIOBase::GetPixelTypeAsString(io->GetPixelType()) + " of " +
                                 src.header.pixel_type;
     src.header.format = format_name(*io);
+    src.header.orientation_known = orientation_known(*io);
     src.io = io;
 }
 
@@ -431,7 +447,7 @@ void set_geometry(itk::ImageIOBase& io, const Lattice& lattice) {
     std::vector<std::vector<double>> axes;
     for (unsigned a = 0; a < 3; ++a) axes.push_back({m[a], m[3 + a], m[6 + a]});
     if (is_minc(io)) {
-        prepare_minc_io(io);
+        prepare_io(io);
         flip_ras_lps(origin, axes);  // LPS -> MINC's RAS
     }
     itk::ImageIORegion region(3);
@@ -533,8 +549,9 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
 
 ImageHeader read_image_header(const std::string& path) { return open_source(path).header; }
 
-Grid<float> read_image(const std::string& path, std::uint64_t max_bytes) {
+Grid<float> read_image(const std::string& path, std::uint64_t max_bytes, ImageHeader* header) {
     const Source src = open_source(path);
+    if (header != nullptr) *header = src.header;
     const Lattice lattice = validate(src, max_bytes);
     verify_data(src);
     Grid<float> grid;
@@ -555,8 +572,9 @@ Grid<float> read_image(const std::string& path, std::uint64_t max_bytes) {
     return grid;
 }
 
-Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_bytes) {
+Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_bytes, ImageHeader* header) {
     const Source src = open_source(path);
+    if (header != nullptr) *header = src.header;
     const Lattice lattice = validate(src, max_bytes);
     verify_data(src);
     Grid<std::uint8_t> grid;

@@ -35,6 +35,9 @@ struct ImageHeader {
     int components = 1;       // values per voxel (3 for RGB)
     std::string pixel_type;   // stored type: "short", "float", ...; "rgb of unsigned_char" etc. if not scalar
     std::string format;       // "NIfTI", "MetaImage", "NRRD", "MINC", "DICOM", "DICOM series", ...
+    // False when the header gives no orientation (a NIfTI with qform and sform codes 0, an Analyze
+    // file): the axes are read as LPS identity, which may not be where the head's top is.
+    bool orientation_known = true;
 };
 
 // Default refusal threshold for read_image / read_label_image: the image, held as one float per
@@ -54,12 +57,13 @@ ImageHeader read_image_header(const std::string& path);
 // multi-component (RGB, vector) images, empty images, images larger than kMaxLatticePoints or
 // `max_bytes` (as float), non-positive or non-finite spacing, non-finite origin, singular
 // direction, and NaN/infinite voxels ("N voxels are NaN or infinite").
-Grid<float> read_image(const std::string& path, std::uint64_t max_bytes = kDefaultImageMemoryLimit);
+// `header` (optional) receives the header read_image_header would give.
+Grid<float> read_image(const std::string& path, std::uint64_t max_bytes = kDefaultImageMemoryLimit, ImageHeader* header = nullptr);
 
 // Reads an integer label image (values 0..255; for masks nonzero means foreground). Same checks
 // as read_image, plus: every value must be an integer in 0..255.
-Grid<std::uint8_t> read_label_image(const std::string& path,
-                                    std::uint64_t max_bytes = kDefaultImageMemoryLimit);
+Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_bytes = kDefaultImageMemoryLimit,
+                                    ImageHeader* header = nullptr);
 
 // Write with the full geometry (spacing, origin, direction). The format follows the extension:
 // .nii.gz (recommended), .nii, .mha, .mhd (+ .raw), .nrrd, .nhdr (+ .raw), .mnc, or any other

@@ -249,16 +249,63 @@ Mask stripped_foreground(const Grid<float>& image, double threshold) {
     return fill_holes(largest_component(f));
 }
 
-// The head within `extent_mm` of its highest voxel along the world's superior axis (LPS z; the
-// lattice's direction cosines included); `below` counts what is left out. 0: the whole head.
-Mask cranial(const Mask& head, double extent_mm, std::size_t& below) {
+// Which way is up in the image: height (mm) = g · voxel index, and the head's cross-section in the
+// array's face that looks most inferior (mm²), where a neck leaves the field of view.
+struct Vertical {
+    double g[3] = {0, 0, 0};
+    double exit_mm2 = 0;
+};
+
+// The solid head's voxels in the face `side` (0: index 0, 1: the last) of axis `a`, in mm².
+double face_exit_mm2(const Mask& head, int a, int side) {
+    const Vec3i d = head.dims();
+    const Vec3d sp = head.lattice().spacing();
+    const int dims[3] = {d.x, d.y, d.z};
+    const double area[3] = {sp.y * sp.z, sp.x * sp.z, sp.x * sp.y};
+    const int slice = side == 0 ? 0 : dims[a] - 1;
+    std::size_t n = 0;
+    for (int z = a == 2 ? slice : 0; z < (a == 2 ? slice + 1 : d.z); ++z)
+        for (int y = a == 1 ? slice : 0; y < (a == 1 ? slice + 1 : d.y); ++y)
+            for (int x = a == 0 ? slice : 0; x < (a == 0 ? slice + 1 : d.x); ++x) n += head({x, y, z}) != 0;
+    return static_cast<double>(n) * area[a];
+}
+
+// From the header: the world's superior axis (LPS z; the direction cosines included), the inferior
+// face the one whose axis runs most along it. From the head (a header without orientation): the face
+// the head leaves the field of view through most is inferior, up runs away from it.
+Vertical vertical(const Mask& head, bool from_header) {
+    Vertical v;
+    const Lattice& lat = head.lattice();
+    const Vec3d sp = lat.spacing();
+    const double step[3] = {sp.x, sp.y, sp.z};
+    if (from_header) {
+        const double z0 = lat.to_world({0, 0, 0}).z;
+        v.g[0] = lat.to_world({1, 0, 0}).z - z0;
+        v.g[1] = lat.to_world({0, 1, 0}).z - z0;
+        v.g[2] = lat.to_world({0, 0, 1}).z - z0;
+        int a = 0;  // the axis most along the superior axis (per millimetre)
+        for (int k = 1; k < 3; ++k)
+            if (std::abs(v.g[k]) / step[k] > std::abs(v.g[a]) / step[a]) a = k;
+        v.exit_mm2 = face_exit_mm2(head, a, v.g[a] > 0 ? 0 : 1);
+        return v;
+    }
+    int best_a = 2, best_side = 0;
+    for (int a = 0; a < 3; ++a)
+        for (int side = 0; side < 2; ++side) {
+            const double e = face_exit_mm2(head, a, side);
+            if (e > v.exit_mm2) v.exit_mm2 = e, best_a = a, best_side = side;
+        }
+    v.g[best_a] = best_side == 0 ? step[best_a] : -step[best_a];
+    return v;
+}
+
+// The head within `extent_mm` of its highest voxel along `up`; `below` counts what is left out.
+// 0: the whole head.
+Mask cranial(const Mask& head, const Vertical& up, double extent_mm, std::size_t& below) {
     below = 0;
     if (extent_mm <= 0) return head;
-    const Lattice& lat = head.lattice();
-    const Vec3i d = lat.dims();
-    const double z0 = lat.to_world({0, 0, 0}).z;
-    const double gx = lat.to_world({1, 0, 0}).z - z0, gy = lat.to_world({0, 1, 0}).z - z0, gz = lat.to_world({0, 0, 1}).z - z0;
-    const auto height = [&](int x, int y, int z) { return z0 + gx * x + gy * y + gz * z; };
+    const Vec3i d = head.dims();
+    const auto height = [&](int x, int y, int z) { return up.g[0] * x + up.g[1] * y + up.g[2] * z; };
     double top = -std::numeric_limits<double>::infinity();
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
@@ -323,6 +370,7 @@ void validate(const BrainMaskOptions& o) {
     require(std::isfinite(o.head_closing_mm) && o.head_closing_mm >= 0 && o.head_closing_mm <= 50, "head_closing_mm must lie in [0, 50]");
     require(std::isfinite(o.brain_extent_mm) && (o.brain_extent_mm == 0 || (o.brain_extent_mm >= 100 && o.brain_extent_mm <= 1000)),
             "brain_extent_mm must be 0 (the whole head) or lie in [100, 1000]");
+    require(std::isfinite(o.neck_exit_mm2) && o.neck_exit_mm2 >= 0 && o.neck_exit_mm2 <= 1e6, "neck_exit_mm2 must lie in [0, 1e6]");
     require(std::isfinite(o.stripped_near_mm) && o.stripped_near_mm > 0 && o.stripped_near_mm <= 50, "stripped_near_mm must lie in (0, 50]");
     require(std::isfinite(o.stripped_fraction) && o.stripped_fraction > 0 && o.stripped_fraction <= 1, "stripped_fraction must lie in (0, 1]");
 }
@@ -342,7 +390,10 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     }
     const Mask& whole_head = reuse ? known->solid : found.solid;
     const Grid<float>& depth = reuse ? known->depth : found.depth;
-    const Mask head = cranial(whole_head, o.brain_extent_mm, r.below_voxels);
+    const Vertical up = vertical(whole_head, o.superior_from_header);
+    r.inferior_exit_mm2 = up.exit_mm2;
+    r.superior_from_header = o.superior_from_header;
+    const Mask head = cranial(whole_head, up, up.exit_mm2 >= o.neck_exit_mm2 ? o.brain_extent_mm : 0.0, r.below_voxels);
     r.head_voxels = count(head);
     const Grid<float> smooth = gaussian_smooth(image, o.smoothing_mm);
     white_matter_peak(image, head, depth, r);

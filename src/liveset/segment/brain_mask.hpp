@@ -47,6 +47,15 @@ struct BrainMaskOptions {
     // as the deep head's white matter (FSL's robustfov keeps 170 mm from the top of the head too).
     // The depth is still measured from the whole head's surface. 0: the whole head.
     double brain_extent_mm = 170.0;
+    // ... but only where a neck leaves the field of view: the head's cross-section in the array's
+    // most inferior face is at least this (mm²; a neck's is ~100 cm²). A head that ends inside the
+    // image has nothing to cut.
+    double neck_exit_mm2 = 1000.0;
+    // Whether the header says which way is superior. False for a header without orientation (an
+    // Analyze file, a NIfTI with neither qform nor sform, read as identity: its z may be the
+    // anterior axis of a coronal stack, and the cut would take 30 mm of frontal lobe): the face the
+    // head leaves the field of view through most (the neck) is then taken as inferior.
+    bool superior_from_header = true;
     // Skull-stripped input: at least `stripped_fraction` of the mask's boundary lies within
     // `stripped_near_mm` of the head's surface (a full head has scalp and skull in between). The
     // mask is then the filled non-background foreground. Set detect_skull_stripped false to skip.
@@ -75,6 +84,8 @@ struct BrainMaskReport {
     double tissue_high = 0;
     std::size_t head_voxels = 0;      // solid head (filled, closed foreground) within brain_extent_mm of its top
     std::size_t below_voxels = 0;     // solid head further below its top (neck, shoulders), left out
+    double inferior_exit_mm2 = 0;     // the solid head's cross-section in the array's most inferior face (mm²)
+    bool superior_from_header = true; // the options': up was the header's superior axis, else found from the head
     std::size_t tissue_voxels = 0;    // head voxels in the tissue window
     std::size_t core_voxels = 0;      // largest component after the erosion
     double surface_contact = 0;       // fraction of the mask boundary near the head surface
