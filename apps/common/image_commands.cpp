@@ -230,9 +230,10 @@ SeedFit fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage& prepared, std::
     }
     if (kept.empty() && !roi->by_default)
         throw UsageError(fmt::format("every seed lies outside {}, the first at voxel ({}, {}, {})", what, outside[0].x, outside[0].y, outside[0].z));
-    if (kept.empty()) {  // the default's guess does not fit these seeds
+    if (roi->by_default && 2 * outside.size() > seeds.size()) {  // the default's guess does not fit these seeds
+        const std::string which = kept.empty() ? std::string("every seed lies") : fmt::format("{} of the {} seeds lie", outside.size(), seeds.size());
         drop_default_roi(roi, prepared, out,
-                         fmt::format("every seed lies outside the automatic brain mask (a T1 brain's), the first at voxel ({}, {}, {})",
+                         fmt::format("{} outside the automatic brain mask (a T1 brain's), the first at voxel ({}, {}, {})", which,
                                      outside[0].x, outside[0].y, outside[0].z),
                          none_hint);
         return out;

@@ -76,7 +76,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
         strings (0-based, radius in voxels); seeds_mm: LPS mm ``"X,Y,Z[:R]"`` (radius in mm).
     roi: None (the default: the automatic brain mask when the image is a full head, else none; a
         seed whose ball lies wholly outside it is left out with a warning naming ``roi="none"``,
-        and when every seed does - or over 5 % of ``init_mask`` lies outside - the whole image is
+        and when more than half of them do - or over 5 % of ``init_mask`` lies outside - the whole image is
         segmented, warned), ``"auto"`` (the automatic brain mask, an error when none is found),
         ``"none"`` (the whole image) or a mask (Image/nibabel/array) the front may not leave. Any
         ROI leaves out seeds wholly outside it (warned); all of them outside is a ValueError.

@@ -244,6 +244,16 @@ TEST(RoiAutoCli, AFullHeadIsSegmentedInItsBrainMaskByDefault) {
     EXPECT_NE(j1["warnings"].dump().find("every seed lies outside the automatic brain mask (a T1 brain's), the first at voxel (2, 2, 2): the "
                                          "whole image is segmented, as with --roi none"), std::string::npos) << j1["warnings"].dump();
     EXPECT_EQ(j1["warnings"].dump().find("may have leaked"), std::string::npos);  // the whole image was their choice: no advice
+    // More than half of the seeds outside (two in the air, one in the brain: as the seeds on a T2,
+    // whose mask, looked for as a T1 brain's, is wrong) give the default up too: --roi none's run.
+    const auto [two_air, j2a] = run(head_image(true), " --seed 2,2,2 --seed 61,61,61", "two_air_seeds_head");
+    const auto [two_air_none, j2n] = run(head_image(true), " --roi none --seed 2,2,2 --seed 61,61,61", "two_air_seeds_none");
+    EXPECT_EQ(differ(two_air, two_air_none), 0u);
+    EXPECT_FALSE(j2a.contains("roi"));
+    EXPECT_NE(j2a["warnings"].dump().find("2 of the 3 seeds lie outside the automatic brain mask (a T1 brain's), the first at voxel (2, 2, 2): "
+                                          "the whole image is segmented, as with --roi none"),
+              std::string::npos)
+        << j2a["warnings"].dump();
     // An initial mask: in the brain (a WM ball) the default ROI stays; in the scalp it is given up
     // as the seeds in the air were (the run is --roi none's).
     const Grid<float> head = read_image(head_image(true).string());
