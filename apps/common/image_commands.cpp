@@ -114,8 +114,14 @@ void correct_for(Grid<float>& image, const Grid<std::uint8_t>* fit, BiasCorrecti
     try {
         // N4 models a multiplicative field on magnitude data, whose zero is the air's. Negative values
         // where it would fit (an offset, a z-scored image) put that zero elsewhere: N4 then fits the
-        // image above its floor (the air's value), and the floor is added back.
-        const float offset = negative_share(image, fit) > 0.01 ? image_floor(image) : 0.0f;
+        // image above its floor (the air's value), and the floor is added back. Where the floor is
+        // not below zero (negatives in the tissue only), the default skips N4 as before.
+        const double negative = negative_share(image, fit);
+        const float offset = negative > 0.01 ? std::min(image_floor(image), 0.0f) : 0.0f;
+        if (negative > 0.01 && offset == 0.0f && mode == BiasCorrection::kDefault)  // no floor below zero to fit above
+            return skip(fmt::format("{:.1f} % of the voxels it would fit are negative, but the image's floor is not (negative tissue, "
+                                    "not an offset), outside N4's multiplicative model",
+                                    100.0 * negative));
         if (offset == 0.0f) {
             image = correct_bias(image, fit, {}, &report, interrupt);
         } else {
@@ -289,6 +295,7 @@ nlohmann::json roi_report(const Roi& roi) {
                      {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
                      {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
                      {"below_head_voxels", b->below_voxels}, {"inferior_exit_mm2", b->inferior_exit_mm2},
+                     {"brain_extent_mm", b->brain_extent_mm}, {"head_diameter_mm", b->head_diameter_mm},
                      {"superior", b->superior_from_header ? "header" : "from the head"}};
     return j;
 }

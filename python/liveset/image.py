@@ -90,10 +90,10 @@ class Image:
         if not np.issubdtype(data.dtype, np.integer):
             data = np.asarray(data, dtype=np.float32)
         out = cls.from_affine(data, img.affine)
-        h = getattr(img, "header", None)
-        if h is not None and "qform_code" in h and "sform_code" in h:  # NIfTI; Analyze has neither: oriented by convention only
-            out.oriented = bool(int(h["qform_code"]) or int(h["sform_code"]))
-        elif type(img).__name__ in ("AnalyzeImage", "Spm99AnalyzeImage", "Spm2AnalyzeImage"):
+        import nibabel as nib
+        if isinstance(img, (nib.Nifti1Image, nib.Nifti2Image, nib.Nifti1Pair, nib.Nifti2Pair)):
+            out.oriented = bool(int(img.header["qform_code"]) or int(img.header["sform_code"]))
+        elif isinstance(img, nib.AnalyzeImage):  # the NIfTI classes derive from it: after them
             out.oriented = False
         return out
 

@@ -373,6 +373,20 @@ def test_a_file_without_orientation_reaches_the_brain_mask_as_such(tmp_path):
     assert not u.oriented and not liveset.read_header(unoriented)["oriented"]
     assert not liveset.Image.from_nibabel(nib.load(unoriented)).oriented
     assert liveset.Image.from_nibabel(nib.load(plain)).oriented
+    analyze = str(tmp_path / "unoriented.img")
+    nib.save(nib.AnalyzeImage(img.array, np.eye(4)), analyze)
+    assert not liveset.Image.from_nibabel(nib.load(analyze)).oriented and not liveset.read(analyze).oriented
+    # Headers without qform/sform (MINC's, PAR/REC's, the base class's; `in` fails on them) are oriented.
+    assert liveset.Image.from_nibabel(nib.spatialimages.SpatialImage(img.array, np.eye(4))).oriented
+    minc = str(tmp_path / "oriented.mnc")
+    liveset.write(img, minc)
+    assert liveset.read(minc).oriented
+    try:
+        import h5py  # noqa: F401  (nibabel reads MINC 2 through it)
+    except ImportError:
+        pass
+    else:
+        assert liveset.Image.from_nibabel(nib.load(minc)).oriented
     assert not u.like(u.array).oriented and not liveset.read(unoriented, labels=False).oriented
     kw = dict(mu_raw=130, epsilon_raw=40, iterations=5, bias_correct=False)
     for image, superior in ((liveset.read(plain), "header"), (u, "from the head")):

@@ -456,6 +456,39 @@ TEST(BrainMask, AHeaderWithoutOrientationFindsItsNeckFromTheHead) {
     EXPECT_TRUE(std::equal(o.values().begin(), o.values().end(), a.values().begin()));
 }
 
+// A child's head: BrainWeb with 90 mm of neck at 2 mm, its voxels relabelled 1.4 mm (the head 0.7×,
+// 136 mm across for an adult's 195). Within an adult's 170 mm of its top lies most of its neck, whose
+// muscle outweighs the white matter ("no brain found", as with the scaling switched off); looked for
+// again within 170 mm × 136 / 190, the brain is found, as the adult's at 2 mm is.
+TEST(BrainMask, AChildsHeadWithANeckIsLookedForWithinItsOwnSize) {
+    const BrainWeb& bw = brainweb();
+    Mask labels1;
+    const Grid<float> adult = every_other(with_neck(bw.t1, 90, &labels1, bw.labels));
+    const Mask labels2 = every_other(labels1);
+    const Lattice& l = adult.lattice();
+    const Lattice small(l.dims(), l.spacing() * 0.7, l.origin() * 0.7, l.direction());
+    Grid<float> child(small);
+    Mask labels(small);
+    std::copy(adult.values().begin(), adult.values().end(), child.values().begin());
+    std::copy(labels2.values().begin(), labels2.values().end(), labels.values().begin());
+    BrainMaskReport ra, rc;
+    const Mask a = auto_brain_mask(adult, {}, &ra);
+    EXPECT_DOUBLE_EQ(ra.brain_extent_mm, 170.0);
+    const Mask c = auto_brain_mask(child, {}, &rc);
+    std::printf("child: head %.0f mm (adult %.0f), extent %.0f mm\n", rc.head_diameter_mm, ra.head_diameter_mm, rc.brain_extent_mm);
+    EXPECT_NEAR(rc.head_diameter_mm, 0.7 * ra.head_diameter_mm, 0.05 * ra.head_diameter_mm);
+    EXPECT_LT(rc.brain_extent_mm, 140.0);
+    EXPECT_GT(rc.brain_extent_mm, 102.0);
+    const TruthCheck tc = check_against_truth(c, labels, child), ta = check_against_truth(a, labels, adult);
+    std::printf("child: dice %.4f (adult %.4f), GM in %.4f, WM in %.4f\n", tc.dice, ta.dice, tc.gm, tc.wm);
+    EXPECT_GE(tc.dice, ta.dice - 0.03);
+    EXPECT_GE(tc.gm, 0.97);
+    EXPECT_GE(tc.wm, 0.99);
+    BrainMaskOptions adult_only;
+    adult_only.adult_head_mm = 50;  // every head "adult": no second look
+    EXPECT_THROW(auto_brain_mask(child, adult_only), std::invalid_argument);
+}
+
 // A head that ends inside the field of view has no neck to cut: BrainWeb with 20 mm of air below
 // it (its lowest face then holds no head) keeps the whole head, and its mask is BrainWeb's.
 TEST(BrainMask, AHeadThatEndsInsideTheImageIsNotCut) {

@@ -8,9 +8,11 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 #include <vector>
 
 #include "liveset/segment/morphology.hpp"
@@ -351,6 +353,52 @@ Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Ma
     return brain;
 }
 
+// The head's widest cross-section across `up` within `depth_mm` of its top, as the diameter of the
+// disc of that area (mm): the volume of each layer of height, one slice thick.
+double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
+    const Vec3i d = head.dims();
+    const auto height = [&](int x, int y, int z) { return up.g[0] * x + up.g[1] * y + up.g[2] * z; };
+    const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
+    double top = -std::numeric_limits<double>::infinity();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x)
+                if (head({x, y, z}) != 0) top = std::max(top, height(x, y, z));
+    std::vector<std::size_t> layer(static_cast<std::size_t>(std::lround(depth_mm / layer_mm)) + 1, 0);
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                const auto k = static_cast<std::size_t>(std::lround((top - height(x, y, z)) / layer_mm));
+                if (head({x, y, z}) != 0 && k < layer.size()) ++layer[k];
+            }
+    const Vec3d sp = head.lattice().spacing();
+    const double widest = static_cast<double>(*std::max_element(layer.begin(), layer.end())) * sp.x * sp.y * sp.z / layer_mm;  // mm²
+    return 2.0 * std::sqrt(widest / std::numbers::pi);
+}
+
+// The brain in the head within `extent_mm` of its top (0: all of it): the tissue window, the
+// extraction, the skull-stripped test, `r` filled in. An empty mask when none is found (under
+// min_head_share of that head, not skull-stripped).
+Mask brain_within(const Grid<float>& image, const Grid<float>& smooth, const Mask& whole_head, const Grid<float>& depth, const Vertical& up,
+                  double extent_mm, const BrainMaskOptions& o, BrainMaskReport& r) {
+    const Mask head = cranial(whole_head, up, extent_mm, r.below_voxels);
+    r.brain_extent_mm = extent_mm;
+    r.head_voxels = count(head);
+    white_matter_peak(image, head, depth, r);
+    const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
+    r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;  // CSF/skin | GM/muscle cut
+    r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
+    Mask brain = extract_brain(image, smooth, head, o, r);
+    r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
+    r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
+    if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);
+    r.mask_voxels = count(brain);
+    if (r.mask_voxels == 0) throw std::invalid_argument("brain mask: the mask is empty");
+    const double share = static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1));
+    if (!r.skull_stripped && share < o.min_head_share) return Mask();
+    return brain;
+}
+
 }  // namespace
 
 void validate(const BrainMaskOptions& o) {
@@ -370,6 +418,7 @@ void validate(const BrainMaskOptions& o) {
     require(std::isfinite(o.head_closing_mm) && o.head_closing_mm >= 0 && o.head_closing_mm <= 50, "head_closing_mm must lie in [0, 50]");
     require(std::isfinite(o.brain_extent_mm) && (o.brain_extent_mm == 0 || (o.brain_extent_mm >= 100 && o.brain_extent_mm <= 1000)),
             "brain_extent_mm must be 0 (the whole head) or lie in [100, 1000]");
+    require(std::isfinite(o.adult_head_mm) && o.adult_head_mm >= 50 && o.adult_head_mm <= 500, "adult_head_mm must lie in [50, 500]");
     require(std::isfinite(o.neck_exit_mm2) && o.neck_exit_mm2 >= 0 && o.neck_exit_mm2 <= 1e6, "neck_exit_mm2 must lie in [0, 1e6]");
     require(std::isfinite(o.stripped_near_mm) && o.stripped_near_mm > 0 && o.stripped_near_mm <= 50, "stripped_near_mm must lie in (0, 50]");
     require(std::isfinite(o.stripped_fraction) && o.stripped_fraction > 0 && o.stripped_fraction <= 1, "stripped_fraction must lie in (0, 1]");
@@ -393,24 +442,25 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     const Vertical up = vertical(whole_head, o.superior_from_header);
     r.inferior_exit_mm2 = up.exit_mm2;
     r.superior_from_header = o.superior_from_header;
-    const Mask head = cranial(whole_head, up, up.exit_mm2 >= o.neck_exit_mm2 ? o.brain_extent_mm : 0.0, r.below_voxels);
-    r.head_voxels = count(head);
     const Grid<float> smooth = gaussian_smooth(image, o.smoothing_mm);
-    white_matter_peak(image, head, depth, r);
-    const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
-    r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;  // CSF/skin | GM/muscle cut
-    r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
-    Mask brain = extract_brain(image, smooth, head, o, r);
-    r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
-    r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
-    if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);
-    r.mask_voxels = count(brain);
-    if (r.mask_voxels == 0) throw std::invalid_argument("brain mask: the mask is empty");
-    const double share = static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1));
-    if (!r.skull_stripped && share < o.min_head_share) {
+    const double extent = up.exit_mm2 >= o.neck_exit_mm2 ? o.brain_extent_mm : 0.0;
+    if (extent > 0) r.head_diameter_mm = head_diameter_mm(whole_head, up, 0.65 * extent);
+    BrainMaskReport first = r;
+    Mask brain = brain_within(image, smooth, whole_head, depth, up, extent, o, first);
+    if (brain.size() == 0 && extent > 0) {  // a small head's neck inside an adult's extent: scaled to the head
+        const double scaled = extent * std::clamp(r.head_diameter_mm / o.adult_head_mm, 0.6, 1.0);
+        if (scaled < extent - 1.0) {
+            BrainMaskReport again = r;
+            brain = brain_within(image, smooth, whole_head, depth, up, scaled, o, again);
+            if (brain.size() > 0) first = again;
+        }
+    }
+    r = first;
+    if (brain.size() == 0) {
         char why[160];
         std::snprintf(why, sizeof why, "brain mask: no brain found (the mask holds %zu voxels, %.1f %% of the head, under %.1f %%)",
-                      r.mask_voxels, 100 * share, 100 * o.min_head_share);
+                      r.mask_voxels, 100.0 * static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1)),
+                      100 * o.min_head_share);
         throw std::invalid_argument(why);
     }
     const Vec3d s = image.lattice().spacing();

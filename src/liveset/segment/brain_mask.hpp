@@ -51,6 +51,13 @@ struct BrainMaskOptions {
     // most inferior face is at least this (mm²; a neck's is ~100 cm²). A head that ends inside the
     // image has nothing to cut.
     double neck_exit_mm2 = 1000.0;
+    // A child's head is smaller: within an adult's 170 mm lies its neck, whose muscle outweighs its
+    // white matter ("no brain found"; BrainWeb scaled by 0.7 with 90 mm of neck). Where no brain is
+    // found within brain_extent_mm, it is looked for once more within brain_extent_mm × the head's
+    // size over an adult's (its widest cross-section within 0.65 × brain_extent_mm of its top, as a
+    // disc's diameter, over adult_head_mm; BrainWeb's 195-197 mm at any voxel size), at least 0.6 of it. A head where the
+    // first look succeeds is never cut shorter.
+    double adult_head_mm = 190.0;
     // Whether the header says which way is superior. False for a header without orientation (an
     // Analyze file, a NIfTI with neither qform nor sform, read as identity: its z may be the
     // anterior axis of a coronal stack, and the cut would take 30 mm of frontal lobe): the face the
@@ -85,6 +92,8 @@ struct BrainMaskReport {
     std::size_t head_voxels = 0;      // solid head (filled, closed foreground) within brain_extent_mm of its top
     std::size_t below_voxels = 0;     // solid head further below its top (neck, shoulders), left out
     double inferior_exit_mm2 = 0;     // the solid head's cross-section in the array's most inferior face (mm²)
+    double brain_extent_mm = 0;       // the extent below the top the brain was looked for in (0: the whole head)
+    double head_diameter_mm = 0;      // the head's size (adult_head_mm), where a neck is cut (else 0)
     bool superior_from_header = true; // the options': up was the header's superior axis, else found from the head
     std::size_t tissue_voxels = 0;    // head voxels in the tissue window
     std::size_t core_voxels = 0;      // largest component after the erosion
