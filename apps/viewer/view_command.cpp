@@ -42,6 +42,8 @@ struct ViewArgs : ThresholdArgs {
     std::string workspace_warning;      // the workspace was refused, or its ROI is not the one it was saved with
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
     bool roi_by_default = false;        // set by load_session: no --roi, and the automatic brain mask found
+    // set by load_session: --seed and --seeds, each with how it was given, less those the ROI left out
+    std::vector<std::pair<SeedBall, std::string>> start_seeds;
 };
 
 void parse_size(const std::string& text, int& w, int& h) {
@@ -72,6 +74,34 @@ SessionOptions session_options(const ViewArgs& a) {
     return so;
 }
 
+// --seed and --seeds against the ROI, as `segment` fits them (fit_seeds_to_roi): seeds wholly
+// outside it left out with a warning each, every one outside a ROI asked for an error, and the
+// default ROI given up (the image opened as with --roi none) when more than half are outside.
+void fit_start_seeds(ViewArgs& a, const Lattice& lattice, std::optional<Roi>& roi, PreparedImage& prepared) {
+    std::vector<std::pair<SeedBall, std::string>> given;
+    for (const std::string& text : a.seeds) given.emplace_back(parse_seed_voxel(text, a.seed_radius), "--seed " + text);
+    if (!a.seeds_file.empty())
+        for (const SeedBall& b : read_seed_file(a.seeds_file, a.seed_radius)) given.emplace_back(b, "in " + a.seeds_file + " " + format_seed(b));
+    std::vector<SeedBall> balls;
+    for (const auto& [b, given_as] : given) {
+        check_seed_inside(b, lattice, given_as);
+        balls.push_back(b);
+    }
+    const SeedFit fit = fit_seeds_to_roi(roi, prepared, balls, nullptr, "--roi none");
+    for (const std::string& w : fit.warnings) fmt::print(stderr, "liveset: warning: {}\n", w);
+    if (fit.default_dropped) {
+        a.roi_by_default = false;
+        a.roi = "none";
+    }
+    a.start_seeds.clear();
+    std::size_t k = 0;  // the kept balls, in order, are a subsequence of the given ones
+    for (auto& entry : given)
+        if (k < balls.size() && entry.first.center == balls[k].center && entry.first.radius == balls[k].radius) {
+            a.start_seeds.push_back(std::move(entry));
+            ++k;
+        }
+}
+
 std::unique_ptr<Session> load_session(ViewArgs& a) {
     ImageHeader header;
     Grid<float> image = read_image(a.image, kDefaultImageMemoryLimit, &header);
@@ -94,6 +124,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
         throw UsageError(fmt::format("{}: {}", a.image, e.what()));
     }
     if (!prepared.bias_skipped.empty()) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
+    fit_start_seeds(a, image.lattice(), r, prepared);
     if (r && r->brain_mask)
         fmt::print(stderr, "liveset: note: {}: brain mask of {} voxels ({})\n",
                    a.roi_by_default ? "the front stays in the automatic brain mask by default (--roi none: the whole image)" : "--roi auto",
@@ -111,7 +142,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     }
 }
 
-// --mask / --phi, then --seed and --seeds (a seed outside the image or the ROI is refused).
+// --mask / --phi, then --seed and --seeds (load_session fitted them to the ROI).
 void load_inputs(Session& s, const ViewArgs& a) {
     const Lattice& lattice = s.lattice();
     if (!a.mask.empty()) {
@@ -124,12 +155,7 @@ void load_inputs(Session& s, const ViewArgs& a) {
         s.load_phi(phi);
         if (!s.has_surface()) throw UsageError(fmt::format("--phi {} holds no surface (no sign change)", a.phi));
     }
-    std::vector<std::pair<SeedBall, std::string>> seeds;
-    for (const std::string& text : a.seeds) seeds.emplace_back(parse_seed_voxel(text, a.seed_radius), "--seed " + text);
-    if (!a.seeds_file.empty())
-        for (const SeedBall& b : read_seed_file(a.seeds_file, a.seed_radius)) seeds.emplace_back(b, "in " + a.seeds_file + " " + format_seed(b));
-    for (const auto& [b, given_as] : seeds) {
-        check_seed_inside(b, lattice, given_as);
+    for (const auto& [b, given_as] : a.start_seeds) {  // fitted to the ROI by load_session
         try {
             s.add_seed(b);
         } catch (const std::invalid_argument& e) {

@@ -206,7 +206,9 @@ TEST(ViewCommand, ABadWorkspaceIsOneLineAndTheViewerStillOpens) {
     }
 }
 
-// A seed outside the ROI: refused on the command line (one line) and in a script (the entry named).
+// A seed outside the ROI: on the command line as `segment` takes it (left out with a warning; every
+// seed outside a ROI asked for: one line, exit 1; most of them outside the default ROI: the image
+// opened as with --roi none), and refused in a script (the entry named).
 TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
     const Fixture& f = fixture();
     Grid<std::uint8_t> roi(f.ph.image.lattice());
@@ -219,7 +221,18 @@ TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
     CliResult r = run_cli(fmt::format("view {} --roi {} --seed 40,24,24 --headless --script {}", f.image, roi_path, script("j.json", "[]")));
     EXPECT_NE(r.rc, 0);
     EXPECT_EQ(lines(r.err), 1u) << r.err;
-    EXPECT_NE(r.err.find("seed --seed 40,24,24: the seed at (40, 24, 24) lies outside the region of interest"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("every seed lies outside the ROI " + roi_path + ", the first at voxel (40, 24, 24)"), std::string::npos) << r.err;
+    const std::string seeds_json = (f.dir / "kept_seeds.json").string();
+    r = run_cli(fmt::format("view {} --roi {} --seed 40,24,24 --seed 10,24,24 --headless --script {}", f.image, roi_path,
+                            script("j2.json", "[{\"save_seeds\": \"" + seeds_json + "\"}]")));
+    EXPECT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("the seed at voxel (40, 24, 24) lies outside the ROI " + roi_path + ": it is left out"), std::string::npos) << r.err;
+    {
+        std::ifstream in(seeds_json);
+        const std::string kept((std::istreambuf_iterator<char>(in)), {});
+        EXPECT_NE(kept.find("10,24,24"), std::string::npos) << kept;
+        EXPECT_EQ(kept.find("40,24,24"), std::string::npos) << kept;
+    }
     r = run_cli(fmt::format("view {} --roi {} --headless --script {}", f.image, roi_path,
                             script("k.json", R"([{"seed": [10, 24, 24]}, {"seed": [40, 24, 24]}])")));
     EXPECT_NE(r.rc, 0);
@@ -231,11 +244,20 @@ TEST(ViewCommand, ASeedOutsideTheRoiIsRefused) {
     const std::string head = (f.dir / "head.nii.gz").string();
     write_image(testing::analytic_head(false), head);
     const std::string hint = "the automatic brain mask bounds the front by default on a head; open the image with --roi none";
-    r = run_cli(fmt::format("view {} --no-bias-correct --seed 2,2,2 --headless --script {}", head, script("h.json", "[]")));
-    EXPECT_NE(r.rc, 0);
-    EXPECT_EQ(lines(r.err), 2u) << r.err;  // the note naming the default ROI, then the error
-    EXPECT_NE(r.err.find("seed --seed 2,2,2: the seed at (2, 2, 2) lies outside the region of interest"), std::string::npos) << r.err;
-    EXPECT_NE(r.err.find(hint), std::string::npos) << r.err;
+    r = run_cli(fmt::format("view {} --no-bias-correct --seed 2,2,2 --seed 32,32,32 --headless --script {}", head, script("h.json", "[]")));
+    EXPECT_EQ(r.rc, 0) << r.err;  // left out, named; the default ROI kept (1 of 2 outside)
+    EXPECT_NE(r.err.find("the seed at voxel (2, 2, 2) lies outside the automatic brain mask (the default ROI of a head): it is left out; "
+                         "pass --roi none to segment outside the brain"),
+              std::string::npos)
+        << r.err;
+    EXPECT_NE(r.err.find("by default"), std::string::npos) << r.err;
+    r = run_cli(fmt::format("view {} --no-bias-correct --seed 2,2,2 --headless --script {}", head, script("h1.json", "[]")));
+    EXPECT_EQ(r.rc, 0) << r.err;  // the seeds ask for something else than the brain: the whole image, as segment
+    EXPECT_NE(r.err.find("every seed lies outside the automatic brain mask (a T1 brain's), the first at voxel (2, 2, 2): the whole image is "
+                         "segmented, as with --roi none"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(r.err.find("the front stays in the automatic brain mask by default"), std::string::npos) << r.err;
     r = run_cli(fmt::format("view {} --no-bias-correct --headless --script {}", head, script("i.json", R"([{"seed": [32, 32, 32]}, {"seed": [2, 2, 2]}])")));
     EXPECT_NE(r.rc, 0);
     EXPECT_NE(r.err.find("entry 2 (\"seed\")"), std::string::npos) << r.err;
