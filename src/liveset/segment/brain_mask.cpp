@@ -256,7 +256,19 @@ Mask stripped_foreground(const Grid<float>& image, double threshold) {
 struct Vertical {
     double g[3] = {0, 0, 0};
     double exit_mm2 = 0;
+    double height(Vec3i p) const { return g[0] * p.x + g[1] * p.y + g[2] * p.z; }
 };
+
+// The head's highest point along `up`.
+double head_top(const Mask& head, const Vertical& up) {
+    const Vec3i d = head.dims();
+    double top = -std::numeric_limits<double>::infinity();
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x)
+                if (head({x, y, z}) != 0) top = std::max(top, up.height({x, y, z}));
+    return top;
+}
 
 // The solid head's voxels in the face `side` (0: index 0, 1: the last) of axis `a`, in mm².
 double face_exit_mm2(const Mask& head, int a, int side) {
@@ -307,12 +319,8 @@ Mask cranial(const Mask& head, const Vertical& up, double extent_mm, std::size_t
     below = 0;
     if (extent_mm <= 0) return head;
     const Vec3i d = head.dims();
-    const auto height = [&](int x, int y, int z) { return up.g[0] * x + up.g[1] * y + up.g[2] * z; };
-    double top = -std::numeric_limits<double>::infinity();
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x)
-                if (head({x, y, z}) != 0) top = std::max(top, height(x, y, z));
+    const auto height = [&](int x, int y, int z) { return up.height({x, y, z}); };
+    const double top = head_top(head, up);
     Mask out = head;
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
@@ -357,13 +365,9 @@ Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Ma
 // disc of that area (mm): the volume of each layer of height, one slice thick.
 double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
     const Vec3i d = head.dims();
-    const auto height = [&](int x, int y, int z) { return up.g[0] * x + up.g[1] * y + up.g[2] * z; };
+    const auto height = [&](int x, int y, int z) { return up.height({x, y, z}); };
     const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
-    double top = -std::numeric_limits<double>::infinity();
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x)
-                if (head({x, y, z}) != 0) top = std::max(top, height(x, y, z));
+    const double top = head_top(head, up);
     std::vector<std::size_t> layer(static_cast<std::size_t>(std::lround(depth_mm / layer_mm)) + 1, 0);
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
