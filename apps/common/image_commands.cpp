@@ -51,8 +51,9 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
     };
     try {
         Grid<std::uint8_t> mask = auto_brain_mask(image, options, &report, head.get());
-        // By default only a full head: a skull-stripped brain (or a phantom) has no scalp to leak into.
-        if (arg.empty() && report.skull_stripped) {
+        // By default only a full head: a skull-stripped brain (or a phantom) has no scalp to leak into,
+        // unless its outside was left mid-range (a z-scored brain's 0): the front would flow into it.
+        if (arg.empty() && report.skull_stripped && std::isnan(report.mid_range_fill)) {
             learnt(std::move(mask), std::move(head));
             return std::nullopt;
         }
@@ -296,13 +297,15 @@ nlohmann::json roi_report(const Roi& roi) {
                      {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
                      {"below_head_voxels", b->below_voxels}, {"inferior_exit_mm2", b->inferior_exit_mm2},
                      {"brain_extent_mm", b->brain_extent_mm}, {"head_diameter_mm", b->head_diameter_mm},
-                     {"superior", b->superior_from_header ? "header" : "from the head"}};
+                     {"superior", b->superior_from_header ? "header" : "from the head"},
+                     {"mid_range_fill", std::isnan(b->mid_range_fill) ? nlohmann::json(nullptr) : nlohmann::json(b->mid_range_fill)}};
     return j;
 }
 
 std::string brain_mask_summary(const BrainMaskReport& b) {
     std::string s = fmt::format("{}, tissue window {:.1f}..{:.1f}", b.skull_stripped ? "skull-stripped input" : "full head",
                                 b.tissue_low, b.tissue_high);
+    if (!std::isnan(b.mid_range_fill)) s += fmt::format(", masked outside at {:g} within the tissue's range", b.mid_range_fill);
     if (b.head_threshold > b.background_threshold)
         s += fmt::format(", noisy air σ {:.1f}: head threshold {:.1f}", b.background_noise, b.head_threshold);
     if (b.below_voxels > 0 && !b.skull_stripped)

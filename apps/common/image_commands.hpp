@@ -36,7 +36,9 @@ struct Roi {
     bool by_default = false;                     // "auto" chosen by default, not asked for
 };
 // `arg` empty, the default: the automatic brain mask when the image is a full head (Roi::by_default),
-// else no ROI (a skull-stripped brain has no scalp, muscle or eyes to leak into). "none": no ROI. "auto": auto_brain_mask(image) (UsageError "<option> auto: ..." when it
+// else no ROI (a skull-stripped brain has no scalp, muscle or eyes to leak into; but one whose
+// masked outside lies within its tissue's range, BrainMaskReport::mid_range_fill, keeps it as the
+// default ROI). "none": no ROI. "auto": auto_brain_mask(image) (UsageError "<option> auto: ..." when it
 // fails: constant image, no head, empty mask). Otherwise a mask file overlaying the image
 // (load_mask_like); files named "auto" or "none" can be given as ./auto, ./none.
 // What the default learnt without keeping a ROI: that no head is there, or the automatic brain mask

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <random>
 
 #include "analytic_head.hpp"
@@ -292,6 +293,56 @@ TEST(RoiAutoCli, AFullHeadIsSegmentedInItsBrainMaskByDefault) {
     const auto [s_none, sn] = run(path, " --roi none", "none_stripped");
     EXPECT_FALSE(sd.contains("roi")) << sd.dump();  // ...but not imposed
     EXPECT_EQ(differ(s_default, s_none), 0u);
+}
+
+// A skull-stripped brain z-scored inside its mask, the outside left at 0 (nnU-Net-style): 0 lies in
+// a grey-matter window, and the cortex reaches the mask's edge in one place. By default the brain is found as a
+// skull-stripped one (BrainMask.AMaskedOutsideWithinTheTissueRangeIsTheOutside) and kept as the
+// ROI, after N4 too (its correction about the floor makes the outside uneven): the front stays in
+// the brain; with --roi none it flows out into the field of view.
+TEST(RoiAutoCli, AMaskedOutsideWithinTheTissueRangeIsKeptAsTheDefaultRoi) {
+    Grid<float> head = liveset::testing::analytic_head(false);
+    Grid<std::uint8_t> brain(head.lattice(), 0);
+    double sum = 0, sum2 = 0, n = 0;
+    for (int z = 0; z < 64; ++z)
+        for (int y = 0; y < 64; ++y)
+            for (int x = 0; x < 64; ++x) {
+                const double r = 1.5 * norm(Vec3d{x - 31.5, y - 31.5, z - 31.5});
+                if (r >= 29) continue;  // the brain: white and grey matter, CSF
+                if (r >= 27 && x >= 40 && std::abs(y - 31.5) < 4 && std::abs(z - 31.5) < 4) head({x, y, z}) = 95.0f;  // cortex to the mask's edge
+                brain({x, y, z}) = 1;
+                const double v = head({x, y, z});
+                sum += v, sum2 += v * v, n += 1;
+            }
+    const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+    for (PointIndex i = 0; i < head.size(); ++i) head[i] = brain[i] != 0 ? static_cast<float>((head[i] - mean) / sd) : 0.0f;
+    const fs::path path = work_dir() / "zscored_brain.nii.gz";
+    write_image(head, path.string());
+    const double gm = (95.0 - mean) / sd, eps = 0.5;  // the window: grey matter and the outside's 0, neither CSF nor white matter
+    ASSERT_LT(std::abs(gm), eps);
+    ASSERT_GT((130.0 - mean) / sd, gm + eps + 0.4);
+    ASSERT_LT((45.0 - mean) / sd, gm - eps - 0.4);
+    const std::string o = " --seed 49,32,32:2 --mu-raw " + std::to_string(gm) + " --epsilon-raw " + std::to_string(eps) +
+                          " --iterations 200 --json --out-mask ";
+    const auto outside = [&](const std::string& roi, const std::string& name, nlohmann::json& j) {
+        const fs::path seg = work_dir() / (name + ".nii.gz");
+        const auto r = run_cli("--threads 2 segment " + path.string() + roi + o + seg.string());
+        EXPECT_EQ(r.rc, 0) << r.err;
+        if (r.rc != 0) return std::size_t{0};
+        j = nlohmann::json::parse(r.out);
+        const Grid<std::uint8_t> mask = read_label_image(seg.string());
+        std::size_t out = 0;
+        for (PointIndex i = 0; i < mask.size(); ++i) out += mask[i] != 0 && brain[i] == 0;
+        return out;
+    };
+    nlohmann::json jd, jn;
+    EXPECT_EQ(outside("", "zscored_default", jd), 0u);
+    EXPECT_GT(outside(" --roi none", "zscored_none", jn), 1000u);
+    ASSERT_TRUE(jd.contains("roi")) << jd.dump();
+    EXPECT_TRUE(jd["roi"]["default"].get<bool>());
+    EXPECT_TRUE(jd["roi"]["auto"]["skull_stripped"].get<bool>());
+    EXPECT_EQ(jd["roi"]["auto"]["mid_range_fill"].get<double>(), 0.0);
+    EXPECT_NEAR(jd["bias_correction"]["offset"].get<double>(), *std::min_element(head.values().begin(), head.values().end()), 0.5);
 }
 
 // The analytic head under Rician noise σ 14 (its air a Rayleigh of mode 14): the report gives the

@@ -300,7 +300,9 @@ TEST(BrainMask, FoundAgainInTheHeadItWasFirstFoundIn) {
     for (PointIndex i = 0; i < own.solid.size(); ++i) differ += own.solid[i] != head.solid[i];
     EXPECT_LT(static_cast<double>(differ), 0.005 * static_cast<double>(first.head_voxels));
 
-    BrainMaskHead wrong{Mask(Lattice({3, 3, 3})), Grid<float>(Lattice({3, 3, 3}))};
+    BrainMaskHead wrong;
+    wrong.solid = Mask(Lattice({3, 3, 3}));
+    wrong.depth = Grid<float>(Lattice({3, 3, 3}));
     EXPECT_THROW(auto_brain_mask(t1, {}, nullptr, &wrong), std::invalid_argument);
 }
 
@@ -643,6 +645,55 @@ TEST(BrainMask, AnalyticSkullStrippedHeadIsTheWholeForeground) {
     EXPECT_EQ(r.background_noise, 0.0);  // the zeros are a constant fill, the brain no noise mode
     EXPECT_EQ(r.head_threshold, r.background_threshold);
     for (std::size_t i = 0; i < mask.size(); ++i) ASSERT_EQ(mask[static_cast<PointIndex>(i)], brain[static_cast<PointIndex>(i)]) << i;
+}
+
+// The same skull-stripped head z-scored inside its brain with the outside left at 0 (nnU-Net-style
+// preprocessing): 0 then lies between CSF and grey matter, and read as it is the whole field of view
+// is head. The outside is found as the faces' exact value and read as a dark background: the brain
+// again, exactly. Found again in that head after N4's correction about a floor made the outside
+// uneven (a gradient, the brain scaled): the same brain. Where the faces' value is the lowest
+// (the plain stripped head) or no value holds most of the faces (a full head in noisy air), no
+// masked outside is reported.
+TEST(BrainMask, AMaskedOutsideWithinTheTissueRangeIsTheOutside) {
+    Mask brain;
+    const Grid<float> head = sphere_head({1, 1, 1}, &brain);
+    double sum = 0, sum2 = 0, n = 0;
+    for (PointIndex i = 0; i < head.size(); ++i)
+        if (brain[i] != 0) sum += head[i], sum2 += double(head[i]) * head[i], n += 1;
+    const double mean = sum / n, sd = std::sqrt(sum2 / n - mean * mean);
+    Grid<float> z(head.lattice());
+    for (PointIndex i = 0; i < z.size(); ++i) z[i] = brain[i] != 0 ? static_cast<float>((head[i] - mean) / sd) : 0.0f;
+    ASSERT_LT(*std::min_element(z.values().begin(), z.values().end()), -1.0f);  // CSF below the outside's 0
+    BrainMaskReport r;
+    BrainMaskHead found;
+    const Mask mask = auto_brain_mask(z, {}, &r, &found);
+    EXPECT_TRUE(r.skull_stripped);
+    EXPECT_EQ(r.mid_range_fill, 0.0);
+    for (PointIndex i = 0; i < mask.size(); ++i) ASSERT_EQ(mask[i], brain[i]) << i;
+    ASSERT_TRUE(found.outside.dims() == z.dims());
+    for (PointIndex i = 0; i < mask.size(); ++i) ASSERT_EQ(found.outside[i], 1 - brain[i]) << i;
+
+    Grid<float> corrected = z;
+    const Vec3i d = z.dims();
+    for (int k = 0; k < d.z; ++k)
+        for (int j = 0; j < d.y; ++j)
+            for (int i = 0; i < d.x; ++i)
+                corrected({i, j, k}) = brain({i, j, k}) != 0 ? 1.05f * z({i, j, k}) : 0.002f * static_cast<float>(i + j);
+    BrainMaskReport again;
+    const Mask same = auto_brain_mask(corrected, {}, &again, &found);
+    EXPECT_EQ(again.mid_range_fill, 0.0);
+    for (PointIndex i = 0; i < mask.size(); ++i) ASSERT_EQ(same[i], brain[i]) << i;
+
+    Grid<float> stripped = head;
+    for (PointIndex i = 0; i < stripped.size(); ++i)
+        if (brain[i] == 0) stripped[i] = 0.0f;
+    BrainMaskReport plain, full;
+    BrainMaskHead plain_head;
+    auto_brain_mask(stripped, {}, &plain, &plain_head);
+    EXPECT_TRUE(std::isnan(plain.mid_range_fill));
+    EXPECT_EQ(plain_head.outside.size(), 0u);
+    auto_brain_mask(head, {}, &full);
+    EXPECT_TRUE(std::isnan(full.mid_range_fill));
 }
 
 // A brain without skull under heavy noise (the test phantom, noise 12 %, 1 x 1 x 1.5 mm): whatever

@@ -13,7 +13,6 @@
 #include <stdexcept>
 #include <string>
 #include <vector>
-#include <vector>
 
 #include "liveset/segment/morphology.hpp"
 #include "liveset/segment/smoothing.hpp"
@@ -122,6 +121,54 @@ std::optional<float> constant_fill(const Grid<float>& image) {
     for (float v : image.values()) at_lowest += v == lowest;
     if (static_cast<double>(at_lowest) < 0.02 * static_cast<double>(image.size())) return std::nullopt;
     return lowest;
+}
+
+// A masked image's outside that does not lie below its tissue (a skull-stripped brain z-scored
+// inside its mask with the outside left at 0, as nnU-Net-style preprocessing leaves it: the outside
+// then reads as grey matter and the whole field of view as head). The exact value of at least half
+// of the voxels on the array's six faces, when some voxel is darker and it fills at least 2 % of
+// the image; `outside` receives the voxels of that value connected to the faces. nullopt (and
+// `outside` untouched) otherwise.
+std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
+    const Vec3i d = image.dims();
+    std::vector<float> face;
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y) {
+            if (y == 0 || z == 0 || y == d.y - 1 || z == d.z - 1) {
+                for (int x = 0; x < d.x; ++x) face.push_back(image({x, y, z}));
+            } else {
+                face.push_back(image({0, y, z}));
+                if (d.x > 1) face.push_back(image({d.x - 1, y, z}));
+            }
+        }
+    std::sort(face.begin(), face.end());
+    float mode = face.front();
+    std::size_t best = 0;
+    for (std::size_t i = 0, j = 0; i < face.size(); i = j) {
+        while (j < face.size() && face[j] == face[i]) ++j;
+        if (j - i > best) best = j - i, mode = face[i];
+    }
+    if (2 * best < face.size()) return std::nullopt;
+    const float lowest = *std::min_element(image.values().begin(), image.values().end());
+    if (!(lowest < mode)) return std::nullopt;  // constant_fill's case
+    Mask inside(image.lattice());
+    for (std::size_t i = 0; i < inside.size(); ++i) inside[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != mode;
+    inside = fill_holes(inside);
+    if (static_cast<double>(inside.size() - count(inside)) < 0.02 * static_cast<double>(image.size())) return std::nullopt;
+    outside = std::move(inside);
+    for (std::uint8_t& v : outside.values()) v = v == 0;
+    return mode;
+}
+
+// `image` with the voxels of `outside` set below all the others (by 1 % of the range), so that
+// the masked outside is read as a skull-stripped image's dark background.
+Grid<float> outside_lowered(const Grid<float>& image, const Mask& outside) {
+    const auto [lo, hi] = std::minmax_element(image.values().begin(), image.values().end());
+    const float below = *lo - 0.01f * (*hi - *lo);
+    Grid<float> out = image;
+    for (std::size_t i = 0; i < out.size(); ++i)
+        if (outside[static_cast<PointIndex>(i)] != 0) out[static_cast<PointIndex>(i)] = below;
+    return out;
 }
 
 // The background's noise level (Sijbers et al. 2007; Brummer et al. 1993): the air around a head in
@@ -428,12 +475,11 @@ void validate(const BrainMaskOptions& o) {
     require(std::isfinite(o.stripped_fraction) && o.stripped_fraction > 0 && o.stripped_fraction <= 1, "stripped_fraction must lie in (0, 1]");
 }
 
-Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport* report, BrainMaskHead* known) {
-    validate(o);
-    check_image(image);
+namespace {
+
+// auto_brain_mask on an image whose outside, if masked, is already below the rest.
+Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport* report, BrainMaskHead* known) {
     const bool reuse = known != nullptr && known->solid.size() > 0;
-    if (reuse && (!(known->solid.dims() == image.dims()) || !(known->depth.dims() == image.dims())))
-        throw std::invalid_argument("brain mask: the head given is not of the image's size");
     BrainMaskReport r;
     thresholds(image, o, r);
     BrainMaskHead found;
@@ -471,6 +517,36 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     r.mask_volume_mm3 = static_cast<double>(r.mask_voxels) * s.x * s.y * s.z;
     if (report != nullptr) *report = r;
     if (known != nullptr && !reuse) *known = std::move(found);
+    return brain;
+}
+
+}  // namespace
+
+Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport* report, BrainMaskHead* known) {
+    validate(o);
+    check_image(image);
+    const bool reuse = known != nullptr && known->solid.size() > 0;
+    if (reuse && (!(known->solid.dims() == image.dims()) || !(known->depth.dims() == image.dims()) ||
+                  (known->outside.size() > 0 && !(known->outside.dims() == image.dims()))))
+        throw std::invalid_argument("brain mask: the head given is not of the image's size");
+    Mask outside;
+    double fill = std::numeric_limits<double>::quiet_NaN();
+    if (reuse) {
+        outside = known->outside;
+        fill = known->outside_value;
+    } else if (const std::optional<float> f = mid_range_fill(image, outside)) {
+        fill = *f;
+    }
+    if (outside.size() == 0) return find_brain(image, o, report, known);
+    // A masked outside within the tissue's range: read as a skull-stripped image's dark background.
+    BrainMaskReport r;
+    Grid<std::uint8_t> brain = find_brain(outside_lowered(image, outside), o, &r, known);
+    r.mid_range_fill = fill;
+    if (report != nullptr) *report = r;
+    if (known != nullptr && !reuse) {
+        known->outside = std::move(outside);
+        known->outside_value = fill;
+    }
     return brain;
 }
 

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "liveset/grid/grid.hpp"
 
@@ -99,6 +100,12 @@ struct BrainMaskReport {
     std::size_t core_voxels = 0;      // largest component after the erosion
     double surface_contact = 0;       // fraction of the mask boundary near the head surface
     bool skull_stripped = false;      // the input looked skull-stripped (mask = filled foreground)
+    // A masked outside's value where it lies within the tissue's range (a skull-stripped brain
+    // z-scored inside its mask, the outside left at 0): the exact value of most of the array's
+    // faces, some voxel darker, filling ≥ 2 % of the image. Its voxels connected to the faces are
+    // read as lying below every other (the mask is then found as for a skull-stripped image).
+    // NaN when there is none.
+    double mid_range_fill = std::numeric_limits<double>::quiet_NaN();
     std::size_t mask_voxels = 0;
     double mask_volume_mm3 = 0;
 };
@@ -107,9 +114,13 @@ struct BrainMaskReport {
 // threshold, neck included) and each voxel's depth in it (mm). A smooth multiplicative correction of
 // the intensities (N4) does not move the head's surface against the dark air around it, so the brain
 // can be found again on the corrected image inside the same head (prepare_image, apps/common).
+// A masked outside within the tissue's range (BrainMaskReport::mid_range_fill) is kept with it: N4's
+// correction about a floor (bias_correction.offset) makes it uneven, and it is still the outside.
 struct BrainMaskHead {
     Grid<std::uint8_t> solid;
     Grid<float> depth;
+    Grid<std::uint8_t> outside;  // empty when the image was not so masked
+    double outside_value = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The brain mask (0/1) on the image's lattice. Deterministic for any thread count.
