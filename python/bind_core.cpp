@@ -37,15 +37,15 @@ pyb::tuple read(const std::string& path, bool labels) {
     return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l), h.orientation_known);
 }
 
-void write(const pyb::array& values, const Lattice& lattice, const std::string& path, bool labels) {
+void write(const pyb::array& values, const Lattice& lattice, const std::string& path, bool labels, bool oriented) {
     if (labels) {
         const Grid<std::uint8_t> g = mask_from_array(values, lattice);
         pyb::gil_scoped_release nogil;
-        write_label_image(g, path);
+        write_label_image(g, path, {.orientation_known = oriented});
     } else {
         const Grid<float> g = grid_from_array(values, lattice);
         pyb::gil_scoped_release nogil;
-        write_image(g, path);
+        write_image(g, path, {.orientation_known = oriented});
     }
 }
 
@@ -387,9 +387,9 @@ void register_core(pyb::module_& m) {
         return d;
     }, pyb::arg("path"));
     m.def("_read", &read, pyb::arg("path"), pyb::arg("labels") = false);
-    m.def("_write", [](const pyb::array& v, const pyb::tuple& geo, const std::string& path, bool labels) {
+    m.def("_write", [](const pyb::array& v, const pyb::tuple& geo, const std::string& path, bool labels, bool oriented) {
         if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
-        write(v, lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]), path, labels);
+        write(v, lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]), path, labels, oriented);
     });
     m.def("_segment", [](const pyb::array& v, const pyb::tuple& geo, const pyb::object& progress, const pyb::kwargs& kw) {
         if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");

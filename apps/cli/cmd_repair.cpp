@@ -207,15 +207,16 @@ void print_step_summary(const RepairArgs& a, const std::vector<RepairStepLog>& l
 }
 
 // The outputs every path writes: --out-phi, --out-mask, --out-mesh.
-void write_outputs(const RepairArgs& a, const SparseField& field, const Grid<std::uint8_t>& mask, const Lattice& lattice) {
-    if (!a.out_phi.empty()) write_image(field.phi(), a.out_phi);
-    if (!a.out_mask.empty()) write_label_image(mask, a.out_mask);
+void write_outputs(const RepairArgs& a, const SparseField& field, const Grid<std::uint8_t>& mask, const Lattice& lattice, bool oriented) {
+    if (!a.out_phi.empty()) write_image(field.phi(), a.out_phi, {.orientation_known = oriented});
+    if (!a.out_mask.empty()) write_label_image(mask, a.out_mask, {.orientation_known = oriented});
     if (!a.out_mesh.empty()) write_mesh(a.out_mesh, marching_cubes_band(field.phi(), field.zero_layer()).view(), lattice);
 }
 
 // What a repair run works on: the image, the ROI, the session holding the level set, the sheet band.
 struct RepairInputs {
     Grid<float> image;
+    bool oriented = true;  // the image's header gave an orientation (the outputs say so too)
     std::optional<Grid<std::uint8_t>> roi;
     std::unique_ptr<Session> session;
     std::optional<SheetBand> band;
@@ -224,7 +225,9 @@ struct RepairInputs {
 };
 
 RepairInputs load_inputs(const RepairArgs& a) {
-    RepairInputs in{read_image(a.image), std::nullopt, nullptr, std::nullopt, {}};
+    ImageHeader header;
+    RepairInputs in{read_image(a.image, kDefaultImageMemoryLimit, &header), true, std::nullopt, nullptr, std::nullopt, {}};
+    in.oriented = header.orientation_known;
     if (!a.roi.empty()) in.roi = load_mask_like(a.roi, in.image.lattice(), "--roi");
     // The repair edits through a Session (the viewer's edit path: local update, history, mesher of
     // 8³-cell fragments); the session's scale is robust_scale(image, roi), as before.
@@ -252,7 +255,7 @@ int run_found_holes(const RepairArgs& a, RepairInputs& in, const InterruptGuard&
         return 130;
     }
     const SparseField& field = in.session->field();
-    write_outputs(a, field, inside_mask(field.phi(), in.roi_ptr()), in.image.lattice());
+    write_outputs(a, field, inside_mask(field.phi(), in.roi_ptr()), in.image.lattice(), in.oriented);
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else if (!a.quiet) {
@@ -298,7 +301,7 @@ int run_given_targets(RepairArgs a, RepairInputs& in, const InterruptGuard& inte
                                                   static_cast<int>(std::lround(t.position.z))}, 0, v));
         }
     }
-    write_outputs(a, field, mask, in.image.lattice());
+    write_outputs(a, field, mask, in.image.lattice(), in.oriented);
     print_step_summary(a, log, verdicts, in.band);
     return 0;
 }

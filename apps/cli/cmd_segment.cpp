@@ -128,10 +128,11 @@ int run_segment(const SegmentArgs& a, int threads) {
         return 130;
     }
     const SegmentOutcome& o = run.outcome;
-    write_label_image(o.mask, a.out_mask);
-    if (!a.out_phi.empty()) write_image(o.field->phi(), a.out_phi);
-    if (!a.out_roi.empty()) write_label_image(roi->mask, a.out_roi);
-    if (!a.out_corrected.empty()) write_image(image, a.out_corrected);
+    const WriteOptions as_read{.orientation_known = header.orientation_known};
+    write_label_image(o.mask, a.out_mask, as_read);
+    if (!a.out_phi.empty()) write_image(o.field->phi(), a.out_phi, as_read);
+    if (!a.out_roi.empty()) write_label_image(roi->mask, a.out_roi, as_read);
+    if (!a.out_corrected.empty()) write_image(image, a.out_corrected, as_read);
     std::size_t triangles = 0;
     if (!a.out_mesh.empty()) {
         const Mesh mesh = marching_cubes_band(o.field->phi(), o.field->zero_layer());

@@ -41,6 +41,7 @@ struct ViewArgs : ThresholdArgs {
     std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
     std::string workspace_warning;      // the workspace was refused, or its ROI is not the one it was saved with
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
+    bool image_oriented = true;         // set by load_session: its header gave an orientation (saved masks say so too)
     bool roi_by_default = false;        // set by load_session: no --roi, and the automatic brain mask found
     // set by load_session: --seed and --seeds, each with how it was given, less those the ROI left out
     std::vector<std::pair<SeedBall, std::string>> start_seeds;
@@ -105,6 +106,7 @@ void fit_start_seeds(ViewArgs& a, const Lattice& lattice, std::optional<Roi>& ro
 std::unique_ptr<Session> load_session(ViewArgs& a) {
     ImageHeader header;
     Grid<float> image = read_image(a.image, kDefaultImageMemoryLimit, &header);
+    a.image_oriented = header.orientation_known;
     // A level set to continue (--mask, --phi) may come from another tool: no default ROI to clip it.
     if (a.roi.empty() && (!a.mask.empty() || !a.phi.empty())) a.roi = "none";
     BrainLookup lookup;
@@ -258,6 +260,7 @@ int run_view(ViewArgs& a, int threads) {
     config.roi_none = roi_none;
     config.bias_correct = a.bias_correct;
     config.image_corrected = a.image_corrected;
+    config.image_oriented = a.image_oriented;
     config.params_note = note;
     config.open_warning = a.workspace_warning;
     config.workspace_path = a.workspace;

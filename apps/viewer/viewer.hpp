@@ -94,6 +94,9 @@ struct ViewerConfig {
     // workspaces: a continued workspace corrects its image again, or not).
     bool bias_correct = true;
     bool image_corrected = false;
+    // Whether the session's image file gave an orientation: saved masks and φ of one that gave none
+    // are written without one too (WriteOptions).
+    bool image_oriented = true;
     std::string params_note;  // where the start parameters came from (panel and stderr)
     std::string open_warning;  // what the start should warn about (the workspace's ROI changed): status line and event log
     std::string workspace_path;                   // the panel's workspace file (--workspace)

@@ -22,6 +22,7 @@ constexpr int kOpenPollMs = 40;  // a frame waits this long for the worker (the 
 struct Viewer::Opened {
     std::unique_ptr<Session> session;
     bool corrected = false;    // N4 ran
+    bool oriented = true;      // the header gave an orientation
     bool brain_roi = false;    // the automatic brain mask bounds the front (the default on a head)
     std::string bias_skipped;  // the default correction's warning, when it did not run
     std::string error;         // the image could not be opened
@@ -49,6 +50,7 @@ bool Viewer::open_image(const std::string& path) {
             ImageHeader header;
             Grid<float> image = read_image(path, kDefaultImageMemoryLimit, &header);
             if (cancel->load()) return out;
+            out->oriented = header.orientation_known;
             cli::BrainLookup lookup;
             lookup.options = cli::brain_mask_options(header);
             std::optional<cli::Roi> roi = cli::load_roi(roi_arg, image, "--roi", &lookup);  // as `view IMAGE [--roi none]` (view_command.cpp)
@@ -123,6 +125,7 @@ void Viewer::poll_open(bool wait) {
     config_.roi_path = opened->brain_roi ? "auto" : "none";  // the default's choice, or --roi none
     config_.roi_by_default = opened->brain_roi;
     config_.image_corrected = opened->corrected;
+    config_.image_oriented = opened->oriented;
     image_name_ = std::filesystem::path(path).filename().string();
     attach_session();
     message_ = "opened " + path + (opened->brain_roi ? ", the front bounded by the automatic brain mask" : "") +

@@ -15,7 +15,7 @@ bool Viewer::save_mask(const std::string& path) {
     if (!session_) return fail("open an image first");
     try {
         cli::check_output_path(path, cli::OutputKind::kImage, "mask");
-        write_label_image(session_->mask(), path);
+        write_label_image(session_->mask(), path, {.orientation_known = config_.image_oriented});
     } catch (const std::exception& e) {
         return fail(e.what());
     }
@@ -32,7 +32,7 @@ bool Viewer::save_phi(const std::string& path) {
     if (!session_) return fail("open an image first");
     try {
         cli::check_output_path(path, cli::OutputKind::kImage, "phi");
-        write_image(session_->field().phi(), path);
+        write_image(session_->field().phi(), path, {.orientation_known = config_.image_oriented});
     } catch (const std::exception& e) {
         return fail(e.what());
     }

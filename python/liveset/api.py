@@ -34,9 +34,11 @@ def read_header(path: str) -> dict:
 def write(image, path: str, labels: bool = False) -> None:
     """Write an image atomically (temporary + rename) with its full geometry; the format follows
     the extension (.nii.gz, .nii, .mha, .nrrd, .mnc, ...). ``labels=True`` writes uint8 0..255 (a
-    mask: non-zero -> 1); otherwise float32."""
+    mask: non-zero -> 1); otherwise float32. An image without orientation (``Image.oriented``
+    False: read from a NIfTI without qform and sform, or an Analyze file) is written as one (a
+    NIfTI's qform and sform codes 0), so nibabel and FSL place it where they place its source."""
     img = as_image(image)
-    _liveset._write(img.array, img.geometry, str(path), labels)
+    _liveset._write(img.array, img.geometry, str(path), labels, bool(img.oriented))
 
 
 def _seed_text(seed) -> str:

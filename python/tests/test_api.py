@@ -395,6 +395,43 @@ def test_a_file_without_orientation_reaches_the_brain_mask_as_such(tmp_path):
         assert s.report["roi"]["auto"]["superior"] == superior
 
 
+def test_outputs_of_a_file_without_orientation_are_placed_by_nibabel_where_it_places_the_file(tmp_path):
+    """nibabel places a NIfTI without qform and sform by pixdim (x flipped); an output written with
+    the identity LPS axes and codes 1 would lie mirrored in y against it. So the outputs of such a
+    file (liveset.write of the image or of a segmentation's mask, `liveset segment`'s mask, φ, ROI
+    and corrected image) have codes 0 and nibabel's affine of the file; an oriented file's outputs
+    keep its affine with codes set."""
+    img = _bridged_head()
+    n = nib.Nifti1Image(img.array, None)
+    n.header.set_zooms((1.5, 1.5, 1.5))
+    n.header.set_qform(None, code=0)
+    n.header.set_sform(None, code=0)
+    src = str(tmp_path / "unoriented.nii.gz")
+    nib.save(n, src)
+    source = nib.load(src)
+    u = liveset.read(src)
+    seg = liveset.segment(u, [(32, 32, 32, 3)], mu_raw=130, epsilon_raw=40, iterations=5, bias_correct=False)
+    outputs = {"image": (u, False), "mask": (seg.mask, True)}
+    for name, (image, labels) in outputs.items():
+        liveset.write(image, str(tmp_path / f"{name}.nii.gz"), labels=labels)
+    cli("segment", src, "--seed", "32,32,32:3", "--mu-raw", 130, "--epsilon-raw", 40, "--iterations", 5, "--roi", "auto",
+        "--out-mask", tmp_path / "cli_mask.nii", "--out-phi", tmp_path / "cli_phi.nii.gz", "--out-roi", tmp_path / "cli_roi.nii.gz",
+        "--out-corrected", tmp_path / "cli_corrected.nii.gz", "--quiet")
+    written = list(outputs) + ["cli_mask", "cli_phi", "cli_roi", "cli_corrected"]
+    for name in written:
+        f = nib.load(str(tmp_path / (name + (".nii" if name == "cli_mask" else ".nii.gz"))))
+        assert int(f.header["qform_code"]) == 0 and int(f.header["sform_code"]) == 0, name
+        np.testing.assert_allclose(f.affine, source.affine, atol=1e-5, err_msg=name)
+        assert f.shape == source.shape, name
+    np.testing.assert_array_equal(np.asarray(nib.load(str(tmp_path / "mask.nii.gz")).dataobj), seg.mask.array)
+    oriented = liveset.read(str(tmp_path / "image.nii.gz"))
+    assert not oriented.oriented and int(source.header["sform_code"]) == 0
+    liveset.write(liveset.Image(u.array, u.spacing, u.origin, u.direction), str(tmp_path / "oriented.nii.gz"))
+    f = nib.load(str(tmp_path / "oriented.nii.gz"))
+    assert int(f.header["sform_code"]) != 0
+    np.testing.assert_allclose(f.affine, np.diag([-1.5, -1.5, 1.5, 1.0]), atol=1e-5)  # the LPS identity in RAS
+
+
 def test_session_warns_as_segment_when_its_front_leaks_out_of_the_brain():
     img = _bridged_head()
     seg = liveset.segment(img, [(32, 32, 32, 3)], roi="none", mu_raw=130, epsilon_raw=40, iterations=1000, bias_correct=False)

@@ -3,6 +3,7 @@
 // phrase), atomic writes that leave no temporaries behind, and the BrainWeb data when present.
 #include <gtest/gtest.h>
 #include <sys/mount.h>
+#include <zlib.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -235,6 +236,46 @@ TEST_F(ImageIo, AHeaderWithoutOrientationSaysSo) {
     EXPECT_FALSE(ah.orientation_known);
     ASSERT_EQ(analyze.size(), image.size());
     for (std::size_t i = 0; i < analyze.size(); ++i) ASSERT_EQ(analyze[static_cast<PointIndex>(i)], image[static_cast<PointIndex>(i)]) << i;
+}
+
+// Written as without orientation (WriteOptions): a NIfTI's qform and sform codes are 0 in the file
+// (read raw, both byte positions), it reads back as not oriented with the same voxels and lattice as
+// the unoriented file read above; its other header bytes are ITK's. Other formats take no such
+// mark: they read back oriented, identity axes stored.
+TEST_F(ImageIo, AnImageWithoutOrientationIsWrittenAsOne) {
+    const Grid<float> image = test_image();
+    for (const std::string name : {"u.nii", "u.nii.gz"}) {
+        write_image(image, path("k" + name));
+        write_image(image, path(name), {.orientation_known = false});
+        const auto header_bytes = [&](const std::string& file) {
+            gzFile f = gzopen(path(file).c_str(), "rb");
+            std::string h(348, '\0');
+            EXPECT_EQ(gzread(f, h.data(), 348), 348) << file;
+            gzclose(f);
+            return h;
+        };
+        const std::string known = header_bytes("k" + name), unknown = header_bytes(name);
+        EXPECT_NE(known.substr(252, 4), std::string(4, '\0')) << name;
+        EXPECT_EQ(unknown.substr(252, 4), std::string(4, '\0')) << name;
+        EXPECT_EQ(known.substr(0, 252), unknown.substr(0, 252)) << name;
+        EXPECT_EQ(known.substr(256), unknown.substr(256)) << name;
+        ImageHeader h;
+        const Grid<float> read = read_image(path(name), kDefaultImageMemoryLimit, &h);
+        EXPECT_FALSE(h.orientation_known) << name;
+        EXPECT_EQ(read.lattice().direction(), kIdentity3) << name;
+        ASSERT_EQ(read.size(), image.size());
+        for (std::size_t i = 0; i < read.size(); ++i) ASSERT_EQ(read[static_cast<PointIndex>(i)], image[static_cast<PointIndex>(i)]) << i;
+    }
+    Grid<std::uint8_t> labels(image.lattice(), 0);
+    labels[PointIndex{5}] = 1;
+    write_label_image(labels, path("l.nii.gz"), {.orientation_known = false});
+    ImageHeader lh;
+    EXPECT_EQ(read_label_image(path("l.nii.gz"), kDefaultImageMemoryLimit, &lh)[PointIndex{5}], 1);
+    EXPECT_FALSE(lh.orientation_known);
+    for (const std::string name : {"u.mha", "u.nrrd"}) {
+        write_image(image, path(name), {.orientation_known = false});
+        EXPECT_TRUE(read_image_header(path(name)).orientation_known) << name;
+    }
 }
 
 TEST_F(ImageIo, TwoFileFormatsGetFinalDataFileNames) {

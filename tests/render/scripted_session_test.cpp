@@ -186,6 +186,28 @@ TEST(ScriptedSession, TheCutRuleCutsAHandleAtTheTarget) {
     testing::expect_rod_cut(c, read_label_image(out));
 }
 
+// The viewer's saved mask and φ of an image whose file gave no orientation are written without one
+// too (as `segment`'s outputs: ImageIo.AnImageWithoutOrientationIsWrittenAsOne, and nibabel's
+// placement in the Python suite); an oriented image's keep theirs.
+TEST(ScriptedSession, SavesOfAnImageWithoutOrientationHaveNone) {
+    const fs::path dir = scripts_dir();
+    const testing::RodShell c = testing::rod_shell();
+    for (const bool oriented : {true, false}) {
+        const std::string tag = oriented ? "o" : "u", image = (dir / ("rod_" + tag + ".nii.gz")).string();
+        write_image(c.image, image, {.orientation_known = oriented});
+        write_label_image(c.mask, (dir / "rod_seg.nii.gz").string());
+        const std::string mask = (dir / ("saved_mask_" + tag + ".nii.gz")).string(), phi = (dir / ("saved_phi_" + tag + ".nii")).string();
+        write_text(dir / "save.json", R"([{"save_mask": ")" + mask + R"("}, {"save_phi": ")" + phi + R"("}])");
+        const CliResult r = run_cli("view " + image + " --mask " + (dir / "rod_seg.nii.gz").string() + " --headless --script " +
+                                    (dir / "save.json").string());
+        ASSERT_EQ(r.rc, 0) << r.err;
+        EXPECT_EQ(read_image_header(mask).orientation_known, oriented);
+        EXPECT_EQ(read_image_header(phi).orientation_known, oriented);
+        const Grid<std::uint8_t> saved = read_label_image(mask);
+        EXPECT_TRUE(std::equal(saved.values().begin(), saved.values().end(), c.mask.values().begin()));
+    }
+}
+
 TEST(ScriptedSession, BadScriptsAreRefusedWithOneLineNamingTheEntry) {
     const fs::path dir = scripts_dir();
     PhantomOptions o;

@@ -1,5 +1,5 @@
-// Raw-byte checks of NIfTI and MetaImage files (see file_checks.hpp), with zlib's gz* functions,
-// which read plain and gzip-compressed files alike.
+// Raw-byte checks of NIfTI and MetaImage files, and the orientation-code patch (see file_checks.hpp),
+// with zlib's gz* functions, which read plain and gzip-compressed files alike.
 #include "liveset/io/file_checks.hpp"
 
 #include <zlib.h>
@@ -244,6 +244,45 @@ DataCheck check_metaimage_data(const std::string& path, std::uint64_t raw_bytes)
         result.detail = holds(have, need);
     }
     return result;
+}
+
+bool clear_nifti_orientation(const std::string& path) {
+    std::vector<unsigned char> bytes;
+    bool compressed = false;
+    {
+        std::unique_ptr<gzFile_s, GzClose> file(gzopen(path.c_str(), "rb"));
+        if (!file) return false;
+        compressed = gzdirect(file.get()) == 0;
+        constexpr unsigned kChunk = 1u << 24;
+        for (;;) {
+            const std::size_t at = bytes.size();
+            bytes.resize(at + kChunk);
+            const int n = gzread(file.get(), bytes.data() + at, kChunk);
+            if (n < 0) return false;
+            bytes.resize(at + static_cast<std::size_t>(n));
+            if (n == 0 || !compressed) break;  // a plain file: the header is all that is patched
+        }
+    }
+    if (bytes.size() < 348) return false;
+    const auto size_le = load<std::int32_t>(bytes.data(), false), size_be = load<std::int32_t>(bytes.data(), true);
+    if (size_le != 348 && size_be != 348) return false;
+    if (std::memcmp(bytes.data() + 344, "n+1", 4) != 0 && std::memcmp(bytes.data() + 344, "ni1", 4) != 0) return false;
+    std::memset(bytes.data() + 252, 0, 4);  // qform_code, sform_code (int16 each): 0 in either byte order
+    if (!compressed) {
+        std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(252);
+        f.write(reinterpret_cast<const char*>(bytes.data() + 252), 4);
+        return static_cast<bool>(f.flush());
+    }
+    gzFile out = gzopen(path.c_str(), "wb");
+    if (out == nullptr) return false;
+    bool ok = true;
+    for (std::size_t at = 0; ok && at < bytes.size();) {
+        const unsigned n = static_cast<unsigned>(std::min<std::size_t>(bytes.size() - at, std::size_t{1} << 30));
+        ok = gzwrite(out, bytes.data() + at, n) == static_cast<int>(n);
+        at += n;
+    }
+    return gzclose(out) == Z_OK && ok;
 }
 
 }  // namespace liveset::io_detail

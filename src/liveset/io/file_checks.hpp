@@ -1,6 +1,7 @@
 // Internal to liveset_io: checks on the raw bytes of image files, for the cases where ITK's readers
 // hide damage. niftilib zero-fills the missing part of a short file and silently replaces NaN and
-// infinite floats by 0; MetaIO only prints a warning when a data file is short. No ITK in here.
+// infinite floats by 0; MetaIO only prints a warning when a data file is short. And one patch ITK's
+// NIfTI writer cannot be asked for (orientation codes 0). No ITK in here.
 #pragma once
 
 #include <cstdint>
@@ -22,5 +23,10 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite);
 // MetaImage (.mha with LOCAL data, .mhd with one data file): the data file holds `raw_bytes`
 // (uncompressed) or the header's CompressedDataSize. Multi-file (LIST, pattern) data is unchecked.
 DataCheck check_metaimage_data(const std::string& path, std::uint64_t raw_bytes);
+
+// Sets a NIfTI-1 header's qform_code and sform_code to 0 (no orientation), in place: a .nii is
+// patched, a .nii.gz decompressed, patched and compressed again. False, the file
+// unchanged, when it is not a NIfTI-1 header (ni1/n+1 magic) or cannot be read or written.
+bool clear_nifti_orientation(const std::string& path);
 
 }  // namespace liveset::io_detail

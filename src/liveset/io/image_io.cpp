@@ -463,7 +463,7 @@ void set_geometry(itk::ImageIOBase& io, const Lattice& lattice) {
     io.SetIORegion(region);
 }
 
-void write_grid(const void* data, Component component, const Lattice& lattice, const std::string& path) {
+void write_grid(const void* data, Component component, const Lattice& lattice, const std::string& path, const WriteOptions& options) {
     if (path.empty()) throw ImageIoError("cannot write an image: the path is empty");
     if (lattice.size() == 0) fail_write(path, "the image is empty");
     const fs::path target(path);
@@ -521,6 +521,9 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
         {
             const io_detail::SilencedStderr quiet;  // niftilib/teem print their own error first
             io->Write(data);
+        }
+        if (!options.orientation_known && cls == "NiftiImageIO") {
+            if (!io_detail::clear_nifti_orientation(tmp)) fail_write(path, "cannot mark the written header as without orientation");
         }
         // Read the temporary back: catches writers that do not report short writes (disk full).
         auto check = itk::ImageIOFactory::CreateImageIO(tmp.c_str(), itk::IOFileModeEnum::ReadMode);
@@ -620,12 +623,12 @@ Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_b
     return grid;
 }
 
-void write_image(const Grid<float>& image, const std::string& path) {
-    write_grid(image.values().data(), Component::FLOAT, image.lattice(), path);
+void write_image(const Grid<float>& image, const std::string& path, const WriteOptions& options) {
+    write_grid(image.values().data(), Component::FLOAT, image.lattice(), path, options);
 }
 
-void write_label_image(const Grid<std::uint8_t>& labels, const std::string& path) {
-    write_grid(labels.values().data(), Component::UCHAR, labels.lattice(), path);
+void write_label_image(const Grid<std::uint8_t>& labels, const std::string& path, const WriteOptions& options) {
+    write_grid(labels.values().data(), Component::UCHAR, labels.lattice(), path, options);
 }
 
 bool is_dicom_series_dir(const std::string& path) {

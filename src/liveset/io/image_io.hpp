@@ -80,8 +80,17 @@ Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_b
 // up front when the folder lacks the space. On any failure the temporaries are removed and
 // ImageIoError is thrown ("cannot write "<path>": folder "x" does not exist", "cannot create a
 // file in folder ...", "not enough free space ...", "the file came out short ...").
-void write_image(const Grid<float>& image, const std::string& path);
-void write_label_image(const Grid<std::uint8_t>& labels, const std::string& path);
+//
+// `options.orientation_known` false (the image's source gave none: ImageHeader::orientation_known):
+// a NIfTI (.nii, .nii.gz) is written with qform and sform codes 0, as its source
+// was, so that the tools that place such a file by a rule of their own (nibabel, FSL, FreeSurfer:
+// from pixdim, x flipped) put the two in the same place; ITK-based tools (ITK-SNAP, 3D Slicer)
+// read both as the LPS identity. Other formats store that identity.
+struct WriteOptions {
+    bool orientation_known = true;
+};
+void write_image(const Grid<float>& image, const std::string& path, const WriteOptions& options = {});
+void write_label_image(const Grid<std::uint8_t>& labels, const std::string& path, const WriteOptions& options = {});
 
 // True when `path` is a folder holding at least one DICOM series.
 bool is_dicom_series_dir(const std::string& path);
