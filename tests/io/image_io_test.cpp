@@ -151,7 +151,7 @@ TEST_P(RoundTrip, LabelImageIsExact) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Formats, RoundTrip,
-                         ::testing::Values(".nii", ".nii.gz", ".mha", ".mhd", ".nrrd", ".nhdr", ".mnc"),
+                         ::testing::Values(".nii", ".nii.gz", ".mha", ".mhd", ".nrrd", ".nhdr", ".mnc", ".mgz", ".mgh"),
                          [](const auto& info) {
                              std::string n = info.param + 1;
                              for (char& c : n) c = (c == '.') ? '_' : c;
@@ -276,6 +276,39 @@ TEST_F(ImageIo, AnImageWithoutOrientationIsWrittenAsOne) {
         write_image(image, path(name), {.orientation_known = false});
         EXPECT_TRUE(read_image_header(path(name)).orientation_known) << name;
     }
+}
+
+// FreeSurfer's MGH beyond the round trips (its geometry against nibabel: the Python suite): a header
+// without goodRASflag reads as not oriented; more than one frame, a short file and another version
+// are one line each.
+TEST_F(ImageIo, FreeSurferMghHeadersAreReadAsTheySay) {
+    const auto patched = [&](const std::string& name, std::size_t at, std::vector<unsigned char> bytes, std::size_t keep = 0) {
+        write_image(test_image(), path(name));
+        std::string all;
+        {
+            std::ifstream in(path(name), std::ios::binary);
+            all.assign(std::istreambuf_iterator<char>(in), {});
+        }
+        std::copy(bytes.begin(), bytes.end(), all.begin() + static_cast<std::ptrdiff_t>(at));
+        if (keep > 0) all.resize(keep);
+        std::ofstream(path(name), std::ios::binary | std::ios::trunc) << all;
+        return path(name);
+    };
+    write_image(test_image(), path("plain.mgh"));
+    const ImageHeader plain = read_image_header(path("plain.mgh"));
+    EXPECT_EQ(plain.format, "MGH");
+    EXPECT_TRUE(plain.orientation_known);
+
+    ImageHeader h;
+    const Grid<float> unoriented = read_image(patched("flag0.mgh", 28, {0, 0}), kDefaultImageMemoryLimit, &h);  // goodRASflag 0
+    EXPECT_FALSE(h.orientation_known);
+    EXPECT_EQ(unoriented.lattice().spacing(), (Vec3d{1, 1, 1}));  // as nibabel: 1 mm, its default axes
+    EXPECT_EQ(unoriented[PointIndex{17}], test_image()[PointIndex{17}]);
+
+    expect_error([&] { read_image(patched("frames.mgh", 16, {0, 0, 0, 2})); }, path("frames.mgh"), "is a 4D image");
+    expect_error([&] { read_image(patched("short.mgh", 0, {}, 284 + 40)); }, path("short.mgh"), "corrupt or truncated");
+    expect_error([&] { read_image(patched("version.mgh", 0, {0, 0, 0, 2})); }, path("version.mgh"), "is not an MGH file (its version is 2, not 1)");
+    expect_error([&] { read_image(patched("type.mgh", 20, {0, 0, 0, 6})); }, path("type.mgh"), "has MGH voxel type 6, which liveset does not read");
 }
 
 TEST_F(ImageIo, TwoFileFormatsGetFinalDataFileNames) {

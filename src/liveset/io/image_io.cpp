@@ -37,6 +37,7 @@
 #include "liveset/grid/large_page_allocator.hpp"
 #include "liveset/io/file_checks.hpp"
 #include "liveset/io/messages.hpp"
+#include "liveset/io/mgh_image_io.hpp"
 #include "liveset/io/minc_world.hpp"
 
 namespace liveset {
@@ -68,6 +69,14 @@ void register_factories() {
     });
 }
 
+// The ImageIO for `path`: FreeSurfer's MGH by its name (.mgh, .mgz; ours, mgh_image_io.hpp), else
+// the registered factories' choice (null when none takes it). A file that claims to be MGH and is
+// not still gets the MGH reader, whose error then says why.
+itk::ImageIOBase::Pointer create_io(const std::string& path, itk::IOFileModeEnum mode) {
+    if (io_detail::is_mgh_name(path)) return io_detail::MghImageIO::New().GetPointer();
+    return itk::ImageIOFactory::CreateImageIO(path.c_str(), mode);
+}
+
 [[noreturn]] void fail_read(const std::string& path, const std::string& what) {
     throw ImageIoError("cannot read " + quoted(path) + ": " + what);
 }
@@ -86,12 +95,13 @@ std::string format_name(const itk::ImageIOBase& io) {
     if (cls == "NrrdImageIO") return "NRRD";
     if (cls == "MINCImageIO") return "MINC";
     if (cls == "GDCMImageIO") return "DICOM";
+    if (cls == "MghImageIO") return "MGH";
     const auto at = cls.find("ImageIO");
     return at == std::string::npos ? cls : cls.substr(0, at);
 }
 
 const char* kFormatsHint =
-    "liveset reads .nii/.nii.gz, .mha/.mhd, .nrrd/.nhdr, .mnc and folders of DICOM slices";
+    "liveset reads .nii/.nii.gz, .mha/.mhd, .nrrd/.nhdr, .mnc, .mgh/.mgz and folders of DICOM slices";
 
 // ---------------------------------------------------------------------------------------------
 // MINC: its RAS world is converted to LPS on read and back on write (minc_world.hpp says why)
@@ -108,6 +118,7 @@ void keep_minc_world_as_stored(MincIO& io) {
 // False for a NIfTI (or Analyze) header whose qform and sform codes are both 0 (NIFTI_XFORM_UNKNOWN):
 // its axes carry no orientation, ITK reads them as LPS identity.
 bool orientation_known(const itk::ImageIOBase& io) {
+    if (const auto* mgh = dynamic_cast<const io_detail::MghImageIO*>(&io)) return mgh->orientation_known();  // its goodRASflag
     if (std::string(io.GetNameOfClass()) != "NiftiImageIO") return true;
     std::string q, s;
     const itk::MetaDataDictionary& dict = io.GetMetaDataDictionary();
@@ -185,7 +196,7 @@ void open_file(Source& src) {
     if (fs::file_size(path, ec) == 0 && !ec) fail_read(path, "file is empty (0 bytes)");
     itk::ImageIOBase::Pointer io;
     try {
-        io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::IOFileModeEnum::ReadMode);
+        io = create_io(path, itk::IOFileModeEnum::ReadMode);
     } catch (const itk::ExceptionObject& e) {
         fail_read(path, "file is corrupt or truncated (" + condense(e, path) + ")");
     }
@@ -196,6 +207,8 @@ void open_file(Source& src) {
         io->ReadImageInformation();
     } catch (const itk::ExceptionObject& e) {
         fail_read(path, "file is corrupt or truncated (" + condense(e, path) + ")");
+    } catch (const std::invalid_argument& e) {  // a header we read and do not support (MGH)
+        fail_read(path, e.what());
     } catch (const std::exception& e) {
         fail_read(path, std::string("file is corrupt or truncated (") + e.what() + ")");
     }
@@ -475,13 +488,13 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
     if (!fs::is_directory(dir_status)) fail_write(path, quoted(dir.string()) + " is not a folder");
     if (filename.empty() || fs::is_directory(target, ec)) fail_write(path, "is a folder, not a file name");
     const std::string ext = file_extension(filename);
-    const char* formats = "use .nii.gz, .nii, .mha, .mhd, .nrrd, .nhdr or .mnc";
+    const char* formats = "use .nii.gz, .nii, .mha, .mhd, .nrrd, .nhdr, .mnc or .mgz";
     if (ext.empty()) fail_write(path, std::string("no file extension to choose the format (") + formats + ")");
 
     register_factories();
     itk::ImageIOBase::Pointer io;
     try {
-        io = itk::ImageIOFactory::CreateImageIO(path.c_str(), itk::IOFileModeEnum::WriteMode);
+        io = create_io(path, itk::IOFileModeEnum::WriteMode);
     } catch (const itk::ExceptionObject&) {
         io = nullptr;
     }
@@ -526,7 +539,7 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
             if (!io_detail::clear_nifti_orientation(tmp)) fail_write(path, "cannot mark the written header as without orientation");
         }
         // Read the temporary back: catches writers that do not report short writes (disk full).
-        auto check = itk::ImageIOFactory::CreateImageIO(tmp.c_str(), itk::IOFileModeEnum::ReadMode);
+        auto check = create_io(tmp, itk::IOFileModeEnum::ReadMode);
         if (!check) fail_write(path, "the written file cannot be read back (disk full?)");
         check->SetFileName(tmp);
         check->ReadImageInformation();
