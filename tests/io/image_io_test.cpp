@@ -238,12 +238,15 @@ TEST_F(ImageIo, AHeaderWithoutOrientationSaysSo) {
     for (std::size_t i = 0; i < analyze.size(); ++i) ASSERT_EQ(analyze[static_cast<PointIndex>(i)], image[static_cast<PointIndex>(i)]) << i;
 }
 
-// Written as without orientation (WriteOptions): a NIfTI's qform and sform codes are 0 in the file
-// (read raw, both byte positions), it reads back as not oriented with the same voxels and lattice as
-// the unoriented file read above; its other header bytes are ITK's. Other formats take no such
-// mark: they read back oriented, identity axes stored.
+// Written as without orientation (WriteOptions) on the lattice such a file reads as (the LPS
+// identity at the origin): a NIfTI's qform and sform codes are 0 in the file (read raw, both byte
+// positions), it reads back as not oriented with the same voxels and lattice; its other header
+// bytes are ITK's. A lattice placed otherwise keeps its codes and placement (codes 0 would lose
+// it). Other formats take no such mark: they read back oriented.
 TEST_F(ImageIo, AnImageWithoutOrientationIsWrittenAsOne) {
-    const Grid<float> image = test_image();
+    const Grid<float> oblique = test_image();
+    Grid<float> image(Lattice(oblique.dims(), oblique.lattice().spacing()));
+    std::copy(oblique.values().begin(), oblique.values().end(), image.values().begin());
     for (const std::string name : {"u.nii", "u.nii.gz"}) {
         write_image(image, path("k" + name));
         write_image(image, path(name), {.orientation_known = false});
@@ -262,7 +265,7 @@ TEST_F(ImageIo, AnImageWithoutOrientationIsWrittenAsOne) {
         ImageHeader h;
         const Grid<float> read = read_image(path(name), kDefaultImageMemoryLimit, &h);
         EXPECT_FALSE(h.orientation_known) << name;
-        EXPECT_EQ(read.lattice().direction(), kIdentity3) << name;
+        expect_same_geometry(read.lattice(), image.lattice(), 1e-6);
         ASSERT_EQ(read.size(), image.size());
         for (std::size_t i = 0; i < read.size(); ++i) ASSERT_EQ(read[static_cast<PointIndex>(i)], image[static_cast<PointIndex>(i)]) << i;
     }
@@ -276,6 +279,12 @@ TEST_F(ImageIo, AnImageWithoutOrientationIsWrittenAsOne) {
         write_image(image, path(name), {.orientation_known = false});
         EXPECT_TRUE(read_image_header(path(name)).orientation_known) << name;
     }
+    write_image(oblique, path("placed.nii.gz"), {.orientation_known = false});
+    ImageHeader ph;
+    const Grid<float> placed = read_image(path("placed.nii.gz"), kDefaultImageMemoryLimit, &ph);
+    EXPECT_TRUE(ph.orientation_known);
+    expect_same_geometry(placed.lattice(), oblique.lattice());
+    for (const auto& name : listing()) EXPECT_EQ(name.find(".orient"), std::string::npos) << "left behind: " << name;
 }
 
 // FreeSurfer's MGH beyond the round trips (its geometry against nibabel: the Python suite): a header

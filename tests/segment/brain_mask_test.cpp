@@ -694,6 +694,21 @@ TEST(BrainMask, AMaskedOutsideWithinTheTissueRangeIsTheOutside) {
     EXPECT_EQ(plain_head.outside.size(), 0u);
     auto_brain_mask(head, {}, &full);
     EXPECT_TRUE(std::isnan(full.mid_range_fill));
+    // A few voxels below the outside's value are not a tissue range: a resampler's undershoot at a
+    // stripped brain's edge (the mask and the default of no ROI as without it), stray negatives in
+    // a head's air of zeros.
+    Grid<float> undershoot = stripped, zero_air = head;
+    std::size_t placed = 0;
+    for (PointIndex i = 0; i < undershoot.size() && placed < 40; ++i)
+        if (brain[i] != 0 && (i % 97) == 0) undershoot[i] = -2.0f, ++placed;
+    for (PointIndex i = 0; i < zero_air.size(); ++i)
+        if (zero_air[i] < 6.0f) zero_air[i] = (i % 5000) == 0 ? -3.0f : 0.0f;
+    BrainMaskReport u, a;
+    auto_brain_mask(undershoot, {}, &u);
+    auto_brain_mask(zero_air, {}, &a);
+    EXPECT_TRUE(std::isnan(u.mid_range_fill));
+    EXPECT_TRUE(u.skull_stripped);
+    EXPECT_TRUE(std::isnan(a.mid_range_fill));
 }
 
 // A brain without skull under heavy noise (the test phantom, noise 12 %, 1 x 1 x 1.5 mm): whatever

@@ -247,42 +247,53 @@ DataCheck check_metaimage_data(const std::string& path, std::uint64_t raw_bytes)
 }
 
 bool clear_nifti_orientation(const std::string& path) {
-    std::vector<unsigned char> bytes;
+    // The codes' offsets: NIfTI-1 qform_code, sform_code int16 at 252, 254; NIfTI-2 int32 at 344, 348.
+    std::array<unsigned char, 540> h{};
     bool compressed = false;
+    std::size_t at = 0, width = 0;
     {
-        std::unique_ptr<gzFile_s, GzClose> file(gzopen(path.c_str(), "rb"));
-        if (!file) return false;
-        compressed = gzdirect(file.get()) == 0;
-        constexpr unsigned kChunk = 1u << 24;
-        for (;;) {
-            const std::size_t at = bytes.size();
-            bytes.resize(at + kChunk);
-            const int n = gzread(file.get(), bytes.data() + at, kChunk);
-            if (n < 0) return false;
-            bytes.resize(at + static_cast<std::size_t>(n));
-            if (n == 0 || !compressed) break;  // a plain file: the header is all that is patched
+        std::unique_ptr<gzFile_s, GzClose> in(gzopen(path.c_str(), "rb"));
+        if (!in) return false;
+        compressed = gzdirect(in.get()) == 0;
+        if (gzread(in.get(), h.data(), 348) != 348) return false;
+        const bool n1 = load<std::int32_t>(h.data(), false) == 348 || load<std::int32_t>(h.data(), true) == 348;
+        const bool n2 = load<std::int32_t>(h.data(), false) == 540 || load<std::int32_t>(h.data(), true) == 540;
+        if (n1 && (std::memcmp(h.data() + 344, "n+1", 4) == 0 || std::memcmp(h.data() + 344, "ni1", 4) == 0)) {
+            at = 252, width = 4;
+        } else if (n2 && std::memcmp(h.data() + 4, "n+2", 4) == 0) {
+            at = 344, width = 8;
+        } else {
+            return false;
         }
     }
-    if (bytes.size() < 348) return false;
-    const auto size_le = load<std::int32_t>(bytes.data(), false), size_be = load<std::int32_t>(bytes.data(), true);
-    if (size_le != 348 && size_be != 348) return false;
-    if (std::memcmp(bytes.data() + 344, "n+1", 4) != 0 && std::memcmp(bytes.data() + 344, "ni1", 4) != 0) return false;
-    std::memset(bytes.data() + 252, 0, 4);  // qform_code, sform_code (int16 each): 0 in either byte order
+    const std::vector<unsigned char> zeros(width, 0);  // 0 in either byte order
     if (!compressed) {
         std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
-        f.seekp(252);
-        f.write(reinterpret_cast<const char*>(bytes.data() + 252), 4);
+        f.seekp(static_cast<std::streamoff>(at));
+        f.write(reinterpret_cast<const char*>(zeros.data()), static_cast<std::streamsize>(width));
         return static_cast<bool>(f.flush());
     }
-    gzFile out = gzopen(path.c_str(), "wb");
-    if (out == nullptr) return false;
-    bool ok = true;
-    for (std::size_t at = 0; ok && at < bytes.size();) {
-        const unsigned n = static_cast<unsigned>(std::min<std::size_t>(bytes.size() - at, std::size_t{1} << 30));
-        ok = gzwrite(out, bytes.data() + at, n) == static_cast<int>(n);
-        at += n;
+    // Compressed: streamed through a second temporary (no copy of the image in memory), renamed over.
+    const std::string patched = path + ".orient";
+    std::unique_ptr<gzFile_s, GzClose> in(gzopen(path.c_str(), "rb"));
+    gzFile out = in ? gzopen(patched.c_str(), "wb") : nullptr;
+    bool ok = out != nullptr;
+    std::vector<unsigned char> buf(std::size_t{1} << 22);
+    for (bool first = true; ok; first = false) {
+        const int n = gzread(in.get(), buf.data(), static_cast<unsigned>(buf.size()));
+        if (n < 0) ok = false;
+        if (n <= 0) break;
+        if (first) {
+            if (static_cast<std::size_t>(n) < at + width) ok = false;
+            else std::memset(buf.data() + at, 0, width);
+        }
+        ok = ok && gzwrite(out, buf.data(), static_cast<unsigned>(n)) == n;
     }
-    return gzclose(out) == Z_OK && ok;
+    if (out != nullptr && gzclose(out) != Z_OK) ok = false;
+    std::error_code ec;
+    if (ok) fs::rename(patched, path, ec);
+    if (!ok || ec) fs::remove(patched, ec);
+    return ok && !ec;
 }
 
 }  // namespace liveset::io_detail

@@ -24,9 +24,9 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite);
 // (uncompressed) or the header's CompressedDataSize. Multi-file (LIST, pattern) data is unchecked.
 DataCheck check_metaimage_data(const std::string& path, std::uint64_t raw_bytes);
 
-// Sets a NIfTI-1 header's qform_code and sform_code to 0 (no orientation), in place: a .nii is
-// patched, a .nii.gz decompressed, patched and compressed again. False, the file
-// unchanged, when it is not a NIfTI-1 header (ni1/n+1 magic) or cannot be read or written.
+// Sets a NIfTI header's qform_code and sform_code to 0 (no orientation), in place: a .nii is
+// patched, a .nii.gz streamed through a second temporary (`path`.orient) and renamed over it.
+// NIfTI-1 and NIfTI-2. False when it is neither, or cannot be read or written (`path` then as it was).
 bool clear_nifti_orientation(const std::string& path);
 
 }  // namespace liveset::io_detail

@@ -535,9 +535,12 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
             const io_detail::SilencedStderr quiet;  // niftilib/teem print their own error first
             io->Write(data);
         }
-        if (!options.orientation_known && cls == "NiftiImageIO") {
-            if (!io_detail::clear_nifti_orientation(tmp)) fail_write(path, "cannot mark the written header as without orientation");
-        }
+        // Without orientation only where codes 0 say the same geometry (ITK reads them as the LPS
+        // identity at the origin; an image placed otherwise, e.g. an MGH read with default axes,
+        // keeps its placement and codes).
+        const bool as_read_unoriented = lattice.direction() == kIdentity3 && lattice.origin() == Vec3d{0, 0, 0};
+        if (!options.orientation_known && cls == "NiftiImageIO" && as_read_unoriented && !io_detail::clear_nifti_orientation(tmp))
+            fail_write(path, "cannot mark the written header as without orientation");
         // Read the temporary back: catches writers that do not report short writes (disk full).
         auto check = create_io(tmp, itk::IOFileModeEnum::ReadMode);
         if (!check) fail_write(path, "the written file cannot be read back (disk full?)");

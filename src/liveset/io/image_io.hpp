@@ -85,7 +85,9 @@ Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_b
 // a NIfTI (.nii, .nii.gz) is written with qform and sform codes 0, as its source
 // was, so that the tools that place such a file by a rule of their own (nibabel, FSL, FreeSurfer:
 // from pixdim, x flipped) put the two in the same place; ITK-based tools (ITK-SNAP, 3D Slicer)
-// read both as the LPS identity. Other formats store that identity.
+// read both as the LPS identity. Only where the lattice is that identity at the origin (as ITK
+// reads such a NIfTI): a lattice placed otherwise (an MGH without its flag, read with default
+// axes) keeps its placement and codes. Other formats store the lattice as it is.
 struct WriteOptions {
     bool orientation_known = true;
 };

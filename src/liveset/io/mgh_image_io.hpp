@@ -6,9 +6,10 @@
 // dof, goodRASflag, then, where that flag is set, the voxel sizes, the three axes' direction cosines
 // in RAS (x_r x_a x_s, y_r ..., z_r ...) and the RAS of the centre voxel (dims / 2) — then the
 // voxels, x fastest, big-endian; an optional footer (scan parameters, tags) follows and is ignored.
-// The world is RAS: it is converted to ITK's LPS on read and back on write. A header without the
-// flag gives no orientation (orientation_known() false) and reads as nibabel reads it: 1 mm voxels,
-// its default axes. Written files hold one frame of uchar or float32 voxels, the flag set.
+// The world is RAS: it is converted to ITK's LPS on read and back on write. A header whose flag is
+// not positive gives no orientation (orientation_known() false; FreeSurfer's test — nibabel uses
+// the header for any nonzero flag) and reads with nibabel's default for it: 1 mm voxels, its
+// default axes (x→L, y→S, z→P; FreeSurfer's own default may differ), centred. Written files hold one frame of uchar or float32 voxels, the flag set.
 #pragma once
 
 #include <itkImageIOBase.h>

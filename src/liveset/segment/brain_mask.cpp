@@ -126,8 +126,9 @@ std::optional<float> constant_fill(const Grid<float>& image) {
 // A masked image's outside that does not lie below its tissue (a skull-stripped brain z-scored
 // inside its mask with the outside left at 0, as nnU-Net-style preprocessing leaves it: the outside
 // then reads as grey matter and the whole field of view as head). The exact value of at least half
-// of the voxels on the array's six faces, when some voxel is darker and it fills at least 2 % of
-// the image; `outside` receives the voxels of that value connected to the faces. nullopt (and
+// of the voxels on the array's six faces, when it fills at least 2 % of the image and at least 5 %
+// of the rest lie below it (a few darker voxels — a resampler's undershoot at a stripped brain's
+// edge, stray negatives in integer air — do not count); `outside` receives the voxels of that value connected to the faces. nullopt (and
 // `outside` untouched) otherwise.
 std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
     const Vec3i d = image.dims();
@@ -154,7 +155,11 @@ std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
     Mask inside(image.lattice());
     for (std::size_t i = 0; i < inside.size(); ++i) inside[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != mode;
     inside = fill_holes(inside);
-    if (static_cast<double>(inside.size() - count(inside)) < 0.02 * static_cast<double>(image.size())) return std::nullopt;
+    const std::size_t n_inside = count(inside);
+    if (static_cast<double>(inside.size() - n_inside) < 0.02 * static_cast<double>(image.size())) return std::nullopt;
+    std::size_t darker = 0;  // within the tissue's range: a share of the inside lies below it, not a few
+    for (std::size_t i = 0; i < inside.size(); ++i) darker += inside[static_cast<PointIndex>(i)] != 0 && image[static_cast<PointIndex>(i)] < mode;
+    if (static_cast<double>(darker) < 0.05 * static_cast<double>(n_inside)) return std::nullopt;  // air at 0 and a resampler's undershoot
     outside = std::move(inside);
     for (std::uint8_t& v : outside.values()) v = v == 0;
     return mode;

@@ -102,7 +102,7 @@ struct BrainMaskReport {
     bool skull_stripped = false;      // the input looked skull-stripped (mask = filled foreground)
     // A masked outside's value where it lies within the tissue's range (a skull-stripped brain
     // z-scored inside its mask, the outside left at 0): the exact value of most of the array's
-    // faces, some voxel darker, filling ≥ 2 % of the image. Its voxels connected to the faces are
+    // faces, filling ≥ 2 % of the image, with ≥ 5 % of the rest darker. Its voxels connected to the faces are
     // read as lying below every other (the mask is then found as for a skull-stripped image).
     // NaN when there is none.
     double mid_range_fill = std::numeric_limits<double>::quiet_NaN();
