@@ -1,7 +1,10 @@
 // `liveset eval` (overlap, surface distance and topology of a mask against a ground truth) and
 // `liveset phantom` (the synthetic cortex MR volume with its exact ground truth).
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
+#include <array>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -19,7 +22,9 @@ namespace {
 
 struct EvalArgs {
     std::string mask, truth;
-    int label = -1, mask_label = -1, inner_label = -1;
+    // Each a set of labels (none: non-zero); several name one structure (FreeSurfer's aseg: cortex 3
+    // and 42, white matter 2 and 41).
+    std::vector<int> label, mask_label, inner_label;
     int max_sites = 20;
     bool json = false;
 };
@@ -35,15 +40,21 @@ nlohmann::json sites_json(const std::vector<Perforation>& sites, int limit) {
     return a;
 }
 
-Grid<std::uint8_t> select_label(Grid<std::uint8_t> g, int label) {
-    for (std::uint8_t& v : g.values()) v = label < 0 ? v != 0 : v == label;
+Grid<std::uint8_t> select_label(Grid<std::uint8_t> g, const std::vector<int>& labels) {
+    std::array<std::uint8_t, 256> in{};
+    for (int l : labels) in[static_cast<std::size_t>(l)] = 1;
+    for (std::uint8_t& v : g.values()) v = labels.empty() ? v != 0 : in[v];
     return g;
 }
 
+std::string label_text(const std::vector<int>& labels) { return fmt::format("{}", fmt::join(labels, ",")); }
+
 void run_eval(const EvalArgs& a, int threads) {
     const auto guard = limit_threads(threads);
-    if (a.inner_label >= 0 && a.label < 0) throw UsageError("--inner-label needs --label (both index the truth's label image)");
-    if (a.inner_label >= 0 && a.inner_label == a.label) throw UsageError("--inner-label must differ from --label");
+    if (!a.inner_label.empty() && a.label.empty()) throw UsageError("--inner-label needs --label (both index the truth's label image)");
+    for (int l : a.inner_label)
+        if (std::find(a.label.begin(), a.label.end(), l) != a.label.end())
+            throw UsageError(fmt::format("--inner-label {} is also a --label: the two must differ", l));
     const Grid<std::uint8_t> labels = read_label_image(a.truth);
     const Grid<std::uint8_t> truth = select_label(labels, a.label);
     const Grid<std::uint8_t> mask = select_label(read_label_image(a.mask), a.mask_label);
@@ -55,14 +66,15 @@ void run_eval(const EvalArgs& a, int threads) {
     std::size_t n = 0;
     for (std::uint8_t v : truth.values()) n += v;
     if (n == 0)
-        throw UsageError(a.label >= 0 ? fmt::format("{} has no voxel with label {}", a.truth, a.label)
+        throw UsageError(!a.label.empty() ? fmt::format("{} has no voxel with label {}", a.truth, label_text(a.label))
                                       : fmt::format("{} is empty (no non-zero voxel)", a.truth));
     nlohmann::json j = evaluation_report(mask, truth);
     j["mask"] = a.mask;
     j["truth"]["path"] = a.truth;
-    if (a.label >= 0) j["truth"]["label"] = a.label;
+    if (a.label.size() == 1) j["truth"]["label"] = a.label[0];
+    if (!a.label.empty()) j["truth"]["labels"] = a.label;
     std::vector<Perforation> perforations, cavities;
-    if (a.inner_label >= 0) {  // where to point a repair: tunnels through the structure, bubbles in it
+    if (!a.inner_label.empty()) {  // where to point a repair: tunnels through the structure, bubbles in it
         const Grid<std::uint8_t> inner = select_label(labels, a.inner_label);
         perforations = find_perforations(mask, truth, inner);
         cavities = find_cavities(mask, inner);
@@ -73,11 +85,12 @@ void run_eval(const EvalArgs& a, int threads) {
     if (a.json) {
         fmt::print("{}\n", j.dump());
     } else {
-        fmt::print("liveset eval: {} against {}{}\n", a.mask, a.truth, a.label >= 0 ? fmt::format(" (label {})", a.label) : "");
+        fmt::print("liveset eval: {} against {}{}\n", a.mask, a.truth,
+                   a.label.empty() ? std::string() : fmt::format(" (label{} {})", a.label.size() > 1 ? "s" : "", label_text(a.label)));
         print_evaluation(j);
-        if (a.inner_label >= 0) {
+        if (!a.inner_label.empty()) {
             fmt::print("  hole sites: {} perforation(s) through the structure to label {}, {} spurious cavity(ies); largest:\n",
-                       perforations.size(), a.inner_label, cavities.size());
+                       perforations.size(), label_text(a.inner_label), cavities.size());
             for (const auto* list : {&perforations, &cavities})
                 for (std::size_t k = 0; k < list->size() && static_cast<int>(k) < std::min(a.max_sites, 5); ++k) {
                     const Perforation& p = (*list)[k];
@@ -150,9 +163,11 @@ void add_eval_commands(CLI::App& app, const int& threads) {
     auto* ev = app.add_subcommand("eval", "compare a mask with a ground truth: Dice, Jaccard, HD95, topology and holes");
     ev->add_option("--mask", ea.mask, "segmentation mask (non-zero = foreground)")->required();
     ev->add_option("--truth", ea.truth, "ground-truth mask or label image")->required();
-    ev->add_option("--label", ea.label, "use truth == LABEL (e.g. 2 = grey matter in BrainWeb labels)")->check(CLI::Range(0, 255));
-    ev->add_option("--mask-label", ea.mask_label, "use mask == LABEL")->check(CLI::Range(0, 255));
-    ev->add_option("--inner-label", ea.inner_label, "also locate the holes to repair: perforations through the structure to truth == LABEL (e.g. 3 = white matter under grey matter) and spurious cavities")->check(CLI::Range(0, 255));
+    ev->add_option("--label", ea.label, "use truth == LABEL (e.g. 2 = grey matter in BrainWeb labels); several, repeated or comma-separated, are one structure (FreeSurfer aseg cortex: 3,42)")
+        ->delimiter(',')->check(CLI::Range(0, 255));
+    ev->add_option("--mask-label", ea.mask_label, "use mask == LABEL (several: any of them)")->delimiter(',')->check(CLI::Range(0, 255));
+    ev->add_option("--inner-label", ea.inner_label, "also locate the holes to repair: perforations through the structure to truth == LABEL (e.g. 3 = white matter under grey matter; aseg: 2,41) and spurious cavities")
+        ->delimiter(',')->check(CLI::Range(0, 255));
     ev->add_option("--max-sites", ea.max_sites, "hole sites listed per kind in the JSON report")->check(CLI::Range(0, 100000))->capture_default_str();
     ev->add_flag("--json", ea.json, "print one JSON object (dice, jaccard, volume_difference, hausdorff95_mm, components, euler, genus, holes)");
     ev->callback([&threads] { run_eval(ea, threads); });

@@ -93,7 +93,7 @@ void check_output_path(const std::string& path, OutputKind kind, const std::stri
     std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     auto ends = [&](const std::string& e) { return name.size() > e.size() && name.compare(name.size() - e.size(), e.size(), e) == 0; };
     if (kind == OutputKind::kImage) {
-        for (const char* e : {".nii.gz", ".nii", ".mha", ".mhd", ".nrrd", ".nhdr", ".mnc", ".mgz", ".mgh"})
+        for (const char* e : {".nii.gz", ".nii", ".mha", ".mhd", ".nrrd", ".nhdr", ".mnc", ".mgz", ".mgh", ".mgh.gz"})
             if (ends(e)) return;
         throw UsageError(fmt::format("{} {}: unknown image format; use .nii.gz, .nii, .mha, .mhd, .nrrd, .nhdr, .mnc or .mgz", option, path));
     }

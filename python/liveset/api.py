@@ -169,17 +169,19 @@ def mesh(phi_or_mask, out: Optional[str] = None, kind: str = "auto") -> Mesh:
     return Mesh(v, f, nrm)
 
 
-def evaluate(mask, truth, label: Optional[int] = None) -> dict:
+def evaluate(mask, truth, label=None) -> dict:
     """``liveset eval``'s metrics of a mask against a truth: dice, jaccard, volume_difference,
     hausdorff95_mm, hausdorff_mm, mean_surface_mm, components, euler, genus, cavities, holes and
-    the truth's topology. ``label``: use truth == label (e.g. 2 = grey matter in BrainWeb)."""
+    the truth's topology. ``label``: use truth == label (e.g. 2 = grey matter in BrainWeb); a
+    sequence of labels is one structure (FreeSurfer's aseg cortex: ``(3, 42)``)."""
     m, t = as_image(mask, "mask"), as_image(truth, "truth")
     if not m.same_geometry(t):
         raise ValueError("the mask and the truth do not share a geometry (shape, spacing, origin or direction)")
     ta = np.asarray(t.array)
-    ta = (ta == label) if label is not None else (ta != 0)
-    if label is not None and not ta.any():
-        raise ValueError(f"the truth has no voxel with label {label}")
+    labels = None if label is None else [int(v) for v in (label if np.ndim(label) else [label])]
+    ta = np.isin(ta, labels) if labels is not None else (ta != 0)
+    if labels is not None and not ta.any():
+        raise ValueError(f"the truth has no voxel with label {','.join(map(str, labels))}")
     return json.loads(_liveset._evaluate(np.asarray(m.array) != 0, ta, m.geometry))
 
 

@@ -157,6 +157,21 @@ def test_evaluate_matches_brute_force_and_cli(phantom, cli_segmentation):
         assert ev[k] == ref[k], k
 
 
+def test_evaluate_takes_several_labels_as_one_structure():
+    """FreeSurfer's aseg names the cortex 3 and 42: evaluate(label=(3, 42)) scores a mask of both
+    as 1, label=3 alone 2/3 (brute force), as ``liveset eval --label 3,42``."""
+    t = np.zeros((20, 20, 20), np.uint8)
+    t[5:15, 5:15, 5:10], t[5:15, 5:15, 10:15], t[1, 1, 1] = 3, 42, 2
+    m = np.zeros_like(t)
+    m[5:15, 5:15, 5:15] = 1
+    truth, mask = liveset.Image(t, (1, 1, 1), (0, 0, 0), np.eye(3)), liveset.Image(m, (1, 1, 1), (0, 0, 0), np.eye(3))
+    assert liveset.evaluate(mask, truth, label=(3, 42))["dice"] == pytest.approx(1.0)
+    assert liveset.evaluate(mask, truth, label=[3, 42])["dice"] == pytest.approx(1.0)
+    assert liveset.evaluate(mask, truth, label=3)["dice"] == pytest.approx(2 / 3)
+    with pytest.raises(ValueError, match="no voxel with label 7,8"):
+        liveset.evaluate(mask, truth, label=(7, 8))
+
+
 def test_mesh_of_analytic_sphere_lies_on_it_in_lps_mm(tmp_path):
     shape, centre, radius = (30, 26, 18), np.array([20.0, -5.0, 14.0]), 8.0
     img = liveset.Image(np.zeros(shape, np.float32), SPACING, ORIGIN, DIRECTION)

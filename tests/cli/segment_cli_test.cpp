@@ -203,6 +203,37 @@ TEST(SegmentCli, EvalMatchesHandComputedOverlap) {
     EXPECT_NE(text.out.find("dice 0.6667"), std::string::npos) << text.out;
 }
 
+// Several labels are one structure (FreeSurfer's aseg: cortex 3 and 42): the mask covering two
+// label boxes scores 1 against both, given as a list or repeated, 2/3 against one of them; the
+// report lists them; an inner label among them is refused with one line.
+TEST(SegmentCli, EvalTakesSeveralLabelsAsOneStructure) {
+    Grid<std::uint8_t> labels = box_mask({5, 5, 5}, {15, 15, 10});
+    for (int z = 10; z < 15; ++z)
+        for (int y = 5; y < 15; ++y)
+            for (int x = 5; x < 15; ++x) labels({x, y, z}) = 42;
+    for (std::uint8_t& v : labels.values()) v = v == 1 ? 3 : v;
+    labels({1, 1, 1}) = 2;
+    const fs::path t = work_dir() / "aseg_like.nii.gz", m = work_dir() / "mask_both.nii.gz";
+    write_label_image(labels, t.string());
+    write_label_image(box_mask({5, 5, 5}, {15, 15, 15}), m.string());
+    const auto dice = [&](const std::string& sel) {
+        const Result r = run_cli("eval --json --mask " + m.string() + " --truth " + t.string() + sel);
+        EXPECT_EQ(r.rc, 0) << r.err;
+        return r.rc == 0 ? nlohmann::json::parse(r.out) : nlohmann::json();
+    };
+    const nlohmann::json both = dice(" --label 3,42"), repeated = dice(" --label 3 --label 42"), one = dice(" --label 3");
+    EXPECT_NEAR(both["dice"].get<double>(), 1.0, 1e-12);
+    EXPECT_NEAR(repeated["dice"].get<double>(), 1.0, 1e-12);
+    EXPECT_NEAR(one["dice"].get<double>(), 2.0 / 3.0, 1e-12);
+    EXPECT_EQ(both["truth"]["labels"], nlohmann::json({3, 42}));
+    EXPECT_FALSE(both["truth"].contains("label"));
+    EXPECT_EQ(one["truth"]["label"], 3);
+    const Result clash = run_cli("eval --mask " + m.string() + " --truth " + t.string() + " --label 3,42 --inner-label 2,42");
+    EXPECT_NE(clash.rc, 0);
+    EXPECT_EQ(lines(clash.err), 1) << clash.err;
+    EXPECT_NE(clash.err.find("--inner-label 42 is also a --label"), std::string::npos) << clash.err;
+}
+
 namespace {
 
 // Runs the CLI with `args`, sends SIGINT after 1.5 s and returns its exit status (-1 when it did

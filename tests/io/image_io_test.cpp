@@ -151,7 +151,7 @@ TEST_P(RoundTrip, LabelImageIsExact) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Formats, RoundTrip,
-                         ::testing::Values(".nii", ".nii.gz", ".mha", ".mhd", ".nrrd", ".nhdr", ".mnc", ".mgz", ".mgh"),
+                         ::testing::Values(".nii", ".nii.gz", ".mha", ".mhd", ".nrrd", ".nhdr", ".mnc", ".mgz", ".mgh", ".mgh.gz"),
                          [](const auto& info) {
                              std::string n = info.param + 1;
                              for (char& c : n) c = (c == '.') ? '_' : c;

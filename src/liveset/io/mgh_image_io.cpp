@@ -25,12 +25,15 @@ struct GzClose {
 };
 using Gz = std::unique_ptr<gzFile_s, GzClose>;
 
-std::string lower_extension(const std::string& path) {
-    const auto dot = path.find_last_of('.');
-    if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return {};
-    std::string e = path.substr(dot);
-    for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return e;
+// ".mgh", ".mgz" or ".mgh.gz" (any case) when `path` ends so, else "".
+std::string mgh_extension(const std::string& path) {
+    std::string name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
+    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    for (const char* e : {".mgh.gz", ".mgh", ".mgz"}) {
+        const std::string ext(e);
+        if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0) return ext;
+    }
+    return {};
 }
 
 // Big-endian values in a byte buffer, and back.
@@ -74,16 +77,15 @@ bool read_exact(gzFile f, unsigned char* p, std::size_t bytes) {
 
 }  // namespace
 
-bool is_mgh_name(const std::string& path) {
-    const std::string e = lower_extension(path);
-    return e == ".mgh" || e == ".mgz";
-}
+bool is_mgh_name(const std::string& path) { return !mgh_extension(path).empty(); }
 
 MghImageIO::MghImageIO() {
     AddSupportedReadExtension(".mgh");
     AddSupportedReadExtension(".mgz");
+    AddSupportedReadExtension(".mgh.gz");
     AddSupportedWriteExtension(".mgh");
     AddSupportedWriteExtension(".mgz");
+    AddSupportedWriteExtension(".mgh.gz");
     SetNumberOfComponents(1);
     SetPixelType(itk::IOPixelEnum::SCALAR);
     SetByteOrderToBigEndian();
@@ -188,7 +190,7 @@ void MghImageIO::Write(const void* buffer) {
     const std::size_t size = type_size(type), bytes = count * size;
     std::vector<unsigned char> data(static_cast<const unsigned char*>(buffer), static_cast<const unsigned char*>(buffer) + bytes);
     swap_values(data.data(), bytes, size);
-    const bool compress = lower_extension(GetFileName()) == ".mgz";
+    const bool compress = mgh_extension(GetFileName()) != ".mgh";  // .mgz, .mgh.gz
     gzFile f = gzopen(GetFileName(), compress ? "wb6" : "wbT");  // T: plain, no gzip wrapper
     if (f == nullptr) throw std::runtime_error("cannot create the file");
     bool ok = gzwrite(f, h.data(), kHeaderBytes) == static_cast<int>(kHeaderBytes);

@@ -1,4 +1,4 @@
-// FreeSurfer's MGH volumes (.mgh; .mgz compressed) as an ITK ImageIO, driven by image_io.cpp like
+// FreeSurfer's MGH volumes (.mgh; .mgz or .mgh.gz compressed) as an ITK ImageIO, driven by image_io.cpp like
 // ITK's own (Debian's ITK lacks the MGHIO remote module). Internal to liveset_io.
 //
 // The format (FreeSurfer's mghRead/mghWrite; nibabel.freesurfer.mghformat): a big-endian header of
@@ -19,7 +19,7 @@
 
 namespace liveset::io_detail {
 
-// True when the file name ends in .mgh or .mgz (any case): image_io.cpp then uses MghImageIO.
+// True when the file name ends in .mgh, .mgz or .mgh.gz (any case): image_io.cpp then uses MghImageIO.
 bool is_mgh_name(const std::string& path);
 
 class MghImageIO : public itk::ImageIOBase {
