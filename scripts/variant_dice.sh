@@ -1,6 +1,6 @@
 #!/bin/bash
 # The Dice of one BrainWeb variant segmented from the 8 seeds (docs/BENCHMARKS.md, sessions
-# 50-54): VARIANTS/NAME/{t1.nii.gz|t1.mnc, labels.nii.gz, mask.nii.gz} as the variant scripts write.
+# 50-54): VARIANTS/NAME/{t1.nii.gz|t1.mnc|t1.mgz, labels.nii.gz, mask.nii.gz} as the variant scripts write.
 # Usage: [ROI=auto|none|default] [VARIANTS=DIR] bash scripts/variant_dice.sh BIN NAME TAG [segment options...]
 # A variant folder holding a `seeds` file (brainweb_slab_variants.py --unoriented) is seeded from it.
 # Default ROI: the variant's brain mask. ROI=default gives no --roi (since session 59 the automatic brain
@@ -12,7 +12,7 @@ BIN=$1; V=$2; TAG=$3; shift 3
 D=${VARIANTS:-brainweb-noise-variants}/$V; OUT=${OUT:-/tmp/variant_dice}; mkdir -p "$OUT"
 S=(--seed-mm 35,83,113 --seed-mm 35,125,38 --seed-mm 44,164,92 --seed-mm 71,74,53 --seed-mm 122,149,47 --seed-mm 140,86,74 --seed-mm 38,71,26 --seed-mm 83,23,71)
 [ -f "$D/seeds" ] && read -r -a S < "$D/seeds"  # the seeds as voxels of a variant without orientation
-T1=$D/t1.nii.gz; [ -f "$T1" ] || T1=$D/t1.mnc
+T1=$D/t1.nii.gz; [ -f "$T1" ] || T1=$D/t1.mnc; [ -f "$T1" ] || T1=$D/t1.mgz
 M=$D/mask.nii.gz; [ -f "$M" ] || M=$D/mask.mnc
 R=(--roi "$M"); [ "${ROI:-}" = none ] && R=(--roi none); [ "${ROI:-}" = default ] && R=()
 [ "${ROI:-}" = auto ] && R=(--roi auto --out-roi "$OUT/${V}_${TAG}_roi.nii.gz")
