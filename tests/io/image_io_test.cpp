@@ -444,6 +444,8 @@ TEST_F(ImageIo, UnknownFormat) {
     expect_error([&] { read_image(path("x.nii.gz")); }, path("x.nii.gz"), "unknown image format");
     write_text(path("y.png2"), "?");
     expect_error([&] { read_image(path("y.png2")); }, path("y.png2"), "unknown image format");
+    write_text(path("z.mnc.gz"), std::string("\x1f\x8b\x08\x00", 4) + std::string(60, 'x'));  // BrainWeb serves its MINC gzipped
+    expect_error([&] { read_image(path("z.mnc.gz")); }, path("z.mnc.gz"), "is a gzip-compressed MINC file");
     write_text(path("zero.nii"), "");
     expect_error([&] { read_image(path("zero.nii")); }, path("zero.nii"), "empty");
 }

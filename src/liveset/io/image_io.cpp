@@ -200,7 +200,13 @@ void open_file(Source& src) {
     } catch (const itk::ExceptionObject& e) {
         fail_read(path, "file is corrupt or truncated (" + condense(e, path) + ")");
     }
-    if (!io) fail_read(path, std::string("unknown image format or damaged header (") + kFormatsHint + ")");
+    if (!io) {
+        std::string lower = path;
+        for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        if (lower.size() > 7 && lower.compare(lower.size() - 7, 7, ".mnc.gz") == 0)  // as BrainWeb serves its MINC
+            fail_read(path, "is a gzip-compressed MINC file, which ITK's MINC reader does not open: gunzip it first");
+        fail_read(path, std::string("unknown image format or damaged header (") + kFormatsHint + ")");
+    }
     try {
         prepare_io(*io);
         io->SetFileName(path);

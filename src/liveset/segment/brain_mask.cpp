@@ -128,8 +128,8 @@ std::optional<float> constant_fill(const Grid<float>& image) {
 // then reads as grey matter and the whole field of view as head). The exact value of at least half
 // of the voxels on the array's six faces, when it fills at least 2 % of the image and at least 5 %
 // of the rest lie below it (a few darker voxels — a resampler's undershoot at a stripped brain's
-// edge, stray negatives in integer air — do not count); `outside` receives the voxels of that value connected to the faces. nullopt (and
-// `outside` untouched) otherwise.
+// edge, stray negatives in integer air — do not count); `outside` receives the voxels of that
+// value connected to the faces. nullopt (and `outside` untouched) otherwise.
 std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
     const Vec3i d = image.dims();
     std::vector<float> face;
