@@ -103,6 +103,12 @@ std::string file_extension(const std::string& filename) {
     return filename.substr(last);
 }
 
+std::string lowercase_extension(const std::string& filename) {
+    std::string e = file_extension(filename);
+    for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return e;
+}
+
 AtomicFile::AtomicFile(const fs::path& target) : target_(target) {
     static std::atomic<unsigned> counter{0};
     dir_ = target.parent_path().empty() ? fs::path(".") : target.parent_path();

@@ -13,6 +13,8 @@ namespace liveset {
 
 // ".nii.gz" for "a.nii.gz", ".mha" for "a.mha", "" when the name has no extension.
 std::string file_extension(const std::string& filename);
+// file_extension lower-cased (".nii.gz" for "A.NII.GZ"), for choosing a format by name.
+std::string lowercase_extension(const std::string& filename);
 
 // One atomic output. The temporary keeps the target's extension (so format-by-extension writers
 // pick the same format): "dir/seg.nii.gz" is written as "dir/.seg.tmp-<pid>-<n>.nii.gz". A writer

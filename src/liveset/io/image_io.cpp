@@ -200,13 +200,9 @@ void open_file(Source& src) {
     } catch (const itk::ExceptionObject& e) {
         fail_read(path, "file is corrupt or truncated (" + condense(e, path) + ")");
     }
-    if (!io) {
-        std::string lower = path;
-        for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-        if (lower.size() > 7 && lower.compare(lower.size() - 7, 7, ".mnc.gz") == 0)  // as BrainWeb serves its MINC
-            fail_read(path, "is a gzip-compressed MINC file, which ITK's MINC reader does not open: gunzip it first");
-        fail_read(path, std::string("unknown image format or damaged header (") + kFormatsHint + ")");
-    }
+    if (!io && lowercase_extension(fs::path(path).filename().string()) == ".mnc.gz")  // as BrainWeb serves its MINC
+        fail_read(path, "is a gzip-compressed MINC file, which ITK's MINC reader does not open: gunzip it first");
+    if (!io) fail_read(path, std::string("unknown image format or damaged header (") + kFormatsHint + ")");
     try {
         prepare_io(*io);
         io->SetFileName(path);
@@ -522,8 +518,7 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
     // do not clean up after a failed write: teem keeps a detached .raw open (its disk space stays
     // used), libminc leaks its HDF5 file (HDF5 may then crash at exit). MINC is checked against
     // the uncompressed size.
-    std::string ext_lc = ext;
-    for (char& c : ext_lc) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    const std::string ext_lc = lowercase_extension(filename);
     const double bytes = double(lattice.size()) * (component == Component::FLOAT ? 4 : 1) + 65536;
     const auto space = fs::space(dir, ec);
     if ((two_file || ext_lc == ".nii" || cls == "MINCImageIO") && !ec && double(space.available) < bytes)

@@ -1,14 +1,15 @@
 // FreeSurfer MGH/MGZ reading and writing (see mgh_image_io.hpp), with zlib's gz* functions, which
 // read plain and gzip-compressed files alike.
 #include "liveset/io/mgh_image_io.hpp"
+#include "liveset/base/atomic_file.hpp"
 
 #include <zlib.h>
 
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cctype>
 #include <cstring>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -27,13 +28,8 @@ using Gz = std::unique_ptr<gzFile_s, GzClose>;
 
 // ".mgh", ".mgz" or ".mgh.gz" (any case) when `path` ends so, else "".
 std::string mgh_extension(const std::string& path) {
-    std::string name = path.substr(path.find_last_of('/') == std::string::npos ? 0 : path.find_last_of('/') + 1);
-    for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    for (const char* e : {".mgh.gz", ".mgh", ".mgz"}) {
-        const std::string ext(e);
-        if (name.size() > ext.size() && name.compare(name.size() - ext.size(), ext.size(), ext) == 0) return ext;
-    }
-    return {};
+    const std::string e = lowercase_extension(std::filesystem::path(path).filename().string());
+    return e == ".mgh" || e == ".mgz" || e == ".mgh.gz" ? e : std::string();
 }
 
 // Big-endian values in a byte buffer, and back.
@@ -188,15 +184,17 @@ void MghImageIO::Write(const void* buffer) {
     for (int i = 0; i < 3; ++i) store_be<float>(h.data() + 78 + 4 * i, static_cast<float>(centre[i]));
 
     const std::size_t size = type_size(type), bytes = count * size;
-    std::vector<unsigned char> data(static_cast<const unsigned char*>(buffer), static_cast<const unsigned char*>(buffer) + bytes);
-    swap_values(data.data(), bytes, size);
+    const auto* data = static_cast<const unsigned char*>(buffer);
     const bool compress = mgh_extension(GetFileName()) != ".mgh";  // .mgz, .mgh.gz
     gzFile f = gzopen(GetFileName(), compress ? "wb6" : "wbT");  // T: plain, no gzip wrapper
     if (f == nullptr) throw std::runtime_error("cannot create the file");
     bool ok = gzwrite(f, h.data(), kHeaderBytes) == static_cast<int>(kHeaderBytes);
+    std::vector<unsigned char> chunk(std::size_t{1} << 20);  // big-endian a chunk at a time (a whole-buffer copy doubled the memory)
     for (std::size_t at = 0; ok && at < bytes;) {
-        const unsigned n = static_cast<unsigned>(std::min<std::size_t>(bytes - at, std::size_t{1} << 30));
-        ok = gzwrite(f, data.data() + at, n) == static_cast<int>(n);
+        const std::size_t n = std::min(bytes - at, chunk.size());
+        std::memcpy(chunk.data(), data + at, n);
+        swap_values(chunk.data(), n, size);
+        ok = gzwrite(f, chunk.data(), static_cast<unsigned>(n)) == static_cast<int>(n);
         at += n;
     }
     const std::array<unsigned char, 20> footer{};  // TR, flip angle, TE, TI, FoV: unknown

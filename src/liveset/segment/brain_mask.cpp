@@ -371,13 +371,12 @@ Mask cranial(const Mask& head, const Vertical& up, double extent_mm, std::size_t
     below = 0;
     if (extent_mm <= 0) return head;
     const Vec3i d = head.dims();
-    const auto height = [&](int x, int y, int z) { return up.height({x, y, z}); };
     const double top = head_top(head, up);
     Mask out = head;
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
             for (int x = 0; x < d.x; ++x)
-                if (out({x, y, z}) != 0 && height(x, y, z) < top - extent_mm) {
+                if (out({x, y, z}) != 0 && up.height({x, y, z}) < top - extent_mm) {
                     out({x, y, z}) = 0;
                     ++below;
                 }
@@ -417,14 +416,13 @@ Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Ma
 // disc of that area (mm): the volume of each layer of height, one slice thick.
 double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
     const Vec3i d = head.dims();
-    const auto height = [&](int x, int y, int z) { return up.height({x, y, z}); };
     const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
     const double top = head_top(head, up);
     std::vector<std::size_t> layer(static_cast<std::size_t>(std::lround(depth_mm / layer_mm)) + 1, 0);
     for (int z = 0; z < d.z; ++z)
         for (int y = 0; y < d.y; ++y)
             for (int x = 0; x < d.x; ++x) {
-                const auto k = static_cast<std::size_t>(std::lround((top - height(x, y, z)) / layer_mm));
+                const auto k = static_cast<std::size_t>(std::lround((top - up.height({x, y, z})) / layer_mm));
                 if (head({x, y, z}) != 0 && k < layer.size()) ++layer[k];
             }
     const Vec3d sp = head.lattice().spacing();
@@ -534,14 +532,11 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     if (reuse && (!(known->solid.dims() == image.dims()) || !(known->depth.dims() == image.dims()) ||
                   (known->outside.size() > 0 && !(known->outside.dims() == image.dims()))))
         throw std::invalid_argument("brain mask: the head given is not of the image's size");
-    Mask outside;
-    double fill = std::numeric_limits<double>::quiet_NaN();
-    if (reuse) {
-        outside = known->outside;
-        fill = known->outside_value;
-    } else if (const std::optional<float> f = mid_range_fill(image, outside)) {
-        fill = *f;
-    }
+    Mask found;  // a masked outside found here (the head given keeps its own)
+    double fill = reuse ? known->outside_value : std::numeric_limits<double>::quiet_NaN();
+    if (!reuse)
+        if (const std::optional<float> f = mid_range_fill(image, found)) fill = *f;
+    const Mask& outside = reuse ? known->outside : found;
     if (outside.size() == 0) return find_brain(image, o, report, known);
     // A masked outside within the tissue's range: read as a skull-stripped image's dark background.
     BrainMaskReport r;
@@ -549,7 +544,7 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     r.mid_range_fill = fill;
     if (report != nullptr) *report = r;
     if (known != nullptr && !reuse) {
-        known->outside = std::move(outside);
+        known->outside = std::move(found);
         known->outside_value = fill;
     }
     return brain;
