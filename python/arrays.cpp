@@ -6,6 +6,7 @@
 #include <string>
 
 #include "bindings.hpp"
+#include "image_commands.hpp"
 
 namespace liveset::py {
 
@@ -60,11 +61,16 @@ pyb::tuple geometry_of(const Lattice& l) {
     return pyb::make_tuple(pyb::make_tuple(s.x, s.y, s.z), pyb::make_tuple(o.x, o.y, o.z), dir);
 }
 
-Grid<float> grid_from_array(const pyb::array& values, const Lattice& lattice) {
-    return copy_into<float>(values, lattice, [](double v) {
-        if (!std::isfinite(v)) throw std::invalid_argument("the image holds NaN or infinite values");
+Grid<float> grid_from_array(const pyb::array& values, const Lattice& lattice, bool nan_ok) {
+    return copy_into<float>(values, lattice, [nan_ok](double v) {
+        if (!std::isfinite(v) && !(nan_ok && std::isnan(v)))
+            throw std::invalid_argument(nan_ok ? "the image holds infinite values" : "the image holds NaN or infinite values");
         return static_cast<float>(v);
     });
+}
+
+cli::Scan scan_from_array(const pyb::array& values, const Lattice& lattice) {
+    return cli::scan_of(grid_from_array(values, lattice, true));
 }
 
 Grid<std::uint8_t> mask_from_array(const pyb::array& values, const Lattice& lattice) {

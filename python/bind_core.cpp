@@ -32,7 +32,7 @@ pyb::tuple read(const std::string& path, bool labels) {
         const Lattice l = g.lattice();
         return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l), h.orientation_known);
     }
-    Grid<float> g = [&] { pyb::gil_scoped_release nogil; return read_image(path, kDefaultImageMemoryLimit, &h); }();
+    Grid<float> g = [&] { pyb::gil_scoped_release nogil; return read_image(path, kDefaultImageMemoryLimit, &h, NanVoxels::keep); }();
     const Lattice l = g.lattice();
     return pyb::make_tuple(array_from_grid(std::move(g)), geometry_of(l), h.orientation_known);
 }
@@ -43,7 +43,7 @@ void write(const pyb::array& values, const Lattice& lattice, const std::string& 
         pyb::gil_scoped_release nogil;
         write_label_image(g, path, {.orientation_known = oriented});
     } else {
-        const Grid<float> g = grid_from_array(values, lattice);
+        const Grid<float> g = grid_from_array(values, lattice, true);  // NaN: written as it was read
         pyb::gil_scoped_release nogil;
         write_image(g, path, {.orientation_known = oriented});
     }
@@ -103,7 +103,8 @@ cli::BiasCorrection bias_mode(const std::optional<bool>& bias_correct) {
 }
 
 pyb::dict segment(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a, const pyb::object& progress) {
-    Grid<float> image = grid_from_array(values, lattice);
+    cli::Scan scan = scan_from_array(values, lattice);
+    Grid<float>& image = scan.image;
     SegmentRequest req = request_for(a, lattice);
     cli::BrainLookup lookup = lookup_for(a.oriented);
     std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
@@ -139,6 +140,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     if (!out || out->result.reason == StopReason::kInterrupted) throw pyb::error_already_set();  // a pending KeyboardInterrupt
     nlohmann::json j = cli::segmentation_report(*out, lattice);
     cli::add_bias_report(j, prepared, roi_mask);
+    j["no_data_voxels"] = scan.no_data_voxels;
     for (const std::string& w : seed_fit.warnings) j["warnings"].push_back(w);
     const Grid<std::uint8_t>* brain = seed_fit.default_dropped ? nullptr : prepared.fit(nullptr);  // given up: the user's choice
     if (const std::string w = cli::leak_warning(out->mask, brain, "roi='auto'"); !w.empty()) j["warnings"].push_back(w);
@@ -148,7 +150,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     r["mask"] = array_from_grid(std::move(out->mask));
     r["report"] = j.dump();
     if (roi && roi->source == "auto") r["roi"] = array_from_grid(Grid<std::uint8_t>(roi->mask));
-    if (prepared.bias) r["corrected"] = array_from_grid(std::move(image));
+    if (prepared.bias) r["corrected"] = array_from_grid(scan.restored(image));
     return r;
 }
 
@@ -159,7 +161,8 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
 // bias_correction / warnings / roi.
 pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice, const pyb::object& roi_arg,
                                 const std::optional<bool>& bias_correct, bool oriented) {
-    Grid<float> image = grid_from_array(values, lattice);
+    cli::Scan scan = scan_from_array(values, lattice);
+    Grid<float>& image = scan.image;
     cli::BrainLookup lookup = lookup_for(oriented);
     std::optional<cli::Roi> roi = roi_of(roi_arg, image, &lookup);  // "auto": as segment's
     cli::PreparedImage prepared;
@@ -171,10 +174,14 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
     nlohmann::json j = nlohmann::json::object();
     cli::add_bias_report(j, prepared, r);
     if (roi) j["roi"] = cli::roi_report(*roi);
+    if (scan.no_data_voxels) j["no_data_voxels"] = scan.no_data_voxels;
     pyb::dict d;
     d["report"] = j.dump();
     d["roi"] = roi ? pyb::object(array_from_grid(Grid<std::uint8_t>(roi->mask))) : pyb::object(pyb::none());
-    d["image"] = prepared.bias ? pyb::object(array_from_grid(std::move(image))) : pyb::object(pyb::none());
+    // The image the session works on: the corrected one, or the scan with its NaN lowered; None: the array as given.
+    const bool changed = prepared.bias || scan.no_data_voxels;
+    d["image"] = changed ? pyb::object(array_from_grid(std::move(image))) : pyb::object(pyb::none());
+    d["corrected"] = prepared.bias.has_value();
     d["region_is_brain"] = prepared.fit_is_brain(roi);
     d["model_region"] = prepared.fit_region ? pyb::object(array_from_grid(std::move(*prepared.fit_region))) : pyb::object(pyb::none());
     return d;
@@ -182,7 +189,7 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
 
 // The tissue model fitted where segment() fits it, and the window the seeds would get.
 std::string tissue_model(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a) {
-    Grid<float> image = grid_from_array(values, lattice);
+    Grid<float> image = scan_from_array(values, lattice).image;
     SegmentRequest req = request_for(a, lattice, false);
     cli::BrainLookup lookup = lookup_for(a.oriented);
     std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
@@ -260,7 +267,7 @@ std::string evaluate(const pyb::array& mask, const pyb::array& truth, const Latt
 std::string find_holes_json(const pyb::array& mask, const pyb::array& image, const pyb::object& roi, const Lattice& lattice,
                             const std::optional<std::pair<double, double>>& band, std::size_t min_voxels, double min_sheet_share) {
     const Grid<std::uint8_t> m = mask_from_array(mask, lattice);
-    const Grid<float> img = grid_from_array(image, lattice);
+    const Grid<float> img = scan_from_array(image, lattice).image;
     std::optional<Grid<std::uint8_t>> r;
     if (!roi.is_none()) r = mask_from_array(roi.cast<pyb::array>(), lattice);
     pyb::gil_scoped_release nogil;
@@ -304,7 +311,7 @@ struct RepairHolesArgs {
 // sheet-rule round each, through a Session on `image`. Returns (φ, report JSON).
 pyb::tuple repair_holes(const pyb::array& level, bool is_mask, const pyb::array& image, const pyb::object& roi, const Lattice& lattice,
                         const RepairHolesArgs& a) {
-    const Grid<float> img = grid_from_array(image, lattice);
+    const Grid<float> img = scan_from_array(image, lattice).image;
     std::optional<Grid<std::uint8_t>> r;
     if (!roi.is_none()) r = mask_from_array(roi.cast<pyb::array>(), lattice);
     std::optional<Grid<float>> phi_in;

@@ -13,6 +13,10 @@
 
 #include "liveset/grid/grid.hpp"
 
+namespace liveset::cli {
+struct Scan;  // image_commands.hpp
+}
+
 namespace liveset::py {
 
 namespace pyb = pybind11;
@@ -24,8 +28,12 @@ Lattice lattice_from(const pyb::object& shape, const pyb::object& spacing, const
 pyb::tuple geometry_of(const Lattice& lattice);  // (spacing, origin, direction) as tuples / 3x3 array
 
 // A 3D numpy array (any dtype, any order; index [i, j, k]) copied into a Grid on `lattice`.
-// Throws std::invalid_argument when the shape differs from the lattice's dims or holds NaN/inf.
-Grid<float> grid_from_array(const pyb::array& values, const Lattice& lattice);
+// Throws std::invalid_argument when the shape differs from the lattice's dims or holds NaN/inf
+// (NaN kept with `nan_ok`: an image to write as it is).
+Grid<float> grid_from_array(const pyb::array& values, const Lattice& lattice, bool nan_ok = false);
+// A scan handed as an array (segment, sessions, holes): NaN voxels — a masked image's "no data",
+// as liveset.read keeps them — lowered below the rest, as the CLI reads a file (cli::read_scan).
+cli::Scan scan_from_array(const pyb::array& values, const Lattice& lattice);
 Grid<std::uint8_t> mask_from_array(const pyb::array& values, const Lattice& lattice);  // non-zero -> 1
 // Zero-copy: the Grid moves into a capsule that the Fortran-ordered array (shape I, J, K) keeps alive.
 pyb::array array_from_grid(Grid<float>&& grid);

@@ -31,8 +31,9 @@ struct HolesArgs {
 int run_holes(const HolesArgs& a, int threads) {
     const auto guard = limit_threads(threads);
     if (a.lower.has_value() != a.upper.has_value()) throw UsageError("give both --sheet-lower and --sheet-upper, or neither");
-    ImageHeader header;
-    const Grid<float> image = read_image(a.image, kDefaultImageMemoryLimit, &header);
+    const Scan scan = read_scan(a.image);
+    const Grid<float>& image = scan.image;
+    const ImageHeader& header = scan.header;
     const Grid<float> in = read_image(a.input);
     if (!(in.dims() == image.dims()))
         throw UsageError(fmt::format("{} ({}x{}x{}) does not match the image's size", a.input, in.dims().x, in.dims().y, in.dims().z));
@@ -63,6 +64,7 @@ int run_holes(const HolesArgs& a, int threads) {
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
     }
+    if (scan.no_data_voxels) fmt::print(stderr, "liveset: note: {}\n", scan.note(a.image));  // the inputs are good
     const std::vector<HoleCandidate> holes = find_holes(mask, image, r, fo);
     if (!a.out_mask.empty()) write_label_image(hole_voxels(mask, image, r, fo), a.out_mask, {.orientation_known = header.orientation_known});
     std::size_t total = 0;

@@ -225,9 +225,9 @@ struct RepairInputs {
 };
 
 RepairInputs load_inputs(const RepairArgs& a) {
-    ImageHeader header;
-    RepairInputs in{read_image(a.image, kDefaultImageMemoryLimit, &header), true, std::nullopt, nullptr, std::nullopt, {}};
-    in.oriented = header.orientation_known;
+    Scan scan = read_scan(a.image);
+    const std::string note = scan.note(a.image);
+    RepairInputs in{std::move(scan.image), scan.header.orientation_known, std::nullopt, nullptr, std::nullopt, {}};
     if (!a.roi.empty()) in.roi = load_mask_like(a.roi, in.image.lattice(), "--roi");
     // The repair edits through a Session (the viewer's edit path: local update, history, mesher of
     // 8³-cell fragments); the session's scale is robust_scale(image, roi), as before.
@@ -237,6 +237,7 @@ RepairInputs load_inputs(const RepairArgs& a) {
     load_level_set(*in.session, a.input);
     in.mask_before = inside_mask(in.session->field().phi(), in.roi_ptr());
     in.band = sheet_band(a, in.image, in.mask_before, in.roi_ptr());
+    if (!a.quiet && !note.empty()) fmt::print(stderr, "liveset: note: {}\n", note);  // the inputs are good
     return in;
 }
 

@@ -95,8 +95,9 @@ int run_segment(const SegmentArgs& a, int threads) {
     const InterruptGuard interrupt;
     check_segment_args(a);
 
-    ImageHeader header;
-    Grid<float> image = read_image(a.image, kDefaultImageMemoryLimit, &header);
+    Scan scan = read_scan(a.image);
+    Grid<float>& image = scan.image;
+    const ImageHeader& header = scan.header;
     std::optional<Grid<std::uint8_t>> init;
     BrainLookup lookup;
     lookup.options = brain_mask_options(header);
@@ -122,6 +123,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
 
     add_regions(req, roi, init, fit, prepared.fit_is_brain(roi));
+    if (!a.quiet && scan.no_data_voxels) fmt::print(stderr, "liveset: note: {}\n", scan.note(a.image));  // the inputs are good
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} iterations; nothing written\n", run.outcome.result.iterations);
@@ -132,7 +134,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     write_label_image(o.mask, a.out_mask, as_read);
     if (!a.out_phi.empty()) write_image(o.field->phi(), a.out_phi, as_read);
     if (!a.out_roi.empty()) write_label_image(roi->mask, a.out_roi, as_read);
-    if (!a.out_corrected.empty()) write_image(image, a.out_corrected, as_read);
+    if (!a.out_corrected.empty()) write_image(scan.restored(image), a.out_corrected, as_read);
     std::size_t triangles = 0;
     if (!a.out_mesh.empty()) {
         const Mesh mesh = marching_cubes_band(o.field->phi(), o.field->zero_layer());
@@ -141,6 +143,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     }
 
     nlohmann::json j = segment_report(a, o, image.lattice(), roi, prepared, triangles);
+    j["no_data_voxels"] = scan.no_data_voxels;
     for (const std::string& w : seed_fit.warnings) j["warnings"].push_back(w);
     // The default limit reached before convergence: the mask is a front still moving (a grid whose
     // fine voxels keep the time step small, docs/BENCHMARKS.md session 49, or a very large image).

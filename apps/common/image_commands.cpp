@@ -6,13 +6,54 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
+#include <stdexcept>
 #include <vector>
 
 #include "cli_common.hpp"
 #include "cli_support.hpp"
 #include "liveset/io/image_io.hpp"
+#include "liveset/segment/intensity.hpp"
 
 namespace liveset::cli {
+
+Scan scan_of(Grid<float> image, ImageHeader header) {
+    Scan s{std::move(image), std::move(header), std::nullopt, 0};
+    std::optional<Grid<std::uint8_t>> nan;
+    for (PointIndex i = 0; i < s.image.size(); ++i) {
+        if (!std::isnan(s.image[i])) continue;
+        if (!nan) nan.emplace(s.image.lattice(), 0);
+        (*nan)[i] = 1;
+    }
+    s.no_data_voxels = lower_no_data(s.image);  // refuses infinite voxels, and an image all NaN
+    s.no_data = std::move(nan);
+    return s;
+}
+
+Scan read_scan(const std::string& path) {
+    ImageHeader header;
+    Grid<float> image = read_image(path, kDefaultImageMemoryLimit, &header, NanVoxels::keep);
+    try {
+        return scan_of(std::move(image), std::move(header));
+    } catch (const std::invalid_argument& e) {
+        throw ImageIoError(fmt::format("cannot read \"{}\": {}", path, e.what()));
+    }
+}
+
+std::string Scan::note(const std::string& path) const {
+    if (no_data_voxels == 0) return {};
+    return fmt::format("{} voxel(s) of \"{}\" ({:.1f}%) are NaN, a masked image's \"no data\": read as lying below every other value "
+                       "(outside the brain)",
+                       no_data_voxels, path, 100.0 * static_cast<double>(no_data_voxels) / static_cast<double>(image.size()));
+}
+
+Grid<float> Scan::restored(const Grid<float>& values) const {
+    Grid<float> out = values;
+    if (no_data)
+        for (PointIndex i = 0; i < out.size(); ++i)
+            if ((*no_data)[i]) out[i] = std::numeric_limits<float>::quiet_NaN();
+    return out;
+}
 
 Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& reference, const std::string& option) {
     // Read as real values: a MINC byte mask whose real range is 0..1 holds 1/255 inside, a resampled

@@ -22,6 +22,23 @@
 
 namespace liveset::cli {
 
+// A scan as the commands read it (segment, holes, repair, view, Python): read_image with
+// NanVoxels::keep, then its NaN voxels — a masked image's "no data" — lowered below every other value
+// (lower_no_data), so a NaN-masked brain is segmented as a skull-stripped one.
+struct Scan {
+    Grid<float> image;
+    ImageHeader header;
+    std::optional<Grid<std::uint8_t>> no_data;  // where the NaN voxels were (none when there were none)
+    std::uint64_t no_data_voxels = 0;
+    // "N voxels of "<path>" are NaN (no data): ..." — what a command tells the user; empty without NaN.
+    std::string note(const std::string& path) const;
+    // `image` (the scan, or its corrected image) with NaN back where the scan had it: what is written out.
+    Grid<float> restored(const Grid<float>& image) const;
+};
+Scan read_scan(const std::string& path);
+// An image already read (an array handed to Python) made a scan: NaN voxels lowered as read_scan's.
+Scan scan_of(Grid<float> image, ImageHeader header = {});
+
 // Reads a mask/label image and checks that it overlays `reference` (same dims, spacing, origin
 // and direction within tolerance); UsageError naming `option` otherwise. Non-zero -> 1.
 Grid<std::uint8_t> load_mask_like(const std::string& path, const Lattice& reference, const std::string& option);

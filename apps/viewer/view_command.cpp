@@ -104,8 +104,10 @@ void fit_start_seeds(ViewArgs& a, const Lattice& lattice, std::optional<Roi>& ro
 }
 
 std::unique_ptr<Session> load_session(ViewArgs& a) {
-    ImageHeader header;
-    Grid<float> image = read_image(a.image, kDefaultImageMemoryLimit, &header);
+    Scan scan = read_scan(a.image);
+    if (scan.no_data_voxels) fmt::print(stderr, "liveset: note: {}\n", scan.note(a.image));
+    Grid<float>& image = scan.image;
+    const ImageHeader& header = scan.header;
     a.image_oriented = header.orientation_known;
     // A level set to continue (--mask, --phi) may come from another tool: no default ROI to clip it.
     if (a.roi.empty() && (!a.mask.empty() || !a.phi.empty())) a.roi = "none";

@@ -25,6 +25,7 @@ struct Viewer::Opened {
     bool oriented = true;      // the header gave an orientation
     bool brain_roi = false;    // the automatic brain mask bounds the front (the default on a head)
     std::string bias_skipped;  // the default correction's warning, when it did not run
+    std::string no_data;       // Scan::note: the image's NaN voxels, read as its outside
     std::string error;         // the image could not be opened
 };
 
@@ -47,8 +48,10 @@ bool Viewer::open_image(const std::string& path) {
     const auto work = [path, cancel, mode, options, roi_arg, failed]() -> std::shared_ptr<Opened> {
         try {
             auto out = std::make_shared<Opened>();
-            ImageHeader header;
-            Grid<float> image = read_image(path, kDefaultImageMemoryLimit, &header);
+            cli::Scan scan = cli::read_scan(path);
+            Grid<float>& image = scan.image;
+            const ImageHeader& header = scan.header;
+            out->no_data = scan.note(path);
             if (cancel->load()) return out;
             out->oriented = header.orientation_known;
             cli::BrainLookup lookup;
@@ -129,7 +132,8 @@ void Viewer::poll_open(bool wait) {
     image_name_ = std::filesystem::path(path).filename().string();
     attach_session();
     message_ = "opened " + path + (opened->brain_roi ? ", the front bounded by the automatic brain mask" : "") +
-               (opened->bias_skipped.empty() ? "" : " (" + opened->bias_skipped + ")");
+               (opened->bias_skipped.empty() ? "" : " (" + opened->bias_skipped + ")") +
+               (opened->no_data.empty() ? "" : "; " + opened->no_data);
     message_is_error_ = false;
     log_.add("open", {{"path", path}, {"bias_corrected", opened->corrected}, {"roi", config_.roi_path}});
 }

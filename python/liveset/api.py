@@ -18,8 +18,10 @@ def read(path: str, labels: bool = False) -> Image:
     """Read a 3D image (NIfTI, MetaImage, NRRD, MINC, a DICOM folder) through liveset's C++ IO.
 
     Returns float32 intensities, or uint8 labels with ``labels=True`` (values must be 0..255).
-    Raises ImageIOError (an OSError) with a one-line message on missing, corrupt, 2D, RGB, ...
-    files."""
+    NaN voxels (a masked image's "no data": SPM, ``fslmaths -nan``) stay NaN, as nibabel reads
+    them (a NIfTI's too); ``segment``, ``Session`` and the hole tools read them as lying below every
+    other value, outside the brain. Raises ImageIOError (an OSError) with a one-line message on
+    missing, corrupt, 2D, RGB, ... files, and on infinite voxels."""
     array, (spacing, origin, direction), oriented = _liveset._read(str(path), labels)
     return Image(array, spacing, origin, direction, oriented)
 
@@ -55,8 +57,9 @@ def _seed_text(seed) -> str:
 class Segmentation:
     """What ``segment`` returns: ``mask`` (uint8 0/1, φ < 0 within the ROI), ``phi`` (float32,
     < 0 inside), ``report`` (the dict ``liveset segment --json`` prints: iterations, stop, window,
-    tissue model, volume, ...), ``roi`` when one was used, ``corrected`` when N4 ran (the default:
-    the image the segmentation saw)."""
+    tissue model, volume, ``no_data_voxels``: the image's NaN voxels, ...), ``roi`` when one was
+    used, ``corrected`` when N4 ran (the default: the image the segmentation saw, NaN again where
+    the image had NaN)."""
     mask: Image
     phi: Image
     report: dict

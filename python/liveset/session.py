@@ -34,7 +34,8 @@ class Session:
     ``segment``'s mask. ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
     a head, else none), ``"auto"``, ``"none"`` or a mask (Image, nibabel image or array) the front
     may not leave. ``image`` is the
-    image the session works on (the corrected one when N4 ran), ``corrected`` True when N4 ran,
+    image the session works on (the corrected one when N4 ran; NaN voxels, a masked image's "no
+    data", lowered below the rest as ``segment`` reads them), ``corrected`` True when N4 ran,
     ``roi`` the ROI as an Image (None without one), ``report`` the ``bias_correction`` (or
     ``warnings``) and ``roi`` entries of ``segment``'s report.
 
@@ -57,8 +58,8 @@ class Session:
             raise ValueError("smooth_mm needs alpha: the automatic choice sets both")
         prepared = _liveset._prepare_session_image(img.array, img.geometry, _mask_arg(roi, img, "roi", allow_auto=True),
                                                    None if bias_correct is None else bool(bias_correct), bool(img.oriented))
-        self.corrected = prepared["image"] is not None
-        self.image = img.like(prepared["image"]) if self.corrected else img
+        self.corrected = bool(prepared["corrected"])
+        self.image = img if prepared["image"] is None else img.like(prepared["image"])  # corrected, or its NaN lowered
         self.roi = None if prepared["roi"] is None else img.like(prepared["roi"])
         self.report = json.loads(prepared["report"])
         self._s = _liveset._Session(self.image.array, img.geometry, prepared["roi"], prepared["model_region"],

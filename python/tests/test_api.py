@@ -621,3 +621,36 @@ def test_noise_that_hides_a_tissue_is_seen_through_the_blur_as_segment_sees_it()
     s.add_seed(seed)
     p = s.params
     assert (p["mu"], p["epsilon"], p["alpha"], p["smooth_mm"]) == (seg.report["mu"], seg.report["epsilon"], seg.report["alpha"], 0.5)
+
+
+def test_a_nan_masked_brain_is_read_as_nibabel_reads_it_and_segmented_as_its_lowered_outside(tmp_path):
+    # SPM's masked images hold NaN outside the brain: liveset.read keeps NaN where nibabel reads
+    # it; segment, tissue_model and Session read those voxels as lying below the rest, exactly as
+    # the same brain with its outside lowered by hand (and as `liveset segment` on the file).
+    a = _bridged_head().array
+    r = 1.5 * np.sqrt(((np.indices(a.shape) - 31.5) ** 2).sum(axis=0))
+    a[r >= 29] = np.nan
+    path = str(tmp_path / "nan_brain.nii.gz")
+    nib.save(nib.Nifti1Image(a, np.diag([1.5, 1.5, 1.5, 1])), path)
+    img = liveset.read(path)
+    assert np.array_equal(np.isnan(img.array), np.isnan(np.asarray(nib.load(path).dataobj)))
+    assert np.array_equal(img.array[r < 29], a[r < 29])
+    low = a.copy()
+    lo, hi = np.nanmin(a), np.nanmax(a)
+    low[np.isnan(a)] = np.float32(lo) - np.float32(0.01) * (np.float32(hi) - np.float32(lo))
+    kw = dict(iterations=150, bias_correct=False)
+    seg, ref = liveset.segment(img, [(49, 32, 32, 2)], **kw), liveset.segment(img.like(low), [(49, 32, 32, 2)], **kw)
+    assert seg.report["no_data_voxels"] == int(np.isnan(a).sum()) and ref.report["no_data_voxels"] == 0
+    assert np.array_equal(seg.mask.array, ref.mask.array) and seg.mask.array.sum() > 5000
+    assert not seg.mask.array[np.isnan(a)].any()
+    n4 = liveset.segment(img, [(49, 32, 32, 2)], iterations=5)
+    assert np.array_equal(np.isnan(n4.corrected.array), np.isnan(a))  # NaN again where the image had it
+    out = str(tmp_path / "mask.nii.gz")
+    cli("segment", path, "--seed", "49,32,32:2", "--iterations", "150", "--no-bias-correct", "--quiet", "--out-mask", out)
+    assert np.array_equal(np.asarray(nib.load(out).dataobj), seg.mask.array)
+    assert liveset.tissue_model(img, [(49, 32, 32, 2)])["window"] == liveset.tissue_model(img.like(low), [(49, 32, 32, 2)])["window"]
+    s = liveset.Session(img, bias_correct=False)
+    assert not s.corrected and not np.isnan(s.image.array).any() and s.report["no_data_voxels"] == int(np.isnan(a).sum())
+    written = str(tmp_path / "written.nii.gz")
+    liveset.write(img, written)  # NaN written as read
+    assert np.array_equal(np.isnan(np.asarray(nib.load(written).dataobj)), np.isnan(a))

@@ -505,6 +505,22 @@ TEST_F(ImageIo, NanVoxels) {
     write_image(image, path("nan.nii.gz"));  // writing is faithful
     expect_error([&] { read_image(path("nan.nii.gz")); }, path("nan.nii.gz"), "3 voxels are NaN or infinite");
     expect_error([&] { read_label_image(path("nan.nii.gz")); }, path("nan.nii.gz"), "NaN or infinite");
+    // A scan's NaN are its "no data" (NanVoxels::keep): read where the file holds them (niftilib
+    // alone reads a NIfTI's as 0), whatever the format; infinite voxels are still damage.
+    expect_error([&] { read_image(path("nan.nii.gz"), kDefaultImageMemoryLimit, nullptr, NanVoxels::keep); }, path("nan.nii.gz"),
+                 "2 voxels are infinite");
+    image[10] = image[11] = 1.5f;
+    image[40] = std::numeric_limits<float>::quiet_NaN();
+    for (const std::string name : {"nan_only.nii.gz", "nan_only.nii", "nan_only.mha", "nan_only.nrrd", "nan_only.mgz", "nan_only.mnc"}) {
+        write_image(image, path(name));
+        expect_error([&] { read_image(path(name)); }, path(name), "2 voxels are NaN or infinite");
+        const Grid<float> back = read_image(path(name), kDefaultImageMemoryLimit, nullptr, NanVoxels::keep);
+        ASSERT_EQ(back.size(), image.size()) << name;
+        for (PointIndex i = 0; i < image.size(); ++i) {
+            if (std::isnan(image[i])) EXPECT_TRUE(std::isnan(back[i])) << name << " " << i;
+            else EXPECT_EQ(back[i], image[i]) << name << " " << i;
+        }
+    }
 }
 
 TEST_F(ImageIo, AbsurdSizeFailsFastWithoutAllocating) {

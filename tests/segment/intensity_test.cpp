@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "liveset/segment/intensity.hpp"
 
@@ -54,6 +55,33 @@ TEST(IntensityScale, RejectsFlatImagesBadPercentilesAndEmptyRoi) {
     Grid<float> nan = ramp();
     nan[7] = std::nanf("");
     EXPECT_THROW(robust_scale(nan), std::invalid_argument);
+}
+
+// NaN voxels (a masked image's no data) become the lowest value, 1 % of the others' range below
+// them; the others are untouched; an image all NaN, or one with an infinite voxel, is refused.
+TEST(NoData, NanVoxelsAreLoweredBelowEveryOtherValue) {
+    Grid<float> g = ramp();  // 0..999
+    for (PointIndex i : {PointIndex{0}, PointIndex{500}, PointIndex{999}}) g[i] = std::nanf("");
+    const Grid<float> before = g;
+    EXPECT_EQ(lower_no_data(g), 3u);
+    const float below = 1.0f - 0.01f * (998.0f - 1.0f);  // the finite values span 1..998
+    for (PointIndex i = 0; i < g.size(); ++i) {
+        if (std::isnan(before[i])) EXPECT_EQ(g[i], below) << i;
+        else EXPECT_EQ(g[i], before[i]) << i;
+    }
+    Grid<float> none = ramp();
+    EXPECT_EQ(lower_no_data(none), 0u);
+    EXPECT_EQ(none.values()[999], 999.0f);
+    Grid<float> flat(Lattice({4, 4, 4}), 5.0f);
+    flat[3] = std::nanf("");
+    EXPECT_EQ(lower_no_data(flat), 1u);
+    EXPECT_EQ(flat[3], 4.0f);  // one below a flat image
+    Grid<float> all(Lattice({2, 2, 2}), std::nanf(""));
+    EXPECT_THROW(lower_no_data(all), std::invalid_argument);
+    Grid<float> inf = ramp();
+    inf[5] = -std::numeric_limits<float>::infinity();
+    inf[6] = std::nanf("");
+    EXPECT_THROW(lower_no_data(inf), std::invalid_argument);
 }
 
 TEST(SeedStatistics, BallAroundASeed) {

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <vector>
 
 namespace liveset::io_detail {
@@ -31,11 +32,24 @@ T load(const unsigned char* p, bool swap) {
     return v;
 }
 
+// Counts the non-finite values of `bytes` (and the NaN among them); flags the NaN in `nan_at`
+// (grown as needed; `first` is the index of the chunk's first value).
 template <class T>
-std::uint64_t count_non_finite(const unsigned char* p, std::size_t bytes, bool swap) {
-    std::uint64_t bad = 0;
-    for (std::size_t i = 0; i + sizeof(T) <= bytes; i += sizeof(T)) bad += !std::isfinite(load<T>(p + i, swap));
-    return bad;
+void count_non_finite(const unsigned char* p, std::size_t bytes, bool swap, DataCheck& c, std::uint64_t first,
+                      std::vector<std::uint8_t>* nan_at, std::uint64_t values) {
+    for (std::size_t i = 0; i + sizeof(T) <= bytes; i += sizeof(T)) {
+        const T v = load<T>(p + i, swap);
+        if (std::isfinite(v)) continue;
+        ++c.non_finite;
+        if (!std::isnan(v)) continue;
+        ++c.nan;
+        if (nan_at == nullptr) continue;
+        if (nan_at->empty()) {
+            if (values > (std::uint64_t{1} << 32)) throw std::runtime_error("too many values to flag the NaN among");  // read_image's limits come first
+            nan_at->assign(values, 0);
+        }
+        (*nan_at)[first + i / sizeof(T)] = 1;
+    }
 }
 
 std::string holds(std::uint64_t have, std::uint64_t need) {
@@ -112,8 +126,9 @@ std::optional<NiftiLayout> read_nifti_layout(gzFile f) {
 
 }  // namespace
 
-DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values) {
+DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values, std::vector<std::uint8_t>* nan_at) {
     DataCheck result;
+    if (nan_at != nullptr) nan_at->clear();
     std::unique_ptr<gzFile_s, GzClose> file(gzopen(path.c_str(), "rb"));
     if (!file) return result;
     gzFile f = file.get();
@@ -167,9 +182,11 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values
             error = n < 0;
             break;
         }
-        if (scan_values)
-            result.non_finite += datatype == 16 ? count_non_finite<float>(buf.data(), std::size_t(n), swap)
-                                                : count_non_finite<double>(buf.data(), std::size_t(n), swap);
+        if (scan_values) {
+            const std::uint64_t size = datatype == 16 ? 4 : 8, values = data_bytes / size;
+            if (datatype == 16) count_non_finite<float>(buf.data(), std::size_t(n), swap, result, have / size, nan_at, values);
+            else count_non_finite<double>(buf.data(), std::size_t(n), swap, result, have / size, nan_at, values);
+        }
         have += static_cast<std::uint64_t>(n);
     }
     int errnum = Z_OK;

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace liveset::io_detail {
 
@@ -13,12 +14,15 @@ struct DataCheck {
     bool truncated = false;
     std::string detail;            // why, when truncated ("holds 1000 of 2772 data bytes")
     std::uint64_t non_finite = 0;  // NaN / infinite voxels counted (NIfTI float data only)
+    std::uint64_t nan = 0;         // of which NaN
 };
 
 // Single-file NIfTI-1/-2 (.nii, .nii.gz; compressed or not): the data the header promises is all
 // there; with count_non_finite, NaN and infinite values of float32/float64 data are counted
 // (which means decompressing the file once more). Other layouts (.hdr/.img) pass unchecked.
-DataCheck check_nifti_data(const std::string& path, bool count_non_finite);
+// `nan_at` (with count_non_finite): one flag per stored value, 1 where it is NaN, in file order
+// (niftilib reads those as 0); left empty when the data holds no NaN.
+DataCheck check_nifti_data(const std::string& path, bool count_non_finite, std::vector<std::uint8_t>* nan_at = nullptr);
 
 // MetaImage (.mha with LOCAL data, .mhd with one data file): the data file holds `raw_bytes`
 // (uncompressed) or the header's CompressedDataSize. Multi-file (LIST, pattern) data is unchecked.

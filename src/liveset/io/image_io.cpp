@@ -50,6 +50,7 @@ using io_detail::bytes_text;
 using io_detail::dims_text;
 using io_detail::flip_ras_lps;
 using io_detail::quoted;
+using io_detail::voxels_are_infinite;
 using io_detail::voxels_are_non_finite;
 
 // ---------------------------------------------------------------------------------------------
@@ -431,9 +432,11 @@ void check_finite(const std::string& path, std::span<const float> values) {
 
 // What ITK's readers would hide: a short NIfTI is zero-filled and its NaN/Inf floats become 0, a
 // short MetaImage only prints a warning. `io` has read the header of `file`.
-io_detail::DataCheck check_data(const itk::ImageIOBase& io, const std::string& file, bool count_non_finite) {
+// `nan_at`: as check_nifti_data's.
+io_detail::DataCheck check_data(const itk::ImageIOBase& io, const std::string& file, bool count_non_finite,
+                                std::vector<std::uint8_t>* nan_at = nullptr) {
     const std::string cls = io.GetNameOfClass();
-    if (cls == "NiftiImageIO") return io_detail::check_nifti_data(file, count_non_finite);
+    if (cls == "NiftiImageIO") return io_detail::check_nifti_data(file, count_non_finite, nan_at);
     if (cls == "MetaImageIO") {
         std::uint64_t bytes = io.GetComponentSize() * io.GetNumberOfComponents();
         for (unsigned a = 0; a < io.GetNumberOfDimensions(); ++a) bytes *= io.GetDimensions(a);
@@ -442,11 +445,24 @@ io_detail::DataCheck check_data(const itk::ImageIOBase& io, const std::string& f
     return {};
 }
 
-void verify_data(const Source& src) {
+// `nan_at` (NanVoxels::keep): receives where a NIfTI's NaN values lie (niftilib reads them as 0).
+void verify_data(const Source& src, std::vector<std::uint8_t>* nan_at = nullptr) {
     if (!src.io) return;
-    const io_detail::DataCheck check = check_data(*src.io, src.path, true);
+    const io_detail::DataCheck check = check_data(*src.io, src.path, true, nan_at);
     if (check.truncated) fail_read(src.path, "file is corrupt or truncated (" + check.detail + ")");
-    if (check.non_finite) fail_read(src.path, voxels_are_non_finite(check.non_finite));
+    if (nan_at == nullptr && check.non_finite) fail_read(src.path, voxels_are_non_finite(check.non_finite));
+    if (const std::uint64_t inf = check.non_finite - check.nan; inf) fail_read(src.path, voxels_are_infinite(inf));
+}
+
+// NanVoxels::keep: NaN where the file holds it (`nan_at`, a NIfTI's, or NaN the reader kept);
+// infinite values are still refused.
+void keep_nan(const std::string& path, std::span<float> values, const std::vector<std::uint8_t>& nan_at) {
+    const std::size_t flagged = std::min(nan_at.size(), values.size());
+    for (std::size_t i = 0; i < flagged; ++i)
+        if (nan_at[i]) values[i] = std::numeric_limits<float>::quiet_NaN();
+    std::uint64_t inf = 0;
+    for (float v : values) inf += std::isinf(v);
+    if (inf) fail_read(path, voxels_are_infinite(inf));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -569,11 +585,12 @@ void write_grid(const void* data, Component component, const Lattice& lattice, c
 
 ImageHeader read_image_header(const std::string& path) { return open_source(path).header; }
 
-Grid<float> read_image(const std::string& path, std::uint64_t max_bytes, ImageHeader* header) {
+Grid<float> read_image(const std::string& path, std::uint64_t max_bytes, ImageHeader* header, NanVoxels nan) {
     const Source src = open_source(path);
     if (header != nullptr) *header = src.header;
     const Lattice lattice = validate(src, max_bytes);
-    verify_data(src);
+    std::vector<std::uint8_t> nan_at;
+    verify_data(src, nan == NanVoxels::keep ? &nan_at : nullptr);
     Grid<float> grid;
     try {
         grid = Grid<float>(lattice);
@@ -588,7 +605,8 @@ Grid<float> read_image(const std::string& path, std::uint64_t max_bytes, ImageHe
             std::transform(values, values + n, out.begin(), [](auto v) { return static_cast<float>(v); });
         });
     }
-    check_finite(path, out);
+    if (nan == NanVoxels::keep) keep_nan(path, out, nan_at);
+    else check_finite(path, out);
     return grid;
 }
 

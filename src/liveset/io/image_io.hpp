@@ -56,9 +56,16 @@ ImageHeader read_image_header(const std::string& path);
 // (also a single slice: some axis of size 1), 4D+ images unless the extra axes have size 1,
 // multi-component (RGB, vector) images, empty images, images larger than kMaxLatticePoints or
 // `max_bytes` (as float), non-positive or non-finite spacing, non-finite origin, singular
-// direction, and NaN/infinite voxels ("N voxels are NaN or infinite").
+// direction, and NaN/infinite voxels ("N voxels are NaN or infinite"; with NanVoxels::keep,
+// infinite ones only: "N voxels are infinite").
 // `header` (optional) receives the header read_image_header would give.
-Grid<float> read_image(const std::string& path, std::uint64_t max_bytes = kDefaultImageMemoryLimit, ImageHeader* header = nullptr);
+enum class NanVoxels {
+    refuse,  // a φ, a mask: NaN is damage
+    keep,    // a scan: NaN is a masked image's "no data" (SPM, fslmaths -nan), read as NaN (a NIfTI's
+             // too, which niftilib would read as 0)
+};
+Grid<float> read_image(const std::string& path, std::uint64_t max_bytes = kDefaultImageMemoryLimit, ImageHeader* header = nullptr,
+                       NanVoxels nan = NanVoxels::refuse);
 
 // Reads an integer label image (values 0..255; for masks nonzero means foreground). Same checks
 // as read_image, plus: every value must be an integer in 0..255.

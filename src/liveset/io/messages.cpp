@@ -53,6 +53,8 @@ std::string voxels_are_non_finite(std::uint64_t n) {
     return std::to_string(n) + (n == 1 ? " voxel is" : " voxels are") + " NaN or infinite";
 }
 
+std::string voxels_are_infinite(std::uint64_t n) { return std::to_string(n) + (n == 1 ? " voxel is" : " voxels are") + " infinite"; }
+
 std::string condense(const std::string& text, const std::string& path) {
     std::string s;
     s.reserve(text.size());

@@ -11,6 +11,7 @@ std::string quoted(const std::string& s);                        // "\"s\""
 std::string dims_text(const std::vector<std::uint64_t>& size);  // "181x217x180"
 std::string bytes_text(double bytes);                            // "2.71 KiB"
 std::string voxels_are_non_finite(std::uint64_t n);              // "3 voxels are NaN or infinite"
+std::string voxels_are_infinite(std::uint64_t n);                // "3 voxels are infinite"
 
 // One line out of a library's error text (ITK, teem, ...): drops "ITK ERROR: Class(0x..):"
 // prefixes and line breaks, shortens `path` to its file name (the message names the full path

@@ -1,6 +1,7 @@
 // Automatic brain mask (see brain_mask.hpp): histogram thresholds, morphology in mm, and the test
 // that tells a skull-stripped input from a full head.
 #include "liveset/segment/brain_mask.hpp"
+#include "liveset/segment/intensity.hpp"
 #include "liveset/segment/tissue_model.hpp"
 
 #include <algorithm>
@@ -169,7 +170,7 @@ std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
 // the masked outside is read as a skull-stripped image's dark background.
 Grid<float> outside_lowered(const Grid<float>& image, const Mask& outside) {
     const auto [lo, hi] = std::minmax_element(image.values().begin(), image.values().end());
-    const float below = *lo - 0.01f * (*hi - *lo);
+    const float below = value_below(*lo, *hi);
     Grid<float> out = image;
     for (std::size_t i = 0; i < out.size(); ++i)
         if (outside[static_cast<PointIndex>(i)] != 0) out[static_cast<PointIndex>(i)] = below;

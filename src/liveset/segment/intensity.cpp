@@ -3,8 +3,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "liveset/grid/large_page_allocator.hpp"
 
@@ -40,6 +42,25 @@ double IntensityScale::to_unit(double raw) const {
 }
 
 double IntensityScale::to_raw(double unit) const { return low + unit * (high - low); }
+
+float value_below(float lo, float hi) { return hi > lo ? lo - 0.01f * (hi - lo) : lo - 1.0f; }
+
+std::uint64_t lower_no_data(Grid<float>& image) {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    std::uint64_t nan = 0, inf = 0;
+    for (float v : image.values()) {
+        nan += std::isnan(v);
+        inf += std::isinf(v);
+        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    if (inf) throw std::invalid_argument("the image has " + std::to_string(inf) + " infinite voxel(s)");
+    if (nan == 0) return 0;
+    if (nan == image.size()) throw std::invalid_argument("every voxel of the image is NaN (no data)");
+    const float below = value_below(lo, hi);
+    for (float& v : image.values())
+        if (std::isnan(v)) v = below;
+    return nan;
+}
 
 IntensityScale robust_scale(const Grid<float>& image, const Grid<std::uint8_t>* roi, const ScaleOptions& options) {
     check_roi(image, roi);

@@ -37,6 +37,17 @@ IntensityScale robust_scale(const Grid<float>& image, const Grid<std::uint8_t>* 
 // The image mapped to [0, 1] with `scale`.
 Grid<float> normalise(const Grid<float>& image, const IntensityScale& scale);
 
+// The value a masked image's outside is given so that it lies below every value in [lo, hi]:
+// 1 % of the range below lo (1 below when the range is empty).
+float value_below(float lo, float hi);
+
+// A masked image's "no data" (NaN voxels: SPM's masked images, fslmaths -nan, read with
+// NanVoxels::keep) made its lowest values: every NaN voxel set to value_below(the others' range),
+// so the brain mask finds them as a skull-stripped brain's dark outside and no threshold window
+// around a tissue holds them. Returns how many there were. Throws std::invalid_argument when every
+// voxel is NaN or any is infinite.
+std::uint64_t lower_no_data(Grid<float>& image);
+
 // A seed: a ball in index coordinates (voxels).
 struct SeedBall {
     Vec3d center;
