@@ -463,6 +463,43 @@ TEST_F(ImageIo, TruncatedFiles) {
     expect_error([&] { read_image(path("lost.mhd")); }, path("lost.mhd"), "corrupt or truncated");
 }
 
+// A two-file image (.hdr + .img: a NIfTI pair, as SPM writes it, or Analyze 7.5) is checked as a
+// single file is: niftilib alone reads its NaN and infinite floats as 0 and zero-fills a short .img.
+TEST_F(ImageIo, TwoFileNiftiAndAnalyzeAreCheckedAsASingleFileIs) {
+    Grid<float> image = test_image();
+    image[3] = std::numeric_limits<float>::quiet_NaN();
+    image[10] = std::numeric_limits<float>::infinity();
+    const auto analyze_copy = [&](const std::string& from, const std::string& to) {  // the pair's header without its "ni1" magic
+        std::ifstream in(path(from + ".hdr"), std::ios::binary);
+        std::string hdr((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        ASSERT_EQ(hdr.substr(344, 3), "ni1");
+        hdr.replace(344, 4, std::string(4, '\0'));
+        write_text(path(to + ".hdr"), hdr);
+        fs::copy_file(path(from + ".img"), path(to + ".img"), fs::copy_options::overwrite_existing);
+    };
+    write_image(image, path("pair.hdr"));
+    ASSERT_TRUE(fs::exists(path("pair.img")));
+    analyze_copy("pair", "analyze");
+    for (const std::string name : {"pair.hdr", "pair.img", "analyze.hdr", "analyze.img"}) {
+        expect_error([&] { read_image(path(name)); }, path(name), "2 voxels are NaN or infinite");
+        expect_error([&] { read_image(path(name), kDefaultImageMemoryLimit, nullptr, NanVoxels::keep); }, path(name), "1 voxel is infinite");
+    }
+    image[10] = 2.5f;
+    write_image(image, path("pair.hdr"));
+    analyze_copy("pair", "analyze");
+    for (const std::string name : {"pair.hdr", "analyze.img"}) {
+        const Grid<float> back = read_image(path(name), kDefaultImageMemoryLimit, nullptr, NanVoxels::keep);
+        for (PointIndex i = 0; i < image.size(); ++i) {
+            if (std::isnan(image[i])) EXPECT_TRUE(std::isnan(back[i])) << name << " " << i;
+            else EXPECT_EQ(back[i], image[i]) << name << " " << i;
+        }
+    }
+    write_image(test_image(), path("cut.hdr"));
+    fs::resize_file(path("cut.img"), fs::file_size(path("cut.img")) / 2);
+    expect_error([&] { read_image(path("cut.hdr")); }, path("cut.hdr"), "corrupt or truncated");
+    expect_error([&] { read_label_image(path("cut.img")); }, path("cut.img"), "corrupt or truncated");
+}
+
 TEST_F(ImageIo, TwoDImage) {
     const float v[12] = {};
     write_mha(path("flat.mha"), "NDims = 2\nDimSize = 3 4\nElementType = MET_FLOAT\n", v, sizeof v);

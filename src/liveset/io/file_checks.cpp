@@ -77,8 +77,10 @@ std::string trim(const std::string& s) {
     return s.substr(a, s.find_last_not_of(" \t\r") - a + 1);
 }
 
-// Where a single-file NIfTI's voxel data lies and what it holds, read from its header (the
-// stream is left just after the header); nullopt when it is not one (ITK then has its say).
+// Where a NIfTI's voxel data lies and what it holds, read from its header (the stream is left
+// just after the header); nullopt when it is not one (ITK then has its say). `pair`: the header
+// of a two-file image (.hdr + .img: NIfTI "ni1"/"ni2", or Analyze 7.5 with no magic), whose
+// offset counts from the start of the .img.
 struct NiftiLayout {
     bool swap = false;
     int datatype = 0;
@@ -86,7 +88,7 @@ struct NiftiLayout {
     int header_bytes = 0;
 };
 
-std::optional<NiftiLayout> read_nifti_layout(gzFile f) {
+std::optional<NiftiLayout> read_nifti_layout(gzFile f, bool pair) {
     // Read exactly the header (348 bytes for NIfTI-1, 540 for NIfTI-2): the data starts later.
     unsigned char h[540] = {};
     int got = gzread(f, h, 348);
@@ -99,19 +101,20 @@ std::optional<NiftiLayout> read_nifti_layout(gzFile f) {
     int datatype = 0, bitpix = 0;
     double vox_offset = 0;
     if (sizeof_hdr == 348) {
-        if (std::memcmp(h + 344, "n+1", 4) != 0) return std::nullopt;
+        // A pair's header: "ni1", or Analyze 7.5 (no magic; its vox_offset field is the same float).
+        if (pair ? std::memcmp(h + 344, "n+1", 4) == 0 : std::memcmp(h + 344, "n+1", 4) != 0) return std::nullopt;
         for (int i = 0; i < 8; ++i) dim[i] = load<std::int16_t>(h + 40 + 2 * i, swap);
         datatype = load<std::int16_t>(h + 70, swap);
         bitpix = load<std::int16_t>(h + 72, swap);
-        vox_offset = std::max<double>(352, load<float>(h + 108, swap));
+        vox_offset = std::max<double>(pair ? 0 : 352, load<float>(h + 108, swap));
     } else if (sizeof_hdr == 540) {
         if (gzread(f, h + 348, 192) != 192) return std::nullopt;
         got = 540;
-        if (std::memcmp(h + 4, "n+2", 4) != 0) return std::nullopt;
+        if (std::memcmp(h + 4, pair ? "ni2" : "n+2", 4) != 0) return std::nullopt;
         for (int i = 0; i < 8; ++i) dim[i] = load<std::int64_t>(h + 16 + 8 * i, swap);
         datatype = load<std::int16_t>(h + 12, swap);
         bitpix = load<std::int16_t>(h + 14, swap);
-        vox_offset = std::max<double>(544, static_cast<double>(load<std::int64_t>(h + 168, swap)));
+        vox_offset = std::max<double>(pair ? 0 : 544, static_cast<double>(load<std::int64_t>(h + 168, swap)));
     } else {
         return std::nullopt;
     }
@@ -121,7 +124,35 @@ std::optional<NiftiLayout> read_nifti_layout(gzFile f) {
         if (dim[i] <= 0) return std::nullopt;
         data_bytes *= static_cast<std::uint64_t>(dim[i]);
     }
-    return NiftiLayout{swap, datatype, static_cast<std::uint64_t>(vox_offset), data_bytes, got};
+    return NiftiLayout{swap, datatype, static_cast<std::uint64_t>(vox_offset), data_bytes, pair ? 0 : got};
+}
+
+bool ends_with(const std::string& s, const char* suffix) {
+    const std::size_t n = std::strlen(suffix);
+    if (s.size() < n) return false;
+    for (std::size_t i = 0; i < n; ++i)
+        if (std::tolower(static_cast<unsigned char>(s[s.size() - n + i])) != suffix[i]) return false;
+    return true;
+}
+
+// A two-file image's header and data files, named as niftilib finds them (x.hdr[.gz] with
+// x.img[.gz], either named); false for a single file.
+bool pair_files(const std::string& path, std::string& header, std::string& data) {
+    std::error_code ec;
+    for (const char* ext : {".hdr.gz", ".hdr", ".img.gz", ".img"}) {
+        if (!ends_with(path, ext)) continue;
+        const std::string stem = path.substr(0, path.size() - std::strlen(ext));
+        const bool is_header = ext[1] == 'h';
+        const std::string other = is_header ? ".img" : ".hdr";
+        for (const std::string& candidate : {stem + other + (ends_with(path, ".gz") ? ".gz" : ""), stem + other + (ends_with(path, ".gz") ? "" : ".gz")}) {
+            if (!fs::exists(candidate, ec)) continue;
+            header = is_header ? path : candidate;
+            data = is_header ? candidate : path;
+            return true;
+        }
+        return false;
+    }
+    return false;
 }
 
 }  // namespace
@@ -129,11 +160,15 @@ std::optional<NiftiLayout> read_nifti_layout(gzFile f) {
 DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values, std::vector<std::uint8_t>* nan_at) {
     DataCheck result;
     if (nan_at != nullptr) nan_at->clear();
-    std::unique_ptr<gzFile_s, GzClose> file(gzopen(path.c_str(), "rb"));
+    std::string header_path = path, data_path = path;
+    const bool pair = pair_files(path, header_path, data_path);
+    std::unique_ptr<gzFile_s, GzClose> file(gzopen(header_path.c_str(), "rb"));
+    if (!file) return result;
+    const std::optional<NiftiLayout> layout = read_nifti_layout(file.get(), pair);
+    if (!layout) return result;
+    if (pair) file.reset(gzopen(data_path.c_str(), "rb"));  // the data: from the .img's first byte
     if (!file) return result;
     gzFile f = file.get();
-    const std::optional<NiftiLayout> layout = read_nifti_layout(f);
-    if (!layout) return result;
     const bool swap = layout->swap;
     const int datatype = layout->datatype;
     const std::uint64_t data_bytes = layout->data_bytes;
@@ -148,7 +183,7 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values
     if (!scan_values) {
         if (!compressed) {
             std::error_code ec;
-            const std::uint64_t size = fs::file_size(path, ec);
+            const std::uint64_t size = fs::file_size(data_path, ec);
             if (!ec && size < end) {
                 result.truncated = true;
                 result.detail = holds(size > offset ? size - offset : 0, data_bytes);
@@ -156,7 +191,7 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values
             return result;
         }
         std::uint32_t isize = 0;
-        if (gzip_isize(path, isize) && isize == static_cast<std::uint32_t>(end)) return result;
+        if (gzip_isize(data_path, isize) && isize == static_cast<std::uint32_t>(end)) return result;
     }
 
     // Stream the data: count the bytes that are really there (and non-finite values).

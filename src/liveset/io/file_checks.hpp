@@ -17,9 +17,10 @@ struct DataCheck {
     std::uint64_t nan = 0;         // of which NaN
 };
 
-// Single-file NIfTI-1/-2 (.nii, .nii.gz; compressed or not): the data the header promises is all
-// there; with count_non_finite, NaN and infinite values of float32/float64 data are counted
-// (which means decompressing the file once more). Other layouts (.hdr/.img) pass unchecked.
+// NIfTI-1/-2 (.nii, .nii.gz; compressed or not), and two-file images (`path` either file of a
+// .hdr/.img pair, each maybe .gz: NIfTI "ni1"/"ni2" or Analyze 7.5, which niftilib reads too): the
+// data the header promises is all there; with count_non_finite, NaN and infinite values of
+// float32/float64 data are counted (which means decompressing the file once more).
 // `nan_at` (with count_non_finite): one flag per stored value, 1 where it is NaN, in file order
 // (niftilib reads those as 0); left empty when the data holds no NaN.
 DataCheck check_nifti_data(const std::string& path, bool count_non_finite, std::vector<std::uint8_t>* nan_at = nullptr);
