@@ -440,9 +440,11 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
 
 nlohmann::json tissue_model_report(const TissueModel& m, const ModelWindow* w) {
     nlohmann::json classes = nlohmann::json::array();
-    for (std::size_t c = 0; c < m.classes.size(); ++c)
-        classes.push_back({{"name", tissue_class_name(m, static_cast<int>(c))}, {"mean", m.classes[c].mean},
-                           {"sigma", m.classes[c].sigma}, {"weight", m.classes[c].weight}});
+    for (std::size_t c = 0; c < m.classes.size(); ++c) {
+        const TissueClass& t = m.classes[c];
+        classes.push_back({{"name", tissue_class_name(m, static_cast<int>(c))}, {"mean", t.mean}, {"sigma", t.sigma}, {"weight", t.weight},
+                           {"peak_sigma", std::isfinite(t.peak_sigma) ? nlohmann::json(t.peak_sigma) : nlohmann::json(nullptr)}});
+    }
     nlohmann::json j{{"classes", classes}, {"partial_volume", m.mixed}, {"voxels", m.voxels},
                      {"iterations", m.iterations}, {"converged", m.converged}, {"usable", m.usable()}};
     if (!m.usable()) j["degenerate"] = m.degenerate;

@@ -2,9 +2,11 @@
 // thresholds against brute force, the window rule's invariances and its warnings and fallbacks.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "liveset/segment/alpha.hpp"
 #include "liveset/segment/pipeline.hpp"
 #include "liveset/segment/tissue_model.hpp"
 #include "liveset/segment/window.hpp"
@@ -56,6 +58,42 @@ TEST(TissueModel, RecoversTheClassesOfAPartialVolumeMixture) {
     EXPECT_EQ(m.classify(97.0), 1);
     EXPECT_EQ(m.classify(40.0), 0);
     EXPECT_EQ(m.classify(140.0), 2);
+}
+
+// The histogram's own peak widths on a sound mixture: no narrower than the fit's σ (the noise
+// ratio then reads σ, as before) and within 35 % of the true spread (partial-volume voxels widen a
+// peak's side, never narrow it). The end to end case, a pinned white matter: PinnedT1Cli.
+TEST(TissueModel, APeakWidthIsNoNarrowerThanASoundFit) {
+    const std::vector<float> v = sample(kT1, 0.25, 200000, 1);
+    const TissueModel m = fit_tissue_model(v);
+    ASSERT_TRUE(m.usable()) << m.degenerate;
+    for (std::size_t c = 0; c < 3; ++c) {
+        EXPECT_GT(m.classes[c].peak_sigma, 0.9 * kT1[c].sigma) << c;
+        EXPECT_LT(m.classes[c].peak_sigma, 1.35 * kT1[c].sigma) << c;
+        EXPECT_NEAR(m.classes[c].spread(), m.classes[c].sigma, 0.1 * m.classes[c].sigma) << c;
+    }
+}
+
+// A class that takes voxels its peak does not hold (here a shoulder of grey matter's partial volume
+// with a pinned white matter, fitted without the mixed classes, as the EM ends up on FreeSurfer's
+// T1.mgz) widens; its peak does not, and the spread the noise ratio reads is the peak's.
+TEST(TissueModel, APeakWidthBoundsAFitWidenedByVoxelsItsPeakDoesNotHold) {
+    std::vector<float> v = sample({{40, 5, 0.15}, {82, 4, 0.45}}, 0.0, 200000, 3);
+    std::mt19937 rng(4);
+    std::uniform_real_distribution<double> shoulder(86.0, 106.0);
+    for (int i = 0; i < 24000; ++i) v.push_back(static_cast<float>(shoulder(rng)));
+    v.insert(v.end(), 60000, 110.0f);  // white matter pinned to one value
+    TissueModelOptions o;
+    o.partial_volume = false;
+    const TissueModel m = fit_tissue_model(v, o);
+    ASSERT_TRUE(m.usable()) << m.degenerate;
+    ASSERT_EQ(m.classes.size(), 3u);
+    const TissueClass& gm = m.classes[1];
+    EXPECT_GT(gm.sigma, 1.5 * 4.0);
+    EXPECT_NEAR(gm.peak_sigma, 4.0, 1.0);
+    EXPECT_EQ(gm.spread(), gm.peak_sigma);
+    const AlphaChoice a = automatic_alpha(&m, 82.0, {1.0f, 1.0f, 1.0f}, 1);
+    EXPECT_NEAR(a.noise_ratio, std::max(gm.peak_sigma, m.classes[2].spread()) / (m.classes[2].mean - gm.mean), 1e-12);
 }
 
 TEST(TissueModel, PartialVolumeClassesKeepThePureMeansWhereAPlainMixtureShiftsThem) {

@@ -12,7 +12,8 @@ namespace liveset {
 
 namespace {
 
-// The larger σ of the window's class k and of the class j whose mean is nearest k's, over the
+// The larger spread (TissueClass::spread: σ, or the narrower peak the histogram shows) of the
+// window's class k and of the class j whose mean is nearest k's, over the
 // distance between their means; NaN (class −1) without a usable model of at least two classes with
 // distinct means.
 double noise_ratio(const TissueModel* model, double centre, int window_class, int& tissue_class) {
@@ -29,7 +30,7 @@ double noise_ratio(const TissueModel* model, double centre, int window_class, in
     std::size_t j = k == 0 ? 1 : 0;  // the nearest other class: its border with k is the window's nearer edge
     for (std::size_t i = 0; i < c.size(); ++i)
         if (i != k && std::abs(c[i].mean - c[k].mean) < std::abs(c[j].mean - c[k].mean)) j = i;
-    const double gap = std::abs(c[j].mean - c[k].mean), sigma = std::max(c[k].sigma, c[j].sigma);
+    const double gap = std::abs(c[j].mean - c[k].mean), sigma = std::max(c[k].spread(), c[j].spread());
     if (!(gap > 0.0) || !std::isfinite(gap) || !std::isfinite(sigma)) return std::numeric_limits<double>::quiet_NaN();
     tissue_class = static_cast<int>(k);
     return sigma / gap;  // both spreads blur that border

@@ -46,8 +46,14 @@ void sort_values(LargeVector<float>& v) {
     }, scratch);
 }
 
-// Non-empty bins of the values between the options' quantiles.
-std::vector<Bin> histogram(std::span<const float> values, const TissueModelOptions& o, std::size_t& used) {
+// The histogram's counts over its whole range (empty bins too): bin b holds [lo + b·width, lo + (b+1)·width).
+struct DenseHistogram {
+    std::vector<double> counts;
+    double lo = 0.0, width = 1.0;
+};
+
+// Non-empty bins of the values between the options' quantiles (and, in `dense`, all of them).
+std::vector<Bin> histogram(std::span<const float> values, const TissueModelOptions& o, std::size_t& used, DenseHistogram* dense = nullptr) {
     LargeVector<float> v(values.begin(), values.end());
     sort_values(v);
     const double lo = quantile_sorted(v, o.low_quantile), hi = quantile_sorted(v, o.high_quantile);
@@ -69,7 +75,41 @@ std::vector<Bin> histogram(std::span<const float> values, const TissueModelOptio
         const double m = s[b] / n[b];
         bins.push_back({n[b], m, std::max(0.0, s2[b] / n[b] - m * m)});
     }
+    if (dense) *dense = {std::move(n), lo, (hi - lo) / o.bins};
     return bins;
+}
+
+// TissueClass::peak_sigma of a class (mean, sigma) on the histogram: smoothed by a Gaussian of
+// max(3 bins, 1 % of the range) (it fills the comb an integer image rescaled leaves), the peak is
+// the smoothed maximum within mean ± sigma, each side's half width at half maximum is taken as
+// 1.1774 σ, and the smoothing's σ comes off in quadrature.
+double peak_sigma(const DenseHistogram& h, double mean, double sigma) {
+    const double inf = std::numeric_limits<double>::infinity();
+    const auto n = static_cast<std::ptrdiff_t>(h.counts.size());
+    const double s = std::max(3.0, 0.01 * static_cast<double>(n));  // in bins
+    const auto reach = static_cast<std::ptrdiff_t>(std::ceil(4.0 * s));
+    std::vector<double> kernel(static_cast<std::size_t>(2 * reach + 1));
+    for (std::ptrdiff_t k = -reach; k <= reach; ++k) kernel[static_cast<std::size_t>(k + reach)] = std::exp(-0.5 * (k / s) * (k / s));
+    std::vector<double> d(h.counts.size(), 0.0);
+    for (std::ptrdiff_t b = 0; b < n; ++b)
+        for (std::ptrdiff_t k = -reach; k <= reach; ++k)
+            if (b + k >= 0 && b + k < n) d[static_cast<std::size_t>(b)] += kernel[static_cast<std::size_t>(k + reach)] * h.counts[static_cast<std::size_t>(b + k)];
+    const auto bin_of = [&](double x) { return static_cast<std::ptrdiff_t>(std::floor((x - h.lo) / h.width)); };
+    const std::ptrdiff_t from = std::max<std::ptrdiff_t>(0, bin_of(mean - std::max(sigma, 2 * h.width)));
+    const std::ptrdiff_t to = std::min<std::ptrdiff_t>(n - 1, bin_of(mean + std::max(sigma, 2 * h.width)));
+    if (from >= to) return inf;
+    std::ptrdiff_t p = from;
+    for (std::ptrdiff_t b = from; b <= to; ++b)
+        if (d[static_cast<std::size_t>(b)] > d[static_cast<std::size_t>(p)]) p = b;
+    if (p == from || p == to) return inf;  // no peak of its own in that range
+    const double half = 0.5 * d[static_cast<std::size_t>(p)];
+    std::ptrdiff_t l = p, r = p;
+    while (l > 0 && d[static_cast<std::size_t>(l)] > half) --l;
+    while (r < n - 1 && d[static_cast<std::size_t>(r)] > half) ++r;
+    if (d[static_cast<std::size_t>(l)] > half || d[static_cast<std::size_t>(r)] > half) return inf;
+    const double hw = static_cast<double>(std::max(p - l, r - p)) * h.width;  // the wider side
+    const double g = hw / std::sqrt(2.0 * std::log(2.0)), smoothing = s * h.width;
+    return std::sqrt(std::max(g * g - smoothing * smoothing, h.width * h.width));
 }
 
 std::vector<std::size_t> otsu_splits(const std::vector<Bin>& bins, int k) {
@@ -250,7 +290,8 @@ TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOpt
     for (const float x : values)
         if (!std::isfinite(x)) throw std::invalid_argument("image has non-finite voxels");
     std::size_t used = 0;
-    const std::vector<Bin> bins = histogram(values, o, used);
+    DenseHistogram dense;
+    const std::vector<Bin> bins = histogram(values, o, used, &dense);
     if (bins.size() < static_cast<std::size_t>(2 * o.classes)) {
         std::ostringstream os;
         os << "the region has " << bins.size() << " distinct intensity levels: too few for " << o.classes << " tissue classes";
@@ -282,6 +323,7 @@ TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOpt
             m.note = "the partial-volume fit failed (" + why + "): plain mixture used";
     }
     m.degenerate = degeneracy(m);
+    for (TissueClass& c : m.classes) c.peak_sigma = peak_sigma(dense, c.mean, c.sigma);
     return m;
 }
 

@@ -23,7 +23,9 @@
 // µ is the window's centre and ε its half width.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -48,6 +50,15 @@ struct TissueClass {
     double mean = 0.0;    // raw units
     double sigma = 0.0;
     double weight = 0.0;  // share of the region's voxels in this pure class
+    // The spread the histogram's own peak shows for this class: its wider side's half width at
+    // half maximum as a Gaussian σ (the histogram smoothed, that smoothing taken out); infinite
+    // when the class has no peak of its own (the smoothed histogram's maximum within mean ± sigma
+    // lies on that range's edge, or a side never falls to half). Where the fit's σ is wider than
+    // this, the class took voxels its peak does not hold: a neighbour pinned to one value (an
+    // intensity-normalised T1, FreeSurfer's white matter at 110) leaves its partial-volume voxels to
+    // it. What the noise ratio (alpha.hpp) reads: min(sigma, peak_sigma).
+    double peak_sigma = std::numeric_limits<double>::infinity();
+    double spread() const { return std::min(sigma, peak_sigma); }
 };
 
 struct TissueModel {
