@@ -102,12 +102,19 @@ double peak_sigma(const DenseHistogram& h, double mean, double sigma) {
     for (std::ptrdiff_t b = from; b <= to; ++b)
         if (d[static_cast<std::size_t>(b)] > d[static_cast<std::size_t>(p)]) p = b;
     if (p == from || p == to) return inf;  // no peak of its own in that range
-    const double half = 0.5 * d[static_cast<std::size_t>(p)];
+    const auto at = [&](std::ptrdiff_t b) { return d[static_cast<std::size_t>(b)]; };
+    const double half = 0.5 * at(p);
     std::ptrdiff_t l = p, r = p;
-    while (l > 0 && d[static_cast<std::size_t>(l)] > half) --l;
-    while (r < n - 1 && d[static_cast<std::size_t>(r)] > half) ++r;
-    if (d[static_cast<std::size_t>(l)] > half || d[static_cast<std::size_t>(r)] > half) return inf;
-    const double hw = static_cast<double>(std::max(p - l, r - p)) * h.width;  // the wider side
+    while (l > 0 && at(l) > half) --l;
+    while (r < n - 1 && at(r) > half) ++r;
+    if (at(l) > half || at(r) > half) return inf;
+    // Positions between bins (linear crossings, the peak at its parabola's vertex), so the width
+    // follows the data continuously: a shifted or rescaled image gives the same α to rounding.
+    const double curve = at(p - 1) - 2.0 * at(p) + at(p + 1);
+    const double peak = static_cast<double>(p) + (curve < 0.0 ? 0.5 * (at(p - 1) - at(p + 1)) / curve : 0.0);
+    const double left = static_cast<double>(l) + (half - at(l)) / (at(l + 1) - at(l));
+    const double right = static_cast<double>(r) - (half - at(r)) / (at(r - 1) - at(r));
+    const double hw = std::max(peak - left, right - peak) * h.width;  // the wider side
     const double g = hw / std::sqrt(2.0 * std::log(2.0)), smoothing = s * h.width;
     return std::sqrt(std::max(g * g - smoothing * smoothing, h.width * h.width));
 }

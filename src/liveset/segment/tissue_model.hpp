@@ -53,12 +53,18 @@ struct TissueClass {
     // The spread the histogram's own peak shows for this class: its wider side's half width at
     // half maximum as a Gaussian σ (the histogram smoothed, that smoothing taken out); infinite
     // when the class has no peak of its own (the smoothed histogram's maximum within mean ± sigma
-    // lies on that range's edge, or a side never falls to half). Where the fit's σ is wider than
-    // this, the class took voxels its peak does not hold: a neighbour pinned to one value (an
-    // intensity-normalised T1, FreeSurfer's white matter at 110) leaves its partial-volume voxels to
-    // it. What the noise ratio (alpha.hpp) reads: min(sigma, peak_sigma).
+    // lies on that range's edge, or a side never falls to half). On a sound fit the two agree to
+    // about a quarter (the peak's wider side a little wider: partial volume); a fit much wider than
+    // its peak took voxels the peak does not hold: a neighbour pinned to one value (an
+    // intensity-normalised T1, FreeSurfer's white matter at 110) leaves its partial-volume voxels to it.
     double peak_sigma = std::numeric_limits<double>::infinity();
-    double spread() const { return std::min(sigma, peak_sigma); }
+    // What the noise ratio (alpha.hpp) reads: sigma up to 1.3 × peak_sigma, peak_sigma from 1.8 ×,
+    // a linear blend between (no jump in α as an image changes a little).
+    double spread() const {
+        if (!(sigma > 1.3 * peak_sigma)) return sigma;
+        const double t = std::min((sigma / peak_sigma - 1.3) / 0.5, 1.0);
+        return sigma - t * (sigma - peak_sigma);
+    }
 };
 
 struct TissueModel {
