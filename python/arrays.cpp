@@ -74,7 +74,10 @@ cli::Scan scan_from_array(const pyb::array& values, const Lattice& lattice) {
 }
 
 Grid<std::uint8_t> mask_from_array(const pyb::array& values, const Lattice& lattice) {
-    return copy_into<std::uint8_t>(values, lattice, [](double v) { return static_cast<std::uint8_t>(v != 0.0); });
+    return copy_into<std::uint8_t>(values, lattice, [](double v) {
+        if (std::isnan(v)) throw std::invalid_argument("the mask holds NaN values");  // no data is no answer there
+        return static_cast<std::uint8_t>(v != 0.0);
+    });
 }
 
 pyb::array array_from_grid(Grid<float>&& grid) { return wrap(std::move(grid)); }

@@ -119,7 +119,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     cli::SeedFit seed_fit;  // seeds outside the ROI
     {
         pyb::gil_scoped_release nogil;
-        prepared = cli::prepare_image(image, roi, mode, &interrupt.flag(), &lookup);
+        prepared = cli::prepare_image(image, roi, mode, &interrupt.flag(), &lookup, scan.no_data ? &*scan.no_data : nullptr);
         seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, init ? &*init : nullptr, "roi='none'");
         roi_mask = roi ? &roi->mask : nullptr;
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
@@ -168,13 +168,13 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
     cli::PreparedImage prepared;
     {
         pyb::gil_scoped_release nogil;
-        prepared = cli::prepare_image(image, roi, bias_mode(bias_correct), nullptr, &lookup);
+        prepared = cli::prepare_image(image, roi, bias_mode(bias_correct), nullptr, &lookup, scan.no_data ? &*scan.no_data : nullptr);
     }
     const Grid<std::uint8_t>* r = roi ? &roi->mask : nullptr;
     nlohmann::json j = nlohmann::json::object();
     cli::add_bias_report(j, prepared, r);
     if (roi) j["roi"] = cli::roi_report(*roi);
-    if (scan.no_data_voxels) j["no_data_voxels"] = scan.no_data_voxels;
+    j["no_data_voxels"] = scan.no_data_voxels;
     pyb::dict d;
     d["report"] = j.dump();
     d["roi"] = roi ? pyb::object(array_from_grid(Grid<std::uint8_t>(roi->mask))) : pyb::object(pyb::none());
@@ -189,12 +189,13 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
 
 // The tissue model fitted where segment() fits it, and the window the seeds would get.
 std::string tissue_model(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a) {
-    Grid<float> image = scan_from_array(values, lattice).image;
+    cli::Scan scan = scan_from_array(values, lattice);
+    Grid<float>& image = scan.image;
     SegmentRequest req = request_for(a, lattice, false);
     cli::BrainLookup lookup = lookup_for(a.oriented);
     std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
     pyb::gil_scoped_release nogil;
-    cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct), nullptr, &lookup);  // as segment
+    cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct), nullptr, &lookup, scan.no_data ? &*scan.no_data : nullptr);  // as segment
     const cli::SeedFit seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, nullptr, "roi='none'");
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);

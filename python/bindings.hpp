@@ -34,7 +34,7 @@ Grid<float> grid_from_array(const pyb::array& values, const Lattice& lattice, bo
 // A scan handed as an array (segment, sessions, holes): NaN voxels — a masked image's "no data",
 // as liveset.read keeps them — lowered below the rest, as the CLI reads a file (cli::read_scan).
 cli::Scan scan_from_array(const pyb::array& values, const Lattice& lattice);
-Grid<std::uint8_t> mask_from_array(const pyb::array& values, const Lattice& lattice);  // non-zero -> 1
+Grid<std::uint8_t> mask_from_array(const pyb::array& values, const Lattice& lattice);  // non-zero -> 1; NaN refused
 // Zero-copy: the Grid moves into a capsule that the Fortran-ordered array (shape I, J, K) keeps alive.
 pyb::array array_from_grid(Grid<float>&& grid);
 pyb::array array_from_grid(Grid<std::uint8_t>&& grid);

@@ -109,7 +109,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.
     const BiasCorrection mode = bias_mode(a.bias_correct, a.bias_given || !a.out_corrected.empty());
-    PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag(), &lookup);
+    PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag(), &lookup, scan.no_data ? &*scan.no_data : nullptr);
     if (prepared.bias && prepared.bias->interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
         return 130;

@@ -19,14 +19,9 @@ namespace liveset::cli {
 
 Scan scan_of(Grid<float> image, ImageHeader header) {
     Scan s{std::move(image), std::move(header), std::nullopt, 0};
-    std::optional<Grid<std::uint8_t>> nan;
-    for (PointIndex i = 0; i < s.image.size(); ++i) {
-        if (!std::isnan(s.image[i])) continue;
-        if (!nan) nan.emplace(s.image.lattice(), 0);
-        (*nan)[i] = 1;
-    }
-    s.no_data_voxels = lower_no_data(s.image);  // refuses infinite voxels, and an image all NaN
-    s.no_data = std::move(nan);
+    s.no_data = lower_no_data(s.image);  // refuses infinite voxels, and an image all NaN
+    if (s.no_data)
+        for (const std::uint8_t v : s.no_data->values()) s.no_data_voxels += v;
     return s;
 }
 
@@ -210,7 +205,7 @@ void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMa
 }  // namespace
 
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt,
-                            BrainLookup* lookup) {
+                            BrainLookup* lookup, const Grid<std::uint8_t>* no_data) {
     PreparedImage out;
     const BrainMaskOptions options = lookup ? lookup->options : BrainMaskOptions{};
     BrainMaskHead own_head;  // the fit region's head, without a ROI
@@ -223,6 +218,8 @@ PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCor
     }
     if (mode != BiasCorrection::kOff) {
         correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
+        // N4 divides the lowered no-data voxels by its field too: below the corrected image again.
+        if (out.bias && !out.bias->interrupted && no_data) lower_voxels(image, *no_data);
         if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : fit_head, options, out);
     }
     if (roi) roi->head.reset();  // only needed here

@@ -127,8 +127,10 @@ struct PreparedImage {
 // field drags the first mask's tissue window off (BrainWeb × a ±40 % field: brain mask Dice 0.904,
 // found again 0.943; docs/BENCHMARKS.md, session 56).
 // `lookup`: load_roi's, so a default that kept no ROI is not looked for again.
+// `no_data`: a scan's no-data voxels (Scan::no_data), set below the corrected image again after N4.
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode,
-                            const std::atomic<bool>* interrupt = nullptr, BrainLookup* lookup = nullptr);
+                            const std::atomic<bool>* interrupt = nullptr, BrainLookup* lookup = nullptr,
+                            const Grid<std::uint8_t>* no_data = nullptr);
 // What fit_seeds_to_roi said and did.
 struct SeedFit {
     std::vector<std::string> warnings;

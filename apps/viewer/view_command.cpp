@@ -123,7 +123,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     const BiasCorrection mode = bias_mode(a.workspace_bias.value_or(a.bias_correct), a.bias_given || a.workspace_bias);
     PreparedImage prepared;
     try {
-        prepared = prepare_image(image, r, mode, nullptr, &lookup);
+        prepared = prepare_image(image, r, mode, nullptr, &lookup, scan.no_data ? &*scan.no_data : nullptr);
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{}: {}", a.image, e.what()));
     }

@@ -69,6 +69,10 @@ protected:
         const float q = std::numeric_limits<float>::infinity();
         std::memcpy(inf.data(), &q, sizeof q);
         metaimage("inf.mha", 3, "4 4 4", "1 1 1", 0, inf);
+        std::string nan(4 * 4 * 4 * 4, '\0');
+        const float n = std::numeric_limits<float>::quiet_NaN();
+        std::memcpy(nan.data(), &n, sizeof n);
+        metaimage("nan.mha", 3, "4 4 4", "1 1 1", 0, nan);
         write_bytes("a_file", "a file, not a folder");
     }
     static void TearDownTestSuite() { fs::remove_all(dir_); }
@@ -179,6 +183,16 @@ TEST_F(HostileInput, GoodInputsWork) {  // the tables below would pass vacuously
 TEST_F(HostileInput, EveryBrokenImageInEverySlot) {
     for (const std::string& slot : kImageSlots)
         for (const BrokenFile& b : kBrokenFiles) expect_refused(fill(slot, b.name, dir_.string()), b.phrase);
+}
+
+// NaN is a scan's "no data" (no_data_cli_test), but damage in a mask or a level set: every slot
+// but the scan's (segment's image, repair's and holes' --image) refuses it.
+TEST_F(HostileInput, NanInAMaskOrALevelSetIsRefused) {
+    for (const std::string& slot : kImageSlots) {
+        if (slot.rfind("segment {}", 0) == 0 || slot.find("--image {}") != std::string::npos) continue;
+        expect_refused(fill(slot, "nan.mha", dir_.string()), "NaN or infinite");
+    }
+    expect_refused(fill(std::string("holes {} --image GOOD"), "nan.mha", dir_.string()), "NaN or infinite");
 }
 
 TEST_F(HostileInput, ImpossibleOutputs) {

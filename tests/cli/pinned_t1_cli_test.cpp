@@ -44,7 +44,8 @@ double spread(const nlohmann::json& c) {  // TissueClass::spread
     const double s = c["sigma"].get<double>();
     if (c["peak_sigma"].is_null() || !(s > 1.3 * c["peak_sigma"].get<double>())) return s;
     const double p = c["peak_sigma"].get<double>();
-    return s - std::min((s / p - 1.3) / 0.5, 1.0) * (s - p);
+    const double t = (s / p - 1.3) / 0.5;
+    return t >= 1.0 ? p : s - t * (s - p);
 }
 
 }  // namespace

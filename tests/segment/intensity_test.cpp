@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "liveset/segment/intensity.hpp"
 
@@ -63,19 +64,26 @@ TEST(NoData, NanVoxelsAreLoweredBelowEveryOtherValue) {
     Grid<float> g = ramp();  // 0..999
     for (PointIndex i : {PointIndex{0}, PointIndex{500}, PointIndex{999}}) g[i] = std::nanf("");
     const Grid<float> before = g;
-    EXPECT_EQ(lower_no_data(g), 3u);
+    const std::optional<Grid<std::uint8_t>> where = lower_no_data(g);
+    ASSERT_TRUE(where.has_value());
     const float below = 1.0f - 0.01f * (998.0f - 1.0f);  // the finite values span 1..998
     for (PointIndex i = 0; i < g.size(); ++i) {
+        EXPECT_EQ((*where)[i], std::isnan(before[i]) ? 1 : 0) << i;
         if (std::isnan(before[i])) EXPECT_EQ(g[i], below) << i;
         else EXPECT_EQ(g[i], before[i]) << i;
     }
     Grid<float> none = ramp();
-    EXPECT_EQ(lower_no_data(none), 0u);
+    EXPECT_FALSE(lower_no_data(none).has_value());
     EXPECT_EQ(none.values()[999], 999.0f);
     Grid<float> flat(Lattice({4, 4, 4}), 5.0f);
     flat[3] = std::nanf("");
-    EXPECT_EQ(lower_no_data(flat), 1u);
+    EXPECT_TRUE(lower_no_data(flat).has_value());
     EXPECT_EQ(flat[3], 4.0f);  // one below a flat image
+    Grid<float> again = g;  // lowered again (after N4 moved them): below the others' range as it is now
+    for (PointIndex i = 0; i < again.size(); ++i) again[i] = (*where)[i] ? 2000.0f : 2.0f * before[i];
+    lower_voxels(again, *where);
+    for (PointIndex i = 0; i < again.size(); ++i)
+        EXPECT_EQ(again[i], (*where)[i] ? 2.0f - 0.01f * (1996.0f - 2.0f) : 2.0f * before[i]) << i;
     Grid<float> all(Lattice({2, 2, 2}), std::nanf(""));
     EXPECT_THROW(lower_no_data(all), std::invalid_argument);
     Grid<float> inf = ramp();

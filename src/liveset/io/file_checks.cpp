@@ -13,7 +13,6 @@
 #include <fstream>
 #include <memory>
 #include <optional>
-#include <stdexcept>
 #include <vector>
 
 namespace liveset::io_detail {
@@ -32,11 +31,12 @@ T load(const unsigned char* p, bool swap) {
     return v;
 }
 
-// Counts the non-finite values of `bytes` (and the NaN among them); flags the NaN in `nan_at`
-// (grown as needed; `first` is the index of the chunk's first value).
+// Counts the non-finite values of `bytes` (and the NaN among them); flags the NaN in `nan_at`,
+// grown only as far as the data read so far (`first` is the index of the chunk's first value), so
+// a header promising more than the file holds allocates nothing for it.
 template <class T>
 void count_non_finite(const unsigned char* p, std::size_t bytes, bool swap, DataCheck& c, std::uint64_t first,
-                      std::vector<std::uint8_t>* nan_at, std::uint64_t values) {
+                      std::vector<std::uint8_t>* nan_at) {
     for (std::size_t i = 0; i + sizeof(T) <= bytes; i += sizeof(T)) {
         const T v = load<T>(p + i, swap);
         if (std::isfinite(v)) continue;
@@ -44,11 +44,9 @@ void count_non_finite(const unsigned char* p, std::size_t bytes, bool swap, Data
         if (!std::isnan(v)) continue;
         ++c.nan;
         if (nan_at == nullptr) continue;
-        if (nan_at->empty()) {
-            if (values > (std::uint64_t{1} << 32)) throw std::runtime_error("too many values to flag the NaN among");  // read_image's limits come first
-            nan_at->assign(values, 0);
-        }
-        (*nan_at)[first + i / sizeof(T)] = 1;
+        const std::uint64_t at = first + i / sizeof(T);
+        if (nan_at->size() <= at) nan_at->resize(static_cast<std::size_t>(first + bytes / sizeof(T)), 0);
+        (*nan_at)[static_cast<std::size_t>(at)] = 1;
     }
 }
 
@@ -135,16 +133,22 @@ bool ends_with(const std::string& s, const char* suffix) {
     return true;
 }
 
-// A two-file image's header and data files, named as niftilib finds them (x.hdr[.gz] with
-// x.img[.gz], either named); false for a single file.
+// A two-file image's header and data files, named as niftilib finds them: x.hdr[.gz] with x.img,
+// else x.img.gz (and the other way round), the partner's extension in the case of the one given
+// (niftilib's nifti_findimgname: X.HDR with X.IMG); false for a single file.
 bool pair_files(const std::string& path, std::string& header, std::string& data) {
     std::error_code ec;
     for (const char* ext : {".hdr.gz", ".hdr", ".img.gz", ".img"}) {
         if (!ends_with(path, ext)) continue;
-        const std::string stem = path.substr(0, path.size() - std::strlen(ext));
-        const bool is_header = ext[1] == 'h';
-        const std::string other = is_header ? ".img" : ".hdr";
-        for (const std::string& candidate : {stem + other + (ends_with(path, ".gz") ? ".gz" : ""), stem + other + (ends_with(path, ".gz") ? "" : ".gz")}) {
+        const std::size_t dot = path.size() - std::strlen(ext);
+        const std::string stem = path.substr(0, dot);
+        const bool is_header = ext[1] == 'h', upper = std::isupper(static_cast<unsigned char>(path[dot + 1])) != 0;
+        std::string other = is_header ? ".img" : ".hdr", gz = ".gz";
+        if (upper) {
+            for (char& ch : other) ch = static_cast<char>(std::toupper(static_cast<unsigned char>(ch)));
+            gz = ".GZ";
+        }
+        for (const std::string& candidate : {stem + other, stem + other + gz}) {
             if (!fs::exists(candidate, ec)) continue;
             header = is_header ? path : candidate;
             data = is_header ? candidate : path;
@@ -218,9 +222,9 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values
             break;
         }
         if (scan_values) {
-            const std::uint64_t size = datatype == 16 ? 4 : 8, values = data_bytes / size;
-            if (datatype == 16) count_non_finite<float>(buf.data(), std::size_t(n), swap, result, have / size, nan_at, values);
-            else count_non_finite<double>(buf.data(), std::size_t(n), swap, result, have / size, nan_at, values);
+            const std::uint64_t size = datatype == 16 ? 4 : 8;
+            if (datatype == 16) count_non_finite<float>(buf.data(), std::size_t(n), swap, result, have / size, nan_at);
+            else count_non_finite<double>(buf.data(), std::size_t(n), swap, result, have / size, nan_at);
         }
         have += static_cast<std::uint64_t>(n);
     }

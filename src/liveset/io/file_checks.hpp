@@ -22,7 +22,8 @@ struct DataCheck {
 // data the header promises is all there; with count_non_finite, NaN and infinite values of
 // float32/float64 data are counted (which means decompressing the file once more).
 // `nan_at` (with count_non_finite): one flag per stored value, 1 where it is NaN, in file order
-// (niftilib reads those as 0); left empty when the data holds no NaN.
+// (niftilib reads those as 0), up to the last chunk holding a NaN (shorter than the data: the rest
+// holds none); left empty when the data holds no NaN.
 DataCheck check_nifti_data(const std::string& path, bool count_non_finite, std::vector<std::uint8_t>* nan_at = nullptr);
 
 // MetaImage (.mha with LOCAL data, .mhd with one data file): the data file holds `raw_bytes`

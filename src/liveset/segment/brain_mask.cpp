@@ -169,11 +169,8 @@ std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
 // `image` with the voxels of `outside` set below all the others (by 1 % of the range), so that
 // the masked outside is read as a skull-stripped image's dark background.
 Grid<float> outside_lowered(const Grid<float>& image, const Mask& outside) {
-    const auto [lo, hi] = std::minmax_element(image.values().begin(), image.values().end());
-    const float below = value_below(*lo, *hi);
     Grid<float> out = image;
-    for (std::size_t i = 0; i < out.size(); ++i)
-        if (outside[static_cast<PointIndex>(i)] != 0) out[static_cast<PointIndex>(i)] = below;
+    lower_voxels(out, outside);
     return out;
 }
 

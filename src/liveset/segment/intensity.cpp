@@ -45,20 +45,29 @@ double IntensityScale::to_raw(double unit) const { return low + unit * (high - l
 
 float value_below(float lo, float hi) { return hi > lo ? lo - 0.01f * (hi - lo) : lo - 1.0f; }
 
-std::uint64_t lower_no_data(Grid<float>& image) {
+void lower_voxels(Grid<float>& image, const Grid<std::uint8_t>& where) {
     float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    std::uint64_t nan = 0, inf = 0;
-    for (float v : image.values()) {
-        nan += std::isnan(v);
-        inf += std::isinf(v);
-        if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    for (PointIndex i = 0; i < image.size(); ++i)
+        if (where[i] == 0) lo = std::min(lo, image[i]), hi = std::max(hi, image[i]);
+    if (lo > hi) return;  // every voxel is to be lowered: no other to lie below
+    const float below = value_below(lo, hi);
+    for (PointIndex i = 0; i < image.size(); ++i)
+        if (where[i] != 0) image[i] = below;
+}
+
+std::optional<Grid<std::uint8_t>> lower_no_data(Grid<float>& image) {
+    std::optional<Grid<std::uint8_t>> nan;
+    std::uint64_t count = 0, inf = 0;
+    for (PointIndex i = 0; i < image.size(); ++i) {
+        inf += std::isinf(image[i]);
+        if (!std::isnan(image[i])) continue;
+        if (!nan) nan.emplace(image.lattice(), 0);
+        (*nan)[i] = 1;
+        ++count;
     }
     if (inf) throw std::invalid_argument("the image has " + std::to_string(inf) + " infinite voxel(s)");
-    if (nan == 0) return 0;
-    if (nan == image.size()) throw std::invalid_argument("every voxel of the image is NaN (no data)");
-    const float below = value_below(lo, hi);
-    for (float& v : image.values())
-        if (std::isnan(v)) v = below;
+    if (count == image.size()) throw std::invalid_argument("every voxel of the image is NaN (no data)");
+    if (nan) lower_voxels(image, *nan);
     return nan;
 }
 

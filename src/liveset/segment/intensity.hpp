@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -41,12 +42,17 @@ Grid<float> normalise(const Grid<float>& image, const IntensityScale& scale);
 // 1 % of the range below lo (1 below when the range is empty).
 float value_below(float lo, float hi);
 
+// The voxels of `where` (non-zero; same dims) set to value_below(the other voxels' range): a masked
+// outside read as a skull-stripped image's dark background. Nothing changes when `where` holds every
+// voxel or none.
+void lower_voxels(Grid<float>& image, const Grid<std::uint8_t>& where);
+
 // A masked image's "no data" (NaN voxels: SPM's masked images, fslmaths -nan, read with
 // NanVoxels::keep) made its lowest values: every NaN voxel set to value_below(the others' range),
 // so the brain mask finds them as a skull-stripped brain's dark outside and no threshold window
-// around a tissue holds them. Returns how many there were. Throws std::invalid_argument when every
-// voxel is NaN or any is infinite.
-std::uint64_t lower_no_data(Grid<float>& image);
+// around a tissue holds them. Returns where they were (none: no NaN). Throws
+// std::invalid_argument when every voxel is NaN or any is infinite.
+std::optional<Grid<std::uint8_t>> lower_no_data(Grid<float>& image);
 
 // A seed: a ball in index coordinates (voxels).
 struct SeedBall {

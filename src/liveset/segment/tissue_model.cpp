@@ -79,11 +79,13 @@ std::vector<Bin> histogram(std::span<const float> values, const TissueModelOptio
     return bins;
 }
 
-// TissueClass::peak_sigma of a class (mean, sigma) on the histogram: smoothed by a Gaussian of
+// TissueClass::peak_sigma of class c of `classes` on the histogram: smoothed by a Gaussian of
 // max(3 bins, 1 % of the range) (it fills the comb an integer image rescaled leaves), the peak is
-// the smoothed maximum within mean ± sigma, each side's half width at half maximum is taken as
-// 1.1774 σ, and the smoothing's σ comes off in quadrature.
-double peak_sigma(const DenseHistogram& h, double mean, double sigma) {
+// the smoothed maximum within mean ± max(sigma, 2 bins) and must lie nearer c's mean than any other
+// class's (a wide class does not take a narrower neighbour's peak), each side's half width at half
+// maximum is taken as 1.1774 σ, and the smoothing's σ comes off in quadrature.
+double peak_sigma(const DenseHistogram& h, const std::vector<TissueClass>& classes, std::size_t c) {
+    const double mean = classes[c].mean, sigma = classes[c].sigma;
     const double inf = std::numeric_limits<double>::infinity();
     const auto n = static_cast<std::ptrdiff_t>(h.counts.size());
     const double s = std::max(3.0, 0.01 * static_cast<double>(n));  // in bins
@@ -102,6 +104,9 @@ double peak_sigma(const DenseHistogram& h, double mean, double sigma) {
     for (std::ptrdiff_t b = from; b <= to; ++b)
         if (d[static_cast<std::size_t>(b)] > d[static_cast<std::size_t>(p)]) p = b;
     if (p == from || p == to) return inf;  // no peak of its own in that range
+    const double x = h.lo + (static_cast<double>(p) + 0.5) * h.width;
+    for (const TissueClass& other : classes)
+        if (std::abs(other.mean - x) < std::abs(mean - x)) return inf;  // another class's peak
     const auto at = [&](std::ptrdiff_t b) { return d[static_cast<std::size_t>(b)]; };
     const double half = 0.5 * at(p);
     std::ptrdiff_t l = p, r = p;
@@ -330,7 +335,7 @@ TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOpt
             m.note = "the partial-volume fit failed (" + why + "): plain mixture used";
     }
     m.degenerate = degeneracy(m);
-    for (TissueClass& c : m.classes) c.peak_sigma = peak_sigma(dense, c.mean, c.sigma);
+    for (std::size_t c = 0; c < m.classes.size(); ++c) m.classes[c].peak_sigma = peak_sigma(dense, m.classes, c);
     return m;
 }
 

@@ -53,7 +53,7 @@ struct TissueClass {
     // The spread the histogram's own peak shows for this class: its wider side's half width at
     // half maximum as a Gaussian σ (the histogram smoothed, that smoothing taken out); infinite
     // when the class has no peak of its own (the smoothed histogram's maximum within mean ± sigma
-    // lies on that range's edge, or a side never falls to half). On a sound fit the two agree to
+    // lies on that range's edge or nearer another class's mean, or a side never falls to half). On a sound fit the two agree to
     // about a quarter (the peak's wider side a little wider: partial volume); a fit much wider than
     // its peak took voxels the peak does not hold: a neighbour pinned to one value (an
     // intensity-normalised T1, FreeSurfer's white matter at 110) leaves its partial-volume voxels to it.
@@ -62,8 +62,8 @@ struct TissueClass {
     // a linear blend between (no jump in α as an image changes a little).
     double spread() const {
         if (!(sigma > 1.3 * peak_sigma)) return sigma;
-        const double t = std::min((sigma / peak_sigma - 1.3) / 0.5, 1.0);
-        return sigma - t * (sigma - peak_sigma);
+        const double t = (sigma / peak_sigma - 1.3) / 0.5;
+        return t >= 1.0 ? peak_sigma : sigma - t * (sigma - peak_sigma);
     }
 };
 
