@@ -119,7 +119,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     cli::SeedFit seed_fit;  // seeds outside the ROI
     {
         pyb::gil_scoped_release nogil;
-        prepared = cli::prepare_image(image, roi, mode, &interrupt.flag(), &lookup, scan.no_data ? &*scan.no_data : nullptr);
+        prepared = cli::prepare_image(image, roi, mode, &interrupt.flag(), &lookup, scan.no_data_mask());
         seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, init ? &*init : nullptr, "roi='none'");
         roi_mask = roi ? &roi->mask : nullptr;
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
@@ -168,7 +168,7 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
     cli::PreparedImage prepared;
     {
         pyb::gil_scoped_release nogil;
-        prepared = cli::prepare_image(image, roi, bias_mode(bias_correct), nullptr, &lookup, scan.no_data ? &*scan.no_data : nullptr);
+        prepared = cli::prepare_image(image, roi, bias_mode(bias_correct), nullptr, &lookup, scan.no_data_mask());
     }
     const Grid<std::uint8_t>* r = roi ? &roi->mask : nullptr;
     nlohmann::json j = nlohmann::json::object();
@@ -195,7 +195,7 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
     cli::BrainLookup lookup = lookup_for(a.oriented);
     std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
     pyb::gil_scoped_release nogil;
-    cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct), nullptr, &lookup, scan.no_data ? &*scan.no_data : nullptr);  // as segment
+    cli::PreparedImage prepared = cli::prepare_image(image, roi, bias_mode(a.bias_correct), nullptr, &lookup, scan.no_data_mask());  // as segment
     const cli::SeedFit seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, nullptr, "roi='none'");
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);

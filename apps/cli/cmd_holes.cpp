@@ -64,7 +64,7 @@ int run_holes(const HolesArgs& a, int threads) {
     } catch (const std::invalid_argument& e) {
         throw UsageError(e.what());
     }
-    if (scan.no_data_voxels) fmt::print(stderr, "liveset: note: {}\n", scan.note(a.image));  // the inputs are good
+    scan.print_note(a.image);  // the inputs are good
     const std::vector<HoleCandidate> holes = find_holes(mask, image, r, fo);
     if (!a.out_mask.empty()) write_label_image(hole_voxels(mask, image, r, fo), a.out_mask, {.orientation_known = header.orientation_known});
     std::size_t total = 0;

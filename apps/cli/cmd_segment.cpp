@@ -109,7 +109,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.
     const BiasCorrection mode = bias_mode(a.bias_correct, a.bias_given || !a.out_corrected.empty());
-    PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag(), &lookup, scan.no_data ? &*scan.no_data : nullptr);
+    PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag(), &lookup, scan.no_data_mask());
     if (prepared.bias && prepared.bias->interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
         return 130;
@@ -123,7 +123,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
 
     add_regions(req, roi, init, fit, prepared.fit_is_brain(roi));
-    if (!a.quiet && scan.no_data_voxels) fmt::print(stderr, "liveset: note: {}\n", scan.note(a.image));  // the inputs are good
+    if (!a.quiet) scan.print_note(a.image);  // the inputs are good
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} iterations; nothing written\n", run.outcome.result.iterations);

@@ -42,6 +42,10 @@ std::string Scan::note(const std::string& path) const {
                        no_data_voxels, path, 100.0 * static_cast<double>(no_data_voxels) / static_cast<double>(image.size()));
 }
 
+void Scan::print_note(const std::string& path) const {
+    if (no_data_voxels) fmt::print(stderr, "liveset: note: {}\n", note(path));
+}
+
 Grid<float> Scan::restored(const Grid<float>& values) const {
     Grid<float> out = values;
     if (no_data)

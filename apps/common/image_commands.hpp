@@ -32,6 +32,8 @@ struct Scan {
     std::uint64_t no_data_voxels = 0;
     // "N voxels of "<path>" are NaN (no data): ..." — what a command tells the user; empty without NaN.
     std::string note(const std::string& path) const;
+    void print_note(const std::string& path) const;  // note() on stderr as "liveset: note: ...", if any
+    const Grid<std::uint8_t>* no_data_mask() const { return no_data ? &*no_data : nullptr; }  // prepare_image's
     // `image` (the scan, or its corrected image) with NaN back where the scan had it: what is written out.
     Grid<float> restored(const Grid<float>& image) const;
 };

@@ -105,7 +105,7 @@ void fit_start_seeds(ViewArgs& a, const Lattice& lattice, std::optional<Roi>& ro
 
 std::unique_ptr<Session> load_session(ViewArgs& a) {
     Scan scan = read_scan(a.image);
-    if (scan.no_data_voxels) fmt::print(stderr, "liveset: note: {}\n", scan.note(a.image));
+    scan.print_note(a.image);
     Grid<float>& image = scan.image;
     const ImageHeader& header = scan.header;
     a.image_oriented = header.orientation_known;
@@ -123,7 +123,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     const BiasCorrection mode = bias_mode(a.workspace_bias.value_or(a.bias_correct), a.bias_given || a.workspace_bias);
     PreparedImage prepared;
     try {
-        prepared = prepare_image(image, r, mode, nullptr, &lookup, scan.no_data ? &*scan.no_data : nullptr);
+        prepared = prepare_image(image, r, mode, nullptr, &lookup, scan.no_data_mask());
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{}: {}", a.image, e.what()));
     }

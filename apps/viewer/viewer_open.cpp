@@ -58,7 +58,7 @@ bool Viewer::open_image(const std::string& path) {
             lookup.options = cli::brain_mask_options(header);
             std::optional<cli::Roi> roi = cli::load_roi(roi_arg, image, "--roi", &lookup);  // as `view IMAGE [--roi none]` (view_command.cpp)
             if (cancel->load()) return out;
-            cli::PreparedImage prepared = cli::prepare_image(image, roi, mode, cancel.get(), &lookup, scan.no_data ? &*scan.no_data : nullptr);
+            cli::PreparedImage prepared = cli::prepare_image(image, roi, mode, cancel.get(), &lookup, scan.no_data_mask());
             if (cancel->load()) return out;
             out->corrected = prepared.bias.has_value();
             out->bias_skipped = prepared.bias_skipped;

@@ -79,35 +79,46 @@ std::vector<Bin> histogram(std::span<const float> values, const TissueModelOptio
     return bins;
 }
 
-// TissueClass::peak_sigma of class c of `classes` on the histogram: smoothed by a Gaussian of
-// max(3 bins, 1 % of the range) (it fills the comb an integer image rescaled leaves), the peak is
-// the smoothed maximum within mean ± max(sigma, 2 bins) and must lie nearer c's mean than any other
-// class's (a wide class does not take a narrower neighbour's peak), each side's half width at half
-// maximum is taken as 1.1774 σ, and the smoothing's σ comes off in quadrature.
-double peak_sigma(const DenseHistogram& h, const std::vector<TissueClass>& classes, std::size_t c) {
-    const double mean = classes[c].mean, sigma = classes[c].sigma;
-    const double inf = std::numeric_limits<double>::infinity();
+// The histogram smoothed by a Gaussian of max(3 bins, 1 % of the range) (it fills the comb an
+// integer image rescaled leaves): what peak_sigma reads, once for all classes.
+struct SmoothedHistogram {
+    std::vector<double> d;
+    double lo = 0.0, width = 1.0, sigma_bins = 3.0;
+};
+
+SmoothedHistogram smoothed(const DenseHistogram& h) {
     const auto n = static_cast<std::ptrdiff_t>(h.counts.size());
     const double s = std::max(3.0, 0.01 * static_cast<double>(n));  // in bins
     const auto reach = static_cast<std::ptrdiff_t>(std::ceil(4.0 * s));
     std::vector<double> kernel(static_cast<std::size_t>(2 * reach + 1));
     for (std::ptrdiff_t k = -reach; k <= reach; ++k) kernel[static_cast<std::size_t>(k + reach)] = std::exp(-0.5 * (k / s) * (k / s));
-    std::vector<double> d(h.counts.size(), 0.0);
+    SmoothedHistogram out{std::vector<double>(h.counts.size(), 0.0), h.lo, h.width, s};
     for (std::ptrdiff_t b = 0; b < n; ++b)
         for (std::ptrdiff_t k = -reach; k <= reach; ++k)
-            if (b + k >= 0 && b + k < n) d[static_cast<std::size_t>(b)] += kernel[static_cast<std::size_t>(k + reach)] * h.counts[static_cast<std::size_t>(b + k)];
+            if (b + k >= 0 && b + k < n) out.d[static_cast<std::size_t>(b)] += kernel[static_cast<std::size_t>(k + reach)] * h.counts[static_cast<std::size_t>(b + k)];
+    return out;
+}
+
+// TissueClass::peak_sigma of class c of `classes` on the smoothed histogram: the peak is the
+// maximum within mean ± max(sigma, 2 bins) and must lie nearer c's mean than any other class's (a
+// wide class does not take a narrower neighbour's peak), each side's half width at half maximum is
+// taken as 1.1774 σ, and the smoothing's σ comes off in quadrature.
+double peak_sigma(const SmoothedHistogram& h, const std::vector<TissueClass>& classes, std::size_t c) {
+    const double mean = classes[c].mean, sigma = classes[c].sigma;
+    const double inf = std::numeric_limits<double>::infinity();
+    const auto n = static_cast<std::ptrdiff_t>(h.d.size());
+    const auto at = [&](std::ptrdiff_t b) { return h.d[static_cast<std::size_t>(b)]; };
     const auto bin_of = [&](double x) { return static_cast<std::ptrdiff_t>(std::floor((x - h.lo) / h.width)); };
     const std::ptrdiff_t from = std::max<std::ptrdiff_t>(0, bin_of(mean - std::max(sigma, 2 * h.width)));
     const std::ptrdiff_t to = std::min<std::ptrdiff_t>(n - 1, bin_of(mean + std::max(sigma, 2 * h.width)));
     if (from >= to) return inf;
     std::ptrdiff_t p = from;
     for (std::ptrdiff_t b = from; b <= to; ++b)
-        if (d[static_cast<std::size_t>(b)] > d[static_cast<std::size_t>(p)]) p = b;
+        if (at(b) > at(p)) p = b;
     if (p == from || p == to) return inf;  // no peak of its own in that range
     const double x = h.lo + (static_cast<double>(p) + 0.5) * h.width;
     for (const TissueClass& other : classes)
         if (std::abs(other.mean - x) < std::abs(mean - x)) return inf;  // another class's peak
-    const auto at = [&](std::ptrdiff_t b) { return d[static_cast<std::size_t>(b)]; };
     const double half = 0.5 * at(p);
     std::ptrdiff_t l = p, r = p;
     while (l > 0 && at(l) > half) --l;
@@ -120,7 +131,7 @@ double peak_sigma(const DenseHistogram& h, const std::vector<TissueClass>& class
     const double left = static_cast<double>(l) + (half - at(l)) / (at(l + 1) - at(l));
     const double right = static_cast<double>(r) - (half - at(r)) / (at(r - 1) - at(r));
     const double hw = std::max(peak - left, right - peak) * h.width;  // the wider side
-    const double g = hw / std::sqrt(2.0 * std::log(2.0)), smoothing = s * h.width;
+    const double g = hw / std::sqrt(2.0 * std::log(2.0)), smoothing = h.sigma_bins * h.width;
     return std::sqrt(std::max(g * g - smoothing * smoothing, h.width * h.width));
 }
 
@@ -335,7 +346,8 @@ TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOpt
             m.note = "the partial-volume fit failed (" + why + "): plain mixture used";
     }
     m.degenerate = degeneracy(m);
-    for (std::size_t c = 0; c < m.classes.size(); ++c) m.classes[c].peak_sigma = peak_sigma(dense, m.classes, c);
+    const SmoothedHistogram smooth = smoothed(dense);
+    for (std::size_t c = 0; c < m.classes.size(); ++c) m.classes[c].peak_sigma = peak_sigma(smooth, m.classes, c);
     return m;
 }
 
