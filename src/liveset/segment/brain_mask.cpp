@@ -266,6 +266,21 @@ void white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<fl
     while (j < kBins - 1 && s[static_cast<std::size_t>(j)] > 0.5 * s[static_cast<std::size_t>(peak)]) ++j;
     r.wm_peak = h.centre(peak);
     r.wm_sigma = std::max(h.width, (h.centre(j) - r.wm_peak) / 1.1774);
+    int i = peak;
+    while (i > 0 && s[static_cast<std::size_t>(i)] > 0.5 * s[static_cast<std::size_t>(peak)]) --i;
+    r.wm_low_sigma = std::max(h.width, (r.wm_peak - h.centre(i)) / 1.1774);
+    // Which side of white matter grey matter and CSF lie on (grey_brighter): the deep voxels above the background.
+    const std::optional<float> q10 = quantile_above(image, &deep, r.background_threshold, 0.1);
+    if (!q10) return;
+    const double q50 = *quantile_above(image, &deep, r.background_threshold, 0.5);
+    const double q90 = *quantile_above(image, &deep, r.background_threshold, 0.9), narrow = std::min(r.wm_sigma, r.wm_low_sigma);
+    r.deep_skew = q90 > *q10 ? (q90 + *q10 - 2.0 * q50) / (q90 - *q10) : 0.0;
+    double n = 0, above = 0, below = 0;
+    for (std::size_t k = 0; k < deep.size(); ++k)
+        if (const double x = image[static_cast<PointIndex>(k)]; deep[static_cast<PointIndex>(k)] != 0 && x > r.background_threshold)
+            n += 1, above += x > r.wm_peak + 3 * narrow, below += x < r.wm_peak - 3 * narrow;
+    r.deep_above = above / n;
+    r.deep_below = below / n;
 }
 
 // The brain boundary's share that lies within `near_mm` of the head surface (boundary: mask voxels
@@ -428,6 +443,43 @@ double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
     return 2.0 * std::sqrt(widest / std::numbers::pi);
 }
 
+// Grey matter brighter than white (a T2, a PD): the deep head skewed bright, at least a quarter of
+// it 3 σ above the white-matter peak and over 4 times as much as 3 σ below, and that peak 3 σ clear of
+// the background threshold (not the air's noise cut off there). What each part keeps out (a child's
+// neck, noisy heads, the phantom's bias, a noisy field of view) and the measured margins: docs/ARCHITECTURE.md.
+bool grey_brighter(const BrainMaskReport& r) {
+    return r.deep_skew > 0.0 && r.deep_above >= 0.25 && r.deep_above > 4.0 * r.deep_below &&
+           r.wm_peak - 3.0 * r.wm_low_sigma > r.background_threshold;
+}
+
+// The brain-tissue window (grey and white matter) and the brain it gives. A T1: from the cut between
+// CSF/skin and GM/muscle (three-class Otsu from the background up to white matter) to 4 σ above the
+// white-matter peak. Grey matter brighter (a T2): mirrored, from 3 σ below the white-matter peak (its
+// darker side's width: muscle lies there) to 4 σ above grey matter's peak (the head's tallest above
+// 3 σ over white matter; σ from its brighter side), short of fat and CSF.
+Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o,
+                       bool grey_brighter, BrainMaskReport& r) {
+    r.grey_brighter = grey_brighter;
+    if (!grey_brighter) {
+        const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
+        r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;
+        r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
+    } else {
+        const std::optional<float> top = quantile_above(image, &head, r.background_threshold, 0.995);
+        const double lo = r.wm_peak + 3 * r.wm_sigma;
+        if (!top || !(*top > lo)) return Mask(image.lattice());
+        const Histogram h = histogram(image, head, lo, *top);
+        const std::vector<double> s = smoothed(h.counts, 2.0);
+        const int peak = static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin());
+        int j = peak;
+        while (j < kBins - 1 && s[static_cast<std::size_t>(j)] > 0.5 * s[static_cast<std::size_t>(peak)]) ++j;
+        const double gm_sigma = std::max(h.width, (h.centre(j) - h.centre(peak)) / 1.1774);
+        r.tissue_low = std::max(r.background_threshold, r.wm_peak - 3 * r.wm_low_sigma);
+        r.tissue_high = h.centre(peak) + 4 * gm_sigma;
+    }
+    return extract_brain(image, smooth, head, o, r);
+}
+
 // The brain in the head within `extent_mm` of its top (0: all of it): the tissue window, the
 // extraction, the skull-stripped test, `r` filled in. An empty mask when none is found (under
 // min_head_share of that head, not skull-stripped).
@@ -437,10 +489,7 @@ Mask brain_within(const Grid<float>& image, const Grid<float>& smooth, const Mas
     r.brain_extent_mm = extent_mm;
     r.head_voxels = count(head);
     white_matter_peak(image, head, depth, r);
-    const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
-    r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;  // CSF/skin | GM/muscle cut
-    r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
-    Mask brain = extract_brain(image, smooth, head, o, r);
+    Mask brain = brain_of_contrast(image, smooth, head, o, grey_brighter(r), r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
     r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
     if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);

@@ -88,6 +88,13 @@ struct BrainMaskReport {
     double head_threshold = 0;        // head threshold: background, raised above the air's noise
     double wm_peak = 0;               // white-matter peak of the deep head's histogram
     double wm_sigma = 0;              // its width (upper half-width at half maximum / 1.1774)
+    double wm_low_sigma = 0;          // the same on its lower side
+    // The deep head's voxels above the background: their quantile skew (q90 + q10 − 2·q50)/(q90 − q10),
+    // negative where grey matter and CSF lie below white matter (a T1), positive above (a T2, a PD),
+    // and their shares over and under the white-matter peak by 3 σ (its narrower side's).
+    double deep_skew = 0;
+    double deep_above = 0, deep_below = 0;
+    bool grey_brighter = false;       // the tissue window was mirrored for grey matter brighter than white
     double tissue_low = 0;            // brain-tissue window (image units)
     double tissue_high = 0;
     std::size_t head_voxels = 0;      // solid head (filled, closed foreground) within brain_extent_mm of its top

@@ -78,6 +78,9 @@ struct TissueModel {
     // when it is sound.
     std::string degenerate;
     std::string note;  // e.g. the partial-volume fit failed and the plain mixture is used
+    // Where the EM started: "otsu" (multi-level Otsu's classes) or "peaks" (the histogram's most
+    // prominent peaks; fit_tissue_model keeps that fit where it is clearly the more likely).
+    std::string start = "otsu";
     // σ (mm) of the Gaussian blur (smoothing.hpp) of the image the model was fitted on: 0 for the
     // image itself (fit_window_model, window.hpp, may fit the blurred image when noise hides a class).
     double smooth_mm = 0.0;
