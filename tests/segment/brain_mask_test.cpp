@@ -201,6 +201,21 @@ TEST(BrainMask, ADefacedHeadIsAFullHead) {
     EXPECT_GT(r.surface_contact, 0.05);  // the cut does reach the brain
 }
 
+namespace {
+
+// BrainWeb's labels in another contrast: each label's value, blurred by 0.7 mm, Gaussian noise σ 4 as magnitude.
+Grid<float> labels_as(const Mask& labels, const float (&value)[10]) {
+    Grid<float> image(labels.lattice());
+    for (PointIndex i = 0; i < image.size(); ++i) image[i] = value[std::min<int>(labels[i], 9)];
+    image = gaussian_smooth(image, 0.7);
+    std::mt19937 rng(7);
+    std::normal_distribution<float> noise(0.0f, 4.0f);
+    for (float& v : image.values()) v = std::abs(v + noise(rng));
+    return image;
+}
+
+}  // namespace
+
 // BrainWeb's labels in T2 contrast (docs/BENCHMARKS.md, session 63: CSF 250, GM 110, WM 75, fat
 // 150, muscle 45, skin 80, skull 8, glial matter 140, connective tissue 100; blurred by 0.7 mm,
 // Gaussian noise σ 4 as magnitude). Grey matter and CSF lie above white matter: the deep head's skew
@@ -210,13 +225,7 @@ TEST(BrainMask, ADefacedHeadIsAFullHead) {
 // window then spanned both: GM Dice 0.58).
 TEST(BrainMask, AT2HeadIsMaskedWithTheWindowMirrored) {
     const BrainWeb& bw = brainweb();
-    constexpr float kT2[10] = {0, 250, 110, 75, 150, 45, 80, 8, 140, 100};
-    Grid<float> t2(bw.labels.lattice());
-    for (PointIndex i = 0; i < t2.size(); ++i) t2[i] = kT2[std::min<int>(bw.labels[i], 9)];
-    t2 = gaussian_smooth(t2, 0.7);
-    std::mt19937 rng(7);
-    std::normal_distribution<float> noise(0.0f, 4.0f);
-    for (float& v : t2.values()) v = std::abs(v + noise(rng));
+    const Grid<float> t2 = labels_as(bw.labels, {0, 250, 110, 75, 150, 45, 80, 8, 140, 100});
     BrainMaskReport r;
     const Mask mask = auto_brain_mask(t2, {}, &r);
     const TruthCheck c = check_against_truth(mask, bw.labels, t2);
@@ -232,10 +241,33 @@ TEST(BrainMask, AT2HeadIsMaskedWithTheWindowMirrored) {
     const TissueModel m = fit_tissue_model(t2, &bw.brain_mask);
     ASSERT_TRUE(m.usable()) << m.degenerate;
     ASSERT_EQ(m.classes.size(), 3u);
-    std::printf("t2 model: %.1f / %.1f / %.1f\n", m.classes[0].mean, m.classes[1].mean, m.classes[2].mean);
+    std::printf("t2 model: %.1f / %.1f / %.1f (%s start)\n", m.classes[0].mean, m.classes[1].mean, m.classes[2].mean, m.start.c_str());
+    EXPECT_EQ(m.start, "peaks");
     EXPECT_LT(m.classes[0].mean, 0.5 * (75.0 + 110.0));
     EXPECT_NEAR(m.classes[1].mean, 110.0, 5.0);
     EXPECT_GT(m.classes[2].mean, 200.0);
+    const TissueModel t1 = fit_tissue_model(bw.t1, &bw.brain_mask);  // a T1's fit keeps Otsu's start
+    EXPECT_EQ(t1.start, "otsu");
+}
+
+// The same labels in PD contrast (CSF 200, GM 170, WM 140, fat 170, muscle 100, skin 120, skull 25,
+// glial matter 170, connective tissue 120): grey matter between white matter and CSF, 30 apart, keeps
+// the deep skew small (+0.055); the shares above the white-matter peak decide (54 % above, 4 % below).
+// With the T1 window the mask took most of the head (GM Dice 0.57 by default; 0.81 mirrored).
+TEST(BrainMask, APdHeadIsMaskedWithTheWindowMirrored) {
+    const BrainWeb& bw = brainweb();
+    const Grid<float> pd = labels_as(bw.labels, {0, 200, 170, 140, 170, 100, 120, 25, 170, 120});
+    BrainMaskReport r;
+    const Mask mask = auto_brain_mask(pd, {}, &r);
+    const TruthCheck c = check_against_truth(mask, bw.labels, pd);
+    std::printf("pd: deep skew %.3f (above %.3f, below %.3f), window %.1f..%.1f, dice %.4f, GM in %.4f, WM in %.4f, extracranial in %.4f\n",
+                r.deep_skew, r.deep_above, r.deep_below, r.tissue_low, r.tissue_high, c.dice, c.gm, c.wm, c.extracranial);
+    EXPECT_TRUE(r.grey_brighter);
+    EXPECT_FALSE(r.skull_stripped);
+    EXPECT_GE(c.dice, 0.93);
+    EXPECT_GE(c.gm, 0.97);
+    EXPECT_GE(c.wm, 0.99);
+    EXPECT_LE(c.extracranial, 0.07);  // 5.1 %: its scalp fat is as bright as grey matter
 }
 
 TEST(BrainMask, BrainWebSkullStrippedPassesThrough) {
@@ -517,6 +549,7 @@ TEST(BrainMask, AChildsHeadWithANeckIsLookedForWithinItsOwnSize) {
     const Mask a = auto_brain_mask(adult, {}, &ra);
     EXPECT_DOUBLE_EQ(ra.brain_extent_mm, 170.0);
     const Mask c = auto_brain_mask(child, {}, &rc);
+    EXPECT_FALSE(rc.grey_brighter) << rc.deep_skew;  // a T1 (its first look, into the neck, is kept out by its skew)
     std::printf("child: head %.0f mm (adult %.0f), extent %.0f mm\n", rc.head_diameter_mm, ra.head_diameter_mm, rc.brain_extent_mm);
     EXPECT_NEAR(rc.head_diameter_mm, 0.7 * ra.head_diameter_mm, 0.05 * ra.head_diameter_mm);
     EXPECT_LT(rc.brain_extent_mm, 140.0);

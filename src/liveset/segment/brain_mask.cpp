@@ -452,31 +452,31 @@ bool grey_brighter(const BrainMaskReport& r) {
            r.wm_peak - 3.0 * r.wm_low_sigma > r.background_threshold;
 }
 
-// The brain-tissue window (grey and white matter) and the brain it gives. A T1: from the cut between
-// CSF/skin and GM/muscle (three-class Otsu from the background up to white matter) to 4 σ above the
-// white-matter peak. Grey matter brighter (a T2): mirrored, from 3 σ below the white-matter peak (its
-// darker side's width: muscle lies there) to 4 σ above grey matter's peak (the head's tallest above
-// 3 σ over white matter; σ from its brighter side), short of fat and CSF.
+// The brain-tissue window and the brain it gives. A T1: from the CSF/skin | GM/muscle cut (3-class Otsu
+// up to white matter) to 4 σ above the white-matter peak. `mirrored` (a T2, a PD): from 3 σ below that
+// peak (its darker side's σ: muscle lies there) to 4 σ above grey matter's (the head's tallest above WM
+// + 3 σ, standing inside that range, else the T1 window), short of fat and CSF.
 Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o,
-                       bool grey_brighter, BrainMaskReport& r) {
-    r.grey_brighter = grey_brighter;
-    if (!grey_brighter) {
-        const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
-        r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;
-        r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
-    } else {
+                       bool mirrored, BrainMaskReport& r) {
+    r.grey_brighter = false;
+    if (mirrored) {
         const std::optional<float> top = quantile_above(image, &head, r.background_threshold, 0.995);
         const double lo = r.wm_peak + 3 * r.wm_sigma;
-        if (!top || !(*top > lo)) return Mask(image.lattice());
-        const Histogram h = histogram(image, head, lo, *top);
+        const Histogram h = histogram(image, head, lo, top && *top > lo ? *top : lo + 1.0);
         const std::vector<double> s = smoothed(h.counts, 2.0);
         const int peak = static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin());
         int j = peak;
         while (j < kBins - 1 && s[static_cast<std::size_t>(j)] > 0.5 * s[static_cast<std::size_t>(peak)]) ++j;
-        const double gm_sigma = std::max(h.width, (h.centre(j) - h.centre(peak)) / 1.1774);
-        r.tissue_low = std::max(r.background_threshold, r.wm_peak - 3 * r.wm_low_sigma);
-        r.tissue_high = h.centre(peak) + 4 * gm_sigma;
+        if (top && *top > lo && peak > 0 && j < kBins - 1) {
+            r.grey_brighter = true;
+            r.tissue_low = std::max(r.background_threshold, r.wm_peak - 3 * r.wm_low_sigma);
+            r.tissue_high = h.centre(peak) + 4 * std::max(h.width, (h.centre(j) - h.centre(peak)) / 1.1774);
+            return extract_brain(image, smooth, head, o, r);
+        }
     }
+    const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
+    r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;
+    r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
     return extract_brain(image, smooth, head, o, r);
 }
 

@@ -18,8 +18,8 @@ namespace liveset {
 
 namespace {
 
-constexpr int kMixSteps = 16;
-constexpr double kClearlyMoreLikely = 1e-3;  // nats per voxel (fit_tissue_model's two starts)  // fractions f = (t + ½)/16 sample the partial-volume classes
+constexpr int kMixSteps = 16;  // fractions f = (t + ½)/16 sample the partial-volume classes
+constexpr double kClearlyMoreLikely = 1e-3;  // nats per voxel (fit_tissue_model's two starts)
 
 // One histogram bin: count, and the mean and variance of the values that fell into it.
 struct Bin {
@@ -419,7 +419,7 @@ TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOpt
         // smoothing: a spike is a value an intensity normalisation pinned (FreeSurfer's white matter
         // at 110), whose likelihood would outweigh every tissue's (BrainWeb so pinned with Rician
         // noise σ 9: a class of σ 0.9 at the pin, the seeds' class CSF, GM Dice 0.92 → 0.78).
-        bool peaked = degeneracy(other).empty();
+        bool peaked = degeneracy(other).empty() && other.note.empty();  // its partial-volume fit sound too
         for (std::size_t c = 0; peaked && c < other.classes.size(); ++c)
             peaked = other.classes[c].sigma >= smooth.sigma_bins * smooth.width && std::isfinite(peak_sigma(smooth, other.classes, c));
         if (peaked && (!degeneracy(m).empty() || other.log_likelihood > m.log_likelihood + kClearlyMoreLikely)) {

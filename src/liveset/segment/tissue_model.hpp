@@ -7,8 +7,11 @@
 // whose voxels hold a fraction f ~ U(0, 1) of tissue k+1: N((1−f)µ_k + fµ_{k+1}, (1−f)σ_k² + fσ_{k+1}²)
 // (Santago & Gage 1993; FSL FAST's partial-volume model). Without the mixed classes, voxels on
 // tissue borders widen and shift the pure classes, and a plain Gaussian mixture's decision
-// boundaries drift toward the narrower class. Initialised by multi-level Otsu thresholds, fitted
-// by EM on a histogram (the mixed classes' shapes follow the pure classes' parameters).
+// boundaries drift toward the narrower class. Fitted by EM on a histogram (the mixed classes' shapes
+// follow the pure classes' parameters) from two starts: multi-level Otsu thresholds (a plain
+// mixture first, then the mixed classes) and the histogram's most prominent peaks (the mixed
+// classes at once); the peak start's fit is kept where it is sound, each class a peak of its own and
+// no spike, and it is more likely by over 0.001 nats per voxel or Otsu's fit is not sound.
 //
 // Window rule. The seeds pick their class (the pure class most of their voxels are most probably
 // in). The window reaches from the midpoint with the darker neighbour to the midpoint with the
@@ -79,7 +82,7 @@ struct TissueModel {
     std::string degenerate;
     std::string note;  // e.g. the partial-volume fit failed and the plain mixture is used
     // Where the EM started: "otsu" (multi-level Otsu's classes) or "peaks" (the histogram's most
-    // prominent peaks; fit_tissue_model keeps that fit where it is clearly the more likely).
+    // prominent peaks; see above). `iterations` counts Otsu's plain and mixed runs, the peaks' mixed run.
     std::string start = "otsu";
     // σ (mm) of the Gaussian blur (smoothing.hpp) of the image the model was fitted on: 0 for the
     // image itself (fit_window_model, window.hpp, may fit the blurred image when noise hides a class).
