@@ -214,6 +214,17 @@ Grid<float> labels_as(const Mask& labels, const float (&value)[10]) {
     return image;
 }
 
+// The automatic mask of BrainWeb's labels as `value`, checked against the labels and printed.
+TruthCheck contrast_mask(const char* name, const float (&value)[10], BrainMaskReport& r, Grid<float>* image = nullptr) {
+    const BrainWeb& bw = brainweb();
+    const Grid<float> im = labels_as(bw.labels, value);
+    const TruthCheck c = check_against_truth(auto_brain_mask(im, {}, &r), bw.labels, im);
+    std::printf("%s: deep skew %.3f (above %.3f, below %.3f), window %.1f..%.1f, dice %.4f, GM in %.4f, WM in %.4f, extracranial in %.4f\n",
+                name, r.deep_skew, r.deep_above, r.deep_below, r.tissue_low, r.tissue_high, c.dice, c.gm, c.wm, c.extracranial);
+    if (image) *image = im;
+    return c;
+}
+
 }  // namespace
 
 // BrainWeb's labels in T2 contrast (docs/BENCHMARKS.md, session 63: CSF 250, GM 110, WM 75, fat
@@ -225,12 +236,9 @@ Grid<float> labels_as(const Mask& labels, const float (&value)[10]) {
 // window then spanned both: GM Dice 0.58).
 TEST(BrainMask, AT2HeadIsMaskedWithTheWindowMirrored) {
     const BrainWeb& bw = brainweb();
-    const Grid<float> t2 = labels_as(bw.labels, {0, 250, 110, 75, 150, 45, 80, 8, 140, 100});
     BrainMaskReport r;
-    const Mask mask = auto_brain_mask(t2, {}, &r);
-    const TruthCheck c = check_against_truth(mask, bw.labels, t2);
-    std::printf("t2: deep skew %.3f, window %.1f..%.1f, dice %.4f, GM in %.4f, WM in %.4f, extracranial in %.4f\n", r.deep_skew,
-                r.tissue_low, r.tissue_high, c.dice, c.gm, c.wm, c.extracranial);
+    Grid<float> t2;
+    const TruthCheck c = contrast_mask("t2", {0, 250, 110, 75, 150, 45, 80, 8, 140, 100}, r, &t2);
     EXPECT_TRUE(r.grey_brighter);
     EXPECT_GT(r.deep_skew, 0.4);
     EXPECT_FALSE(r.skull_stripped);
@@ -255,13 +263,8 @@ TEST(BrainMask, AT2HeadIsMaskedWithTheWindowMirrored) {
 // the deep skew small (+0.055); the shares above the white-matter peak decide (54 % above, 4 % below).
 // With the T1 window the mask took most of the head (GM Dice 0.57 by default; 0.81 mirrored).
 TEST(BrainMask, APdHeadIsMaskedWithTheWindowMirrored) {
-    const BrainWeb& bw = brainweb();
-    const Grid<float> pd = labels_as(bw.labels, {0, 200, 170, 140, 170, 100, 120, 25, 170, 120});
     BrainMaskReport r;
-    const Mask mask = auto_brain_mask(pd, {}, &r);
-    const TruthCheck c = check_against_truth(mask, bw.labels, pd);
-    std::printf("pd: deep skew %.3f (above %.3f, below %.3f), window %.1f..%.1f, dice %.4f, GM in %.4f, WM in %.4f, extracranial in %.4f\n",
-                r.deep_skew, r.deep_above, r.deep_below, r.tissue_low, r.tissue_high, c.dice, c.gm, c.wm, c.extracranial);
+    const TruthCheck c = contrast_mask("pd", {0, 200, 170, 140, 170, 100, 120, 25, 170, 120}, r);
     EXPECT_TRUE(r.grey_brighter);
     EXPECT_FALSE(r.skull_stripped);
     EXPECT_GE(c.dice, 0.93);

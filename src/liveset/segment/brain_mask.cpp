@@ -247,31 +247,36 @@ Mask head_foreground(const Grid<float>& image, double threshold) {
     return f;
 }
 
-// White-matter peak and width from the deepest half of the head (T1: mostly white matter).
-void white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r) {
+// The tallest bin of a smoothed histogram and the bins, on either side, where it first falls to half.
+struct Peak { int bin = 0, low = 0, high = 0; };
+Peak tallest(const std::vector<double>& s) {
+    Peak p{static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin())};
+    const double half = 0.5 * s[static_cast<std::size_t>(p.bin)];
+    for (p.high = p.bin; p.high < kBins - 1 && s[static_cast<std::size_t>(p.high)] > half;) ++p.high;
+    for (p.low = p.bin; p.low > 0 && s[static_cast<std::size_t>(p.low)] > half;) --p.low;
+    return p;
+}
+
+// White-matter peak and widths from the deepest half of the head (T1: mostly white matter); returns
+// the head's 99.5th percentile above the background (the histograms' top).
+double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r) {
     float deepest = 0;
     for (std::size_t i = 0; i < head.size(); ++i)
         if (head[static_cast<PointIndex>(i)] != 0) deepest = std::max(deepest, depth[static_cast<PointIndex>(i)]);
     Mask deep(head.lattice());
     for (std::size_t i = 0; i < head.size(); ++i)
         deep[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && depth[static_cast<PointIndex>(i)] >= 0.5f * deepest;
-    const std::optional<float> in_head_top = quantile_above(image, &head, r.background_threshold, 0.995);
-    if (!in_head_top) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
-    const double top = *in_head_top;
-    if (!(top > r.background_threshold)) throw std::invalid_argument("brain mask: no brain tissue found (the head has no contrast)");
-    const Histogram h = histogram(image, deep, r.background_threshold, top);
-    const std::vector<double> s = smoothed(h.counts, 2.0);
-    const int peak = static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin());
-    int j = peak;
-    while (j < kBins - 1 && s[static_cast<std::size_t>(j)] > 0.5 * s[static_cast<std::size_t>(peak)]) ++j;
-    r.wm_peak = h.centre(peak);
-    r.wm_sigma = std::max(h.width, (h.centre(j) - r.wm_peak) / 1.1774);
-    int i = peak;
-    while (i > 0 && s[static_cast<std::size_t>(i)] > 0.5 * s[static_cast<std::size_t>(peak)]) --i;
-    r.wm_low_sigma = std::max(h.width, (r.wm_peak - h.centre(i)) / 1.1774);
+    const std::optional<float> top = quantile_above(image, &head, r.background_threshold, 0.995);
+    if (!top) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
+    if (!(*top > r.background_threshold)) throw std::invalid_argument("brain mask: no brain tissue found (the head has no contrast)");
+    const Histogram h = histogram(image, deep, r.background_threshold, *top);
+    const Peak wm = tallest(smoothed(h.counts, 2.0));
+    r.wm_peak = h.centre(wm.bin);
+    r.wm_sigma = std::max(h.width, (h.centre(wm.high) - r.wm_peak) / 1.1774);
+    r.wm_low_sigma = std::max(h.width, (r.wm_peak - h.centre(wm.low)) / 1.1774);
     // Which side of white matter grey matter and CSF lie on (grey_brighter): the deep voxels above the background.
     const std::optional<float> q10 = quantile_above(image, &deep, r.background_threshold, 0.1);
-    if (!q10) return;
+    if (!q10) return *top;
     const double q50 = *quantile_above(image, &deep, r.background_threshold, 0.5);
     const double q90 = *quantile_above(image, &deep, r.background_threshold, 0.9), narrow = std::min(r.wm_sigma, r.wm_low_sigma);
     r.deep_skew = q90 > *q10 ? (q90 + *q10 - 2.0 * q50) / (q90 - *q10) : 0.0;
@@ -281,6 +286,7 @@ void white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<fl
             n += 1, above += x > r.wm_peak + 3 * narrow, below += x < r.wm_peak - 3 * narrow;
     r.deep_above = above / n;
     r.deep_below = below / n;
+    return *top;
 }
 
 // The brain boundary's share that lies within `near_mm` of the head surface (boundary: mask voxels
@@ -452,25 +458,19 @@ bool grey_brighter(const BrainMaskReport& r) {
            r.wm_peak - 3.0 * r.wm_low_sigma > r.background_threshold;
 }
 
-// The brain-tissue window and the brain it gives. A T1: from the CSF/skin | GM/muscle cut (3-class Otsu
-// up to white matter) to 4 σ above the white-matter peak. `mirrored` (a T2, a PD): from 3 σ below that
-// peak (its darker side's σ: muscle lies there) to 4 σ above grey matter's (the head's tallest above WM
-// + 3 σ, standing inside that range, else the T1 window), short of fat and CSF.
+// The brain-tissue window and the brain it gives. A T1: the CSF/skin | GM/muscle cut (3-class Otsu up
+// to WM) to WM + 4 σ. `mirrored` (T2, PD): WM − 3 σ of its darker side (muscle below) to grey matter's
+// peak + 4 σ (the head's tallest above WM + 3 σ, standing inside that range, else the T1 window).
 Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o,
-                       bool mirrored, BrainMaskReport& r) {
+                       bool mirrored, double top, BrainMaskReport& r) {
     r.grey_brighter = false;
-    if (mirrored) {
-        const std::optional<float> top = quantile_above(image, &head, r.background_threshold, 0.995);
-        const double lo = r.wm_peak + 3 * r.wm_sigma;
-        const Histogram h = histogram(image, head, lo, top && *top > lo ? *top : lo + 1.0);
-        const std::vector<double> s = smoothed(h.counts, 2.0);
-        const int peak = static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin());
-        int j = peak;
-        while (j < kBins - 1 && s[static_cast<std::size_t>(j)] > 0.5 * s[static_cast<std::size_t>(peak)]) ++j;
-        if (top && *top > lo && peak > 0 && j < kBins - 1) {
+    if (const double lo = r.wm_peak + 3 * r.wm_sigma; mirrored && top > lo) {
+        const Histogram h = histogram(image, head, lo, top);
+        const Peak gm = tallest(smoothed(h.counts, 2.0));
+        if (gm.bin > 0 && gm.high < kBins - 1) {
             r.grey_brighter = true;
             r.tissue_low = std::max(r.background_threshold, r.wm_peak - 3 * r.wm_low_sigma);
-            r.tissue_high = h.centre(peak) + 4 * std::max(h.width, (h.centre(j) - h.centre(peak)) / 1.1774);
+            r.tissue_high = h.centre(gm.bin) + 4 * std::max(h.width, (h.centre(gm.high) - h.centre(gm.bin)) / 1.1774);
             return extract_brain(image, smooth, head, o, r);
         }
     }
@@ -488,8 +488,8 @@ Mask brain_within(const Grid<float>& image, const Grid<float>& smooth, const Mas
     const Mask head = cranial(whole_head, up, extent_mm, r.below_voxels);
     r.brain_extent_mm = extent_mm;
     r.head_voxels = count(head);
-    white_matter_peak(image, head, depth, r);
-    Mask brain = brain_of_contrast(image, smooth, head, o, grey_brighter(r), r);
+    const double top = white_matter_peak(image, head, depth, r);
+    Mask brain = brain_of_contrast(image, smooth, head, o, grey_brighter(r), top, r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
     r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
     if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);
