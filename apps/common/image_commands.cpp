@@ -337,7 +337,7 @@ nlohmann::json roi_report(const Roi& roi) {
                      {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold},
                      {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
                      {"deep_skew", b->deep_skew}, {"deep_above", b->deep_above}, {"deep_below", b->deep_below},
-                     {"contrast", b->grey_brighter ? "grey brighter than white (T2, PD)" : "T1"},
+                     {"contrast", to_string(b->contrast)},
                      {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
                      {"below_head_voxels", b->below_voxels}, {"inferior_exit_mm2", b->inferior_exit_mm2},
                      {"brain_extent_mm", b->brain_extent_mm}, {"head_diameter_mm", b->head_diameter_mm},
@@ -349,7 +349,7 @@ nlohmann::json roi_report(const Roi& roi) {
 std::string brain_mask_summary(const BrainMaskReport& b) {
     std::string s = fmt::format("{}, tissue window {:.1f}..{:.1f}", b.skull_stripped ? "skull-stripped input" : "full head",
                                 b.tissue_low, b.tissue_high);
-    if (b.grey_brighter) s += " (mirrored: grey matter brighter than white, as in a T2 or PD)";
+    if (b.contrast == TissueContrast::kGreyBrighter) s += " (mirrored: grey matter brighter than white, as in a T2 or PD)";
     if (!std::isnan(b.mid_range_fill)) s += fmt::format(", masked outside at {:g} within the tissue's range", b.mid_range_fill);
     if (b.head_threshold > b.background_threshold)
         s += fmt::format(", noisy air σ {:.1f}: head threshold {:.1f}", b.background_noise, b.head_threshold);
@@ -451,7 +451,7 @@ nlohmann::json tissue_model_report(const TissueModel& m, const ModelWindow* w) {
     }
     nlohmann::json j{{"classes", classes}, {"partial_volume", m.mixed}, {"voxels", m.voxels},
                      {"iterations", m.iterations}, {"converged", m.converged}, {"usable", m.usable()},
-                     {"start", m.start}};
+                     {"start", m.start}, {"contrast", m.contrast ? nlohmann::json(to_string(*m.contrast)) : nlohmann::json(nullptr)}};
     if (!m.usable()) j["degenerate"] = m.degenerate;
     if (m.smooth_mm > 0) j["fitted_smooth_mm"] = m.smooth_mm;  // fitted on the image blurred by this σ
     if (w) j["seed_class"] = {{"name", tissue_class_name(m, w->seed_class)}, {"index", w->seed_class}, {"share", w->seed_class_share}};

@@ -17,6 +17,7 @@
 #include "liveset/segment/morphology.hpp"
 #include "liveset/segment/smoothing.hpp"
 #include "liveset/segment/tissue_model.hpp"
+#include "liveset/segment/window.hpp"
 
 using namespace liveset;
 
@@ -145,7 +146,8 @@ TruthCheck run_variant(const char* name, const Grid<float>& image, const Mask& l
                 name, c.dice, c.gm, c.wm, c.extracranial, c.leak, r.tissue_low, r.tissue_high, r.surface_contact,
                 int(r.skull_stripped), 100.0 * double(r.mask_voxels) / double(r.head_voxels), s);
     EXPECT_EQ(r.skull_stripped, expect_stripped) << name << ": surface contact " << r.surface_contact;
-    EXPECT_FALSE(r.grey_brighter) << name << ": deep skew " << r.deep_skew;  // every variant here is a T1
+    EXPECT_EQ(r.contrast, TissueContrast::kT1) << name << ": deep skew " << r.deep_skew;  // every variant here is a T1
+    EXPECT_EQ(brain_contrast(image, mask), TissueContrast::kT1) << name;  // and so is the brain it found, read alone
     if (expect_stripped) {  // the truth is the non-zero brain (brain_mask.nii.gz also keeps some non-brain)
         Mask nonzero(image.lattice());
         for (std::size_t i = 0; i < image.size(); ++i) nonzero[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != 0;
@@ -239,7 +241,7 @@ TEST(BrainMask, AT2HeadIsMaskedWithTheWindowMirrored) {
     BrainMaskReport r;
     Grid<float> t2;
     const TruthCheck c = contrast_mask("t2", {0, 250, 110, 75, 150, 45, 80, 8, 140, 100}, r, &t2);
-    EXPECT_TRUE(r.grey_brighter);
+    EXPECT_EQ(r.contrast, TissueContrast::kGreyBrighter);
     EXPECT_GT(r.deep_skew, 0.4);
     EXPECT_FALSE(r.skull_stripped);
     EXPECT_GE(c.dice, 0.91);
@@ -256,6 +258,9 @@ TEST(BrainMask, AT2HeadIsMaskedWithTheWindowMirrored) {
     EXPECT_GT(m.classes[2].mean, 200.0);
     const TissueModel t1 = fit_tissue_model(bw.t1, &bw.brain_mask);  // a T1's fit keeps Otsu's start
     EXPECT_EQ(t1.start, "otsu");
+    // The brain alone, as a brain mask from another tool, reads as a T2 too; BrainWeb's T1 in it does not.
+    EXPECT_EQ(brain_contrast(t2, bw.brain_mask), TissueContrast::kGreyBrighter);
+    EXPECT_EQ(brain_contrast(bw.t1, bw.brain_mask), TissueContrast::kT1);
 }
 
 // The same labels in PD contrast (CSF 200, GM 170, WM 140, fat 170, muscle 100, skin 120, skull 25,
@@ -264,8 +269,10 @@ TEST(BrainMask, AT2HeadIsMaskedWithTheWindowMirrored) {
 // With the T1 window the mask took most of the head (GM Dice 0.57 by default; 0.81 mirrored).
 TEST(BrainMask, APdHeadIsMaskedWithTheWindowMirrored) {
     BrainMaskReport r;
-    const TruthCheck c = contrast_mask("pd", {0, 200, 170, 140, 170, 100, 120, 25, 170, 120}, r);
-    EXPECT_TRUE(r.grey_brighter);
+    Grid<float> pd;
+    const TruthCheck c = contrast_mask("pd", {0, 200, 170, 140, 170, 100, 120, 25, 170, 120}, r, &pd);
+    EXPECT_EQ(r.contrast, TissueContrast::kGreyBrighter);
+    EXPECT_EQ(brain_contrast(pd, brainweb().brain_mask), TissueContrast::kGreyBrighter);
     EXPECT_FALSE(r.skull_stripped);
     EXPECT_GE(c.dice, 0.93);
     EXPECT_GE(c.gm, 0.97);
@@ -552,7 +559,7 @@ TEST(BrainMask, AChildsHeadWithANeckIsLookedForWithinItsOwnSize) {
     const Mask a = auto_brain_mask(adult, {}, &ra);
     EXPECT_DOUBLE_EQ(ra.brain_extent_mm, 170.0);
     const Mask c = auto_brain_mask(child, {}, &rc);
-    EXPECT_FALSE(rc.grey_brighter) << rc.deep_skew;  // a T1 (its first look, into the neck, is kept out by its skew)
+    EXPECT_EQ(rc.contrast, TissueContrast::kT1) << rc.deep_skew;  // a T1 (its first look, into the neck, is kept out by its skew)
     std::printf("child: head %.0f mm (adult %.0f), extent %.0f mm\n", rc.head_diameter_mm, ra.head_diameter_mm, rc.brain_extent_mm);
     EXPECT_NEAR(rc.head_diameter_mm, 0.7 * ra.head_diameter_mm, 0.05 * ra.head_diameter_mm);
     EXPECT_LT(rc.brain_extent_mm, 140.0);
@@ -865,4 +872,52 @@ TEST(BrainMask, BadInputThrowsOneLine) {
         bad.min_head_share = s / 10;
         EXPECT_THROW(validate(bad), std::invalid_argument) << s;
     }
+}
+
+// A T2's tissue model in a whole brain is named from dark to bright WM, GM, CSF (brain_contrast),
+// so its report, its seeds' class and its warnings say the tissue meant. In BrainWeb's brain mask
+// the T2's pure CSF class holds 2.9 % (its partial volume with grey matter the rest): thin, and the
+// brightest here, which read with a T1's names was warned about as a bias field's split ("its WM
+// class ... holds only 2.9 %"). The T1 in the same region keeps CSF, GM, WM; a region not known to be
+// a whole brain is not read (a T1 assumed).
+TEST(BrainMask, AT2BrainsTissueModelNamesItsClassesFromWhiteMatterUp) {
+    const BrainWeb& bw = brainweb();
+    const Grid<float> t2 = labels_as(bw.labels, {0, 250, 110, 75, 150, 45, 80, 8, 140, 100});
+    const Lattice& l = bw.labels.lattice();
+    std::vector<PointIndex> grey;  // grey matter voxels whose 6 neighbours are grey matter too
+    for (PointIndex i = 0; i < bw.labels.size() && grey.size() < 500; ++i) {
+        const Vec3i c = l.coord(i);
+        bool pure = bw.labels[i] == 2 && bw.brain_mask[i] != 0;
+        for (int a = 0; a < 3 && pure; ++a)
+            for (const int d : {-1, 1}) {
+                Vec3i n = c;
+                n[a] += d;
+                pure = pure && l.contains(n) && bw.labels[l.index(n)] == 2;
+            }
+        if (pure) grey.push_back(i);
+    }
+    ASSERT_EQ(grey.size(), 500u);
+    for (const bool is_t2 : {true, false}) {
+        const Grid<float>& image = is_t2 ? t2 : bw.t1;
+        std::vector<std::string> warnings;
+        const std::optional<TissueModel> m = fit_window_model(image, bw.brain_mask, {}, warnings, true);
+        ASSERT_TRUE(m && m->usable() && m->classes.size() == 3) << (m ? m->degenerate : "no model");
+        EXPECT_EQ(m->contrast, is_t2 ? TissueContrast::kGreyBrighter : TissueContrast::kT1);
+        const int csf = is_t2 ? 2 : 0;
+        std::printf("%s: %s %.1f (%.3f), %s %.1f (%.3f), %s %.1f (%.3f)\n", is_t2 ? "t2" : "t1", tissue_class_name(*m, 0).c_str(),
+                    m->classes[0].mean, m->classes[0].weight, tissue_class_name(*m, 1).c_str(), m->classes[1].mean, m->classes[1].weight,
+                    tissue_class_name(*m, 2).c_str(), m->classes[2].mean, m->classes[2].weight);
+        EXPECT_EQ(tissue_class_name(*m, csf), "CSF");
+        EXPECT_EQ(tissue_class_name(*m, 2 - csf), "WM");
+        EXPECT_EQ(tissue_class_name(*m, 1), "GM");
+        if (is_t2) {
+            EXPECT_LT(m->classes[2].weight, 0.03);  // the thin class is CSF...
+        }
+        for (const std::string& w : warnings) EXPECT_EQ(w.find("holds only"), std::string::npos) << w;  // ... and not warned about
+        std::vector<float> values;
+        for (const PointIndex i : grey) values.push_back(image[i]);
+        EXPECT_EQ(tissue_class_name(*m, model_window(*m, values).seed_class), "GM");
+    }
+    std::vector<std::string> warnings;
+    EXPECT_FALSE(fit_window_model(t2, bw.brain_mask, {}, warnings, false)->contrast.has_value());
 }

@@ -1,6 +1,7 @@
-// Image IO through ITK. ITK ImageIO objects are driven directly (no ImageFileReader/Writer
-// templates per pixel type), the IO factories liveset supports are registered explicitly once,
-// and every ITK failure is turned into a one-line ImageIoError that names the file.
+// Image reading through ITK (writing: image_write.cpp). ITK ImageIO objects are driven directly (no
+// ImageFileReader templates per pixel type), the IO factories liveset supports are registered
+// explicitly once (itk_io.hpp), and every ITK failure is turned into a one-line ImageIoError that
+// names the file.
 #include "liveset/io/image_io.hpp"
 
 #include <unistd.h>
@@ -12,30 +13,24 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
-#include <mutex>
 #include <new>
 #include <sstream>
 #include <type_traits>
 #include <vector>
 
 #include <itkGDCMImageIO.h>
-#include <itkGDCMImageIOFactory.h>
 #include <itkGDCMSeriesFileNames.h>
 #include <itkImage.h>
 #include <itkImageIOBase.h>
 #include <itkImageIOFactory.h>
 #include <itkImageSeriesReader.h>
-#include <itkMINCImageIO.h>
-#include <itkMINCImageIOFactory.h>
 #include <itkMetaDataObject.h>
 #include <itkNiftiImageIO.h>
-#include <itkMetaImageIOFactory.h>
-#include <itkNiftiImageIOFactory.h>
-#include <itkNrrdImageIOFactory.h>
 
 #include "liveset/base/atomic_file.hpp"
 #include "liveset/grid/large_page_allocator.hpp"
 #include "liveset/io/file_checks.hpp"
+#include "liveset/io/itk_io.hpp"
 #include "liveset/io/messages.hpp"
 #include "liveset/io/mgh_image_io.hpp"
 #include "liveset/io/minc_world.hpp"
@@ -47,47 +42,18 @@ namespace {
 namespace fs = std::filesystem;
 using Component = itk::IOComponentEnum;
 using io_detail::bytes_text;
+using io_detail::check_data;
+using io_detail::condense;
+using io_detail::create_io;
 using io_detail::dims_text;
+using io_detail::fail_read;
 using io_detail::flip_ras_lps;
+using io_detail::is_minc;
+using io_detail::prepare_io;
 using io_detail::quoted;
+using io_detail::register_factories;
 using io_detail::voxels_are_infinite;
 using io_detail::voxels_are_non_finite;
-
-// ---------------------------------------------------------------------------------------------
-// Factories and messages
-
-// Registers the image IO factories liveset supports, once per process, in priority order. Done
-// here explicitly (not through UseITK's static registration header) so it cannot be dropped by
-// the linker or depend on static initialisation order in a static library.
-void register_factories() {
-    static std::once_flag once;
-    std::call_once(once, [] {
-        itk::NiftiImageIOFactory::RegisterOneFactory();
-        itk::MetaImageIOFactory::RegisterOneFactory();
-        itk::NrrdImageIOFactory::RegisterOneFactory();
-        itk::MINCImageIOFactory::RegisterOneFactory();
-        itk::GDCMImageIOFactory::RegisterOneFactory();
-    });
-}
-
-// The ImageIO for `path`: FreeSurfer's MGH by its name (.mgh, .mgz; ours, mgh_image_io.hpp), else
-// the registered factories' choice (null when none takes it). A file that claims to be MGH and is
-// not still gets the MGH reader, whose error then says why.
-itk::ImageIOBase::Pointer create_io(const std::string& path, itk::IOFileModeEnum mode) {
-    if (io_detail::is_mgh_name(path)) return io_detail::MghImageIO::New().GetPointer();
-    return itk::ImageIOFactory::CreateImageIO(path.c_str(), mode);
-}
-
-[[noreturn]] void fail_read(const std::string& path, const std::string& what) {
-    throw ImageIoError("cannot read " + quoted(path) + ": " + what);
-}
-[[noreturn]] void fail_write(const std::string& path, const std::string& what) {
-    throw ImageIoError("cannot write " + quoted(path) + ": " + what);
-}
-
-std::string condense(const itk::ExceptionObject& e, const std::string& path) {
-    return io_detail::condense(e.GetDescription(), path);
-}
 
 std::string format_name(const itk::ImageIOBase& io) {
     const std::string cls = io.GetNameOfClass();
@@ -104,18 +70,6 @@ std::string format_name(const itk::ImageIOBase& io) {
 const char* kFormatsHint =
     "liveset reads .nii/.nii.gz, .mha/.mhd, .nrrd/.nhdr, .mnc, .mgh/.mgz and folders of DICOM slices";
 
-// ---------------------------------------------------------------------------------------------
-// MINC: its RAS world is converted to LPS on read and back on write (minc_world.hpp says why)
-
-bool is_minc(const itk::ImageIOBase& io) { return std::string(io.GetNameOfClass()) == "MINCImageIO"; }
-
-// Later ITK releases can convert MINC's RAS to LPS themselves (SetRAStoLPS): switched off where
-// it exists, so that flip_ras_lps below is the one conversion.
-template <class MincIO>
-void keep_minc_world_as_stored(MincIO& io) {
-    if constexpr (requires { io.SetRAStoLPS(false); }) io.SetRAStoLPS(false);
-}
-
 // False for a NIfTI (or Analyze) header whose qform and sform codes are both 0 (NIFTI_XFORM_UNKNOWN):
 // its axes carry no orientation, ITK reads them as LPS identity.
 bool orientation_known(const itk::ImageIOBase& io) {
@@ -125,13 +79,6 @@ bool orientation_known(const itk::ImageIOBase& io) {
     const itk::MetaDataDictionary& dict = io.GetMetaDataDictionary();
     if (!itk::ExposeMetaData<std::string>(dict, "qform_code", q) || !itk::ExposeMetaData<std::string>(dict, "sform_code", s)) return true;
     return !(q == "0" && s == "0");
-}
-
-void prepare_io(itk::ImageIOBase& io) {
-    if (auto* minc = dynamic_cast<itk::MINCImageIO*>(&io)) keep_minc_world_as_stored(*minc);
-    // An Analyze file is read as ITK 4 read it (the axes as stored, no orientation: orientation_known
-    // false), without the default flavour's multi-line deprecation warning on stderr.
-    if (auto* nifti = dynamic_cast<itk::NiftiImageIO*>(&io)) nifti->SetLegacyAnalyze75Mode(itk::NiftiImageIOEnums::Analyze75Flavor::AnalyzeITK4);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -430,21 +377,6 @@ void check_finite(const std::string& path, std::span<const float> values) {
     if (bad) fail_read(path, voxels_are_non_finite(bad));
 }
 
-// What ITK's readers would hide: a short NIfTI is zero-filled and its NaN/Inf floats become 0, a
-// short MetaImage only prints a warning. `io` has read the header of `file`.
-// `nan_at`: as check_nifti_data's.
-io_detail::DataCheck check_data(const itk::ImageIOBase& io, const std::string& file, bool count_non_finite,
-                                std::vector<std::uint8_t>* nan_at = nullptr) {
-    const std::string cls = io.GetNameOfClass();
-    if (cls == "NiftiImageIO") return io_detail::check_nifti_data(file, count_non_finite, nan_at);
-    if (cls == "MetaImageIO") {
-        std::uint64_t bytes = io.GetComponentSize() * io.GetNumberOfComponents();
-        for (unsigned a = 0; a < io.GetNumberOfDimensions(); ++a) bytes *= io.GetDimensions(a);
-        return io_detail::check_metaimage_data(file, bytes);
-    }
-    return {};
-}
-
 // `nan_at` (NanVoxels::keep): receives where a NIfTI's NaN values lie (niftilib reads them as 0).
 void verify_data(const Source& src, std::vector<std::uint8_t>* nan_at = nullptr) {
     if (!src.io) return;
@@ -463,119 +395,6 @@ void keep_nan(const std::string& path, std::span<float> values, const std::vecto
     std::uint64_t inf = 0;
     for (float v : values) inf += std::isinf(v);
     if (inf) fail_read(path, voxels_are_infinite(inf));
-}
-
-// ---------------------------------------------------------------------------------------------
-// Writing
-
-// Hands the lattice's geometry to a writer (MINC: converted to RAS) and sets the whole image as the region.
-void set_geometry(itk::ImageIOBase& io, const Lattice& lattice) {
-    io.SetNumberOfDimensions(3);
-    const Vec3i d = lattice.dims();
-    const Vec3d s = lattice.spacing(), o = lattice.origin();
-    const Mat3d& m = lattice.direction();
-    std::vector<double> origin{o.x, o.y, o.z};
-    std::vector<std::vector<double>> axes;
-    for (unsigned a = 0; a < 3; ++a) axes.push_back({m[a], m[3 + a], m[6 + a]});
-    if (is_minc(io)) {
-        prepare_io(io);
-        flip_ras_lps(origin, axes);  // LPS -> MINC's RAS
-    }
-    itk::ImageIORegion region(3);
-    for (unsigned a = 0; a < 3; ++a) {
-        const int ai = static_cast<int>(a);
-        io.SetDimensions(a, static_cast<itk::SizeValueType>(d[ai]));
-        io.SetSpacing(a, s[ai]);
-        io.SetOrigin(a, origin[a]);
-        io.SetDirection(a, axes[a]);
-        region.SetIndex(a, 0);
-        region.SetSize(a, static_cast<itk::SizeValueType>(d[ai]));
-    }
-    io.SetIORegion(region);
-}
-
-void write_grid(const void* data, Component component, const Lattice& lattice, const std::string& path, const WriteOptions& options) {
-    if (path.empty()) throw ImageIoError("cannot write an image: the path is empty");
-    if (lattice.size() == 0) fail_write(path, "the image is empty");
-    const fs::path target(path);
-    const std::string filename = target.filename().string();
-    const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-    std::error_code ec;
-    const auto dir_status = fs::status(dir, ec);
-    if (!fs::exists(dir_status)) fail_write(path, "folder " + quoted(dir.string()) + " does not exist");
-    if (!fs::is_directory(dir_status)) fail_write(path, quoted(dir.string()) + " is not a folder");
-    if (filename.empty() || fs::is_directory(target, ec)) fail_write(path, "is a folder, not a file name");
-    const std::string ext = file_extension(filename);
-    const char* formats = "use .nii.gz, .nii, .mha, .mhd, .nrrd, .nhdr, .mnc or .mgz";
-    if (ext.empty()) fail_write(path, std::string("no file extension to choose the format (") + formats + ")");
-
-    register_factories();
-    itk::ImageIOBase::Pointer io;
-    try {
-        io = create_io(path, itk::IOFileModeEnum::WriteMode);
-    } catch (const itk::ExceptionObject&) {
-        io = nullptr;
-    }
-    if (!io) fail_write(path, "unknown image format " + quoted(ext) + " for writing (" + formats + ")");
-    const std::string cls = io->GetNameOfClass();
-    if (cls == "GDCMImageIO") fail_write(path, std::string("writing DICOM is not supported (") + formats + ")");
-
-    set_geometry(*io, lattice);
-    const Vec3i d = lattice.dims();
-    io->SetPixelType(itk::IOPixelEnum::SCALAR);
-    io->SetComponentType(component);
-    io->SetNumberOfComponents(1);
-    // Two-file formats stay uncompressed (.raw, readable by anything); single files are compressed
-    // where the format allows it (.nii vs .nii.gz is decided by the extension itself).
-    const bool two_file = cls == "MetaImageIO" ? ext != ".mha" : (cls == "NrrdImageIO" && ext != ".nrrd");
-    io->SetUseCompression(!two_file);
-
-    // Uncompressed output must fit, known before writing. Checked up front because some writers
-    // do not clean up after a failed write: teem keeps a detached .raw open (its disk space stays
-    // used), libminc leaks its HDF5 file (HDF5 may then crash at exit). MINC is checked against
-    // the uncompressed size.
-    const std::string ext_lc = lowercase_extension(filename);
-    const double bytes = double(lattice.size()) * (component == Component::FLOAT ? 4 : 1) + 65536;
-    const auto space = fs::space(dir, ec);
-    if ((two_file || ext_lc == ".nii" || cls == "MINCImageIO") && !ec && double(space.available) < bytes)
-        fail_write(path, "not enough free space in folder " + quoted(dir.string()) + " (" +
-                             bytes_text(double(space.available)) + " free, about " + bytes_text(bytes) + " needed)");
-
-    // Written to a hidden temporary next to the target, checked, then renamed over the target.
-    // Every failure below removes the temporaries (AtomicFile's destructor).
-    AtomicFile out(target);
-    const std::string tmp = out.temp_path().string();
-    try {
-        out.create();  // a clear reason (permissions, read-only file system) before ITK tries
-        io->SetFileName(tmp);
-        {
-            const io_detail::SilencedStderr quiet;  // niftilib/teem print their own error first
-            io->Write(data);
-        }
-        // Without orientation only where codes 0 say the same geometry (ITK reads them as the LPS
-        // identity at the origin; an image placed otherwise, e.g. an MGH read with default axes,
-        // keeps its placement and codes).
-        const bool as_read_unoriented = lattice.direction() == kIdentity3 && lattice.origin() == Vec3d{0, 0, 0};
-        if (!options.orientation_known && cls == "NiftiImageIO" && as_read_unoriented && !io_detail::clear_nifti_orientation(tmp))
-            fail_write(path, "cannot mark the written header as without orientation");
-        // Read the temporary back: catches writers that do not report short writes (disk full).
-        auto check = create_io(tmp, itk::IOFileModeEnum::ReadMode);
-        if (!check) fail_write(path, "the written file cannot be read back (disk full?)");
-        check->SetFileName(tmp);
-        check->ReadImageInformation();
-        for (unsigned a = 0; a < 3; ++a)
-            if (check->GetDimensions(a) != static_cast<itk::SizeValueType>(d[static_cast<int>(a)]))
-                fail_write(path, "the written file does not read back with the same size (disk full?)");
-        const io_detail::DataCheck data_check = check_data(*check, tmp, false);
-        if (data_check.truncated) fail_write(path, "the file came out short, " + data_check.detail + " (disk full?)");
-        out.commit(two_file);
-    } catch (const ImageIoError&) {
-        throw;
-    } catch (const itk::ExceptionObject& e) {
-        fail_write(path, condense(e, tmp));
-    } catch (const std::exception& e) {
-        fail_write(path, e.what());
-    }
 }
 
 }  // namespace
@@ -656,14 +475,6 @@ Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_b
         }
     });
     return grid;
-}
-
-void write_image(const Grid<float>& image, const std::string& path, const WriteOptions& options) {
-    write_grid(image.values().data(), Component::FLOAT, image.lattice(), path, options);
-}
-
-void write_label_image(const Grid<std::uint8_t>& labels, const std::string& path, const WriteOptions& options) {
-    write_grid(labels.values().data(), Component::UCHAR, labels.lattice(), path, options);
 }
 
 bool is_dicom_series_dir(const std::string& path) {

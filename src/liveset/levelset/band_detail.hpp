@@ -19,6 +19,7 @@
 
 #include "liveset/grid/index_decoder.hpp"
 #include "liveset/grid/lattice.hpp"
+#include "liveset/levelset/sparse_field.hpp"
 
 namespace liveset::detail {
 
@@ -198,3 +199,16 @@ void join_parts(std::vector<Part>& parts, std::vector<T> Part::*field, std::vect
 }
 
 }  // namespace liveset::detail
+
+namespace liveset {
+
+// A band point into the region being repaired, once (a pending point is not added again); inline in
+// every file of the step, for the hot collection loops.
+[[gnu::always_inline]] inline void SparseField::mark_pending(PointIndex i, std::vector<RegionPoint>& region) {
+    const std::int8_t s = status_[i];
+    if (detail::is_temp(s)) return;
+    region.push_back({i, s, phi_[i]});
+    status_[i] = detail::pending_of(s);
+}
+
+}  // namespace liveset

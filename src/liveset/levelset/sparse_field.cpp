@@ -1,6 +1,6 @@
-// SparseField implementation: initialisation, the global step and the shared order-independent
-// band repair up to the re-layering (relayer.cpp; local edits and undo in local_edits.cpp; the
-// scheme in sparse_field.hpp).
+// SparseField implementation: the global step and the shared order-independent band repair up to
+// the re-layering (initialisation in initialise.cpp; re-layering in relayer.cpp; local edits and
+// undo in local_edits.cpp; the scheme in sparse_field.hpp).
 #include "liveset/levelset/sparse_field.hpp"
 
 #include <tbb/blocked_range.h>
@@ -90,121 +90,6 @@ void SparseField::list_remove(PointIndex i, int layer) {
     list.pop_back();
     slot_[i] = kNoSlot;
     if (layer == 0) ++zero_reordered_;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Initialisation
-
-void SparseField::evaluate_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo, Vec3i hi) {
-    // Evaluated into a grid of the box and checked before anything of the field changes, so a
-    // throw (a value that is not finite, or one from `sdf` itself) leaves the field as it was.
-    const Vec3i n{hi.x - lo.x + 1, hi.y - lo.y + 1, hi.z - lo.z + 1};
-    Grid<float> values{Lattice(n)};
-    const float far = static_cast<float>(layers_ + 1);
-    // Evaluate the distance in the box (clamped to the far value); zero layer = |φ| ≤ 0.5.
-    tbb::parallel_for(0, n.z, [&](int z) {
-        for (int y = 0; y < n.y; ++y)
-            for (int x = 0; x < n.x; ++x) {
-                const double v = sdf(Vec3d{static_cast<double>(lo.x + x), static_cast<double>(lo.y + y), static_cast<double>(lo.z + z)});
-                values[values.lattice().index({x, y, z})] =
-                    std::isfinite(v) ? static_cast<float>(std::clamp(v, -static_cast<double>(far), static_cast<double>(far)))
-                                     : std::numeric_limits<float>::quiet_NaN();
-            }
-    });
-    for (std::size_t i = 0; i < values.size(); ++i)
-        if (!std::isfinite(values[static_cast<PointIndex>(i)]))
-            throw std::invalid_argument("signed distance is not finite at " +
-                                        point_text(lattice(), lattice().index(lo + values.lattice().coord(static_cast<PointIndex>(i)))));
-    activity_.reset();  // a new front: everything awake again
-    for (auto& l : lists_) l.clear();
-    slot_.fill(kNoSlot);
-    slots_stale_ = false;
-    // Copied, not moved: φ keeps its storage (the viewer's crash handler reads it in place).
-    // Outside the box the function is at least the far value, which the clamp makes exactly far.
-    if (!(n == lattice().dims())) phi_.fill(far);
-    for (int z = 0; z < n.z; ++z)
-        for (int y = 0; y < n.y; ++y) {
-            const auto row = values.values().subspan(values.lattice().index({0, y, z}), static_cast<std::size_t>(n.x));
-            std::copy(row.begin(), row.end(), phi_.values().begin() + lattice().index(lo + Vec3i{0, y, z}));
-        }
-}
-
-void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {
-    init_from_sdf(sdf, {0, 0, 0}, lattice().dims() - Vec3i{1, 1, 1});
-}
-
-void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo, Vec3i hi) {
-    const Vec3i d = lattice().dims();
-    for (int a = 0; a < 3; ++a) {
-        lo[a] = std::clamp(lo[a], 0, d[a] - 1);
-        hi[a] = std::clamp(hi[a], lo[a], d[a] - 1);
-    }
-    evaluate_sdf(sdf, lo, hi);
-    // The box grown by one point: outside it every point and all its neighbours hold the far
-    // value, so neither pass below can find anything there.
-    Vec3i glo = lo, ghi = hi;
-    for (int a = 0; a < 3; ++a) {
-        glo[a] = std::max(lo[a] - 1, 0);
-        ghi[a] = std::min(hi[a] + 1, d[a] - 1);
-    }
-    const auto for_box = [&](const auto& f) {
-        for (int z = glo.z; z <= ghi.z; ++z)
-            for (int y = glo.y; y <= ghi.y; ++y) {
-                const PointIndex row = lattice().index({0, y, z});
-                for (int x = glo.x; x <= ghi.x; ++x) f(row + static_cast<PointIndex>(x));
-            }
-    };
-    // A sign change between two far points (a function steeper than a distance) would leave the
-    // front without zero-layer points: pull both sides onto the zero layer.
-    std::vector<PointIndex> steep;
-    for_box([&](PointIndex i) {
-        const float v = phi_[i];
-        if (std::abs(v) <= 0.5f) return;
-        bool opposite = false;
-        for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
-            if (std::abs(phi_[q]) > 0.5f && ((phi_[q] < 0) != (v < 0))) opposite = true;
-        });
-        if (opposite) steep.push_back(i);
-    });
-    for (PointIndex i : steep) phi_[i] = phi_[i] < 0 ? -0.5f : 0.5f;
-
-    const float far = static_cast<float>(layers_ + 1);
-    if (!(glo == Vec3i{0, 0, 0} && ghi == d - Vec3i{1, 1, 1})) status_.fill(far_outside());
-    std::vector<PointIndex> zero;
-    for_box([&](PointIndex i) {
-        if (std::abs(phi_[i]) <= 0.5f) {
-            status_[i] = 0;
-            zero.push_back(i);
-            list_add(i, 0);
-        } else {
-            status_[i] = phi_[i] < 0 ? far_inside() : far_outside();
-            phi_[i] = phi_[i] < 0 ? -far : far;
-        }
-    });
-    // Every other point is far: the sweep reaches the new layers from the zero layer.
-    std::vector<RegionPoint> region;
-    region.reserve(zero.size() * (2 * static_cast<std::size_t>(layers_) + 1));
-    for (PointIndex i : zero) mark_pending(i, region);
-    sweep_whole_band(region, zero);
-    finish(region);
-}
-
-void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
-    if (!(mask.dims() == lattice().dims()))
-        throw std::invalid_argument("mask dimensions " + mask.lattice().describe() +
-                                    " differ from the level-set lattice " + lattice().describe());
-    // Boundary voxels of either side become the zero layer (±0.5: the front lies half-way).
-    const Lattice& lat = lattice();
-    const std::function<double(Vec3d)> from_mask = [&](Vec3d p) {
-        const PointIndex i = lat.index(p.cast<int>());
-        const bool inside = mask[i] != 0;
-        bool boundary = false;
-        for_each_neighbor6(lat, decoder_, i, [&](PointIndex q) { boundary = boundary || ((mask[q] != 0) != inside); });
-        const double far = layers_ + 1;
-        if (boundary) return inside ? -0.5 : 0.5;
-        return inside ? -far : far;
-    };
-    init_from_sdf(from_mask);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -533,13 +418,6 @@ void SparseField::relist(PointList& zero) {
     // The slots are written when next needed (ensure_slots): a growing front rebuilds its lists
     // step after step and needs none of them.
     slots_stale_ = true;
-}
-
-[[gnu::always_inline]] inline void SparseField::mark_pending(PointIndex i, std::vector<RegionPoint>& region) {
-    const std::int8_t s = status_[i];
-    if (is_temp(s)) return;
-    region.push_back({i, s, phi_[i]});
-    status_[i] = detail::pending_of(s);
 }
 
 void SparseField::collect_ball(PointIndex seed, std::vector<RegionPoint>& region) {

@@ -1,11 +1,10 @@
 // Automatic brain mask (see brain_mask.hpp): histogram thresholds, morphology in mm, and the test
 // that tells a skull-stripped input from a full head.
 #include "liveset/segment/brain_mask.hpp"
+#include "liveset/segment/brain_histogram.hpp"
 #include "liveset/segment/intensity.hpp"
-#include "liveset/segment/tissue_model.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -22,85 +21,14 @@ namespace liveset {
 
 namespace {
 
-using Mask = Grid<std::uint8_t>;
+using namespace brain_detail;
 
-constexpr int kBins = 128;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::size_t count(const Mask& m) {
     std::size_t n = 0;
     for (std::uint8_t v : m.values()) n += v != 0;
     return n;
-}
-
-// The value at fraction q in [0, 1] of the sorted values of `image` inside `mask` (all voxels when
-// null) that lie above `above` — element floor(q·(n − 1)), as std::nth_element places it — or
-// nullopt when there is none. By a histogram of the values' order-preserving bit patterns (their
-// top 16 bits) and a selection among the values of the one bin that holds the element: two passes
-// and no copy of the image.
-std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, double above, double q) {
-    const auto key = [](float v) {
-        const auto u = std::bit_cast<std::uint32_t>(v);
-        return (u & 0x80000000u) != 0 ? ~u : (u | 0x80000000u);
-    };
-    const auto kept = [&](std::size_t i) { return (mask == nullptr || (*mask)[static_cast<PointIndex>(i)] != 0) && image[static_cast<PointIndex>(i)] > above; };
-    std::vector<std::size_t> bins(std::size_t{1} << 16, 0);
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < image.size(); ++i)
-        if (kept(i)) {
-            ++bins[key(image[static_cast<PointIndex>(i)]) >> 16];
-            ++n;
-        }
-    if (n == 0) return std::nullopt;
-    auto k = static_cast<std::size_t>(q * static_cast<double>(n - 1));
-    std::size_t bin = 0;
-    while (k >= bins[bin]) k -= bins[bin++];
-    std::vector<float> in_bin;
-    in_bin.reserve(bins[bin]);
-    for (std::size_t i = 0; i < image.size(); ++i)
-        if (kept(i) && key(image[static_cast<PointIndex>(i)]) >> 16 == bin) in_bin.push_back(image[static_cast<PointIndex>(i)]);
-    std::nth_element(in_bin.begin(), in_bin.begin() + static_cast<std::ptrdiff_t>(k), in_bin.end());
-    return in_bin[k];
-}
-
-// A kBins-bin histogram over [lo, hi] of the image's voxels inside `mask` (values outside the range
-// are not counted).
-struct Histogram {
-    double lo = 0, width = 1;
-    std::vector<double> counts = std::vector<double>(kBins, 0.0);
-    double centre(int bin) const { return lo + (bin + 0.5) * width; }
-};
-
-Histogram histogram(const Grid<float>& image, const Mask& mask, double lo, double hi) {
-    Histogram h;
-    h.lo = lo;
-    h.width = (hi - lo) / kBins;
-    for (std::size_t i = 0; i < image.size(); ++i) {
-        const double v = image[static_cast<PointIndex>(i)];
-        if (mask[static_cast<PointIndex>(i)] == 0 || v < lo || v > hi) continue;
-        h.counts[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((v - lo) / h.width)))] += 1.0;
-    }
-    return h;
-}
-
-std::vector<double> smoothed(const std::vector<double>& c, double sigma_bins) {
-    const int r = static_cast<int>(std::ceil(3 * sigma_bins));
-    std::vector<double> out(c.size(), 0.0);
-    for (int i = 0; i < static_cast<int>(c.size()); ++i)
-        for (int k = -r; k <= r; ++k) {
-            const int j = std::clamp(i + k, 0, static_cast<int>(c.size()) - 1);
-            out[static_cast<std::size_t>(i)] += c[static_cast<std::size_t>(j)] * std::exp(-0.5 * k * k / (sigma_bins * sigma_bins));
-        }
-    return out;
-}
-
-// Three-class Otsu (tissue_model.hpp) on a histogram: returns the first bins of the middle and
-// upper classes.
-std::pair<int, int> otsu3(const std::vector<double>& h, const Histogram& geom) {
-    std::vector<double> centres(h.size());
-    for (std::size_t i = 0; i < h.size(); ++i) centres[i] = geom.centre(static_cast<int>(i));
-    const std::vector<std::size_t> s = otsu_split_bins(h, centres, 3);
-    return {static_cast<int>(s[0]), static_cast<int>(s[1])};
 }
 
 void check_image(const Grid<float>& image) {
@@ -245,48 +173,6 @@ Mask head_foreground(const Grid<float>& image, double threshold) {
     if (n == 0 || static_cast<double>(count(erode_mm(f, r))) < 0.05 * static_cast<double>(n))
         throw std::invalid_argument("brain mask: no head found (the foreground has no solid part: noise or an empty scan?)");
     return f;
-}
-
-// The tallest bin of a smoothed histogram and the bins, on either side, where it first falls to half.
-struct Peak { int bin = 0, low = 0, high = 0; };
-Peak tallest(const std::vector<double>& s) {
-    Peak p{static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin())};
-    const double half = 0.5 * s[static_cast<std::size_t>(p.bin)];
-    for (p.high = p.bin; p.high < kBins - 1 && s[static_cast<std::size_t>(p.high)] > half;) ++p.high;
-    for (p.low = p.bin; p.low > 0 && s[static_cast<std::size_t>(p.low)] > half;) --p.low;
-    return p;
-}
-
-// White-matter peak and widths from the deepest half of the head (T1: mostly white matter); returns
-// the head's 99.5th percentile above the background (the histograms' top).
-double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r) {
-    float deepest = 0;
-    for (std::size_t i = 0; i < head.size(); ++i)
-        if (head[static_cast<PointIndex>(i)] != 0) deepest = std::max(deepest, depth[static_cast<PointIndex>(i)]);
-    Mask deep(head.lattice());
-    for (std::size_t i = 0; i < head.size(); ++i)
-        deep[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && depth[static_cast<PointIndex>(i)] >= 0.5f * deepest;
-    const std::optional<float> top = quantile_above(image, &head, r.background_threshold, 0.995);
-    if (!top) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
-    if (!(*top > r.background_threshold)) throw std::invalid_argument("brain mask: no brain tissue found (the head has no contrast)");
-    const Histogram h = histogram(image, deep, r.background_threshold, *top);
-    const Peak wm = tallest(smoothed(h.counts, 2.0));
-    r.wm_peak = h.centre(wm.bin);
-    r.wm_sigma = std::max(h.width, (h.centre(wm.high) - r.wm_peak) / 1.1774);
-    r.wm_low_sigma = std::max(h.width, (r.wm_peak - h.centre(wm.low)) / 1.1774);
-    // Which side of white matter grey matter and CSF lie on (grey_brighter): the deep voxels above the background.
-    const std::optional<float> q10 = quantile_above(image, &deep, r.background_threshold, 0.1);
-    if (!q10) return *top;
-    const double q50 = *quantile_above(image, &deep, r.background_threshold, 0.5);
-    const double q90 = *quantile_above(image, &deep, r.background_threshold, 0.9), narrow = std::min(r.wm_sigma, r.wm_low_sigma);
-    r.deep_skew = q90 > *q10 ? (q90 + *q10 - 2.0 * q50) / (q90 - *q10) : 0.0;
-    double n = 0, above = 0, below = 0;
-    for (std::size_t k = 0; k < deep.size(); ++k)
-        if (const double x = image[static_cast<PointIndex>(k)]; deep[static_cast<PointIndex>(k)] != 0 && x > r.background_threshold)
-            n += 1, above += x > r.wm_peak + 3 * narrow, below += x < r.wm_peak - 3 * narrow;
-    r.deep_above = above / n;
-    r.deep_below = below / n;
-    return *top;
 }
 
 // The brain boundary's share that lies within `near_mm` of the head surface (boundary: mask voxels
@@ -449,34 +335,33 @@ double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
     return 2.0 * std::sqrt(widest / std::numbers::pi);
 }
 
-// Grey matter brighter than white (a T2, a PD): the deep head skewed bright, at least a quarter of
-// it 3 σ above the white-matter peak and over 4 times as much as 3 σ below, and that peak 3 σ clear of
-// the background threshold (not the air's noise cut off there). What each part keeps out (a child's
-// neck, noisy heads, the phantom's bias, a noisy field of view) and the measured margins: docs/ARCHITECTURE.md.
-bool grey_brighter(const BrainMaskReport& r) {
-    return r.deep_skew > 0.0 && r.deep_above >= 0.25 && r.deep_above > 4.0 * r.deep_below &&
-           r.wm_peak - 3.0 * r.wm_low_sigma > r.background_threshold;
+// Grey matter's peak in the head above WM + 3 σ (the tallest there, standing inside that range, with
+// its σ from the upper half width), or nullopt.
+std::optional<std::pair<double, double>> grey_peak_above(const Grid<float>& image, const Mask& head, double top, const BrainMaskReport& r) {
+    const double lo = r.wm_peak + 3 * r.wm_sigma;
+    if (!(top > lo)) return std::nullopt;
+    const Histogram h = histogram(image, head, lo, top);
+    const Peak gm = tallest(smoothed(h.counts, 2.0));
+    if (gm.bin == 0 || gm.high == kBins - 1) return std::nullopt;
+    return std::pair{h.centre(gm.bin), std::max(h.width, (h.centre(gm.high) - h.centre(gm.bin)) / 1.1774)};
 }
 
 // The brain-tissue window and the brain it gives. A T1: the CSF/skin | GM/muscle cut (3-class Otsu up
-// to WM) to WM + 4 σ. `mirrored` (T2, PD): WM − 3 σ of its darker side (muscle below) to grey matter's
-// peak + 4 σ (the head's tallest above WM + 3 σ, standing inside that range, else the T1 window).
+// to WM) to WM + 4 σ. Grey matter brighter (T2, PD): WM − 3 σ of its darker side (muscle below) to grey
+// matter's peak + 4 σ (grey_peak_above; without one, the T1 window). r.contrast says which was taken.
 Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o,
-                       bool mirrored, double top, BrainMaskReport& r) {
-    r.grey_brighter = false;
-    if (const double lo = r.wm_peak + 3 * r.wm_sigma; mirrored && top > lo) {
-        const Histogram h = histogram(image, head, lo, top);
-        const Peak gm = tallest(smoothed(h.counts, 2.0));
-        if (gm.bin > 0 && gm.high < kBins - 1) {
-            r.grey_brighter = true;
-            r.tissue_low = std::max(r.background_threshold, r.wm_peak - 3 * r.wm_low_sigma);
-            r.tissue_high = h.centre(gm.bin) + 4 * std::max(h.width, (h.centre(gm.high) - h.centre(gm.bin)) / 1.1774);
-            return extract_brain(image, smooth, head, o, r);
-        }
+                       TissueContrast contrast, double top, BrainMaskReport& r) {
+    const std::optional<std::pair<double, double>> gm =
+        contrast == TissueContrast::kGreyBrighter ? grey_peak_above(image, head, top, r) : std::nullopt;
+    r.contrast = gm ? TissueContrast::kGreyBrighter : TissueContrast::kT1;
+    if (gm) {
+        r.tissue_low = std::max(r.background_threshold, r.wm_peak - 3 * r.wm_low_sigma);
+        r.tissue_high = gm->first + 4 * gm->second;
+    } else {
+        const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
+        r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;
+        r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
     }
-    const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
-    r.tissue_low = h.lo + otsu3(h.counts, h).first * h.width;
-    r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
     return extract_brain(image, smooth, head, o, r);
 }
 
@@ -489,7 +374,7 @@ Mask brain_within(const Grid<float>& image, const Grid<float>& smooth, const Mas
     r.brain_extent_mm = extent_mm;
     r.head_voxels = count(head);
     const double top = white_matter_peak(image, head, depth, r);
-    Mask brain = brain_of_contrast(image, smooth, head, o, grey_brighter(r), top, r);
+    Mask brain = brain_of_contrast(image, smooth, head, o, deep_contrast(r, true), top, r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
     r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
     if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);
@@ -595,6 +480,23 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
         known->outside_value = fill;
     }
     return brain;
+}
+
+TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain) {
+    check_image(image);
+    if (!(brain.dims() == image.dims())) throw std::invalid_argument("brain mask: the region is not of the image's size");
+    float low = std::numeric_limits<float>::infinity();
+    for (std::size_t i = 0; i < image.size(); ++i)
+        if (brain[static_cast<PointIndex>(i)] != 0) low = std::min(low, image[static_cast<PointIndex>(i)]);
+    if (!std::isfinite(low)) return TissueContrast::kT1;
+    BrainMaskReport r;  // no air inside a brain: every voxel of it counts
+    r.background_threshold = std::nextafter(low, -std::numeric_limits<float>::infinity());
+    try {
+        white_matter_peak(image, brain, depth_mm(brain), r);
+    } catch (const std::invalid_argument&) {  // one value throughout
+        return TissueContrast::kT1;
+    }
+    return deep_contrast(r, false);
 }
 
 }  // namespace liveset

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "liveset/grid/grid.hpp"
+#include "liveset/segment/tissue_model.hpp"
 
 namespace liveset {
 
@@ -94,7 +95,10 @@ struct BrainMaskReport {
     // and their shares over and under the white-matter peak by 3 σ (its narrower side's).
     double deep_skew = 0;
     double deep_above = 0, deep_below = 0;
-    bool grey_brighter = false;       // the tissue window was mirrored for grey matter brighter than white
+    // The contrast read off the deep head (deep_contrast, brain_histogram.hpp) as the tissue window
+    // was taken: a T1's, or mirrored for grey matter brighter than white (T2, PD; one that finds no
+    // grey-matter peak for it falls back to a T1's).
+    TissueContrast contrast = TissueContrast::kT1;
     double tissue_low = 0;            // brain-tissue window (image units)
     double tissue_high = 0;
     std::size_t head_voxels = 0;      // solid head (filled, closed foreground) within brain_extent_mm of its top
@@ -139,5 +143,11 @@ struct BrainMaskHead {
 // head of another size, or when no brain tissue survives the erosion (mask empty).
 Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& options = {},
                                    BrainMaskReport* report = nullptr, BrainMaskHead* head = nullptr);
+
+// A whole brain's contrast, by the rule auto_brain_mask reads the deep head with (deep_contrast,
+// brain_histogram.hpp) on the deep half of `brain` (by depth inside it), for a brain mask from any
+// source (a region without air: no background test). A T1 for an empty region or one of a single
+// value. Throws std::invalid_argument as auto_brain_mask for a bad image, or a region of another size.
+TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain);
 
 }  // namespace liveset

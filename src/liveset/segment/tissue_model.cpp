@@ -469,10 +469,18 @@ std::vector<double> otsu_thresholds(std::span<const float> values, int classes, 
     return t;
 }
 
+const char* to_string(TissueContrast contrast) {
+    switch (contrast) {
+        case TissueContrast::kT1: return "T1";
+        case TissueContrast::kGreyBrighter: return "grey brighter than white (T2, PD)";
+    }
+    return "?";
+}
+
 std::string tissue_class_name(const TissueModel& model, int k) {
     if (model.classes.size() == 3 && k >= 0 && k < 3) {
-        static const char* const names[] = {"CSF", "GM", "WM"};
-        return names[k];
+        static const char* const names[2][3] = {{"CSF", "GM", "WM"}, {"WM", "GM", "CSF"}};
+        return names[static_cast<int>(model.contrast.value_or(TissueContrast::kT1))][k];
     }
     return "class " + std::to_string(k + 1);
 }

@@ -70,6 +70,13 @@ struct TissueClass {
     }
 };
 
+// The order of a brain's tissues by intensity, as the automatic brain mask reads it off the deep
+// head or a brain (brain_mask.hpp; docs/ARCHITECTURE.md): a T1, CSF < GM < WM; grey matter brighter
+// than white (a T2, a PD), WM < GM < CSF. (A FLAIR, CSF < WM < GM, is read as neither: untested.)
+enum class TissueContrast { kT1, kGreyBrighter };
+// "T1", "grey brighter than white (T2, PD)".
+const char* to_string(TissueContrast contrast);
+
 struct TissueModel {
     std::vector<TissueClass> classes;  // sorted by mean
     std::vector<double> mixed;         // weight of the partial-volume class between k and k+1
@@ -87,6 +94,10 @@ struct TissueModel {
     // σ (mm) of the Gaussian blur (smoothing.hpp) of the image the model was fitted on: 0 for the
     // image itself (fit_window_model, window.hpp, may fit the blurred image when noise hides a class).
     double smooth_mm = 0.0;
+    // The region's contrast where it is a whole brain (brain_contrast, brain_mask.hpp; set by
+    // fit_window_model, window.hpp); nullopt for a region that is not (not read: a T1 assumed). It
+    // names three classes (tissue_class_name).
+    std::optional<TissueContrast> contrast;
 
     bool usable() const { return degenerate.empty(); }
     // Index of the pure class with the largest posterior at `value` (mixed classes ignored).
@@ -126,7 +137,8 @@ std::vector<std::size_t> otsu_split_bins(std::span<const double> counts, std::sp
 // histogram of `bins` bins between their 0.1 and 99.9 % quantiles.
 std::vector<double> otsu_thresholds(std::span<const float> values, int classes, int bins = 256);
 
-// "CSF/GM/WM"-style names for a T1 model of 3 classes, else "class 1".."class K".
+// The tissue names of a model of 3 classes from dark to bright by its contrast (a T1 where not read):
+// CSF, GM, WM, or WM, GM, CSF (grey brighter). "class 1".."class K" for other class counts.
 std::string tissue_class_name(const TissueModel& model, int k);
 
 }  // namespace liveset

@@ -60,14 +60,15 @@ constexpr const char* kShadingHint = "if the scan is shaded: check that it was b
 // region measured is like that, but a bias field can split a tissue into a thin bright class and the
 // rest (BrainWeb under a +-20 % ramp along z: WM 1.1 %, Dice 0.86; 0.936 after N4). Every BrainWeb
 // variant and whole-brain ROI measured keeps each of them at 14 % or more (docs/BENCHMARKS.md,
-// session 47). The darkest class is left out (a tight brain mask leaves next to no CSF), and so are
-// other class counts (a fourth class may be a small lesion population).
+// session 47). CSF is left out (a tight brain mask leaves next to no CSF: the darkest class, the
+// brightest in a T2 or PD), and so are other class counts (a fourth class may be a small lesion population).
 void thin_class_warnings(const TissueModel& m, std::vector<std::string>& warnings) {
     constexpr double kThinClass = 0.03;
     if (m.classes.size() != 3) return;
-    for (std::size_t k = 1; k < m.classes.size(); ++k) {
+    const std::size_t csf = m.contrast == TissueContrast::kGreyBrighter ? 2 : 0;
+    for (std::size_t k = 0; k < m.classes.size(); ++k) {
         const TissueClass& c = m.classes[k];
-        if (c.weight >= kThinClass) continue;
+        if (k == csf || c.weight >= kThinClass) continue;
         std::ostringstream os;
         os.precision(4);  // the mean as window_warnings prints means; the share rounded down, so never "3.0 %"
         os << "tissue model: its " << tissue_class_name(m, static_cast<int>(k)) << " class (mean " << c.mean << ") holds only ";
@@ -138,6 +139,12 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
             m = std::move(next);
         }
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
+        if (whole_brain) {  // which way the classes are named (not read off an image with NaN)
+            try {
+                m.contrast = brain_contrast(image, region);
+            } catch (const std::invalid_argument&) {
+            }
+        }
         // (On BrainWeb only its shaded variants fail the partial-volume fit: say so. Fitted through
         // noise that hid a tissue, the noise is the likelier cause.)
         if (!m.note.empty())

@@ -1,0 +1,118 @@
+// Histogram helpers of the automatic brain mask and its reading of the deep head (brain_histogram.hpp).
+#include "liveset/segment/brain_histogram.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <stdexcept>
+
+#include "liveset/segment/tissue_model.hpp"
+
+namespace liveset::brain_detail {
+
+// The value at fraction q in [0, 1] of the sorted values of `image` inside `mask` (all voxels when
+// null) that lie above `above` — element floor(q·(n − 1)), as std::nth_element places it — or
+// nullopt when there is none. By a histogram of the values' order-preserving bit patterns (their
+// top 16 bits) and a selection among the values of the one bin that holds the element: two passes
+// and no copy of the image.
+std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, double above, double q) {
+    const auto key = [](float v) {
+        const auto u = std::bit_cast<std::uint32_t>(v);
+        return (u & 0x80000000u) != 0 ? ~u : (u | 0x80000000u);
+    };
+    const auto kept = [&](std::size_t i) { return (mask == nullptr || (*mask)[static_cast<PointIndex>(i)] != 0) && image[static_cast<PointIndex>(i)] > above; };
+    std::vector<std::size_t> bins(std::size_t{1} << 16, 0);
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < image.size(); ++i)
+        if (kept(i)) {
+            ++bins[key(image[static_cast<PointIndex>(i)]) >> 16];
+            ++n;
+        }
+    if (n == 0) return std::nullopt;
+    auto k = static_cast<std::size_t>(q * static_cast<double>(n - 1));
+    std::size_t bin = 0;
+    while (k >= bins[bin]) k -= bins[bin++];
+    std::vector<float> in_bin;
+    in_bin.reserve(bins[bin]);
+    for (std::size_t i = 0; i < image.size(); ++i)
+        if (kept(i) && key(image[static_cast<PointIndex>(i)]) >> 16 == bin) in_bin.push_back(image[static_cast<PointIndex>(i)]);
+    std::nth_element(in_bin.begin(), in_bin.begin() + static_cast<std::ptrdiff_t>(k), in_bin.end());
+    return in_bin[k];
+}
+
+Histogram histogram(const Grid<float>& image, const Mask& mask, double lo, double hi) {
+    Histogram h;
+    h.lo = lo;
+    h.width = (hi - lo) / kBins;
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        const double v = image[static_cast<PointIndex>(i)];
+        if (mask[static_cast<PointIndex>(i)] == 0 || v < lo || v > hi) continue;
+        h.counts[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((v - lo) / h.width)))] += 1.0;
+    }
+    return h;
+}
+
+std::vector<double> smoothed(const std::vector<double>& c, double sigma_bins) {
+    const int r = static_cast<int>(std::ceil(3 * sigma_bins));
+    std::vector<double> out(c.size(), 0.0);
+    for (int i = 0; i < static_cast<int>(c.size()); ++i)
+        for (int k = -r; k <= r; ++k) {
+            const int j = std::clamp(i + k, 0, static_cast<int>(c.size()) - 1);
+            out[static_cast<std::size_t>(i)] += c[static_cast<std::size_t>(j)] * std::exp(-0.5 * k * k / (sigma_bins * sigma_bins));
+        }
+    return out;
+}
+
+std::pair<int, int> otsu3(const std::vector<double>& h, const Histogram& geom) {
+    std::vector<double> centres(h.size());
+    for (std::size_t i = 0; i < h.size(); ++i) centres[i] = geom.centre(static_cast<int>(i));
+    const std::vector<std::size_t> s = otsu_split_bins(h, centres, 3);
+    return {static_cast<int>(s[0]), static_cast<int>(s[1])};
+}
+
+Peak tallest(const std::vector<double>& s) {
+    Peak p{static_cast<int>(std::max_element(s.begin(), s.end()) - s.begin())};
+    const double half = 0.5 * s[static_cast<std::size_t>(p.bin)];
+    for (p.high = p.bin; p.high < kBins - 1 && s[static_cast<std::size_t>(p.high)] > half;) ++p.high;
+    for (p.low = p.bin; p.low > 0 && s[static_cast<std::size_t>(p.low)] > half;) --p.low;
+    return p;
+}
+
+double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r) {
+    float deepest = 0;
+    for (std::size_t i = 0; i < head.size(); ++i)
+        if (head[static_cast<PointIndex>(i)] != 0) deepest = std::max(deepest, depth[static_cast<PointIndex>(i)]);
+    Mask deep(head.lattice());
+    for (std::size_t i = 0; i < head.size(); ++i)
+        deep[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && depth[static_cast<PointIndex>(i)] >= 0.5f * deepest;
+    const std::optional<float> top = quantile_above(image, &head, r.background_threshold, 0.995);
+    if (!top) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
+    if (!(*top > r.background_threshold)) throw std::invalid_argument("brain mask: no brain tissue found (the head has no contrast)");
+    const Histogram h = histogram(image, deep, r.background_threshold, *top);
+    const Peak wm = tallest(smoothed(h.counts, 2.0));
+    r.wm_peak = h.centre(wm.bin);
+    r.wm_sigma = std::max(h.width, (h.centre(wm.high) - r.wm_peak) / 1.1774);
+    r.wm_low_sigma = std::max(h.width, (r.wm_peak - h.centre(wm.low)) / 1.1774);
+    // Which side of white matter grey matter and CSF lie on (deep_contrast): the deep voxels above the background.
+    const std::optional<float> q10 = quantile_above(image, &deep, r.background_threshold, 0.1);
+    if (!q10) return *top;
+    const double q50 = *quantile_above(image, &deep, r.background_threshold, 0.5);
+    const double q90 = *quantile_above(image, &deep, r.background_threshold, 0.9), narrow = std::min(r.wm_sigma, r.wm_low_sigma);
+    r.deep_skew = q90 > *q10 ? (q90 + *q10 - 2.0 * q50) / (q90 - *q10) : 0.0;
+    double n = 0, above = 0, below = 0;
+    for (std::size_t k = 0; k < deep.size(); ++k)
+        if (const double x = image[static_cast<PointIndex>(k)]; deep[static_cast<PointIndex>(k)] != 0 && x > r.background_threshold)
+            n += 1, above += x > r.wm_peak + 3 * narrow, below += x < r.wm_peak - 3 * narrow;
+    r.deep_above = above / n;
+    r.deep_below = below / n;
+    return *top;
+}
+
+TissueContrast deep_contrast(const BrainMaskReport& r, bool in_head) {
+    if (r.deep_skew > 0.0 && r.deep_above >= 0.25 && r.deep_above > 4.0 * r.deep_below &&
+        (!in_head || r.wm_peak - 3.0 * r.wm_low_sigma > r.background_threshold))
+        return TissueContrast::kGreyBrighter;
+    return TissueContrast::kT1;
+}
+
+}  // namespace liveset::brain_detail

@@ -1,0 +1,58 @@
+// Histogram helpers of the automatic brain mask (brain_mask.cpp) and its reading of the deep head's
+// contrast (T1, or grey matter brighter than white: T2, PD). Internal to the segment library.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/segment/brain_mask.hpp"
+
+namespace liveset::brain_detail {
+
+using Mask = Grid<std::uint8_t>;
+
+constexpr int kBins = 128;
+
+// The value at fraction q in [0, 1] of the sorted values of `image` inside `mask` (all voxels when
+// null) that lie above `above` (element floor(q·(n − 1)), as std::nth_element places it), or
+// nullopt when there is none. Two passes, no copy of the image.
+std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, double above, double q);
+
+// A kBins-bin histogram over [lo, hi] of the image's voxels inside `mask` (values outside the range
+// are not counted).
+struct Histogram {
+    double lo = 0, width = 1;
+    std::vector<double> counts = std::vector<double>(kBins, 0.0);
+    double centre(int bin) const { return lo + (bin + 0.5) * width; }
+};
+Histogram histogram(const Grid<float>& image, const Mask& mask, double lo, double hi);
+
+// Counts smoothed by a Gaussian of sigma_bins bins (the ends repeated).
+std::vector<double> smoothed(const std::vector<double>& c, double sigma_bins);
+
+// Three-class Otsu (tissue_model.hpp) on a histogram: the first bins of the middle and upper classes.
+std::pair<int, int> otsu3(const std::vector<double>& h, const Histogram& geom);
+
+// The tallest bin of a smoothed histogram and the bins, on either side, where it first falls to half.
+struct Peak { int bin = 0, low = 0, high = 0; };
+Peak tallest(const std::vector<double>& s);
+
+// White-matter peak and widths from the deepest half of `head` by `depth` (mm; T1: mostly white
+// matter), and that half's skew and shares about the peak (BrainMaskReport::deep_skew, deep_above,
+// deep_below), all of it over r.background_threshold; returns the head's 99.5th percentile above
+// the background (the histograms' top). Throws std::invalid_argument where nothing lies above the
+// background, or all of it at one value.
+double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r);
+
+// The contrast of a deep head (or brain) from white_matter_peak's figures. Grey matter brighter than
+// white (a T2, a PD): the deep part skewed bright, at least a quarter of it 3 σ above the white-matter
+// peak and over 4 times as much as 3 σ below, and - in a head (`in_head`) - that peak 3 σ clear of
+// the background threshold (not the air's noise cut off there). Else a T1. What each part keeps out
+// (a child's neck, noisy heads, the phantom's bias, a noisy field of view) and the measured margins:
+// docs/ARCHITECTURE.md.
+TissueContrast deep_contrast(const BrainMaskReport& r, bool in_head);
+
+}  // namespace liveset::brain_detail
