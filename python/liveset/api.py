@@ -137,10 +137,12 @@ def _mask_arg(mask, img: Image, what: str, allow_auto: bool = False):
 def tissue_model(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius: float = 2.0,
                  roi=None, classes: int = 3, window_from: str = "model",
                  bias_correct: Optional[bool] = None) -> dict:
-    """The tissue model (CSF/GM/WM mixture with partial volume) fitted where ``segment`` fits it,
+    """The tissue model (a mixture of tissue classes with partial volume) fitted where ``segment`` fits it,
     on the image ``segment`` fits it on (bias-corrected as there: ``bias_correct`` as in
     ``segment``), and, with seeds, the threshold window ``segment`` would use: a dict with
-    ``intensity_scale``, ``tissue_model`` (classes: name, mean, sigma, weight; seed_class),
+    ``intensity_scale``, ``tissue_model`` (classes: name, mean, sigma, weight; seed_class; contrast:
+    "T1" or "grey brighter than white (T2, PD)" where the region is a whole brain, naming the classes
+    CSF, GM, WM or WM, GM, CSF from dark to bright, else None),
     ``window`` (mu, epsilon normalised; mu_raw, epsilon_raw, lower_raw, upper_raw; source),
     ``warnings`` and, when N4 ran, ``bias_correction``."""
     img = as_image(image)

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -668,6 +669,7 @@ TEST(BrainMask, AnalyticHeadGivesTheBrainSphereWithinAVoxel) {
         const Grid<float> head = sphere_head(spacing, &brain);
         BrainMaskReport r;
         const Mask mask = auto_brain_mask(head, {}, &r);
+        EXPECT_EQ(brain_contrast(head, mask), TissueContrast::kT1);  // the phantom's brain alone reads as a T1 too
         std::size_t differ = 0;
         for (std::size_t i = 0; i < mask.size(); ++i) differ += mask[static_cast<PointIndex>(i)] != brain[static_cast<PointIndex>(i)];
         std::printf("spacing %s: window %.1f..%.1f, brain %zu voxels, mask %zu, %zu differ, contact %.2f\n",
@@ -919,5 +921,14 @@ TEST(BrainMask, AT2BrainsTissueModelNamesItsClassesFromWhiteMatterUp) {
         EXPECT_EQ(tissue_class_name(*m, model_window(*m, values).seed_class), "GM");
     }
     std::vector<std::string> warnings;
-    EXPECT_FALSE(fit_window_model(t2, bw.brain_mask, {}, warnings, false)->contrast.has_value());
+    const std::optional<TissueModel> roi_model = fit_window_model(t2, bw.brain_mask, {}, warnings, false);
+    ASSERT_TRUE(roi_model.has_value());
+    EXPECT_FALSE(roi_model->contrast.has_value());
+    // The automatic mask, as --roi auto hands it over, reads the same; and NaN outside it is not read.
+    Mask automatic = auto_brain_mask(t2);
+    EXPECT_EQ(brain_contrast(t2, automatic), TissueContrast::kGreyBrighter);
+    Grid<float> masked = t2;
+    for (PointIndex i = 0; i < masked.size(); ++i)
+        if (automatic[i] == 0) masked[i] = std::numeric_limits<float>::quiet_NaN();
+    EXPECT_EQ(brain_contrast(masked, automatic), TissueContrast::kGreyBrighter);
 }

@@ -17,16 +17,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Component = itk::IOComponentEnum;
-using io_detail::bytes_text;
-using io_detail::check_data;
-using io_detail::condense;
-using io_detail::create_io;
-using io_detail::fail_write;
-using io_detail::flip_ras_lps;
-using io_detail::is_minc;
-using io_detail::prepare_io;
-using io_detail::quoted;
-using io_detail::register_factories;
+using namespace io_detail;  // itk_io.hpp, messages.hpp, minc_world.hpp
 
 // Hands the lattice's geometry to a writer (MINC: converted to RAS) and sets the whole image as the region.
 void set_geometry(itk::ImageIOBase& io, const Lattice& lattice) {

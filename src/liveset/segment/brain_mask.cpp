@@ -21,7 +21,17 @@ namespace liveset {
 
 namespace {
 
-using namespace brain_detail;
+using brain_detail::Histogram;
+using brain_detail::kBins;
+using brain_detail::Mask;
+using brain_detail::Peak;
+using brain_detail::deep_contrast;
+using brain_detail::histogram;
+using brain_detail::otsu3;
+using brain_detail::quantile_above;
+using brain_detail::smoothed;
+using brain_detail::tallest;
+using brain_detail::white_matter_peak;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -483,16 +493,20 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
 }
 
 TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain) {
-    check_image(image);
     if (!(brain.dims() == image.dims())) throw std::invalid_argument("brain mask: the region is not of the image's size");
+    Mask finite(brain.lattice(), 0);  // the brain's voxels with a value (a masked scan's NaN outside it are not read)
     float low = std::numeric_limits<float>::infinity();
-    for (std::size_t i = 0; i < image.size(); ++i)
-        if (brain[static_cast<PointIndex>(i)] != 0) low = std::min(low, image[static_cast<PointIndex>(i)]);
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if (brain[p] == 0 || !std::isfinite(image[p])) continue;
+        finite[p] = 1;
+        low = std::min(low, image[p]);
+    }
     if (!std::isfinite(low)) return TissueContrast::kT1;
     BrainMaskReport r;  // no air inside a brain: every voxel of it counts
     r.background_threshold = std::nextafter(low, -std::numeric_limits<float>::infinity());
     try {
-        white_matter_peak(image, brain, depth_mm(brain), r);
+        white_matter_peak(image, finite, depth_mm(brain), r);
     } catch (const std::invalid_argument&) {  // one value throughout
         return TissueContrast::kT1;
     }

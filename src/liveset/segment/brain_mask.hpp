@@ -146,8 +146,10 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
 
 // A whole brain's contrast, by the rule auto_brain_mask reads the deep head with (deep_contrast,
 // brain_histogram.hpp) on the deep half of `brain` (by depth inside it), for a brain mask from any
-// source (a region without air: no background test). A T1 for an empty region or one of a single
-// value. Throws std::invalid_argument as auto_brain_mask for a bad image, or a region of another size.
+// source (a region without air: no background test); its non-finite voxels are left out. A T1 for an
+// empty region or one of a single value. It may differ from BrainMaskReport::contrast of the same
+// brain, which also tests the background and falls back to a T1's window without a grey-matter peak.
+// Throws std::invalid_argument for a region of another size than the image.
 TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain);
 
 }  // namespace liveset

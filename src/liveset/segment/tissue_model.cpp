@@ -479,8 +479,11 @@ const char* to_string(TissueContrast contrast) {
 
 std::string tissue_class_name(const TissueModel& model, int k) {
     if (model.classes.size() == 3 && k >= 0 && k < 3) {
-        static const char* const names[2][3] = {{"CSF", "GM", "WM"}, {"WM", "GM", "CSF"}};
-        return names[static_cast<int>(model.contrast.value_or(TissueContrast::kT1))][k];
+        static const char* const t1[] = {"CSF", "GM", "WM"};
+        switch (model.contrast.value_or(TissueContrast::kT1)) {
+            case TissueContrast::kT1: return t1[k];
+            case TissueContrast::kGreyBrighter: return t1[2 - k];
+        }
     }
     return "class " + std::to_string(k + 1);
 }

@@ -72,7 +72,8 @@ struct TissueClass {
 
 // The order of a brain's tissues by intensity, as the automatic brain mask reads it off the deep
 // head or a brain (brain_mask.hpp; docs/ARCHITECTURE.md): a T1, CSF < GM < WM; grey matter brighter
-// than white (a T2, a PD), WM < GM < CSF. (A FLAIR, CSF < WM < GM, is read as neither: untested.)
+// than white (a T2, a PD), WM < GM < CSF. (A FLAIR, CSF < WM < GM, reads as a T1: its GM and WM
+// classes are then named the wrong way round; docs/BENCHMARKS.md, session 64.)
 enum class TissueContrast { kT1, kGreyBrighter };
 // "T1", "grey brighter than white (T2, PD)".
 const char* to_string(TissueContrast contrast);

@@ -139,12 +139,7 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
             m = std::move(next);
         }
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
-        if (whole_brain) {  // which way the classes are named (not read off an image with NaN)
-            try {
-                m.contrast = brain_contrast(image, region);
-            } catch (const std::invalid_argument&) {
-            }
-        }
+        if (whole_brain) m.contrast = brain_contrast(image, region);  // which way the classes are named
         // (On BrainWeb only its shaded variants fail the partial-volume fit: say so. Fitted through
         // noise that hid a tissue, the noise is the likelier cause.)
         if (!m.note.empty())
