@@ -127,6 +127,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
         if (init) req.initial_mask = &*init;
         req.model_region = fit;
         req.model_region_is_brain = prepared.fit_is_brain(roi);
+        req.brain_mask = lookup.options;
         const SegmentationHook hook = [&](const SegmentationProgress& p, const ChangedPoints&) {
             return interrupt.poll_with([&]() -> pyb::object {
                 return pyb::dict(pyb::arg("iteration") = p.iteration, pyb::arg("zero_layer") = p.zero_layer,
@@ -202,7 +203,7 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
     const IntensityScale scale = robust_scale(image, roi_mask, req.scale);
     std::vector<std::string> warnings;
     bool automatic = false;
-    const Grid<std::uint8_t> region = model_region(image, fit, roi_mask, a.classes, &automatic);
+    const Grid<std::uint8_t> region = model_region(image, fit, roi_mask, a.classes, &automatic, lookup.options);
     const std::optional<TissueModel> model =
         fit_window_model(image, region, req.window.model, warnings, automatic || prepared.fit_is_brain(roi));
     nlohmann::json j;
@@ -266,7 +267,8 @@ std::string evaluate(const pyb::array& mask, const pyb::array& truth, const Latt
 // `liveset holes` (apps/cli/cmd_holes.cpp) on arrays: the sheet's band given or from the tissue
 // model (sheet_window), the candidates largest first. Returns the JSON text.
 std::string find_holes_json(const pyb::array& mask, const pyb::array& image, const pyb::object& roi, const Lattice& lattice,
-                            const std::optional<std::pair<double, double>>& band, std::size_t min_voxels, double min_sheet_share) {
+                            const std::optional<std::pair<double, double>>& band, std::size_t min_voxels, double min_sheet_share,
+                            bool oriented) {
     const Grid<std::uint8_t> m = mask_from_array(mask, lattice);
     const Grid<float> img = scan_from_array(image, lattice).image;
     std::optional<Grid<std::uint8_t>> r;
@@ -280,7 +282,8 @@ std::string find_holes_json(const pyb::array& mask, const pyb::array& image, con
         fo.sheet_lower = band->first;
         fo.sheet_upper = band->second;
     } else {
-        const std::optional<ModelWindow> w = sheet_window(img, m, r ? &*r : nullptr, TissueModelOptions{}, warnings);
+        const std::optional<ModelWindow> w = sheet_window(img, m, r ? &*r : nullptr, TissueModelOptions{}, warnings, nullptr, false,
+                                                              lookup_for(oriented).options);
         if (!w) throw std::invalid_argument("cannot tell the sheet's tissue from the image (" +
                                             (warnings.empty() ? std::string("no tissue model") : warnings.back()) +
                                             "); give sheet_band=(lower, upper)");
@@ -306,6 +309,7 @@ struct RepairHolesArgs {
     double p = 0.3;
     std::uint64_t seed = 1;
     double between_share = 0.25;  // SwarmOptions::sheet_between_share
+    bool oriented = true;         // the image's header gave an orientation (Image.oriented)
 };
 
 // `liveset repair --find-holes` (finder_repair.hpp) on arrays: the finder's largest holes, one
@@ -325,6 +329,7 @@ pyb::tuple repair_holes(const pyb::array& level, bool is_mask, const pyb::array&
         pyb::gil_scoped_release nogil;
         SessionOptions so;
         so.fragment_size = 8;  // as `liveset repair`
+        so.brain_mask = lookup_for(a.oriented).options;
         Session session(img, so, r);
         if (mask_in) session.load_mask(*mask_in);
         else session.load_phi(*phi_in);
@@ -333,7 +338,7 @@ pyb::tuple repair_holes(const pyb::array& level, bool is_mask, const pyb::array&
         if (a.band) {
             in.band = {a.band->first, a.band->second, 0.5 * (a.band->first + a.band->second)};
         } else {
-            const std::optional<cli::SheetBand> b = cli::model_sheet_band(img, inside_mask(session.field().phi(), roi_ptr), roi_ptr);
+            const std::optional<cli::SheetBand> b = cli::model_sheet_band(img, inside_mask(session.field().phi(), roi_ptr), roi_ptr, so.brain_mask);
             if (!b) throw std::invalid_argument("cannot tell the sheet's tissue from the image; give sheet_band=(lower, upper)");
             in.band = *b;
         }
@@ -421,17 +426,18 @@ void register_core(pyb::module_& m) {
         return mesh(v, lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]), is_mask, out);
     });
     m.def("_find_holes", [](const pyb::array& mask, const pyb::array& image, const pyb::object& roi, const pyb::tuple& geo,
-                            const std::optional<std::pair<double, double>>& band, std::size_t min_voxels, double min_sheet_share) {
+                            const std::optional<std::pair<double, double>>& band, std::size_t min_voxels, double min_sheet_share,
+                            bool oriented) {
         if (mask.ndim() != 3) throw std::invalid_argument("the mask must be a 3D array");
         const Lattice l = lattice_from(pyb::make_tuple(mask.shape(0), mask.shape(1), mask.shape(2)), geo[0], geo[1], geo[2]);
-        return find_holes_json(mask, image, roi, l, band, min_voxels, min_sheet_share);
+        return find_holes_json(mask, image, roi, l, band, min_voxels, min_sheet_share, oriented);
     });
     m.def("_repair_holes", [](const pyb::array& level, bool is_mask, const pyb::array& image, const pyb::object& roi, const pyb::tuple& geo,
                               const std::optional<std::pair<double, double>>& band, std::size_t holes, std::size_t min_voxels, int round_steps,
-                              std::size_t agents, double p, std::uint64_t seed, double between_share) {
+                              std::size_t agents, double p, std::uint64_t seed, double between_share, bool oriented) {
         if (level.ndim() != 3) throw std::invalid_argument("phi_or_mask must be a 3D array");
         const Lattice l = lattice_from(pyb::make_tuple(level.shape(0), level.shape(1), level.shape(2)), geo[0], geo[1], geo[2]);
-        return repair_holes(level, is_mask, image, roi, l, RepairHolesArgs{band, holes, min_voxels, agents, round_steps, p, seed, between_share});
+        return repair_holes(level, is_mask, image, roi, l, RepairHolesArgs{band, holes, min_voxels, agents, round_steps, p, seed, between_share, oriented});
     });
     m.def("_evaluate", [](const pyb::array& mask, const pyb::array& truth, const pyb::tuple& geo) {
         if (mask.ndim() != 3) throw std::invalid_argument("the mask must be a 3D array");

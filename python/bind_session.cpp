@@ -15,7 +15,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
                                       const pyb::object& model_region, bool region_is_brain, double n,
                                       std::optional<double> alpha, std::optional<double> smooth_mm, int layers, int fragment_size, std::size_t history,
                                       int agents, double p, std::uint64_t seed, bool sleeping, const std::string& decision,
-                                      double edit_range) {
+                                      double edit_range, bool oriented) {
     if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
     const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
     Grid<float> image = grid_from_array(v, l);
@@ -25,6 +25,9 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     // Where the tissue model is fitted (the automatic brain mask prepare_image found, as the viewer).
     if (!model_region.is_none()) o.model_region = mask_from_array(model_region.cast<pyb::array>(), l);
     o.model_region_is_brain = region_is_brain;  // the ROI or that mask is an automatic brain mask
+    ImageHeader header;
+    header.orientation_known = oriented;
+    o.brain_mask = cli::brain_mask_options(header);  // where no region was found: looked for as segment looks
     o.layers = layers;
     o.fragment_size = fragment_size;
     o.history = history;
@@ -103,7 +106,7 @@ void register_session(pyb::module_& m) {
         .def(pyb::init(&make_session), pyb::arg("image"), pyb::arg("geometry"), pyb::arg("roi"), pyb::arg("model_region"),
              pyb::arg("region_is_brain"), pyb::arg("n"),
              pyb::arg("alpha"), pyb::arg("smooth_mm"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
-             pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"))
+             pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"), pyb::arg("oriented"))
         .def("add_seed", [](Session& s, const std::vector<double>& c, double r) {
             if (!s.lattice().contains(point(c))) throw std::invalid_argument("the seed lies outside the image");
             s.add_seed({point(c), r});

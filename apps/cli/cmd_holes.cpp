@@ -52,7 +52,8 @@ int run_holes(const HolesArgs& a, int threads) {
         fo.sheet_lower = *a.lower;
         fo.sheet_upper = *a.upper;
     } else {
-        const std::optional<ModelWindow> w = sheet_window(image, mask, r, TissueModelOptions{}, warnings);
+        const std::optional<ModelWindow> w = sheet_window(image, mask, r, TissueModelOptions{}, warnings, nullptr, false,
+                                                                  brain_mask_options(header));
         if (!w) throw UsageError(fmt::format("cannot tell the sheet's tissue from the image ({}); give --sheet-lower and --sheet-upper",
                                              warnings.empty() ? "no tissue model" : warnings.back()));
         fo.sheet_lower = w->lower;

@@ -72,9 +72,9 @@ constexpr double kVerdictRadius = kHoleVerdictRadius;  // the finder's verdict c
 // The sheet's band for the finder's verdicts and --decision sheet: given (its mean the band's
 // middle), or the tissue model's (model_sheet_band; nullopt when it cannot be told).
 std::optional<SheetBand> sheet_band(const RepairArgs& a, const Grid<float>& image, const Grid<std::uint8_t>& mask,
-                                    const Grid<std::uint8_t>* roi) {
+                                    const Grid<std::uint8_t>* roi, const BrainMaskOptions& brain) {
     if (a.sheet_lower) return SheetBand{*a.sheet_lower, *a.sheet_upper, 0.5 * (*a.sheet_lower + *a.sheet_upper)};
-    return model_sheet_band(image, mask, roi);
+    return model_sheet_band(image, mask, roi, brain);
 }
 
 // Bad targets, before anything runs or is written: outside the ROI, or with no surface within the
@@ -233,10 +233,11 @@ RepairInputs load_inputs(const RepairArgs& a) {
     // 8³-cell fragments); the session's scale is robust_scale(image, roi), as before.
     SessionOptions so;
     so.fragment_size = 8;
+    so.brain_mask = brain_mask_options(scan.header);  // without a ROI the brain is looked for as `segment` looks
     in.session = std::make_unique<Session>(in.image, so, in.roi);
     load_level_set(*in.session, a.input);
     in.mask_before = inside_mask(in.session->field().phi(), in.roi_ptr());
-    in.band = sheet_band(a, in.image, in.mask_before, in.roi_ptr());
+    in.band = sheet_band(a, in.image, in.mask_before, in.roi_ptr(), so.brain_mask);
     if (!a.quiet && !note.empty()) fmt::print(stderr, "liveset: note: {}\n", note);  // the inputs are good
     return in;
 }

@@ -123,6 +123,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
 
     add_regions(req, roi, init, fit, prepared.fit_is_brain(roi));
+    req.brain_mask = lookup.options;  // where no region was found: looked for again as the ROI was
     if (!a.quiet) scan.print_note(a.image);  // the inputs are good
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {

@@ -63,10 +63,11 @@ HoleFinderOptions SheetBand::finder() const {
     return o;
 }
 
-std::optional<SheetBand> model_sheet_band(const Grid<float>& image, const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* roi) {
+std::optional<SheetBand> model_sheet_band(const Grid<float>& image, const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* roi,
+                                          const BrainMaskOptions& brain) {
     std::vector<std::string> warnings;
     TissueModel model;
-    const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, warnings, &model);
+    const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, warnings, &model, false, brain);
     if (!w) return std::nullopt;
     return SheetBand{w->lower, w->upper, model.classes[static_cast<std::size_t>(w->seed_class)].mean};
 }

@@ -23,8 +23,10 @@ struct SheetBand {
 };
 
 // The tissue model's window and class mean for the class most of `mask`'s voxels are in
-// (sheet_window); nullopt when the model cannot tell the sheet's tissue.
-std::optional<SheetBand> model_sheet_band(const Grid<float>& image, const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* roi);
+// (sheet_window, looking for the brain with `brain`: brain_mask_options(header)); nullopt when the
+// model cannot tell the sheet's tissue.
+std::optional<SheetBand> model_sheet_band(const Grid<float>& image, const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* roi,
+                                          const BrainMaskOptions& brain = {});
 
 struct FoundHolesInput {
     const Grid<float>& image;            // the image the segmentation came from (raw units)

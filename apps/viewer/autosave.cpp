@@ -53,6 +53,7 @@ void Autosave::attach(Session* session, const std::string& image_path, bool corr
     file_.clear();
     if (!enabled() || !session || image_.empty()) return;
     session_ = session;
+    roi_checksum_ = session->roi() ? std::optional(mask_checksum(*session->roi())) : std::nullopt;
     std::error_code ec;
     std::filesystem::create_directories(config_.dir, ec);
     if (ec) {
@@ -84,8 +85,10 @@ std::string Autosave::offer_summary() const {
     if (!offer_) return {};
     const SessionMarks& m = offer_->marks;
     std::string how = offer_->signal ? fmt::format(", saved when the viewer received {}", signal_name(offer_->signal)) : "";
-    return fmt::format("unsaved work from {} ({} seed(s), {} iteration(s){}) in {}", local_time(offer_->unix_time), m.seeds.size(),
-                       m.iterations, how, file_.string());
+    // Older files record no ROI: nothing to compare.
+    const std::string roi = offer_->roi_recorded ? roi_difference(offer_->roi_checksum, roi_checksum_) : "";
+    return fmt::format("unsaved work from {} ({} seed(s), {} iteration(s){}) in {}{}", local_time(offer_->unix_time), m.seeds.size(),
+                       m.iterations, how, file_.string(), roi.empty() ? "" : "; " + roi);
 }
 
 bool Autosave::restore() {
@@ -130,7 +133,7 @@ void Autosave::tick() {
     }
     if (tracked_revision_ != revision) {
         try {
-            crash_->track(image_, session_->marks(), session_->field().phi(), session_->field().status());
+            crash_->track(image_, session_->marks(), roi_checksum_, session_->field().phi(), session_->field().status());
         } catch (const std::exception& e) {
             message_ = e.what();
         }
@@ -143,7 +146,7 @@ void Autosave::tick() {
 
 void Autosave::write(const char* why) {
     try {
-        write_recovery(file_, RecoveryView(image_, 0, static_cast<std::int64_t>(std::time(nullptr)), session_->marks(),
+        write_recovery(file_, RecoveryView(image_, 0, static_cast<std::int64_t>(std::time(nullptr)), session_->marks(), roi_checksum_,
                                            session_->field().phi(), session_->field().status()));
         message_ = fmt::format("{} unsaved work in {}", why, file_.string());
         routine_ = !exited_;

@@ -43,7 +43,9 @@ public:
 
     // The pending offer: a recovery file awaiting the user's choice (autosave waits meanwhile).
     bool offer_pending() const { return offer_.has_value(); }
-    std::string offer_summary() const;  // "unsaved work from 2026-11-23 11:02 (3 seeds, 120 iterations, ...)"
+    // "unsaved work from 2026-11-23 11:02 (3 seeds, 120 iterations, ...)", and how its ROI differs
+    // from this session's ("; saved with another ROI", roi_difference).
+    std::string offer_summary() const;
     // Loads the offered state into the session (false + message() when it cannot).
     bool restore();
     void discard();  // removes the recovery file
@@ -69,6 +71,7 @@ private:
     AutosaveConfig config_;
     Session* session_ = nullptr;
     std::string image_;
+    std::optional<std::uint64_t> roi_checksum_;  // the session's ROI (mask_checksum), recorded in the file
     std::filesystem::path file_;
     std::optional<RecoveryState> offer_;
     std::optional<CrashRecovery> crash_;

@@ -24,7 +24,8 @@ public:
     // What a crash would save: `phi` and `status` are read in place by the handler (they must
     // outlive the registration or be replaced first); the image path and marks are serialised now.
     // Call again whenever the marks change or the grids move.
-    void track(const std::string& image, const SessionMarks& marks, const Grid<float>& phi, const Grid<std::int8_t>& status);
+    void track(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum, const Grid<float>& phi,
+               const Grid<std::int8_t>& status);
     void untrack();  // a crash now writes nothing (e.g. the work was saved)
     const std::filesystem::path& path() const { return path_; }
 

@@ -17,8 +17,9 @@ namespace {
 // inside voxels fall in (as the hole finder picks the sheet's class).
 std::string model_window_for_level_set(const Session& s, ThresholdParams& p, bool& from_seeds) {
     std::vector<std::string> warnings;
-    const std::optional<ModelWindow> w = sheet_window(s.image(), s.mask(), s.roi(), TissueModelOptions{}, warnings, nullptr,
-                                                              s.options().model_region_is_brain);
+    TissueModel model;
+    const std::optional<ModelWindow> w = sheet_window(s.image(), s.mask(), s.roi(), TissueModelOptions{}, warnings, &model,
+                                                              s.options().model_region_is_brain, s.options().brain_mask);
     const IntensityScale& sc = s.scale();
     if (!w) {
         return fmt::format("µ, ε: no usable tissue model ({}); µ {:.4g}, ε {:.4g} (raw) are defaults: set them (panel or --mu-raw/--epsilon-raw)",
@@ -27,8 +28,8 @@ std::string model_window_for_level_set(const Session& s, ThresholdParams& p, boo
     p.mu = std::clamp((w->mu() - sc.low) / (sc.high - sc.low), 0.0, 1.0);
     p.epsilon = sc.unit_length(w->epsilon());
     from_seeds = false;
-    return fmt::format("µ, ε from the tissue model: the window of class {} (most of the level set's inside), µ {:.4g}, ε {:.4g} (raw)",
-                       w->seed_class + 1, w->mu(), w->epsilon());
+    return fmt::format("µ, ε from the tissue model: the window of {} (most of the level set's inside), µ {:.4g}, ε {:.4g} (raw)",
+                       tissue_class_name(model, w->seed_class), w->mu(), w->epsilon());
 }
 
 // Where the session's automatic α (and pre-smoothing) came from (Session::automatic_alpha_choice,

@@ -234,23 +234,15 @@ std::uint64_t image_checksum(const Grid<float>& image) {
     return h.h;
 }
 
-std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask) {
-    recovery_format::Fnv h;
-    for (std::size_t i = 0; i < mask.size(); ++i) {
-        const std::uint8_t inside = mask[static_cast<PointIndex>(i)] != 0;
-        h.add(&inside, 1);
-    }
-    return h.h;
-}
-
 fs::path workspace_state_path(const fs::path& workspace) { return fs::path(workspace.string() + ".state"); }
 
 void save_workspace(const fs::path& path, const Session& session, const std::string& image, const std::string& roi,
                     bool bias_corrected, const WorkspaceView& view) {
     const SessionMarks& m = session.marks();
     const auto now = std::chrono::duration_cast<std::chrono::seconds>(std::chrono::system_clock::now().time_since_epoch()).count();
-    const std::vector<std::uint8_t> state =
-        encode_recovery(RecoveryView(image, 0, static_cast<std::int64_t>(now), m, session.field().phi(), session.field().status()));
+    const std::optional<std::uint64_t> roi_fnv = session.roi() ? std::optional(mask_checksum(*session.roi())) : std::nullopt;
+    const std::vector<std::uint8_t> state = encode_recovery(
+        RecoveryView(image, 0, static_cast<std::int64_t>(now), m, roi_fnv, session.field().phi(), session.field().status()));
     const Lattice& l = session.lattice();
     json seeds = json::array();
     for (const SeedBall& s : m.seeds) seeds.push_back({s.center.x, s.center.y, s.center.z, s.radius});
@@ -261,7 +253,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
            {"geometry", {{"dims", {l.dims().x, l.dims().y, l.dims().z}}, {"spacing", vec(l.spacing())}, {"origin", vec(l.origin())},
                          {"direction", l.direction()}}},
            {"image_fnv", image_checksum(session.image())},
-           {"roi_fnv", session.roi() ? json(mask_checksum(*session.roi())) : json(nullptr)},
+           {"roi_fnv", roi_fnv ? json(*roi_fnv) : json(nullptr)},
            {"state", {{"file", workspace_state_path(path).filename().string()}, {"fnv", trailing_checksum(state)}}},
            {"seeds", seeds},
            {"params", {{"mu", m.params.mu}, {"epsilon", m.params.epsilon}, {"n", m.params.n}, {"alpha", m.params.alpha},

@@ -44,8 +44,7 @@ struct Workspace {
 
 // FNV-1a of the image's voxel values (float bits, in index order).
 std::uint64_t image_checksum(const Grid<float>& image);
-// FNV-1a of a mask's voxels (0 or not, in index order).
-std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask);
+// (The ROI's checksum: mask_checksum, liveset/session/recovery.hpp.)
 // The state file next to a workspace file: "<W>.state".
 std::filesystem::path workspace_state_path(const std::filesystem::path& workspace);
 

@@ -212,7 +212,7 @@ def find_holes(mask, image, roi=None, sheet_band=None, min_voxels: int = 10, min
         r = np.asarray(ri.array) != 0
     band = None if sheet_band is None else (float(sheet_band[0]), float(sheet_band[1]))
     return json.loads(_liveset._find_holes(np.asarray(m.array) != 0, np.asarray(img.array, dtype=np.float32), r,
-                                           m.geometry, band, int(min_voxels), float(min_sheet_share)))
+                                           m.geometry, band, int(min_voxels), float(min_sheet_share), bool(img.oriented)))
 
 
 def set_threads(threads: int) -> None:

@@ -68,7 +68,7 @@ class Session:
                                     None if smooth_mm is None else float(smooth_mm), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),
                                     bool(sleeping), str(decision),
-                                    float(_edit_range(decision, edit_range)))
+                                    float(_edit_range(decision, edit_range)), bool(img.oriented))
 
     # seeds and parameters
     def add_seed(self, ijk: Sequence[float], radius: float = 2.0) -> None:
@@ -254,5 +254,5 @@ def repair_holes(phi_or_mask, image, holes: int = 10, *, roi=None, sheet_band=No
     level = (a != 0) if is_mask else np.asarray(a, dtype=np.float32)
     phi, report = _liveset._repair_holes(level, is_mask, np.asarray(img.array, dtype=np.float32), r, img.geometry, band,
                                           int(holes), int(min_voxels), int(round_steps), int(agents), float(p), int(seed),
-                                          float(between_share))
+                                          float(between_share), bool(img.oriented))
     return img.like(phi), json.loads(report)

@@ -123,6 +123,39 @@ TEST(Autosave, UnsavedWorkIsKeptAtExitRestoredWithRecoverAndGoneOnceSaved) {
     EXPECT_TRUE(recovery_files(rec).empty()) << "the work was saved: its recovery file should be gone";
 }
 
+// The recovery file records the session's ROI; restoring the work where the ROI differs says so
+// (the work is restored: the user chose the ROI), as a continued workspace does.
+TEST(Autosave, ARestoreInAnotherROIIsNamed) {
+    const Fixture& f = fixture();
+    const fs::path rec = f.dir / "rec_roi";
+    fs::remove_all(rec);
+    const Grid<float> image = read_image(f.image);
+    Grid<std::uint8_t> box(image.lattice(), 0);
+    for (int k = 4; k < 60; ++k)
+        for (int j = 4; j < 60; ++j)
+            for (int i = 4; i < 60; ++i) box({i, j, k}) = 1;
+    const fs::path roi = f.dir / "box_roi.nii.gz";
+    write_label_image(box, roi.string());
+    const CliResult first =
+        run_cli(view(f, rec, script(f.dir, "work_roi.json", "[" + f.seeds + R"({"segment": 10}])"), "--roi " + roi.string()));
+    ASSERT_EQ(first.rc, 0) << first.err;
+    const auto files = recovery_files(rec);
+    ASSERT_EQ(files.size(), 1u);
+    const RecoveryState kept = read_recovery(files[0]);
+    EXPECT_TRUE(kept.roi_recorded);
+    ASSERT_TRUE(kept.roi_checksum.has_value());
+    EXPECT_EQ(*kept.roi_checksum, mask_checksum(box));
+    const fs::path idle = script(f.dir, "idle_roi.json", R"([{"layout": "four"}])");
+    const CliResult same = run_cli(view(f, rec, idle, "--roi " + roi.string()));
+    ASSERT_EQ(same.rc, 0) << same.err;
+    EXPECT_NE(same.err.find("--recover restores it"), std::string::npos) << same.err;
+    EXPECT_EQ(same.err.find("ROI"), std::string::npos) << same.err;
+    const CliResult other = run_cli(view(f, rec, idle, "--recover"));
+    ASSERT_EQ(other.rc, 0) << other.err;
+    EXPECT_NE(other.err.find("restored unsaved work"), std::string::npos) << other.err;
+    EXPECT_NE(other.err.find("saved with a ROI, restored without one"), std::string::npos) << other.err;
+}
+
 TEST(Autosave, ATerminationSignalMidSegmentationWritesTheStateItHad) {
     const Fixture& f = fixture();
     const fs::path rec = f.dir / "rec2";

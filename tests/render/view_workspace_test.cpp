@@ -320,7 +320,7 @@ TEST(ViewCommand, AWorkspaceWhoseRoiChangedSaysSo) {
                             script("ws_roi_none.json", R"([{"save_workspace": ")" + w_none + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     ASSERT_TRUE(viewer::read_workspace(w).roi_checksum.has_value());
-    EXPECT_EQ(*viewer::read_workspace(w).roi_checksum, viewer::mask_checksum(read_label_image(roi_path)));
+    EXPECT_EQ(*viewer::read_workspace(w).roi_checksum, mask_checksum(read_label_image(roi_path)));
     EXPECT_TRUE(viewer::read_workspace(w_none).roi_recorded);
     EXPECT_FALSE(viewer::read_workspace(w_none).roi_checksum.has_value());
     for (const std::string& ws : {w, w_n4, w_none}) {

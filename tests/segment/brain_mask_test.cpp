@@ -499,16 +499,25 @@ TEST(BrainMask, ANeckBelowTheHeadIsLeftOut) {
 // anterior one: no neck leaves the field of view there, so the header's cut takes nothing and the
 // neck's muscle wins ("no brain found"). Found from the head (superior_from_header false), the face
 // the neck leaves through is inferior, and the mask is the oriented head's, permuted.
+// `oriented` stored as a coronal stack (left-right, superior -> inferior, posterior -> anterior)
+// with the identity direction and origin 0: a header without orientation (IBSR's).
+template <typename T>
+Grid<T> as_coronal_stack(const Grid<T>& oriented) {
+    const Vec3i d = oriented.dims();
+    const Vec3d sp = oriented.lattice().spacing();
+    Grid<T> coronal(Lattice({d.x, d.z, d.y}, {sp.x, sp.z, sp.y}));
+    for (int k = 0; k < d.y; ++k)
+        for (int j = 0; j < d.z; ++j)
+            for (int i = 0; i < d.x; ++i) coronal({i, j, k}) = oriented({i, k, d.z - 1 - j});
+    return coronal;
+}
+
 TEST(BrainMask, AHeaderWithoutOrientationFindsItsNeckFromTheHead) {
     const BrainWeb& bw = brainweb();
     Mask labels;
     const Grid<float> oriented = every_other(with_neck(bw.t1, 90, &labels, bw.labels));
     const Vec3i d = oriented.dims();
-    const Vec3d sp = oriented.lattice().spacing();
-    Grid<float> coronal(Lattice({d.x, d.z, d.y}, {sp.x, sp.z, sp.y}));  // identity direction, origin 0
-    for (int k = 0; k < d.y; ++k)
-        for (int j = 0; j < d.z; ++j)
-            for (int i = 0; i < d.x; ++i) coronal({i, j, k}) = oriented({i, k, d.z - 1 - j});
+    const Grid<float> coronal = as_coronal_stack(oriented);
     BrainMaskReport r;
     const Mask a = auto_brain_mask(oriented, {}, &r);
     EXPECT_GT(r.below_voxels, 0u);
@@ -539,6 +548,45 @@ TEST(BrainMask, AHeaderWithoutOrientationFindsItsNeckFromTheHead) {
     // The oriented head found from the head too: the same face, the same mask.
     const Mask o = auto_brain_mask(oriented, from_head);
     EXPECT_TRUE(std::equal(o.values().begin(), o.values().end(), a.values().begin()));
+}
+
+// The tools that look for the brain themselves (the tissue model's region without a ROI: `holes`,
+// `repair`, a session's model and hole finder) look as they are told: on the coronal stack
+// without orientation, found from the head, the sheet's window is the oriented head's; looked for
+// as if the header were oriented, the region is another (BrainWeb + 90 mm of neck).
+TEST(BrainMask, TheSheetWindowLooksForTheBrainAsItIsTold) {
+    const BrainWeb& bw = brainweb();
+    Mask labels;
+    const Grid<float> oriented = every_other(with_neck(bw.t1, 90, &labels, bw.labels));
+    const Mask every_other_labels = every_other(labels);
+    Mask grey(every_other_labels.lattice(), 0);
+    for (PointIndex i = 0; i < grey.size(); ++i) grey[i] = every_other_labels[i] == 2;
+    const Grid<float> coronal = as_coronal_stack(oriented);
+    const Mask grey_coronal = as_coronal_stack(grey);
+    BrainMaskOptions from_head;
+    from_head.superior_from_header = false;
+    bool whole_brain = false;
+    const Mask region = model_region(coronal, nullptr, nullptr, 3, &whole_brain, from_head);
+    EXPECT_TRUE(whole_brain);
+    const Mask expected = auto_brain_mask(coronal, from_head);
+    EXPECT_TRUE(std::equal(region.values().begin(), region.values().end(), expected.values().begin()));
+    const Mask header_region = model_region(coronal, nullptr, nullptr, 3, nullptr, BrainMaskOptions{});
+    std::size_t differ = 0, voxels = 0;
+    for (PointIndex i = 0; i < region.size(); ++i) {
+        differ += region[i] != header_region[i];
+        voxels += region[i] != 0;
+    }
+    EXPECT_GT(static_cast<double>(differ), 0.05 * static_cast<double>(voxels));
+    std::vector<std::string> warnings;
+    const std::optional<ModelWindow> want = sheet_window(oriented, grey, nullptr, TissueModelOptions{}, warnings);
+    const std::optional<ModelWindow> got = sheet_window(coronal, grey_coronal, nullptr, TissueModelOptions{}, warnings, nullptr, false, from_head);
+    ASSERT_TRUE(want && got);
+    EXPECT_NEAR(got->lower, want->lower, 0.5);
+    EXPECT_NEAR(got->upper, want->upper, 0.5);
+    const std::optional<ModelWindow> dflt = sheet_window(coronal, grey_coronal, nullptr, TissueModelOptions{}, warnings);
+    // Looked for as if oriented (what `holes` and `repair` did): neck muscle widens the window (68.8..146.3).
+    ASSERT_TRUE(dflt);
+    EXPECT_GT(std::abs(dflt->upper - want->upper), 10.0);
 }
 
 // A child's head: BrainWeb with 90 mm of neck at 2 mm, its voxels relabelled 1.4 mm (the head 0.7×,

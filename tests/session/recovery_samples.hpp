@@ -27,6 +27,7 @@ inline RecoveryState sample_state() {
     s.marks.alpha_automatic = true;
     s.marks.pristine = false;
     s.marks.iterations = 137;
+    s.roi_checksum = 0x0123456789abcdefull;
     s.phi = Grid<float>(lattice);
     int k = 0;
     for (float& v : s.phi.values()) v = static_cast<float>(k++ % 11) * 0.37f - 1.5f;
@@ -53,6 +54,8 @@ inline void expect_same(const RecoveryState& a, const RecoveryState& b) {
     EXPECT_EQ(a.marks.window_from_seeds, b.marks.window_from_seeds);
     EXPECT_EQ(a.marks.alpha_automatic, b.marks.alpha_automatic);
     EXPECT_EQ(a.marks.iterations, b.marks.iterations);
+    EXPECT_EQ(a.roi_recorded, b.roi_recorded);
+    EXPECT_EQ(a.roi_checksum, b.roi_checksum);
     EXPECT_TRUE(a.phi.lattice().same_geometry(b.phi.lattice(), 0.0));
     ASSERT_EQ(a.phi.size(), b.phi.size());
     for (std::size_t i = 0; i < a.phi.size(); ++i)

@@ -48,13 +48,18 @@ constexpr std::size_t kPathLength = 24;
 std::size_t dims_offset(const RecoveryState& s) { return kPathLength + 4 + s.image.size(); }
 std::size_t spacing_offset(const RecoveryState& s) { return dims_offset(s) + 12; }
 std::size_t params_offset(const RecoveryState& s) { return spacing_offset(s) + 15 * 8; }
-std::size_t voxels_offset(const RecoveryState& s) { return params_offset(s) + 5 * 8 + 1 + 4 + 4 + s.marks.seeds.size() * 32; }
+std::size_t roi_offset(const RecoveryState& s) { return params_offset(s) + 5 * 8 + 1 + 4 + 4 + s.marks.seeds.size() * 32; }
+std::size_t voxels_offset(const RecoveryState& s) { return roi_offset(s) + 1 + 8; }
 
-// The same state in an older layout: `version` (1 or 2) had no smoothing σ after α.
+// The same state in an older layout: `version` 1-3 recorded no ROI, 1 and 2 had no smoothing σ after α.
 std::vector<std::uint8_t> older(const RecoveryState& s, std::uint32_t version) {
     std::vector<std::uint8_t> bytes = encode_recovery(s);
-    const auto at = bytes.begin() + static_cast<std::ptrdiff_t>(params_offset(s) + 32);
-    bytes.erase(at, at + 8);
+    const auto roi = bytes.begin() + static_cast<std::ptrdiff_t>(roi_offset(s));
+    bytes.erase(roi, roi + 9);
+    if (version < 3) {
+        const auto at = bytes.begin() + static_cast<std::ptrdiff_t>(params_offset(s) + 32);
+        bytes.erase(at, at + 8);
+    }
     std::memcpy(bytes.data() + 8, &version, 4);
     reseal(bytes);
     return bytes;
@@ -108,7 +113,7 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
     auto f32 = [](float v) { std::vector<std::uint8_t> b(4); std::memcpy(b.data(), &v, 4); return b; };
     const std::vector<Case> cases{
         {"wrong magic", 0, {'N', 'I', 'F', 'T'}, "wrong magic"},
-        {"version 4", 8, u32(4), "version 4"},
+        {"version 5", 8, u32(5), "version 5"},
         {"version 0", 8, u32(0), "version 0"},
         {"path length beyond the file", kPathLength, u32(1000000), "too long"},
         {"zero dimension", dims_offset(s), i32(0), "invalid geometry"},
@@ -125,6 +130,8 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
         {"negative iterations", params_offset(s) + 41, i32(-1), "negative iteration"},
         {"four billion seeds", params_offset(s) + 45, u32(0xFFFFFFFFu), "seed count"},
         {"seed radius 0", params_offset(s) + 49 + 24, f64(0.0), "non-positive radius"},
+        {"ROI flag 2", roi_offset(s), {2}, "invalid ROI flag"},
+        {"a ROI checksum without a ROI", roi_offset(s), {0}, "without a ROI"},
         {"voxel count off by one", voxels_offset(s), u64(s.phi.size() + 1), "voxel count"},
         {"NaN in phi", voxels_offset(s) + 8 + 4 * 17, f32(std::numeric_limits<float>::quiet_NaN()), "NaN"},
         {"infinity in phi", voxels_offset(s) + 8, f32(std::numeric_limits<float>::infinity()), "NaN or infinite"},
@@ -165,7 +172,37 @@ TEST(Recovery, VersionTwoFilesReadWithoutSmoothing) {
     EXPECT_EQ(old.marks.params.smooth_mm, 0.0);
     RecoveryState expected = s;
     expected.marks.params.smooth_mm = 0.0;
+    expected.roi_recorded = false;
+    expected.roi_checksum.reset();
     expect_same(old, expected);  // everything else as saved, φ and statuses bit for bit
+}
+
+// Version 4 records the session's ROI (its mask_checksum, or none); version 3 recorded nothing, and
+// reads as such, so that a restore compares only what was written.
+TEST(Recovery, TheROIIsRecordedAndOlderFilesSayTheyRecordedNone) {
+    RecoveryState s = sample_state();
+    const std::vector<std::uint8_t> v3 = older(s, 3);
+    RecoveryState expected = s;
+    expected.roi_recorded = false;
+    expected.roi_checksum.reset();
+    expect_same(decode_recovery(v3.data(), v3.size()), expected);
+    s.roi_checksum.reset();
+    const std::vector<std::uint8_t> none = encode_recovery(s);
+    const RecoveryState back = decode_recovery(none.data(), none.size());
+    EXPECT_TRUE(back.roi_recorded);
+    EXPECT_FALSE(back.roi_checksum.has_value());
+    // The checksum reads a mask's inside/outside only, and tells two masks apart.
+    Grid<std::uint8_t> a(Lattice({4, 3, 2}), 0), b = a;
+    a[5] = 1;
+    b[5] = 255;
+    EXPECT_EQ(mask_checksum(a), mask_checksum(b));
+    b[6] = 1;
+    EXPECT_NE(mask_checksum(a), mask_checksum(b));
+    EXPECT_EQ(roi_difference(mask_checksum(a), mask_checksum(a)), "");
+    EXPECT_EQ(roi_difference(std::nullopt, std::nullopt), "");
+    EXPECT_EQ(roi_difference(mask_checksum(a), mask_checksum(b)), "saved with another ROI");
+    EXPECT_EQ(roi_difference(std::nullopt, mask_checksum(a)), "saved without a ROI, restored with one");
+    EXPECT_EQ(roi_difference(mask_checksum(a), std::nullopt), "saved with a ROI, restored without one");
 }
 
 TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {

@@ -36,6 +36,9 @@ struct SegmentRequest {
     // That region (model_region, else the ROI) is a whole brain - the automatic brain mask - so the
     // model may be fitted through noise that hides a tissue (fit_window_model, window.hpp).
     bool model_region_is_brain = false;
+    // How to look for the automatic brain mask where no region or ROI is given (model_region,
+    // window.hpp): the front ends' brain_mask_options(header).
+    BrainMaskOptions brain_mask;
     double n = 4.0;
     // The curvature weight; absent: automatic_alpha() (alpha.hpp) from the tissue model's noise
     // ratio of the window's class and the voxel shape (the fallback 0.1 without a usable model).

@@ -28,7 +28,7 @@ void WindowOptions::validate() const {
 }
 
 Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_t>* region, const Grid<std::uint8_t>* roi,
-                                int classes, bool* whole_brain) {
+                                int classes, bool* whole_brain, const BrainMaskOptions& brain) {
     if (whole_brain) *whole_brain = false;
     for (const Grid<std::uint8_t>* m : {region, roi})
         if (m && !(m->dims() == image.dims())) {
@@ -39,9 +39,9 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
     if (region) return *region;
     if (roi) return *roi;
     try {  // a head (or a skull-stripped brain, or the phantom): the automatic brain mask
-        Grid<std::uint8_t> brain = auto_brain_mask(image);
+        Grid<std::uint8_t> found = auto_brain_mask(image, brain);
         if (whole_brain) *whole_brain = true;
-        return brain;
+        return found;
     } catch (const std::invalid_argument&) {  // not a head: the foreground
     }
     // Background and the tissue classes: the lowest threshold separates the background.
@@ -204,7 +204,8 @@ WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& s
 
 std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                         const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
-                                        std::vector<std::string>& warnings, TissueModel* model, bool roi_is_brain) {
+                                        std::vector<std::string>& warnings, TissueModel* model, bool roi_is_brain,
+                                        const BrainMaskOptions& brain) {
     if (!(mask.dims() == image.dims()) || (roi && !(roi->dims() == image.dims())))
         throw std::invalid_argument("sheet window: image, mask and ROI differ in size");
     const auto inside = [&](PointIndex i) { return mask[i] && (!roi || (*roi)[i]); };
@@ -215,7 +216,7 @@ std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std
         return std::nullopt;
     }
     bool whole_brain = false;
-    const Grid<std::uint8_t> region = model_region(image, nullptr, roi, options.classes, &whole_brain);
+    const Grid<std::uint8_t> region = model_region(image, nullptr, roi, options.classes, &whole_brain, brain);
     const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings, whole_brain || (roi && roi_is_brain));
     if (!m || !m->usable()) return std::nullopt;
     if (model) *model = *m;

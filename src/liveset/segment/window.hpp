@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "liveset/segment/brain_mask.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/tissue_model.hpp"
 
@@ -39,9 +40,12 @@ struct WindowEstimate {
 // brain mask (brain_mask.hpp; full-head scans must not mix scalp and muscle into the classes),
 // else, when that finds no head, the image's foreground (voxels above the lowest of the Otsu
 // thresholds that split the image into background and `classes` tissue classes). `whole_brain`
-// (optional) is set when the region is that automatic brain mask, else cleared.
+// (optional) is set when the region is that automatic brain mask, else cleared. `brain` says how
+// to look for it: the front ends' brain_mask_options(header), so that a header without
+// orientation has the head's top found from the head.
 Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_t>* region,
-                                const Grid<std::uint8_t>* roi, int classes, bool* whole_brain = nullptr);
+                                const Grid<std::uint8_t>* roi, int classes, bool* whole_brain = nullptr,
+                                const BrainMaskOptions& brain = {});
 
 // Fits the model for estimate_window(). Never throws on data the model cannot describe: returns
 // nullopt (or a degenerate model) and says why in `warnings`. `whole_brain`: the region is a whole
@@ -67,10 +71,12 @@ std::vector<std::string> window_warnings(const TissueModel& model, double lower,
 // from the tissue model fitted in model_region(image, nullptr, roi, classes). nullopt, with the
 // reason in `warnings`, when the model cannot be used or the mask is empty. `model` (optional)
 // receives the fitted model. `roi_is_brain`: the ROI is an automatic brain mask (`--roi auto`), a
-// whole brain to fit_window_model as the mask model_region finds itself without a ROI. Throws
-// std::invalid_argument when the sizes differ.
+// whole brain to fit_window_model as the mask model_region finds itself without a ROI. `brain`:
+// how model_region looks for that mask (its header's orientation). Throws std::invalid_argument
+// when the sizes differ.
 std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                         const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
-                                        std::vector<std::string>& warnings, TissueModel* model = nullptr, bool roi_is_brain = false);
+                                        std::vector<std::string>& warnings, TissueModel* model = nullptr, bool roi_is_brain = false,
+                                        const BrainMaskOptions& brain = {});
 
 }  // namespace liveset

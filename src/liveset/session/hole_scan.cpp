@@ -32,7 +32,8 @@ HoleScan scan_holes(Grid<std::uint8_t> mask, const Grid<float>& image, const Gri
         s.finder.sheet_upper = *options.sheet_upper;
         s.band_from = "given";
     } else {
-        const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, s.warnings, nullptr, options.roi_is_brain);
+        const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, s.warnings, nullptr, options.roi_is_brain,
+                                                              options.brain_mask);
         if (!w)
             throw std::invalid_argument("hole finder: cannot tell the sheet's tissue from the image (" +
                                         (s.warnings.empty() ? std::string("no tissue model") : s.warnings.back()) + "); give the sheet band");

@@ -20,7 +20,7 @@ static_assert(std::endian::native == std::endian::little, "recovery files are wr
 namespace {
 
 constexpr char kMagic[8] = {'L', 'S', 'R', 'E', 'C', 'O', 'V', '1'};
-constexpr std::uint32_t kVersion = 3;  // 1: the flags byte held window_from_seeds only; 2: no smooth_mm
+constexpr std::uint32_t kVersion = 4;  // 1: the flags byte held window_from_seeds only; 2: no smooth_mm; 3: no ROI
 constexpr std::uint32_t kMaxPath = 4096;
 constexpr std::uint32_t kMaxSeeds = 100000;
 
@@ -35,7 +35,8 @@ void put(std::vector<std::uint8_t>& out, T value) {
 
 namespace recovery_format {
 
-std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, const Lattice& lattice) {
+std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum,
+                                        const Lattice& lattice) {
     if (image.size() > kMaxPath) throw std::runtime_error("recovery: the image path is too long");
     if (marks.seeds.size() > kMaxSeeds) throw std::runtime_error("recovery: too many seeds");
     std::vector<std::uint8_t> out;
@@ -58,6 +59,8 @@ std::vector<std::uint8_t> encode_header(const std::string& image, const SessionM
     put(out, static_cast<std::uint32_t>(marks.seeds.size()));
     for (const SeedBall& b : marks.seeds)
         for (double v : {b.center.x, b.center.y, b.center.z, b.radius}) put(out, v);
+    put(out, static_cast<std::uint8_t>(roi_checksum ? 1 : 0));
+    put(out, roi_checksum.value_or(0));
     put(out, static_cast<std::uint64_t>(lattice.size()));
     return out;
 }
@@ -106,6 +109,22 @@ private:
 
 }  // namespace
 
+std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask) {
+    Fnv h;
+    for (const std::uint8_t v : mask.values()) {
+        const std::uint8_t inside = v != 0;
+        h.add(&inside, 1);
+    }
+    return h.h;
+}
+
+std::string roi_difference(std::optional<std::uint64_t> saved, std::optional<std::uint64_t> now) {
+    if (saved == now) return {};
+    if (!saved) return "saved without a ROI, restored with one";
+    if (!now) return "saved with a ROI, restored without one";
+    return "saved with another ROI";
+}
+
 std::filesystem::path recovery_path(const std::filesystem::path& dir, const std::string& image, const std::string& variant) {
     std::error_code ec;
     std::filesystem::path full = std::filesystem::weakly_canonical(std::filesystem::absolute(image, ec), ec);
@@ -122,7 +141,7 @@ std::filesystem::path recovery_path(const std::filesystem::path& dir, const std:
 
 std::vector<std::uint8_t> encode_recovery(const RecoveryView& state) {
     if (state.status.size() != state.phi.size()) throw std::runtime_error("recovery: status and phi differ in size");
-    std::vector<std::uint8_t> out = recovery_format::encode_header(state.image, state.marks, state.phi.lattice());
+    std::vector<std::uint8_t> out = recovery_format::encode_header(state.image, state.marks, state.roi_checksum, state.phi.lattice());
     const auto sig = static_cast<std::uint32_t>(state.signal);
     std::memcpy(out.data() + kSignalOffset, &sig, sizeof sig);
     std::memcpy(out.data() + kTimeOffset, &state.unix_time, sizeof state.unix_time);
@@ -210,6 +229,14 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
         b.radius = r.finite("seeds");
         if (b.radius <= 0) throw std::runtime_error("a seed with a non-positive radius");
         s.marks.seeds.push_back(b);
+    }
+    s.roi_recorded = version >= 4;
+    if (s.roi_recorded) {
+        const std::uint8_t has_roi = r.get<std::uint8_t>("ROI");
+        if (has_roi > 1) throw std::runtime_error("invalid ROI flag");
+        const std::uint64_t fnv = r.get<std::uint64_t>("ROI");
+        if (has_roi) s.roi_checksum = fnv;
+        else if (fnv != 0) throw std::runtime_error("a ROI checksum without a ROI");
     }
     const std::uint64_t voxels = r.get<std::uint64_t>("voxel count");
     if (voxels != lattice.size()) throw std::runtime_error("the voxel count does not match the dimensions");

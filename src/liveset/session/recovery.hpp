@@ -2,15 +2,17 @@
 // periodically, at exit without saving, and from a crash signal handler, so that the next start can
 // offer to restore it. One small binary format of our own (little-endian):
 //
-//   "LSRECOV1"  u32 version (3)  u32 signal (0: autosave)  i64 unix time
+//   "LSRECOV1"  u32 version (4)  u32 signal (0: autosave)  i64 unix time
 //   u32 n + n bytes: the image's path          i32 dims[3]  f64 spacing[3] origin[3] direction[9]
 //   f64 µ ε n α σ  u8 flags  i32 iterations  u32 seeds + (f64 x y z radius) per seed
+//   u8 ROI (0: none, 1: one)  u64 its mask_checksum (0 without one)
 //   u64 voxels (= dims product)  f32 φ[voxels]  i8 sparse-field status[voxels]
 //   u64 FNV-1a of every byte before it
 //
 // flags: bit 0 window_from_seeds, bit 1 alpha_automatic (version 1, still read, had bit 0 only;
 // versions 1 and 2 have no smoothing σ: read as 0 - with a fixed α as they ran; an automatic α
-// takes today's rule, blur included, when the session next builds its speed).
+// takes today's rule, blur included, when the session next builds its speed; versions 1-3 record
+// no ROI: RecoveryState::roi_recorded false).
 // The viewer's crash path (apps/viewer/crash_recovery) writes the same bytes with async-signal-safe
 // calls only, from the pieces in recovery_format. Every read is checked (sizes, magic, checksum,
 // geometry) and refused with one line. Standard library only.
@@ -18,6 +20,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,22 +34,35 @@ struct RecoveryState {
     int signal = 0;              // 0: written by an autosave; otherwise the signal that ended the run
     std::int64_t unix_time = 0;  // when it was written
     SessionMarks marks;          // seeds, parameters, iterations (pristine is not stored: false)
+    // The session's ROI when it was written: its mask_checksum, none without a ROI (read from
+    // version 4; older files record nothing: roi_recorded false).
+    bool roi_recorded = true;
+    std::optional<std::uint64_t> roi_checksum;
     Grid<float> phi;             // < 0 inside, with the image's geometry
     Grid<std::int8_t> status;    // the sparse field's layer of each point (same lattice)
 };
+
+// FNV-1a over a mask's inside/outside bits (1 byte per voxel, 0 or 1): how a recovery file and a
+// workspace record the ROI they were written with.
+std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask);
+// What a work saved with ROI `saved` (none: without one) meets when restored in a session whose
+// ROI has checksum `now`: empty when the same, else a short phrase ("saved without a ROI, restored
+// with one", "saved with another ROI", "saved with a ROI, restored without one").
+std::string roi_difference(std::optional<std::uint64_t> saved, std::optional<std::uint64_t> now);
 
 // What encode_recovery and write_recovery read: a state's parts where they live, so an autosave
 // serialises the session's grids without copying them first. A RecoveryState converts to it.
 struct RecoveryView {
     RecoveryView(const std::string& image_, int signal_, std::int64_t unix_time_, const SessionMarks& marks_,
-                 const Grid<float>& phi_, const Grid<std::int8_t>& status_)
-        : image(image_), signal(signal_), unix_time(unix_time_), marks(marks_), phi(phi_), status(status_) {}
+                 std::optional<std::uint64_t> roi_checksum_, const Grid<float>& phi_, const Grid<std::int8_t>& status_)
+        : image(image_), signal(signal_), unix_time(unix_time_), marks(marks_), roi_checksum(roi_checksum_), phi(phi_), status(status_) {}
     RecoveryView(const RecoveryState& s)  // implicit on purpose
-        : RecoveryView(s.image, s.signal, s.unix_time, s.marks, s.phi, s.status) {}
+        : RecoveryView(s.image, s.signal, s.unix_time, s.marks, s.roi_checksum, s.phi, s.status) {}
     const std::string& image;
     int signal;
     std::int64_t unix_time;
     const SessionMarks& marks;
+    std::optional<std::uint64_t> roi_checksum;  // mask_checksum of the session's ROI; none without one
     const Grid<float>& phi;
     const Grid<std::int8_t>& status;
 };
@@ -87,7 +103,8 @@ struct Fnv {
 
 // The file up to and including the voxel count, with signal 0 and time 0. Throws
 // std::runtime_error when the path or the seed list is too long for the format.
-std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, const Lattice& lattice);
+std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum,
+                                        const Lattice& lattice);
 }  // namespace recovery_format
 
 }  // namespace liveset

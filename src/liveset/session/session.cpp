@@ -199,7 +199,7 @@ const std::optional<TissueModel>& Session::tissue_model() const {
         std::vector<std::string> ignored;  // window_estimate() reports an unusable model
         const Grid<std::uint8_t>* region = options_.model_region ? &*options_.model_region : nullptr;
         bool automatic = false;
-        const Grid<std::uint8_t> fit = model_region(image_, region, roi(), options_.window.model.classes, &automatic);
+        const Grid<std::uint8_t> fit = model_region(image_, region, roi(), options_.window.model.classes, &automatic, options_.brain_mask);
         model_ = fit_window_model(image_, fit, options_.window.model, ignored, automatic || options_.model_region_is_brain);
     }
     return *model_;
