@@ -340,7 +340,7 @@ nlohmann::json roi_report(const Roi& roi) {
                      {"contrast", to_string(b->contrast)},
                      {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
                      {"below_head_voxels", b->below_voxels}, {"inferior_exit_mm2", b->inferior_exit_mm2},
-                     {"brain_extent_mm", b->brain_extent_mm}, {"head_diameter_mm", b->head_diameter_mm},
+                     {"brain_extent_mm", b->brain_extent_mm}, {"cut_contact_mm2", b->cut_contact_mm2}, {"head_diameter_mm", b->head_diameter_mm},
                      {"superior", b->superior_from_header ? "header" : "from the head"},
                      {"mid_range_fill", std::isnan(b->mid_range_fill) ? nlohmann::json(nullptr) : nlohmann::json(b->mid_range_fill)}};
     return j;

@@ -375,6 +375,48 @@ Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, cons
     return extract_brain(image, smooth, head, o, r);
 }
 
+// The brain's cross-section where the head is cut `extent_mm` below its top (mm²): its voxels within
+// a slab of 3 mm above the cut, per mm of height.
+double cut_contact_mm2(const Mask& brain, const Mask& whole_head, const Vertical& up, double extent_mm) {
+    const double cut = head_top(whole_head, up) - extent_mm, slab = 3.0;
+    const Vec3i d = brain.dims();
+    std::size_t n = 0;
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x)
+                if (brain({x, y, z}) != 0) {
+                    const double h = up.height({x, y, z});
+                    n += h >= cut && h < cut + slab;
+                }
+    const Vec3d s = brain.lattice().spacing();
+    return static_cast<double>(n) * s.x * s.y * s.z / slab;
+}
+
+// A head tilted in the field of view (pitched, rolled) reaches further below its top than an
+// upright one, and its cut took the lower temporal lobe and cerebellum: where the brain meets the
+// cut over more than cut_contact_mm2, it is extracted again, with the first look's tissue window
+// (a neck never reads it), from the head cut kExtendStepMm lower, up to kExtendMaxMm.
+constexpr double kExtendStepMm = 15.0, kExtendMaxMm = 60.0;
+Mask below_the_cut(const Grid<float>& image, const Grid<float>& smooth, const Mask& whole_head, const Vertical& up,
+                   const BrainMaskOptions& o, Mask brain, BrainMaskReport& r) {
+    const double first_extent = r.brain_extent_mm;
+    r.cut_contact_mm2 = cut_contact_mm2(brain, whole_head, up, first_extent);
+    if (o.cut_contact_mm2 <= 0) return brain;
+    for (double extent = first_extent + kExtendStepMm; extent <= first_extent + kExtendMaxMm + 1e-9; extent += kExtendStepMm) {
+        if (cut_contact_mm2(brain, whole_head, up, r.brain_extent_mm) <= o.cut_contact_mm2) break;
+        BrainMaskReport again = r;
+        const Mask head = cranial(whole_head, up, extent, again.below_voxels);
+        again.head_voxels = count(head);
+        again.brain_extent_mm = extent;
+        Mask lower = extract_brain(image, smooth, head, o, again);
+        again.mask_voxels = count(lower);
+        if (again.mask_voxels <= r.mask_voxels) break;
+        brain = std::move(lower);
+        r = again;
+    }
+    return brain;
+}
+
 // The brain in the head within `extent_mm` of its top (0: all of it): the tissue window, the
 // extraction, the skull-stripped test, `r` filled in. An empty mask when none is found (under
 // min_head_share of that head, not skull-stripped).
@@ -416,6 +458,7 @@ void validate(const BrainMaskOptions& o) {
             "brain_extent_mm must be 0 (the whole head) or lie in [100, 1000]");
     require(std::isfinite(o.adult_head_mm) && o.adult_head_mm >= 50 && o.adult_head_mm <= 500, "adult_head_mm must lie in [50, 500]");
     require(std::isfinite(o.neck_exit_mm2) && o.neck_exit_mm2 >= 0 && o.neck_exit_mm2 <= 1e6, "neck_exit_mm2 must lie in [0, 1e6]");
+    require(std::isfinite(o.cut_contact_mm2) && o.cut_contact_mm2 >= 0 && o.cut_contact_mm2 <= 1e6, "cut_contact_mm2 must lie in [0, 1e6]");
     require(std::isfinite(o.stripped_near_mm) && o.stripped_near_mm > 0 && o.stripped_near_mm <= 50, "stripped_near_mm must lie in (0, 50]");
     require(std::isfinite(o.stripped_fraction) && o.stripped_fraction > 0 && o.stripped_fraction <= 1, "stripped_fraction must lie in (0, 1]");
 }
@@ -450,6 +493,8 @@ Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& 
             if (brain.size() > 0) first = again;
         }
     }
+    if (brain.size() > 0 && !first.skull_stripped && first.brain_extent_mm > 0)
+        brain = below_the_cut(image, smooth, whole_head, up, o, std::move(brain), first);
     r = first;
     if (brain.size() == 0) {
         char why[160];

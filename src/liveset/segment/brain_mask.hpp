@@ -53,6 +53,12 @@ struct BrainMaskOptions {
     // most inferior face is at least this (mm²; a neck's is ~100 cm²). A head that ends inside the
     // image has nothing to cut.
     double neck_exit_mm2 = 1000.0;
+    // ... and a tilted head (pitched or rolled in the field of view) reaches further below its top:
+    // where the brain found meets the cut over more than this (mm²; an upright brain's brainstem
+    // ~10 cm², BrainWeb rolled 5° 37 cm², pitched back 20° 63 cm²), the brain is extracted again
+    // from the head cut 15 mm lower (up to 60 mm), with the tissue window the first look found.
+    // 0: never.
+    double cut_contact_mm2 = 2000.0;
     // A child's head is smaller: within an adult's 170 mm lies its neck, whose muscle outweighs its
     // white matter ("no brain found"; BrainWeb scaled by 0.7 with 90 mm of neck). Where no brain is
     // found within brain_extent_mm, it is looked for once more within brain_extent_mm × the head's
@@ -105,6 +111,8 @@ struct BrainMaskReport {
     std::size_t below_voxels = 0;     // solid head further below its top (neck, shoulders), left out
     double inferior_exit_mm2 = 0;     // the solid head's cross-section in the array's most inferior face (mm²)
     double brain_extent_mm = 0;       // the extent below the top the brain was looked for in (0: the whole head)
+    double cut_contact_mm2 = 0;       // the brain's cross-section at the first cut (0: no cut); over the
+                                      // option's, brain_extent_mm grew (a tilted head)
     double head_diameter_mm = 0;      // the head's size (adult_head_mm), where a neck is cut (else 0)
     bool superior_from_header = true; // the options': up was the header's superior axis, else found from the head
     std::size_t tissue_voxels = 0;    // head voxels in the tissue window
