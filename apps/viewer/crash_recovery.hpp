@@ -22,7 +22,8 @@ public:
     CrashRecovery& operator=(const CrashRecovery&) = delete;
 
     // What a crash would save: `phi` and `status` are read in place by the handler (they must
-    // outlive the registration or be replaced first); the image path and marks are serialised now.
+    // outlive the registration or be replaced first); the image path, the marks and the ROI's
+    // checksum (mask_checksum; none without a ROI) are serialised now.
     // Call again whenever the marks change or the grids move.
     void track(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum, const Grid<float>& phi,
                const Grid<std::int8_t>& status);

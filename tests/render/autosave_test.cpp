@@ -153,7 +153,7 @@ TEST(Autosave, ARestoreInAnotherROIIsNamed) {
     const CliResult other = run_cli(view(f, rec, idle, "--recover"));
     ASSERT_EQ(other.rc, 0) << other.err;
     EXPECT_NE(other.err.find("restored unsaved work"), std::string::npos) << other.err;
-    EXPECT_NE(other.err.find("saved with a ROI, restored without one"), std::string::npos) << other.err;
+    EXPECT_NE(other.err.find("saved with a ROI, opened without one"), std::string::npos) << other.err;
 }
 
 TEST(Autosave, ATerminationSignalMidSegmentationWritesTheStateItHad) {

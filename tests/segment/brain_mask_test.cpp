@@ -554,6 +554,8 @@ TEST(BrainMask, ATiltedHeadIsCutLowerWhereItsBrainMeetsTheCut) {
     }
 }
 
+namespace {
+
 // `oriented` stored as a coronal stack (left-right, superior -> inferior, posterior -> anterior)
 // with the identity direction and origin 0: a header without orientation (IBSR's).
 template <typename T>
@@ -566,6 +568,8 @@ Grid<T> as_coronal_stack(const Grid<T>& oriented) {
             for (int i = 0; i < d.x; ++i) coronal({i, j, k}) = oriented({i, k, d.z - 1 - j});
     return coronal;
 }
+
+}  // namespace
 
 TEST(BrainMask, AHeaderWithoutOrientationFindsItsNeckFromTheHead) {
     const BrainWeb& bw = brainweb();

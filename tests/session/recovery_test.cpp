@@ -201,8 +201,8 @@ TEST(Recovery, TheROIIsRecordedAndOlderFilesSayTheyRecordedNone) {
     EXPECT_EQ(roi_difference(mask_checksum(a), mask_checksum(a)), "");
     EXPECT_EQ(roi_difference(std::nullopt, std::nullopt), "");
     EXPECT_EQ(roi_difference(mask_checksum(a), mask_checksum(b)), "saved with another ROI");
-    EXPECT_EQ(roi_difference(std::nullopt, mask_checksum(a)), "saved without a ROI, restored with one");
-    EXPECT_EQ(roi_difference(mask_checksum(a), std::nullopt), "saved with a ROI, restored without one");
+    EXPECT_EQ(roi_difference(std::nullopt, mask_checksum(a)), "saved without a ROI, opened with one");
+    EXPECT_EQ(roi_difference(mask_checksum(a), std::nullopt), "saved with a ROI, opened without one");
 }
 
 TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {

@@ -376,9 +376,11 @@ Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, cons
 }
 
 // The brain's cross-section where the head is cut `extent_mm` below its top (mm²): its voxels within
-// a slab of 3 mm above the cut, per mm of height.
+// a slab above the cut, per mm of height. The slab is whole slices of the array's most vertical
+// axis, at least 3 mm (a 6 mm slice: one), so that quantised heights count no slice twice.
 double cut_contact_mm2(const Mask& brain, const Mask& whole_head, const Vertical& up, double extent_mm) {
-    const double cut = head_top(whole_head, up) - extent_mm, slab = 3.0;
+    const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
+    const double cut = head_top(whole_head, up) - extent_mm, slab = layer_mm * std::ceil(3.0 / layer_mm - 1e-9);
     const Vec3i d = brain.dims();
     std::size_t n = 0;
     for (int z = 0; z < d.z; ++z)
@@ -395,24 +397,31 @@ double cut_contact_mm2(const Mask& brain, const Mask& whole_head, const Vertical
 // A head tilted in the field of view (pitched, rolled) reaches further below its top than an
 // upright one, and its cut took the lower temporal lobe and cerebellum: where the brain meets the
 // cut over more than cut_contact_mm2, it is extracted again, with the first look's tissue window
-// (a neck never reads it), from the head cut kExtendStepMm lower, up to kExtendMaxMm.
-constexpr double kExtendStepMm = 15.0, kExtendMaxMm = 60.0;
+// (a neck never reads it), from the head cut kExtendStepMm lower, up to kExtendMaxMm. A look that
+// adds more than kExtendMaxGrowth of the first mask is not a brain's lower edge (tilts of 5-30°
+// add 1-6 %: tissue joined through the brainstem to a neck) and ends the search, unkept.
+constexpr double kExtendStepMm = 15.0, kExtendMaxMm = 60.0, kExtendMaxGrowth = 0.15;
 Mask below_the_cut(const Grid<float>& image, const Grid<float>& smooth, const Mask& whole_head, const Vertical& up,
                    const BrainMaskOptions& o, Mask brain, BrainMaskReport& r) {
     const double first_extent = r.brain_extent_mm;
+    const std::size_t first_voxels = r.mask_voxels;
     r.cut_contact_mm2 = cut_contact_mm2(brain, whole_head, up, first_extent);
     if (o.cut_contact_mm2 <= 0) return brain;
-    for (double extent = first_extent + kExtendStepMm; extent <= first_extent + kExtendMaxMm + 1e-9; extent += kExtendStepMm) {
-        if (cut_contact_mm2(brain, whole_head, up, r.brain_extent_mm) <= o.cut_contact_mm2) break;
+    double contact = r.cut_contact_mm2;
+    for (double extent = first_extent + kExtendStepMm; contact > o.cut_contact_mm2 && extent <= first_extent + kExtendMaxMm + 1e-9;
+         extent += kExtendStepMm) {
         BrainMaskReport again = r;
         const Mask head = cranial(whole_head, up, extent, again.below_voxels);
         again.head_voxels = count(head);
         again.brain_extent_mm = extent;
         Mask lower = extract_brain(image, smooth, head, o, again);
         again.mask_voxels = count(lower);
-        if (again.mask_voxels <= r.mask_voxels) break;
+        if (again.mask_voxels <= r.mask_voxels ||
+            static_cast<double>(again.mask_voxels) > (1.0 + kExtendMaxGrowth) * static_cast<double>(first_voxels))
+            break;
         brain = std::move(lower);
         r = again;
+        contact = cut_contact_mm2(brain, whole_head, up, extent);
     }
     return brain;
 }
@@ -493,7 +502,8 @@ Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& 
             if (brain.size() > 0) first = again;
         }
     }
-    if (brain.size() > 0 && !first.skull_stripped && first.brain_extent_mm > 0)
+    // Not after a child's scaled look: below it lies the neck the adult look failed on.
+    if (brain.size() > 0 && !first.skull_stripped && first.brain_extent_mm == extent && extent > 0)
         brain = below_the_cut(image, smooth, whole_head, up, o, std::move(brain), first);
     r = first;
     if (brain.size() == 0) {

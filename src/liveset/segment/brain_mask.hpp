@@ -55,7 +55,7 @@ struct BrainMaskOptions {
     double neck_exit_mm2 = 1000.0;
     // ... and a tilted head (pitched or rolled in the field of view) reaches further below its top:
     // where the brain found meets the cut over more than this (mm²; an upright brain's brainstem
-    // ~10 cm², BrainWeb rolled 5° 37 cm², pitched back 20° 63 cm²), the brain is extracted again
+    // ~10 cm², BrainWeb rolled 5° 39 cm², pitched back 20° 64 cm²), the brain is extracted again
     // from the head cut 15 mm lower (up to 60 mm), with the tissue window the first look found.
     // 0: never.
     double cut_contact_mm2 = 2000.0;
@@ -112,7 +112,8 @@ struct BrainMaskReport {
     double inferior_exit_mm2 = 0;     // the solid head's cross-section in the array's most inferior face (mm²)
     double brain_extent_mm = 0;       // the extent below the top the brain was looked for in (0: the whole head)
     double cut_contact_mm2 = 0;       // the brain's cross-section at the first cut (0: no cut); over the
-                                      // option's, brain_extent_mm grew (a tilted head)
+                                      // option's, the brain was looked for lower (a tilted head), and
+                                      // brain_extent_mm is where the last look kept cut
     double head_diameter_mm = 0;      // the head's size (adult_head_mm), where a neck is cut (else 0)
     bool superior_from_header = true; // the options': up was the header's superior axis, else found from the head
     std::size_t tissue_voxels = 0;    // head voxels in the tissue window

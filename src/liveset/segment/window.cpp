@@ -38,6 +38,7 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
         }
     if (region) return *region;
     if (roi) return *roi;
+    validate(brain);  // bad options are an error, not "no head"
     try {  // a head (or a skull-stripped brain, or the phantom): the automatic brain mask
         Grid<std::uint8_t> found = auto_brain_mask(image, brain);
         if (whole_brain) *whole_brain = true;

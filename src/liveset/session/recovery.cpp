@@ -120,8 +120,8 @@ std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask) {
 
 std::string roi_difference(std::optional<std::uint64_t> saved, std::optional<std::uint64_t> now) {
     if (saved == now) return {};
-    if (!saved) return "saved without a ROI, restored with one";
-    if (!now) return "saved with a ROI, restored without one";
+    if (!saved) return "saved without a ROI, opened with one";
+    if (!now) return "saved with a ROI, opened without one";
     return "saved with another ROI";
 }
 

@@ -46,8 +46,8 @@ struct RecoveryState {
 // workspace record the ROI they were written with.
 std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask);
 // What a work saved with ROI `saved` (none: without one) meets when restored in a session whose
-// ROI has checksum `now`: empty when the same, else a short phrase ("saved without a ROI, restored
-// with one", "saved with another ROI", "saved with a ROI, restored without one").
+// ROI has checksum `now`: empty when the same, else a short phrase ("saved without a ROI, opened
+// with one", "saved with another ROI", "saved with a ROI, opened without one").
 std::string roi_difference(std::optional<std::uint64_t> saved, std::optional<std::uint64_t> now);
 
 // What encode_recovery and write_recovery read: a state's parts where they live, so an autosave
@@ -56,7 +56,9 @@ struct RecoveryView {
     RecoveryView(const std::string& image_, int signal_, std::int64_t unix_time_, const SessionMarks& marks_,
                  std::optional<std::uint64_t> roi_checksum_, const Grid<float>& phi_, const Grid<std::int8_t>& status_)
         : image(image_), signal(signal_), unix_time(unix_time_), marks(marks_), roi_checksum(roi_checksum_), phi(phi_), status(status_) {}
-    RecoveryView(const RecoveryState& s)  // implicit on purpose
+    // Implicit on purpose. A state read from a version 1-3 file (roi_recorded false) is written as
+    // one saved without a ROI: nothing re-encodes such a state but the tests and the fuzzer.
+    RecoveryView(const RecoveryState& s)
         : RecoveryView(s.image, s.signal, s.unix_time, s.marks, s.roi_checksum, s.phi, s.status) {}
     const std::string& image;
     int signal;
