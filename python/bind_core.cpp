@@ -77,10 +77,8 @@ struct SegmentArgs {
 
 // The automatic brain mask's lookup for an image whose file did (not) give an orientation, as the CLI's.
 cli::BrainLookup lookup_for(bool oriented) {
-    ImageHeader h;
-    h.orientation_known = oriented;
     cli::BrainLookup lookup;
-    lookup.options = cli::brain_mask_options(h);
+    lookup.options = brain_options_for(oriented);
     return lookup;
 }
 
@@ -283,7 +281,7 @@ std::string find_holes_json(const pyb::array& mask, const pyb::array& image, con
         fo.sheet_upper = band->second;
     } else {
         const std::optional<ModelWindow> w = sheet_window(img, m, r ? &*r : nullptr, TissueModelOptions{}, warnings, nullptr, false,
-                                                              lookup_for(oriented).options);
+                                                              brain_options_for(oriented));
         if (!w) throw std::invalid_argument("cannot tell the sheet's tissue from the image (" +
                                             (warnings.empty() ? std::string("no tissue model") : warnings.back()) +
                                             "); give sheet_band=(lower, upper)");
@@ -329,7 +327,7 @@ pyb::tuple repair_holes(const pyb::array& level, bool is_mask, const pyb::array&
         pyb::gil_scoped_release nogil;
         SessionOptions so;
         so.fragment_size = 8;  // as `liveset repair`
-        so.brain_mask = lookup_for(a.oriented).options;
+        so.brain_mask = brain_options_for(a.oriented);
         Session session(img, so, r);
         if (mask_in) session.load_mask(*mask_in);
         else session.load_phi(*phi_in);
@@ -383,6 +381,12 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
 }
 
 }  // namespace
+
+BrainMaskOptions brain_options_for(bool oriented) {
+    ImageHeader h;
+    h.orientation_known = oriented;
+    return cli::brain_mask_options(h);
+}
 
 void register_core(pyb::module_& m) {
     m.def("_read_header", [](const std::string& path) {

@@ -25,9 +25,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     // Where the tissue model is fitted (the automatic brain mask prepare_image found, as the viewer).
     if (!model_region.is_none()) o.model_region = mask_from_array(model_region.cast<pyb::array>(), l);
     o.model_region_is_brain = region_is_brain;  // the ROI or that mask is an automatic brain mask
-    ImageHeader header;
-    header.orientation_known = oriented;
-    o.brain_mask = cli::brain_mask_options(header);  // where no region was found: looked for as segment looks
+    o.brain_mask = brain_options_for(oriented);  // where no region was found: looked for as segment looks
     o.layers = layers;
     o.fragment_size = fragment_size;
     o.history = history;

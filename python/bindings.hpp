@@ -12,6 +12,7 @@
 #include <optional>
 
 #include "liveset/grid/grid.hpp"
+#include "liveset/segment/brain_mask.hpp"
 
 namespace liveset::cli {
 struct Scan;  // image_commands.hpp
@@ -38,6 +39,9 @@ Grid<std::uint8_t> mask_from_array(const pyb::array& values, const Lattice& latt
 // Zero-copy: the Grid moves into a capsule that the Fortran-ordered array (shape I, J, K) keeps alive.
 pyb::array array_from_grid(Grid<float>&& grid);
 pyb::array array_from_grid(Grid<std::uint8_t>&& grid);
+// How the automatic brain mask is looked for in an image whose file did (not) give an orientation
+// (Image.oriented), as the CLI's cli::brain_mask_options(header).
+BrainMaskOptions brain_options_for(bool oriented);
 
 // Ctrl-C while the GIL is released: poll() (called from a long C++ loop, on the thread that
 // released the GIL) re-acquires the GIL at most every 20 ms, runs Python's signal handlers and,

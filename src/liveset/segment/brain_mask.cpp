@@ -375,12 +375,12 @@ Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, cons
     return extract_brain(image, smooth, head, o, r);
 }
 
-// The brain's cross-section where the head is cut `extent_mm` below its top (mm²): its voxels within
-// a slab above the cut, per mm of height. The slab is whole slices of the array's most vertical
-// axis, at least 3 mm (a 6 mm slice: one), so that quantised heights count no slice twice.
-double cut_contact_mm2(const Mask& brain, const Mask& whole_head, const Vertical& up, double extent_mm) {
+// The brain's cross-section where the head is cut at height `cut` (mm²): its voxels within a slab
+// above the cut, per mm of height. The slab is whole slices of the array's most vertical axis, at
+// least 3 mm (a 6 mm slice: one), so that quantised heights count no slice twice.
+double cut_contact_mm2(const Mask& brain, const Vertical& up, double cut) {
     const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
-    const double cut = head_top(whole_head, up) - extent_mm, slab = layer_mm * std::ceil(3.0 / layer_mm - 1e-9);
+    const double slab = layer_mm * std::ceil(3.0 / layer_mm - 1e-9);
     const Vec3i d = brain.dims();
     std::size_t n = 0;
     for (int z = 0; z < d.z; ++z)
@@ -405,7 +405,8 @@ Mask below_the_cut(const Grid<float>& image, const Grid<float>& smooth, const Ma
                    const BrainMaskOptions& o, Mask brain, BrainMaskReport& r) {
     const double first_extent = r.brain_extent_mm;
     const std::size_t first_voxels = r.mask_voxels;
-    r.cut_contact_mm2 = cut_contact_mm2(brain, whole_head, up, first_extent);
+    const double top = head_top(whole_head, up);
+    r.cut_contact_mm2 = cut_contact_mm2(brain, up, top - first_extent);
     if (o.cut_contact_mm2 <= 0) return brain;
     double contact = r.cut_contact_mm2;
     for (double extent = first_extent + kExtendStepMm; contact > o.cut_contact_mm2 && extent <= first_extent + kExtendMaxMm + 1e-9;
@@ -421,7 +422,7 @@ Mask below_the_cut(const Grid<float>& image, const Grid<float>& smooth, const Ma
             break;
         brain = std::move(lower);
         r = again;
-        contact = cut_contact_mm2(brain, whole_head, up, extent);
+        contact = cut_contact_mm2(brain, up, top - extent);
     }
     return brain;
 }
