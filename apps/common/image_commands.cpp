@@ -86,6 +86,7 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
     const auto learnt = [&](std::optional<Grid<std::uint8_t>> mask, std::shared_ptr<BrainMaskHead> where) {
         if (lookup == nullptr) return;
         lookup->done = true;
+        if (mask) lookup->report = report;
         lookup->mask = std::move(mask);
         lookup->head = std::move(where);
     };
@@ -107,9 +108,10 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
     }
 }
 
-std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head, const BrainMaskOptions& options) {
+std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head, const BrainMaskOptions& options,
+                                                      BrainMaskReport* report) {
     try {
-        return auto_brain_mask(image, options, nullptr, head);
+        return auto_brain_mask(image, options, report, head);
     } catch (const std::invalid_argument&) {
         return std::nullopt;
     }
@@ -190,18 +192,29 @@ void correct_for(Grid<float>& image, const Grid<std::uint8_t>* fit, BiasCorrecti
 namespace {
 
 // The automatic brain mask (ROI "auto", or the fit region without a ROI) found again on the corrected
-// image, in the head it was first found in (`head`; null: the head is found again too).
+// image, in the head it was first found in (`head`; null: the head is found again too). A field N4
+// takes out changes neither a head's contrast nor its skull: a second look that loses the first's
+// grey-brighter reading (T2, PD), or takes for a stripped brain a head whose skull the first found,
+// was misled (N4 fitted in a PD's brain flattens its grey-white contrast, grey matter lying outside
+// white: the second look then read a T1 and took the whole head for a stripped brain;
+// docs/BENCHMARKS.md, session 66), and the first stays. (A first look misled by a field, read as a
+// T1, may be corrected.)
 void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMaskHead* head, const BrainMaskOptions& options,
-                      PreparedImage& out) {
+                      const BrainMaskReport* first, PreparedImage& out) {
     Grid<std::uint8_t>* automatic = roi ? (roi->brain_mask ? &roi->mask : nullptr) : out.fit_region ? &*out.fit_region : nullptr;
     if (automatic == nullptr) return;
     BrainMaskReport report;
     BrainMaskHead anew;
+    Grid<std::uint8_t> again;
     try {
-        *automatic = auto_brain_mask(image, options, &report, head ? head : &anew);
+        again = auto_brain_mask(image, options, &report, head ? head : &anew);
     } catch (const std::invalid_argument&) {
         return;  // none found there: the first stays
     }
+    if (first && ((first->contrast == TissueContrast::kGreyBrighter && report.contrast != first->contrast) ||
+                  (report.skull_stripped && !first->skull_stripped)))
+        return;
+    *automatic = std::move(again);
     if (roi) roi->brain_mask = report;
     out.brain_mask_after_n4 = report.mask_voxels;
 }
@@ -214,17 +227,21 @@ PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCor
     const BrainMaskOptions options = lookup ? lookup->options : BrainMaskOptions{};
     BrainMaskHead own_head;  // the fit region's head, without a ROI
     BrainMaskHead* fit_head = &own_head;
+    BrainMaskReport fit_report;
+    const BrainMaskReport* first = roi && roi->brain_mask ? &*roi->brain_mask : nullptr;  // how the mask was first found
     if (!roi && lookup && lookup->done) {  // the default looked already
         out.fit_region = std::move(lookup->mask);
+        if (lookup->report) first = &*lookup->report;
         if (lookup->head) fit_head = lookup->head.get();
     } else if (!roi) {
-        out.fit_region = try_auto_brain_mask(image, fit_head, options);
+        out.fit_region = try_auto_brain_mask(image, fit_head, options, &fit_report);
+        if (out.fit_region) first = &fit_report;
     }
     if (mode != BiasCorrection::kOff) {
         correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
         // N4 divides the lowered no-data voxels by its field too: below the corrected image again.
         if (out.bias && !out.bias->interrupted && no_data) lower_voxels(image, *no_data);
-        if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : fit_head, options, out);
+        if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : fit_head, options, first, out);
     }
     if (roi) roi->head.reset();  // only needed here
     return out;
@@ -337,6 +354,7 @@ nlohmann::json roi_report(const Roi& roi) {
                      {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold},
                      {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
                      {"deep_skew", b->deep_skew}, {"deep_above", b->deep_above}, {"deep_below", b->deep_below},
+                     {"deep_grey_peak", std::isnan(b->deep_grey_peak) ? nlohmann::json(nullptr) : nlohmann::json(b->deep_grey_peak)},
                      {"contrast", to_string(b->contrast)},
                      {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
                      {"below_head_voxels", b->below_voxels}, {"inferior_exit_mm2", b->inferior_exit_mm2},
@@ -451,7 +469,8 @@ nlohmann::json tissue_model_report(const TissueModel& m, const ModelWindow* w) {
     }
     nlohmann::json j{{"classes", classes}, {"partial_volume", m.mixed}, {"voxels", m.voxels},
                      {"iterations", m.iterations}, {"converged", m.converged}, {"usable", m.usable()},
-                     {"start", m.start}, {"contrast", m.contrast ? nlohmann::json(to_string(*m.contrast)) : nlohmann::json(nullptr)}};
+                     {"start", m.start}, {"contrast", m.contrast ? nlohmann::json(to_string(*m.contrast)) : nlohmann::json(nullptr)},
+                     {"floor", m.floor ? nlohmann::json(*m.floor) : nlohmann::json(nullptr)}};
     if (!m.usable()) j["degenerate"] = m.degenerate;
     if (m.smooth_mm > 0) j["fitted_smooth_mm"] = m.smooth_mm;  // fitted on the image blurred by this σ
     if (w) j["seed_class"] = {{"name", tissue_class_name(m, w->seed_class)}, {"index", w->seed_class}, {"share", w->seed_class_share}};

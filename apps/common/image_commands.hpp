@@ -68,6 +68,7 @@ struct BrainLookup {
     bool done = false;                       // the default looked and kept no ROI
     std::optional<Grid<std::uint8_t>> mask;  // what it found (none: no head)
     std::shared_ptr<BrainMaskHead> head;     // where it found it
+    std::optional<BrainMaskReport> report;   // how (with a mask)
     BrainMaskOptions options;
 };
 // The automatic brain mask's options for an image with this header: where the header gives no
@@ -78,9 +79,9 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
 // What a seed refused by a ROI chosen by default is told (after the session's own message).
 inline constexpr const char* kDefaultRoiHint =
     ": the automatic brain mask bounds the front by default on a head; open the image with --roi none to segment outside the brain";
-// auto_brain_mask(image, options, nullptr, head), or nullopt when the image does not look like a head (no error).
+// auto_brain_mask(image, options, report, head), or nullopt when the image does not look like a head (no error).
 std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head = nullptr,
-                                                      const BrainMaskOptions& options = {});
+                                                      const BrainMaskOptions& options = {}, BrainMaskReport* report = nullptr);
 // {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".
 nlohmann::json roi_report(const Roi& roi);
 // One line: "  roi          auto brain mask (...): N voxels, V ml".
@@ -125,7 +126,8 @@ struct PreparedImage {
 // interrupted and the image is unchanged). Throws std::invalid_argument (kRequired) as correct_bias.
 // An automatic brain mask (`roi` "auto", or the fit region without a ROI) is found again on the
 // corrected image once N4 ran, inside the head the first was found in (Roi::head, released here),
-// and replaces the first (kept when none is found there): a strong
+// and replaces the first (kept when none is found there, or when it reads the head otherwise: a T1
+// where the first read grey brighter, or a stripped brain where the first found a skull): a strong
 // field drags the first mask's tissue window off (BrainWeb × a ±40 % field: brain mask Dice 0.904,
 // found again 0.943; docs/BENCHMARKS.md, session 56).
 // `lookup`: load_roi's, so a default that kept no ROI is not looked for again.

@@ -14,6 +14,7 @@
 #include "cli_run.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/segment/brain_mask.hpp"
+#include "liveset/segment/smoothing.hpp"
 #include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
@@ -425,6 +426,44 @@ TEST(RoiAutoCli, AStrongBiasFieldIsCorrectedBeforeTheMaskIsFoundAgain) {
     EXPECT_EQ(j["bias_correction"]["brain_mask_after_voxels"].get<std::size_t>(), again_report.mask_voxels);
     EXPECT_EQ(j["roi"]["voxels"].get<std::size_t>(), again_report.mask_voxels);
     EXPECT_EQ(j["roi"]["auto"]["tissue_low"].get<double>(), again_report.tissue_low);
+}
+
+// A PD of low grey-white contrast (BrainWeb's labels: CSF 185, GM 162, WM 145, blurred 0.7 mm, noise
+// σ 4): N4, fitted in its first brain mask, takes part of that contrast for a field (grey matter lies
+// outside white matter), and the mask found again on the corrected image read the head as a T1 and
+// took all of it for a stripped brain (GM Dice 0.49 by default). A second look that reads the head
+// otherwise than the first is not kept: the written ROI is the first look's, and N4's report counts
+// no mask found again.
+TEST(RoiAutoCli, ASecondLookThatReadsTheHeadOtherwiseIsNotKept) {
+    const Grid<std::uint8_t> labels = read_label_image((fs::path(LIVESET_DATA_DIR) / "brainweb" / "labels_crisp.nii.gz").string());
+    const float value[10] = {0, 185, 162, 145, 165, 100, 120, 25, 165, 120};
+    Grid<float> pd(labels.lattice());
+    for (PointIndex i = 0; i < pd.size(); ++i) pd[i] = value[std::min<int>(labels[i], 9)];
+    pd = gaussian_smooth(pd, 0.7);
+    std::mt19937 rng(7);
+    std::normal_distribution<float> noise(0.0f, 4.0f);
+    for (float& v : pd.values()) v = std::abs(v + noise(rng));
+    const fs::path image = work_dir() / "pd_low_contrast.nii", roi = work_dir() / "pd_roi.nii", corrected = work_dir() / "pd_corrected.nii";
+    write_image(pd, image.string());
+    const auto r = run_cli("segment " + image.string() + " --roi auto --out-roi " + roi.string() + " --out-corrected " + corrected.string() +
+                           " --seed 35,83,113 --iterations 1 --json --out-mask " + (work_dir() / "pd_seg.nii").string());
+    ASSERT_EQ(r.rc, 0) << r.err;
+    BrainMaskReport first_report, again_report;
+    BrainMaskHead head;
+    const Grid<std::uint8_t> first = auto_brain_mask(read_image(image.string()), {}, &first_report, &head);
+    auto_brain_mask(read_image(corrected.string()), {}, &again_report, &head);
+    std::printf("first look: %s, stripped %d, %zu voxels; on the corrected image: %s, stripped %d, %zu voxels\n",
+                to_string(first_report.contrast), first_report.skull_stripped, first_report.mask_voxels, to_string(again_report.contrast),
+                again_report.skull_stripped, again_report.mask_voxels);
+    EXPECT_EQ(first_report.contrast, TissueContrast::kGreyBrighter);
+    EXPECT_FALSE(first_report.skull_stripped);
+    EXPECT_TRUE(again_report.contrast != first_report.contrast || again_report.skull_stripped);  // the second look misled
+    const Grid<std::uint8_t> written = read_label_image(roi.string());
+    EXPECT_TRUE(std::equal(written.values().begin(), written.values().end(), first.values().begin()));
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_FALSE(j["bias_correction"].contains("brain_mask_after_voxels"));
+    EXPECT_EQ(j["roi"]["voxels"].get<std::size_t>(), first_report.mask_voxels);
+    EXPECT_EQ(j["roi"]["auto"]["contrast"], to_string(TissueContrast::kGreyBrighter));
 }
 
 // Noise that hides a tissue (window.cpp): BrainWeb under Rician noise σ 18, bias-corrected (the

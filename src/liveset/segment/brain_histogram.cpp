@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "liveset/segment/tissue_model.hpp"
@@ -78,6 +79,43 @@ Peak tallest(const std::vector<double>& s) {
     return p;
 }
 
+namespace {
+
+// A peak of smoothed histogram `s` at `bin`, each side's half width ending where it falls to half the
+// peak's height or, before that, at the valley that parts it from a neighbour.
+Peak peak_at(const std::vector<double>& s, int bin) {
+    Peak p{bin, bin, bin};
+    const double half = 0.5 * s[static_cast<std::size_t>(bin)];
+    const auto at = [&](int i) { return s[static_cast<std::size_t>(i)]; };
+    while (p.high < kBins - 1 && at(p.high) > half && at(p.high + 1) <= at(p.high)) ++p.high;
+    while (p.low > 0 && at(p.low) > half && at(p.low - 1) <= at(p.low)) --p.low;
+    return p;
+}
+
+// The two most prominent peaks of smoothed histogram `s`, darker first, where both stand inside it
+// (no end bin) with a prominence of at least kSecondPeak of the tallest bin: a peak's height over
+// the higher of the two lowest points that part it from a taller peak or from the histogram's end.
+constexpr double kSecondPeak = 0.05;
+constexpr double kGreyShare = 0.1;  // T1 heads: ≤ 0.056 above; PDs and T2s measured: 0.25-0.57
+std::optional<std::pair<Peak, Peak>> two_peaks(const std::vector<double>& s) {
+    const double tallest_bin = *std::max_element(s.begin(), s.end());
+    std::vector<std::pair<double, int>> peaks;  // (prominence, bin)
+    for (int b = 1; b + 1 < kBins; ++b) {
+        const double v = s[static_cast<std::size_t>(b)];
+        if (!(v > s[static_cast<std::size_t>(b - 1)] && v >= s[static_cast<std::size_t>(b + 1)])) continue;
+        double left = v, right = v;
+        for (int i = b - 1; i >= 0 && s[static_cast<std::size_t>(i)] <= v; --i) left = std::min(left, s[static_cast<std::size_t>(i)]);
+        for (int i = b + 1; i < kBins && s[static_cast<std::size_t>(i)] <= v; ++i) right = std::min(right, s[static_cast<std::size_t>(i)]);
+        if (const double prominence = v - std::max(left, right); prominence >= kSecondPeak * tallest_bin) peaks.emplace_back(prominence, b);
+    }
+    if (peaks.size() < 2) return std::nullopt;
+    std::sort(peaks.begin(), peaks.end(), [](const auto& x, const auto& y) { return x.first > y.first || (x.first == y.first && x.second < y.second); });
+    const int a = std::min(peaks[0].second, peaks[1].second), b = std::max(peaks[0].second, peaks[1].second);
+    return std::pair{peak_at(s, a), peak_at(s, b)};
+}
+
+}  // namespace
+
 double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r) {
     float deepest = 0;
     for (std::size_t i = 0; i < head.size(); ++i)
@@ -89,27 +127,49 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
     if (!top) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
     if (!(*top > r.background_threshold)) throw std::invalid_argument("brain mask: no brain tissue found (the head has no contrast)");
     const Histogram h = histogram(image, deep, r.background_threshold, *top);
-    const Peak wm = tallest(smoothed(h.counts, 2.0));
-    r.wm_peak = h.centre(wm.bin);
-    r.wm_sigma = std::max(h.width, (h.centre(wm.high) - r.wm_peak) / 1.1774);
-    r.wm_low_sigma = std::max(h.width, (r.wm_peak - h.centre(wm.low)) / 1.1774);
+    const std::vector<double> s = smoothed(h.counts, 2.0);
+    const auto take = [&](const Peak& p, BrainMaskReport& into) {  // a peak as white matter's, and the shares about it
+        into.wm_peak = h.centre(p.bin);
+        into.wm_sigma = std::max(h.width, (h.centre(p.high) - into.wm_peak) / 1.1774);
+        into.wm_low_sigma = std::max(h.width, (into.wm_peak - h.centre(p.low)) / 1.1774);
+        into.deep_above = into.deep_below = 0;
+        const double narrow = std::min(into.wm_sigma, into.wm_low_sigma);
+        double n = 0, above = 0, below = 0;
+        for (std::size_t k = 0; k < deep.size(); ++k)
+            if (const double x = image[static_cast<PointIndex>(k)]; deep[static_cast<PointIndex>(k)] != 0 && x > r.background_threshold)
+                n += 1, above += x > into.wm_peak + 3 * narrow, below += x < into.wm_peak - 3 * narrow;
+        if (n > 0) into.deep_above = above / n, into.deep_below = below / n;
+    };
+    // White matter: the tallest peak (a T1's deep head is mostly white matter).
+    take(tallest(s), r);
+    r.deep_grey_peak = std::numeric_limits<double>::quiet_NaN();
     // Which side of white matter grey matter and CSF lie on (deep_contrast): the deep voxels above the background.
     const std::optional<float> q10 = quantile_above(image, &deep, r.background_threshold, 0.1);
     if (!q10) return *top;
     const double q50 = *quantile_above(image, &deep, r.background_threshold, 0.5);
-    const double q90 = *quantile_above(image, &deep, r.background_threshold, 0.9), narrow = std::min(r.wm_sigma, r.wm_low_sigma);
+    const double q90 = *quantile_above(image, &deep, r.background_threshold, 0.9);
     r.deep_skew = q90 > *q10 ? (q90 + *q10 - 2.0 * q50) / (q90 - *q10) : 0.0;
-    double n = 0, above = 0, below = 0;
-    for (std::size_t k = 0; k < deep.size(); ++k)
-        if (const double x = image[static_cast<PointIndex>(k)]; deep[static_cast<PointIndex>(k)] != 0 && x > r.background_threshold)
-            n += 1, above += x > r.wm_peak + 3 * narrow, below += x < r.wm_peak - 3 * narrow;
-    r.deep_above = above / n;
-    r.deep_below = below / n;
+    // Skewed bright with two peaks standing out: the darker white matter's, the brighter grey
+    // matter's (a PD's grey matter can outnumber its white matter there, and a low grey-white
+    // contrast puts it within 3 σ of it), where that reads as grey brighter: at least kGreyShare of
+    // the deep head 3 σ above that white matter, over twice as much as below, and white matter 3 σ
+    // clear of the background. Else the tallest stays.
+    if (r.deep_skew > 0.0)
+        if (const auto two = two_peaks(s)) {
+            BrainMaskReport alt = r;
+            take(two->first, alt);
+            if (alt.deep_above >= kGreyShare && alt.deep_above > 2.0 * alt.deep_below &&
+                alt.wm_peak - 3.0 * alt.wm_low_sigma > r.background_threshold) {
+                alt.deep_grey_peak = h.centre(two->second.bin);
+                alt.deep_grey_sigma = std::max(h.width, (h.centre(two->second.high) - alt.deep_grey_peak) / 1.1774);
+                r = alt;
+            }
+        }
     return *top;
 }
 
 TissueContrast deep_contrast(const BrainMaskReport& r, bool in_head) {
-    if (r.deep_skew > 0.0 && r.deep_above >= 0.25 && r.deep_above > 4.0 * r.deep_below &&
+    if (r.deep_skew > 0.0 && (std::isfinite(r.deep_grey_peak) || (r.deep_above >= 0.25 && r.deep_above > 4.0 * r.deep_below)) &&
         (!in_head || r.wm_peak - 3.0 * r.wm_low_sigma > r.background_threshold))
         return TissueContrast::kGreyBrighter;
     return TissueContrast::kT1;

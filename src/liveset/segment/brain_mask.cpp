@@ -361,8 +361,9 @@ std::optional<std::pair<double, double>> grey_peak_above(const Grid<float>& imag
 // matter's peak + 4 σ (grey_peak_above; without one, the T1 window). r.contrast says which was taken.
 Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o,
                        TissueContrast contrast, double top, BrainMaskReport& r) {
-    const std::optional<std::pair<double, double>> gm =
-        contrast == TissueContrast::kGreyBrighter ? grey_peak_above(image, head, top, r) : std::nullopt;
+    std::optional<std::pair<double, double>> gm;
+    if (contrast == TissueContrast::kGreyBrighter)
+        gm = std::isfinite(r.deep_grey_peak) ? std::pair{r.deep_grey_peak, r.deep_grey_sigma} : grey_peak_above(image, head, top, r);
     r.contrast = gm ? TissueContrast::kGreyBrighter : TissueContrast::kT1;
     if (gm) {
         r.tissue_low = std::max(r.background_threshold, r.wm_peak - 3 * r.wm_low_sigma);
@@ -548,7 +549,8 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     return brain;
 }
 
-TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain) {
+TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain, double* tissue_floor) {
+    if (tissue_floor) *tissue_floor = -std::numeric_limits<double>::infinity();
     if (!(brain.dims() == image.dims())) throw std::invalid_argument("brain mask: the region is not of the image's size");
     Mask finite(brain.lattice(), 0);  // the brain's voxels with a value (a masked scan's NaN outside it are not read)
     float low = std::numeric_limits<float>::infinity();
@@ -566,7 +568,9 @@ TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>
     } catch (const std::invalid_argument&) {  // one value throughout
         return TissueContrast::kT1;
     }
-    return deep_contrast(r, false);
+    const TissueContrast contrast = deep_contrast(r, false);
+    if (tissue_floor && contrast == TissueContrast::kGreyBrighter) *tissue_floor = r.wm_peak - 3.0 * r.wm_low_sigma;
+    return contrast;
 }
 
 }  // namespace liveset

@@ -101,6 +101,11 @@ struct BrainMaskReport {
     // and their shares over and under the white-matter peak by 3 σ (its narrower side's).
     double deep_skew = 0;
     double deep_above = 0, deep_below = 0;
+    // Skewed bright (deep_skew > 0) with two peaks standing out in the deep head's histogram: the
+    // brighter, grey matter's, and its width (upper half-width, to its valley with CSF at most); the
+    // darker is then the white-matter peak. NaN otherwise.
+    double deep_grey_peak = std::numeric_limits<double>::quiet_NaN();
+    double deep_grey_sigma = 0;
     // The contrast read off the deep head (deep_contrast, brain_histogram.hpp) as the tissue window
     // was taken: a T1's, or mirrored for grey matter brighter than white (T2, PD; one that finds no
     // grey-matter peak for it falls back to a T1's).
@@ -158,7 +163,10 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
 // source (a region without air: no background test); its non-finite voxels are left out. A T1 for an
 // empty region or one of a single value. It may differ from BrainMaskReport::contrast of the same
 // brain, which also tests the background and falls back to a T1's window without a grey-matter peak.
+// `tissue_floor` (optional) receives, for a brain whose grey matter is brighter than its white, the
+// white-matter peak less 3 σ of its darker side: white matter is such a brain's darkest tissue, so
+// what lies below is not brain (the skull, dura and air a mask takes in); −∞ otherwise.
 // Throws std::invalid_argument for a region of another size than the image.
-TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain);
+TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain, double* tissue_floor = nullptr);
 
 }  // namespace liveset

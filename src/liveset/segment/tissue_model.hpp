@@ -99,6 +99,9 @@ struct TissueModel {
     // fit_window_model, window.hpp); nullopt for a region that is not (not read: a T1 assumed). It
     // names three classes (tissue_class_name).
     std::optional<TissueContrast> contrast;
+    // Where grey matter is brighter than white in a whole brain (fit_window_model): the region's
+    // voxels at or below this value, darker than white matter (not brain), were left out of the fit.
+    std::optional<double> floor;
 
     bool usable() const { return degenerate.empty(); }
     // Index of the pure class with the largest posterior at `value` (mixed classes ignored).

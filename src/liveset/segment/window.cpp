@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -111,15 +112,54 @@ std::optional<TissueModel> fit_through_noise(const Grid<float>& image, const Gri
     return blurred;
 }
 
+// The region's voxels above `floor` (a grey-brighter brain's, brain_contrast); nullopt for no finite
+// floor or where they are under half of the region's voxels with a value (not such a brain).
+std::optional<Grid<std::uint8_t>> above_floor(const Grid<float>& image, const Grid<std::uint8_t>& region, double floor) {
+    if (!std::isfinite(floor)) return std::nullopt;
+    Grid<std::uint8_t> tissue = region;
+    std::size_t in = 0, kept = 0;
+    for (PointIndex i = 0; i < tissue.size(); ++i) {
+        in += tissue[i] != 0 && std::isfinite(image[i]);
+        tissue[i] = tissue[i] != 0 && image[i] > floor;
+        kept += tissue[i];
+    }
+    if (2 * kept < in) return std::nullopt;
+    return tissue;
+}
+
 }  // namespace
 
 std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid<std::uint8_t>& region,
                                             const TissueModelOptions& options, std::vector<std::string>& warnings,
                                             bool whole_brain) {
     try {
-        TissueModel m = fit_tissue_model(image, &region, options);
+        // A whole brain's contrast names the classes. Where grey matter is brighter than white (a T2,
+        // a PD) white matter is the darkest tissue, and the mask's voxels below it (skull, dura, a rim
+        // of air) are a fourth population three classes cannot hold: the fit spent a class on them
+        // and took grey matter and CSF as one (a PD: GM Dice 0.81; docs/BENCHMARKS.md, session 66).
+        // They are left out of the fit, unless that leaves under half the region (not such a brain)
+        // or the fit without them is unsound where the whole region's is sound (a T2: its thin pure
+        // CSF then fails the partial-volume fit; with the skull and muscle it held, it did not).
+        double floor = -std::numeric_limits<double>::infinity();
+        std::optional<TissueContrast> contrast;
+        if (whole_brain) contrast = brain_contrast(image, region, &floor);
+        const std::optional<Grid<std::uint8_t>> tissue = above_floor(image, region, floor);
+        if (!tissue) floor = -std::numeric_limits<double>::infinity();
+        const Grid<std::uint8_t>* fit = tissue ? &*tissue : &region;
+        TissueModel m = fit_tissue_model(image, fit, options);
+        const auto sound = [](const TissueModel& t) { return t.usable() && t.note.empty(); };
+        if (fit != &region && !sound(m)) {
+            try {
+                if (TissueModel whole = fit_tissue_model(image, &region, options); sound(whole)) {
+                    m = std::move(whole);
+                    fit = &region;
+                    floor = -std::numeric_limits<double>::infinity();
+                }
+            } catch (const std::invalid_argument&) {  // the whole region cannot be fitted (NaN in it): the fit above the floor stays
+            }
+        }
         if (!m.usable() && whole_brain)
-            if (std::optional<TissueModel> b = fit_through_noise(image, region, options, m)) {
+            if (std::optional<TissueModel> b = fit_through_noise(image, *fit, options, m)) {
                 std::ostringstream os;
                 os.precision(3);
                 os << "tissue model: on the image " << m.degenerate << "; blurred by " << b->smooth_mm
@@ -133,14 +173,15 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
         for (TissueModelOptions fewer = options; !m.usable() && fewer.classes > 2;) {
             const std::string why = m.degenerate;
             --fewer.classes;
-            TissueModel next = fit_tissue_model(image, &region, fewer);
+            TissueModel next = fit_tissue_model(image, fit, fewer);
             if (next.usable())
                 warnings.push_back("tissue model: " + std::to_string(options.classes) + " classes do not fit (" + why + "); " +
                                    std::to_string(fewer.classes) + " used");
             m = std::move(next);
         }
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
-        if (whole_brain) m.contrast = brain_contrast(image, region);  // which way the classes are named
+        m.contrast = contrast;  // which way the classes are named
+        if (std::isfinite(floor)) m.floor = floor;
         // (On BrainWeb only its shaded variants fail the partial-volume fit: say so. Fitted through
         // noise that hid a tissue, the noise is the likelier cause.)
         if (!m.note.empty())
