@@ -45,17 +45,17 @@ Peak tallest(const std::vector<double>& s);
 // (BrainMaskReport::deep_skew, deep_above, deep_below), all of it over r.background_threshold. Skewed
 // bright with two prominent peaks (≥ 5 % of the tallest bin), the darker is taken as white matter's
 // and the brighter as grey matter's (deep_grey_peak) where at least 10 % of the half lies 3 σ above
-// that white matter, over twice as much as below, and it stands 3 σ clear of the background; returns the head's 99.5th percentile above
-// the background (the histograms' top). Throws std::invalid_argument where nothing lies above the
+// that white matter, over twice as much as below, and it stands 3 σ clear of the background. Returns
+// the head's 99.5th percentile above the background (the histograms' top). Throws std::invalid_argument where nothing lies above the
 // background, or all of it at one value.
 double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r);
 
 // The contrast of a deep head (or brain) from white_matter_peak's figures. Grey matter brighter than
 // white (a T2, a PD): the deep part skewed bright, with a grey-matter peak (deep_grey_peak) or at
-// least a quarter of it 3 σ above the white-matter peak and over 4 times as much as 3 σ below, and - in a head (`in_head`) - that peak 3 σ clear of
-// the background threshold (not the air's noise cut off there). Else a T1. What each part keeps out
-// (a child's neck, noisy heads, the phantom's bias, a noisy field of view) and the measured margins:
-// docs/ARCHITECTURE.md.
+// least a quarter of it 3 σ above the white-matter peak and over 4 times as much as 3 σ below, and -
+// in a head (`in_head`) - that peak 3 σ clear of the background threshold (not the air's noise cut
+// off there). Else a T1. What each part keeps out (a child's neck, noisy heads, the phantom's bias, a
+// noisy field of view) and the measured margins: docs/ARCHITECTURE.md.
 TissueContrast deep_contrast(const BrainMaskReport& r, bool in_head);
 
 }  // namespace liveset::brain_detail

@@ -144,7 +144,6 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
         std::optional<TissueContrast> contrast;
         if (whole_brain) contrast = brain_contrast(image, region, &floor);
         const std::optional<Grid<std::uint8_t>> tissue = above_floor(image, region, floor);
-        if (!tissue) floor = -std::numeric_limits<double>::infinity();
         const Grid<std::uint8_t>* fit = tissue ? &*tissue : &region;
         TissueModel m = fit_tissue_model(image, fit, options);
         const auto sound = [](const TissueModel& t) { return t.usable() && t.note.empty(); };
@@ -153,7 +152,6 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
                 if (TissueModel whole = fit_tissue_model(image, &region, options); sound(whole)) {
                     m = std::move(whole);
                     fit = &region;
-                    floor = -std::numeric_limits<double>::infinity();
                 }
             } catch (const std::invalid_argument&) {  // the whole region cannot be fitted (NaN in it): the fit above the floor stays
             }
@@ -181,7 +179,7 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
         }
         if (!m.usable()) warnings.push_back("tissue model not usable (" + m.degenerate + ")");
         m.contrast = contrast;  // which way the classes are named
-        if (std::isfinite(floor)) m.floor = floor;
+        if (fit != &region) m.floor = floor;  // fitted above it
         // (On BrainWeb only its shaded variants fail the partial-volume fit: say so. Fitted through
         // noise that hid a tissue, the noise is the likelier cause.)
         if (!m.note.empty())
