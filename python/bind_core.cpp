@@ -125,6 +125,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
         if (init) req.initial_mask = &*init;
         req.model_region = fit;
         req.model_region_is_brain = prepared.fit_is_brain(roi);
+        req.model_region_grey_brighter = prepared.grey_brighter;
         req.brain_mask = lookup.options;
         const SegmentationHook hook = [&](const SegmentationProgress& p, const ChangedPoints&) {
             return interrupt.poll_with([&]() -> pyb::object {
@@ -182,6 +183,7 @@ pyb::dict prepare_session_image(const pyb::array& values, const Lattice& lattice
     d["image"] = changed ? pyb::object(array_from_grid(std::move(image))) : pyb::object(pyb::none());
     d["corrected"] = prepared.bias.has_value();
     d["region_is_brain"] = prepared.fit_is_brain(roi);
+    d["region_grey_brighter"] = prepared.grey_brighter;
     d["model_region"] = prepared.fit_region ? pyb::object(array_from_grid(std::move(*prepared.fit_region))) : pyb::object(pyb::none());
     return d;
 }
@@ -203,7 +205,7 @@ std::string tissue_model(const pyb::array& values, const Lattice& lattice, const
     bool automatic = false;
     const Grid<std::uint8_t> region = model_region(image, fit, roi_mask, a.classes, &automatic, lookup.options);
     const std::optional<TissueModel> model =
-        fit_window_model(image, region, req.window.model, warnings, automatic || prepared.fit_is_brain(roi));
+        fit_window_model(image, region, req.window.model, warnings, automatic || prepared.fit_is_brain(roi), prepared.grey_brighter);
     nlohmann::json j;
     j["intensity_scale"] = {{"low", scale.low}, {"high", scale.high}};
     if (!req.seeds.empty()) {

@@ -12,7 +12,7 @@ namespace liveset::py {
 namespace {
 
 std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo, const pyb::object& roi,
-                                      const pyb::object& model_region, bool region_is_brain, double n,
+                                      const pyb::object& model_region, bool region_is_brain, bool region_grey_brighter, double n,
                                       std::optional<double> alpha, std::optional<double> smooth_mm, int layers, int fragment_size, std::size_t history,
                                       int agents, double p, std::uint64_t seed, bool sleeping, const std::string& decision,
                                       double edit_range, bool oriented) {
@@ -25,6 +25,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     // Where the tissue model is fitted (the automatic brain mask prepare_image found, as the viewer).
     if (!model_region.is_none()) o.model_region = mask_from_array(model_region.cast<pyb::array>(), l);
     o.model_region_is_brain = region_is_brain;  // the ROI or that mask is an automatic brain mask
+    o.model_region_grey_brighter = region_grey_brighter;  // read so before N4
     o.brain_mask = brain_options_for(oriented);  // where no region was found: looked for as segment looks
     o.layers = layers;
     o.fragment_size = fragment_size;
@@ -102,7 +103,7 @@ Vec3d point(const std::vector<double>& p) {
 void register_session(pyb::module_& m) {
     pyb::class_<Session>(m, "_Session")
         .def(pyb::init(&make_session), pyb::arg("image"), pyb::arg("geometry"), pyb::arg("roi"), pyb::arg("model_region"),
-             pyb::arg("region_is_brain"), pyb::arg("n"),
+             pyb::arg("region_is_brain"), pyb::arg("region_grey_brighter"), pyb::arg("n"),
              pyb::arg("alpha"), pyb::arg("smooth_mm"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
              pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"), pyb::arg("oriented"))
         .def("add_seed", [](Session& s, const std::vector<double>& c, double r) {

@@ -65,11 +65,12 @@ SegmentRequest segment_request(const SegmentArgs& a, const Lattice& lattice) {
 
 // The request's regions: the ROI, the initial mask and where the tissue model is fitted.
 void add_regions(SegmentRequest& req, const std::optional<Roi>& roi, const std::optional<Grid<std::uint8_t>>& init,
-                 const Grid<std::uint8_t>* fit, bool fit_is_brain) {
+                 const Grid<std::uint8_t>* fit, const PreparedImage& prepared) {
     if (roi) req.roi = &roi->mask;
     if (init) req.initial_mask = &*init;
     req.model_region = fit;
-    req.model_region_is_brain = fit_is_brain;
+    req.model_region_is_brain = prepared.fit_is_brain(roi);
+    req.model_region_grey_brighter = prepared.grey_brighter;
 }
 
 // The report: the segmentation's, the bias correction's, the ROI and what was written.
@@ -122,7 +123,7 @@ int run_segment(const SegmentArgs& a, int threads) {
     const Grid<std::uint8_t>* roi_mask = roi ? &roi->mask : nullptr;
     const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
 
-    add_regions(req, roi, init, fit, prepared.fit_is_brain(roi));
+    add_regions(req, roi, init, fit, prepared);
     req.brain_mask = lookup.options;  // where no region was found: looked for again as the ROI was
     if (!a.quiet) scan.print_note(a.image);  // the inputs are good
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);

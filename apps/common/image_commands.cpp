@@ -238,7 +238,10 @@ PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCor
         if (out.fit_region) first = &fit_report;
     }
     if (mode != BiasCorrection::kOff) {
-        correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
+        const Grid<std::uint8_t>* fit = out.fit(roi ? &roi->mask : nullptr);
+        const bool grey_brighter = fit && brain_contrast(image, *fit) == TissueContrast::kGreyBrighter;  // as the scan has it
+        correct_for(image, fit, mode, interrupt, out);
+        out.grey_brighter = out.bias && grey_brighter;
         // N4 divides the lowered no-data voxels by its field too: below the corrected image again.
         if (out.bias && !out.bias->interrupted && no_data) lower_voxels(image, *no_data);
         if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : fit_head, options, first, out);
@@ -359,6 +362,7 @@ nlohmann::json roi_report(const Roi& roi) {
                      {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
                      {"below_head_voxels", b->below_voxels}, {"inferior_exit_mm2", b->inferior_exit_mm2},
                      {"brain_extent_mm", b->brain_extent_mm}, {"cut_contact_mm2", b->cut_contact_mm2}, {"head_diameter_mm", b->head_diameter_mm},
+                     {"csf_voxels", b->csf_voxels},
                      {"superior", b->superior_from_header ? "header" : "from the head"},
                      {"mid_range_fill", std::isnan(b->mid_range_fill) ? nlohmann::json(nullptr) : nlohmann::json(b->mid_range_fill)}};
     return j;

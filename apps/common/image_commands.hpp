@@ -113,6 +113,11 @@ struct PreparedImage {
     // The floor N4 fitted the image above when it held negative values where N4 fits (an offset, a
     // z-scored image), added back after; 0 when none.
     float bias_offset = 0.0f;
+    // That region (fit()) read as grey brighter than white (a T2, a PD; brain_contrast) on the image
+    // before N4, which ran: SegmentRequest::model_region_grey_brighter. N4 fitted in such a brain
+    // takes part of its grey-white contrast for a field (a PD of low contrast in its own brain mask
+    // then read as a T1: GM Dice 0.79; docs/BENCHMARKS.md, session 67).
+    bool grey_brighter = false;
     // The region N4 and the tissue model are fitted in: the ROI, else fit_region, else none (N4
     // then takes Otsu's foreground).
     const Grid<std::uint8_t>* fit(const Grid<std::uint8_t>* roi) const { return roi ? roi : fit_region ? &*fit_region : nullptr; }

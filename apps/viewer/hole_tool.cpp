@@ -45,6 +45,7 @@ bool HoleTool::start(const Session& session, const HoleScanOptions& options) {
     started_ = std::chrono::steady_clock::now();
     HoleScanOptions o = options;
     o.roi_is_brain = session.options().model_region_is_brain;  // an automatic brain mask as the ROI: a whole brain
+    o.grey_brighter = session.options().model_region_grey_brighter;
     o.brain_mask = session.options().brain_mask;                // the image's orientation, as the session looked
     job_ = std::async(std::launch::async, [image = image_, roi = roi_, mask = std::move(mask), o, before, sites = job_sites_]() mutable {
         Result r;

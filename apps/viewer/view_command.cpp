@@ -135,6 +135,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
                    r->brain_mask->mask_voxels, brain_mask_summary(*r->brain_mask));
     SessionOptions so = session_options(a);
     so.model_region_is_brain = prepared.fit_is_brain(r);
+    so.model_region_grey_brighter = prepared.grey_brighter;
     so.brain_mask = lookup.options;
     std::optional<Grid<std::uint8_t>> roi;
     if (r) roi = std::move(r->mask);

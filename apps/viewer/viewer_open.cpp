@@ -65,6 +65,7 @@ bool Viewer::open_image(const std::string& path) {
             out->brain_roi = roi.has_value();
             SessionOptions with_region = options;
             with_region.model_region_is_brain = prepared.fit_is_brain(roi);
+            with_region.model_region_grey_brighter = prepared.grey_brighter;
             with_region.brain_mask = lookup.options;
             with_region.model_region = std::move(prepared.fit_region);
             std::optional<Grid<std::uint8_t>> roi_mask;

@@ -63,7 +63,7 @@ class Session:
         self.roi = None if prepared["roi"] is None else img.like(prepared["roi"])
         self.report = json.loads(prepared["report"])
         self._s = _liveset._Session(self.image.array, img.geometry, prepared["roi"], prepared["model_region"],
-                                    bool(prepared["region_is_brain"]), float(n),
+                                    bool(prepared["region_is_brain"]), bool(prepared["region_grey_brighter"]), float(n),
                                     None if alpha is None else float(alpha),
                                     None if smooth_mm is None else float(smooth_mm), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),

@@ -534,4 +534,9 @@ TEST(BrainMask, BadInputThrowsOneLine) {
         bad.min_head_share = s / 10;
         EXPECT_THROW(validate(bad), std::invalid_argument) << s;
     }
+    for (double reach : {-1.0, 51.0, std::nan("")}) {
+        bad = {};
+        bad.csf_reach_mm = reach;
+        EXPECT_THROW(validate(bad), std::invalid_argument) << reach;
+    }
 }

@@ -303,6 +303,21 @@ Mask intersect(Mask a, const Mask& b) {
     return a;
 }
 
+// The brain and the voxels of `head` brighter than `above` (on `smooth`) within `reach_mm` that join
+// it: a T2's or PD's CSF about the brain, above its window (GM peak + 4 σ, a fifth of the way to
+// CSF where a T1's lower cut lies halfway). Without it a T2's mask held 57 % of the CSF, the model's
+// pure CSF class failed and GM's window ended at 136, not 179 (GM Dice 0.873 → 0.946; BENCHMARKS.md,
+// session 67). The dark skull stops it. Taken once the cut is settled: the CSF about the brainstem
+// widened the brain's cross-section there and the head read as tilted, its neck taken in.
+Mask with_bright_csf(const Mask& brain, const Mask& head, const Grid<float>& smooth, double above, double reach_mm) {
+    Mask grown = dilate_mm(brain, reach_mm);
+    for (std::size_t i = 0; i < grown.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        grown[p] = brain[p] != 0 || (grown[p] != 0 && head[p] != 0 && smooth[p] > above);
+    }
+    return fill_holes(largest_component(grown));
+}
+
 // Tissue window → erosion → largest component → regrowth inside the window → fill → close → rim.
 Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o, BrainMaskReport& r) {
     Mask tissue(image.lattice());
@@ -464,6 +479,7 @@ void validate(const BrainMaskOptions& o) {
     require(std::isfinite(o.regrow_margin_mm) && o.regrow_margin_mm >= 0 && o.regrow_margin_mm <= 50, "regrow_margin_mm must lie in [0, 50]");
     require(std::isfinite(o.closing_mm) && o.closing_mm >= 0 && o.closing_mm <= 50, "closing_mm must lie in [0, 50]");
     require(std::isfinite(o.rim_mm) && o.rim_mm >= 0 && o.rim_mm <= 50, "rim_mm must lie in [0, 50]");
+    require(std::isfinite(o.csf_reach_mm) && o.csf_reach_mm >= 0 && o.csf_reach_mm <= 50, "csf_reach_mm must lie in [0, 50]");
     require(std::isfinite(o.head_closing_mm) && o.head_closing_mm >= 0 && o.head_closing_mm <= 50, "head_closing_mm must lie in [0, 50]");
     require(std::isfinite(o.brain_extent_mm) && (o.brain_extent_mm == 0 || (o.brain_extent_mm >= 100 && o.brain_extent_mm <= 1000)),
             "brain_extent_mm must be 0 (the whole head) or lie in [100, 1000]");
@@ -507,6 +523,13 @@ Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& 
     // Not after a child's scaled look: below it lies the neck the adult look failed on.
     if (brain.size() > 0 && !first.skull_stripped && first.brain_extent_mm == extent && extent > 0)
         brain = below_the_cut(image, smooth, whole_head, up, o, std::move(brain), first);
+    if (brain.size() > 0 && !first.skull_stripped && first.contrast == TissueContrast::kGreyBrighter && o.csf_reach_mm > 0) {
+        std::size_t below = 0;
+        brain = with_bright_csf(brain, cranial(whole_head, up, first.brain_extent_mm, below), smooth, first.tissue_high, o.csf_reach_mm);
+        const std::size_t voxels = count(brain);
+        first.csf_voxels = voxels - first.mask_voxels;
+        first.mask_voxels = voxels;
+    }
     r = first;
     if (brain.size() == 0) {
         char why[160];
@@ -549,7 +572,7 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     return brain;
 }
 
-TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain, double* tissue_floor) {
+TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain, double* tissue_floor, bool known_grey_brighter) {
     if (tissue_floor) *tissue_floor = -std::numeric_limits<double>::infinity();
     if (!(brain.dims() == image.dims())) throw std::invalid_argument("brain mask: the region is not of the image's size");
     Mask finite(brain.lattice(), 0);  // the brain's voxels with a value (a masked scan's NaN outside it are not read)
@@ -568,7 +591,7 @@ TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>
     } catch (const std::invalid_argument&) {  // one value throughout
         return TissueContrast::kT1;
     }
-    const TissueContrast contrast = deep_contrast(r, false);
+    const TissueContrast contrast = known_grey_brighter ? TissueContrast::kGreyBrighter : deep_contrast(r, false);
     if (tissue_floor && contrast == TissueContrast::kGreyBrighter) *tissue_floor = r.wm_peak - 3.0 * r.wm_low_sigma;
     return contrast;
 }

@@ -41,6 +41,10 @@ struct BrainMaskOptions {
     double closing_mm = 6.0;
     // Final growth into voxels brighter than the background threshold (extracerebral CSF, dark cortex).
     double rim_mm = 2.0;
+    // Grey matter brighter than white (T2, PD): the CSF around the brain, brighter than the tissue
+    // window, is taken in where it joins the brain within this distance (mm) of it (not in a
+    // skull-stripped input, whose mask is its foreground). 0: not.
+    double csf_reach_mm = 5.0;
     // Closing of the head foreground that bridges the dark skull, giving a solid head whose surface
     // the skull-stripping test measures from.
     double head_closing_mm = 5.0;
@@ -131,6 +135,7 @@ struct BrainMaskReport {
     // read as lying below every other (the mask is then found as for a skull-stripped image).
     // NaN when there is none.
     double mid_range_fill = std::numeric_limits<double>::quiet_NaN();
+    std::size_t csf_voxels = 0;       // the bright CSF taken in around a grey-brighter brain (csf_reach_mm)
     std::size_t mask_voxels = 0;
     double mask_volume_mm3 = 0;
 };
@@ -166,7 +171,12 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
 // `tissue_floor` (optional) receives, for a brain whose grey matter is brighter than its white, the
 // white-matter peak less 3 σ of its darker side: white matter is such a brain's darkest tissue, so
 // what lies below is not brain (the skull, dura and air a mask takes in); −∞ otherwise.
+// `known_grey_brighter`: the brain was read so on the image before N4 (PreparedImage, apps/common):
+// it is read so here too, and the floor taken below the white-matter peak found here. (N4 fitted in
+// such a brain takes part of its grey-white contrast for a field, grey matter lying outside white
+// matter; a low-contrast PD then reads as a T1. N4 cannot give a T1 that contrast.)
 // Throws std::invalid_argument for a region of another size than the image.
-TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain, double* tissue_floor = nullptr);
+TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>& brain, double* tissue_floor = nullptr,
+                              bool known_grey_brighter = false);
 
 }  // namespace liveset

@@ -22,7 +22,8 @@ void choose_window(const Grid<float>& image, const SegmentRequest& req, SegmentO
     if (!req.seeds.empty()) {  // the model: for the window, or to check the user's window
         bool automatic = false;  // no region given: the automatic brain mask, when the image is a head
         const Grid<std::uint8_t> region = model_region(image, req.model_region, req.roi, req.window.model.classes, &automatic, req.brain_mask);
-        out.model = fit_window_model(image, region, req.window.model, out.warnings, automatic || req.model_region_is_brain);
+        out.model = fit_window_model(image, region, req.window.model, out.warnings, automatic || req.model_region_is_brain,
+                                     req.model_region_grey_brighter);
     }
     if (!mu || !epsilon) {
         if (req.seeds.empty())

@@ -131,18 +131,20 @@ std::optional<Grid<std::uint8_t>> above_floor(const Grid<float>& image, const Gr
 
 std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid<std::uint8_t>& region,
                                             const TissueModelOptions& options, std::vector<std::string>& warnings,
-                                            bool whole_brain) {
+                                            bool whole_brain, bool known_grey_brighter) {
     try {
-        // A whole brain's contrast names the classes. Where grey matter is brighter than white (a T2,
-        // a PD) white matter is the darkest tissue, and the mask's voxels below it (skull, dura, a rim
-        // of air) are a fourth population three classes cannot hold: the fit spent a class on them
-        // and took grey matter and CSF as one (a PD: GM Dice 0.81; docs/BENCHMARKS.md, session 66).
-        // They are left out of the fit, unless that leaves under half the region (not such a brain)
-        // or the fit without them is unsound where the whole region's is sound (a T2: its thin pure
-        // CSF then fails the partial-volume fit; with the skull and muscle it held, it did not).
+        // The region's contrast names the classes, whatever the region: an automatic brain mask, a
+        // brain mask from another tool, a ROI (a PD in its brain mask given as a file was fitted as
+        // a T1: GM Dice 0.80 where the automatic mask gave 0.92; docs/BENCHMARKS.md, session 67).
+        // Where grey matter is brighter than white (a T2, a PD) white matter is the darkest tissue,
+        // and the region's voxels below it (skull, dura, a rim of air) are a fourth population three
+        // classes cannot hold: the fit spent a class on them and took grey matter and CSF as one (a
+        // PD: GM Dice 0.81; session 66). They are left out of the fit, unless that leaves under half
+        // the region (not such a brain) or the fit without them is unsound where the whole region's
+        // is sound (a T2: its thin pure CSF then fails the partial-volume fit; with the skull and
+        // muscle it held, it did not).
         double floor = -std::numeric_limits<double>::infinity();
-        std::optional<TissueContrast> contrast;
-        if (whole_brain) contrast = brain_contrast(image, region, &floor);
+        const TissueContrast contrast = brain_contrast(image, region, &floor, known_grey_brighter);
         const std::optional<Grid<std::uint8_t>> tissue = above_floor(image, region, floor);
         const Grid<std::uint8_t>* fit = tissue ? &*tissue : &region;
         TissueModel m = fit_tissue_model(image, fit, options);
@@ -245,7 +247,7 @@ WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& s
 std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                         const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
                                         std::vector<std::string>& warnings, TissueModel* model, bool roi_is_brain,
-                                        const BrainMaskOptions& brain) {
+                                        const BrainMaskOptions& brain, bool known_grey_brighter) {
     if (!(mask.dims() == image.dims()) || (roi && !(roi->dims() == image.dims())))
         throw std::invalid_argument("sheet window: image, mask and ROI differ in size");
     const auto inside = [&](PointIndex i) { return mask[i] && (!roi || (*roi)[i]); };
@@ -257,7 +259,8 @@ std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std
     }
     bool whole_brain = false;
     const Grid<std::uint8_t> region = model_region(image, nullptr, roi, options.classes, &whole_brain, brain);
-    const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings, whole_brain || (roi && roi_is_brain));
+    const std::optional<TissueModel> m =
+        fit_window_model(image, region, options, warnings, whole_brain || (roi && roi_is_brain), known_grey_brighter);
     if (!m || !m->usable()) return std::nullopt;
     if (model) *model = *m;
     // The voxels vote on the image the model was fitted on (blurred when noise hid a tissue).

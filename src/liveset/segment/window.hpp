@@ -51,13 +51,14 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
 // nullopt (or a degenerate model) and says why in `warnings`. `whole_brain`: the region is a whole
 // brain (the automatic brain mask), so every class asked for is in it; when noise makes two of
 // them overlap on the image, the model is fitted on the image blurred as the threshold term reads
-// it (TissueModel::smooth_mm; docs/ARCHITECTURE.md, "Noise that hides a tissue"). A whole brain
-// read as grey brighter than white (brain_contrast) is fitted without its voxels darker than white
-// matter (TissueModel::floor), unless that leaves under half of it or that fit is unsound where the
-// whole region's is sound.
+// it (TissueModel::smooth_mm; docs/ARCHITECTURE.md, "Noise that hides a tissue"). Any region's
+// contrast is read (brain_contrast; TissueModel::contrast): one read as grey brighter than white is
+// fitted without its voxels darker than white matter (TissueModel::floor), unless that leaves under
+// half of it or that fit is unsound where the whole region's is sound. `known_grey_brighter`: the
+// region read so before N4 (brain_contrast).
 std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid<std::uint8_t>& region,
                                             const TissueModelOptions& options, std::vector<std::string>& warnings,
-                                            bool whole_brain = false);
+                                            bool whole_brain = false, bool known_grey_brighter = false);
 
 // The window for `seeds` on the raw `image` (normalised by `scale`): the model's when `model` is
 // usable and options.estimate is kModel, else the seeds' statistics (with a warning saying why).
@@ -75,11 +76,12 @@ std::vector<std::string> window_warnings(const TissueModel& model, double lower,
 // reason in `warnings`, when the model cannot be used or the mask is empty. `model` (optional)
 // receives the fitted model. `roi_is_brain`: the ROI is an automatic brain mask (`--roi auto`), a
 // whole brain to fit_window_model as the mask model_region finds itself without a ROI. `brain`:
-// how model_region looks for that mask (its header's orientation). Throws std::invalid_argument
+// how model_region looks for that mask (its header's orientation). `known_grey_brighter`: as
+// fit_window_model's (SessionOptions::model_region_grey_brighter). Throws std::invalid_argument
 // when the sizes differ.
 std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                         const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
                                         std::vector<std::string>& warnings, TissueModel* model = nullptr, bool roi_is_brain = false,
-                                        const BrainMaskOptions& brain = {});
+                                        const BrainMaskOptions& brain = {}, bool known_grey_brighter = false);
 
 }  // namespace liveset

@@ -33,7 +33,7 @@ HoleScan scan_holes(Grid<std::uint8_t> mask, const Grid<float>& image, const Gri
         s.band_from = "given";
     } else {
         const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, s.warnings, nullptr, options.roi_is_brain,
-                                                              options.brain_mask);
+                                                              options.brain_mask, options.grey_brighter);
         if (!w)
             throw std::invalid_argument("hole finder: cannot tell the sheet's tissue from the image (" +
                                         (s.warnings.empty() ? std::string("no tissue model") : s.warnings.back()) + "); give the sheet band");

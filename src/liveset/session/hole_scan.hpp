@@ -28,6 +28,7 @@ struct HoleScanOptions {
     // class most of the mask's voxels are in (sheet_window).
     std::optional<double> sheet_lower, sheet_upper;
     bool roi_is_brain = false;  // the ROI is an automatic brain mask (sheet_window; SessionOptions::model_region_is_brain)
+    bool grey_brighter = false;  // read so before N4 (sheet_window; SessionOptions::model_region_grey_brighter)
     BrainMaskOptions brain_mask;  // how sheet_window looks for the brain without a ROI (SessionOptions::brain_mask)
     void validate() const;  // std::invalid_argument with a one-line message
 };

@@ -200,7 +200,8 @@ const std::optional<TissueModel>& Session::tissue_model() const {
         const Grid<std::uint8_t>* region = options_.model_region ? &*options_.model_region : nullptr;
         bool automatic = false;
         const Grid<std::uint8_t> fit = model_region(image_, region, roi(), options_.window.model.classes, &automatic, options_.brain_mask);
-        model_ = fit_window_model(image_, fit, options_.window.model, ignored, automatic || options_.model_region_is_brain);
+        model_ = fit_window_model(image_, fit, options_.window.model, ignored, automatic || options_.model_region_is_brain,
+                                  options_.model_region_grey_brighter);
     }
     return *model_;
 }

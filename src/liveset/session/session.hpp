@@ -53,6 +53,7 @@ struct SessionOptions {
     // automatic brain mask of the image, else its foreground. Same dimensions as the image.
     std::optional<Grid<std::uint8_t>> model_region;
     bool model_region_is_brain = false;  // as SegmentRequest::model_region_is_brain
+    bool model_region_grey_brighter = false;  // as SegmentRequest::model_region_grey_brighter
     BrainMaskOptions brain_mask;         // as SegmentRequest::brain_mask (also the hole finder's, HoleScanOptions)
     SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
     RepairOptions repair;              // swarm settings (steps unused: the caller steps)
