@@ -219,6 +219,18 @@ void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMa
     out.brain_mask_after_n4 = report.mask_voxels;
 }
 
+// PreparedImage::grey_brighter on the image as given: the automatic brain mask's region read
+// (brain_contrast), or for a ROI from a file the head's reading (auto_brain_mask's): such a ROI may
+// be any shape, and a box astride a T1's cortex and scalp reads grey brighter.
+bool read_grey_brighter(const Grid<float>& image, const std::optional<Roi>& roi, const PreparedImage& out, const BrainMaskOptions& options) {
+    if (roi && !roi->brain_mask) {
+        BrainMaskReport head;
+        return try_auto_brain_mask(image, nullptr, options, &head) && head.contrast == TissueContrast::kGreyBrighter;
+    }
+    const Grid<std::uint8_t>* fit = out.fit(roi ? &roi->mask : nullptr);
+    return fit && brain_contrast(image, *fit) == TissueContrast::kGreyBrighter;
+}
+
 }  // namespace
 
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt,
@@ -237,11 +249,9 @@ PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCor
         out.fit_region = try_auto_brain_mask(image, fit_head, options, &fit_report);
         if (out.fit_region) first = &fit_report;
     }
+    out.grey_brighter = read_grey_brighter(image, roi, out, options);  // as the scan has it, before N4
     if (mode != BiasCorrection::kOff) {
-        const Grid<std::uint8_t>* fit = out.fit(roi ? &roi->mask : nullptr);
-        const bool grey_brighter = fit && brain_contrast(image, *fit) == TissueContrast::kGreyBrighter;  // as the scan has it
-        correct_for(image, fit, mode, interrupt, out);
-        out.grey_brighter = out.bias && grey_brighter;
+        correct_for(image, out.fit(roi ? &roi->mask : nullptr), mode, interrupt, out);
         // N4 divides the lowered no-data voxels by its field too: below the corrected image again.
         if (out.bias && !out.bias->interrupted && no_data) lower_voxels(image, *no_data);
         if (out.bias && !out.bias->interrupted) find_brain_again(image, roi, roi ? roi->head.get() : fit_head, options, first, out);

@@ -113,10 +113,12 @@ struct PreparedImage {
     // The floor N4 fitted the image above when it held negative values where N4 fits (an offset, a
     // z-scored image), added back after; 0 when none.
     float bias_offset = 0.0f;
-    // That region (fit()) read as grey brighter than white (a T2, a PD; brain_contrast) on the image
-    // before N4, which ran: SegmentRequest::model_region_grey_brighter. N4 fitted in such a brain
-    // takes part of its grey-white contrast for a field (a PD of low contrast in its own brain mask
-    // then read as a T1: GM Dice 0.79; docs/BENCHMARKS.md, session 67).
+    // The image read as grey brighter than white (a T2, a PD) before N4: in the fit region where that
+    // is an automatic brain mask (brain_contrast), in its head for a ROI from a file (auto_brain_mask's
+    // reading; false where no head is found): SegmentRequest::model_region_grey_brighter. N4 fitted
+    // in such a brain takes part of its grey-white contrast for a field (a PD of low contrast then
+    // read as a T1), and a ROI from a file was not read at all (a PD in its own brain mask: GM Dice
+    // 0.81; docs/BENCHMARKS.md, session 67).
     bool grey_brighter = false;
     // The region N4 and the tissue model are fitted in: the ROI, else fit_region, else none (N4
     // then takes Otsu's foreground).

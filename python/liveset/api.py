@@ -141,10 +141,11 @@ def tissue_model(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_r
     on the image ``segment`` fits it on (bias-corrected as there: ``bias_correct`` as in
     ``segment``), and, with seeds, the threshold window ``segment`` would use: a dict with
     ``intensity_scale``, ``tissue_model`` (classes: name, mean, sigma, weight; seed_class; contrast:
-    "T1" or "grey brighter than white (T2, PD)", read in the region the model is fitted in (on the
-    image before N4 too: a grey-brighter reading there stays), naming the classes CSF, GM, WM or
-    WM, GM, CSF from dark to bright; floor: where grey is brighter than white, the value below which
-    the region's voxels, darker than white matter, were left out of the fit, else None),
+    "T1" or "grey brighter than white (T2, PD)" where the region is a whole brain or the image reads
+    grey brighter (off its brain or, with a ROI given as a mask, its head; before N4 too), naming the
+    classes CSF, GM, WM or WM, GM, CSF from dark to bright, else None; floor: where grey is brighter
+    than white, the value below which the region's voxels, darker than white matter, were left out
+    of the fit, else None),
     ``window`` (mu, epsilon normalised; mu_raw, epsilon_raw, lower_raw, upper_raw; source),
     ``warnings`` and, when N4 ran, ``bias_correction``."""
     img = as_image(image)

@@ -55,8 +55,9 @@ class Subject:
         # stripped brain's mid-range outside; 65: a tilted head's brain extracted below the 170 mm cut
         # where it meets it, and the tissue model's brain looked for as the header says; 66: a T2's or
         # PD's contrast read by the deep head's two peaks, its model fitted above white matter, and the
-        # mask found again after N4 kept only where it reads the head as the first did; 67: a ROI file
-        # read for its contrast, and a grey-brighter reading before N4 kept), so a resumed
+        # mask found again after N4 kept only where it reads the head as the first did; 67: the bright
+        # CSF about a T2's or PD's brain taken into its automatic mask, a ROI file read for its
+        # contrast, and a grey-brighter reading before N4 kept), so a resumed
         # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)

@@ -116,7 +116,7 @@ std::optional<std::pair<Peak, Peak>> two_peaks(const std::vector<double>& s) {
 
 }  // namespace
 
-double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r) {
+double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r, bool grey_brighter) {
     float deepest = 0;
     for (std::size_t i = 0; i < head.size(); ++i)
         if (head[static_cast<PointIndex>(i)] != 0) deepest = std::max(deepest, depth[static_cast<PointIndex>(i)]);
@@ -153,13 +153,15 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
     // matter's (a PD's grey matter can outnumber its white matter there, and a low grey-white
     // contrast puts it within 3 σ of it), where that reads as grey brighter: at least kGreyShare of
     // the deep head 3 σ above that white matter, over twice as much as below, and white matter 3 σ
-    // clear of the background. Else the tallest stays.
-    if (r.deep_skew > 0.0)
+    // clear of the background. Else the tallest stays. Known grey-brighter (a corrected image whose
+    // field took part of that contrast), two peaks are read so whatever the shares: the tallest may
+    // be grey matter's, and the floor below white matter (brain_contrast) would cut white matter.
+    if (r.deep_skew > 0.0 || grey_brighter)
         if (const auto two = two_peaks(s)) {
             BrainMaskReport alt = r;
             take(two->first, alt);
-            if (alt.deep_above >= kGreyShare && alt.deep_above > 2.0 * alt.deep_below &&
-                alt.wm_peak - 3.0 * alt.wm_low_sigma > r.background_threshold) {
+            if (grey_brighter || (alt.deep_above >= kGreyShare && alt.deep_above > 2.0 * alt.deep_below &&
+                                  alt.wm_peak - 3.0 * alt.wm_low_sigma > r.background_threshold)) {
                 alt.deep_grey_peak = h.centre(two->second.bin);
                 alt.deep_grey_sigma = std::max(h.width, (h.centre(two->second.high) - alt.deep_grey_peak) / 1.1774);
                 r = alt;

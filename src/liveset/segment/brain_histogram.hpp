@@ -46,9 +46,11 @@ Peak tallest(const std::vector<double>& s);
 // bright with two prominent peaks (≥ 5 % of the tallest bin), the darker is taken as white matter's
 // and the brighter as grey matter's (deep_grey_peak) where at least 10 % of the half lies 3 σ above
 // that white matter, over twice as much as below, and it stands 3 σ clear of the background. Returns
-// the head's 99.5th percentile above the background (the histograms' top). Throws std::invalid_argument where nothing lies above the
-// background, or all of it at one value.
-double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r);
+// the head's 99.5th percentile above the background (the histograms' top). `grey_brighter`: known so
+// (read before N4, brain_contrast): two such peaks are read so without the share tests. Throws
+// std::invalid_argument where nothing lies above the background, or all of it at one value.
+double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r,
+                         bool grey_brighter = false);
 
 // The contrast of a deep head (or brain) from white_matter_peak's figures. Grey matter brighter than
 // white (a T2, a PD): the deep part skewed bright, with a grey-matter peak (deep_grey_peak) or at

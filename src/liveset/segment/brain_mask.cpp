@@ -315,7 +315,9 @@ Mask with_bright_csf(const Mask& brain, const Mask& head, const Grid<float>& smo
         const auto p = static_cast<PointIndex>(i);
         grown[p] = brain[p] != 0 || (grown[p] != 0 && head[p] != 0 && smooth[p] > above);
     }
-    return fill_holes(largest_component(grown));
+    grown = largest_component(grown);
+    for (std::size_t i = 0; i < grown.size(); ++i) grown[static_cast<PointIndex>(i)] |= brain[static_cast<PointIndex>(i)];  // nothing lost
+    return fill_holes(grown);
 }
 
 // Tissue window → erosion → largest component → regrowth inside the window → fill → close → rim.
@@ -587,7 +589,7 @@ TissueContrast brain_contrast(const Grid<float>& image, const Grid<std::uint8_t>
     BrainMaskReport r;  // no air inside a brain: every voxel of it counts
     r.background_threshold = std::nextafter(low, -std::numeric_limits<float>::infinity());
     try {
-        white_matter_peak(image, finite, depth_mm(brain), r);
+        white_matter_peak(image, finite, depth_mm(brain), r, known_grey_brighter);
     } catch (const std::invalid_argument&) {  // one value throughout
         return TissueContrast::kT1;
     }

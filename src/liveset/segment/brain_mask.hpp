@@ -163,7 +163,7 @@ struct BrainMaskHead {
 Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& options = {},
                                    BrainMaskReport* report = nullptr, BrainMaskHead* head = nullptr);
 
-// A whole brain's contrast, by the rule auto_brain_mask reads the deep head with (deep_contrast,
+// A region's contrast, by the rule auto_brain_mask reads the deep head with (deep_contrast,
 // brain_histogram.hpp) on the deep half of `brain` (by depth inside it), for a brain mask from any
 // source (a region without air: no background test); its non-finite voxels are left out. A T1 for an
 // empty region or one of a single value. It may differ from BrainMaskReport::contrast of the same

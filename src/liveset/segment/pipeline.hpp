@@ -36,8 +36,8 @@ struct SegmentRequest {
     // That region (model_region, else the ROI) is a whole brain - the automatic brain mask - so the
     // model may be fitted through noise that hides a tissue (fit_window_model, window.hpp).
     bool model_region_is_brain = false;
-    // That region read as grey brighter than white on the image before N4 (PreparedImage::grey_brighter,
-    // apps/common): the model reads it so on the corrected image too (brain_contrast, brain_mask.hpp).
+    // The image read as grey brighter than white before N4 (PreparedImage::grey_brighter, apps/common):
+    // the model's region is read so on the corrected image too, any region (brain_contrast).
     bool model_region_grey_brighter = false;
     // How to look for the automatic brain mask where no region or ROI is given (model_region,
     // window.hpp): the front ends' brain_mask_options(header).

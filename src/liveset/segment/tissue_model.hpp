@@ -95,9 +95,9 @@ struct TissueModel {
     // σ (mm) of the Gaussian blur (smoothing.hpp) of the image the model was fitted on: 0 for the
     // image itself (fit_window_model, window.hpp, may fit the blurred image when noise hides a class).
     double smooth_mm = 0.0;
-    // The region's contrast (brain_contrast, brain_mask.hpp; set by fit_window_model, window.hpp);
-    // nullopt where fit_tissue_model was called alone (not read: a T1 assumed). It names three
-    // classes (tissue_class_name).
+    // The region's contrast (brain_contrast, brain_mask.hpp; set by fit_window_model, window.hpp, for
+    // a whole brain or an image known to be grey brighter); nullopt otherwise (not read: a T1
+    // assumed). It names three classes (tissue_class_name).
     std::optional<TissueContrast> contrast;
     // Where grey matter is brighter than white in the region (fit_window_model): the region's
     // voxels at or below this value, darker than white matter (not brain), were left out of the fit.

@@ -133,9 +133,10 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
                                             const TissueModelOptions& options, std::vector<std::string>& warnings,
                                             bool whole_brain, bool known_grey_brighter) {
     try {
-        // The region's contrast names the classes, whatever the region: an automatic brain mask, a
-        // brain mask from another tool, a ROI (a PD in its brain mask given as a file was fitted as
-        // a T1: GM Dice 0.80 where the automatic mask gave 0.92; docs/BENCHMARKS.md, session 67).
+        // The contrast names the classes: a whole brain's read off it, another region's (a ROI, a
+        // brain mask from another tool) known from the head (`known_grey_brighter`; a PD in its brain
+        // mask given as a file was fitted as a T1: GM Dice 0.81; docs/BENCHMARKS.md, session 67) -
+        // a ROI is not read itself: a box astride a T1's cortex and scalp reads grey brighter.
         // Where grey matter is brighter than white (a T2, a PD) white matter is the darkest tissue,
         // and the region's voxels below it (skull, dura, a rim of air) are a fourth population three
         // classes cannot hold: the fit spent a class on them and took grey matter and CSF as one (a
@@ -144,7 +145,8 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
         // is sound (a T2: its thin pure CSF then fails the partial-volume fit; with the skull and
         // muscle it held, it did not).
         double floor = -std::numeric_limits<double>::infinity();
-        const TissueContrast contrast = brain_contrast(image, region, &floor, known_grey_brighter);
+        std::optional<TissueContrast> contrast;
+        if (whole_brain || known_grey_brighter) contrast = brain_contrast(image, region, &floor, known_grey_brighter);
         const std::optional<Grid<std::uint8_t>> tissue = above_floor(image, region, floor);
         const Grid<std::uint8_t>* fit = tissue ? &*tissue : &region;
         TissueModel m = fit_tissue_model(image, fit, options);

@@ -51,11 +51,11 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
 // nullopt (or a degenerate model) and says why in `warnings`. `whole_brain`: the region is a whole
 // brain (the automatic brain mask), so every class asked for is in it; when noise makes two of
 // them overlap on the image, the model is fitted on the image blurred as the threshold term reads
-// it (TissueModel::smooth_mm; docs/ARCHITECTURE.md, "Noise that hides a tissue"). Any region's
-// contrast is read (brain_contrast; TissueModel::contrast): one read as grey brighter than white is
-// fitted without its voxels darker than white matter (TissueModel::floor), unless that leaves under
-// half of it or that fit is unsound where the whole region's is sound. `known_grey_brighter`: the
-// region read so before N4 (brain_contrast).
+// it (TissueModel::smooth_mm; docs/ARCHITECTURE.md, "Noise that hides a tissue"). A whole brain's
+// contrast is read (brain_contrast; TissueModel::contrast); `known_grey_brighter`: the image read as
+// grey brighter than white before N4 (PreparedImage, apps/common; any region). A region of such a
+// brain is fitted without its voxels darker than white matter (TissueModel::floor), unless that
+// leaves under half of it or that fit is unsound where the whole region's is sound.
 std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid<std::uint8_t>& region,
                                             const TissueModelOptions& options, std::vector<std::string>& warnings,
                                             bool whole_brain = false, bool known_grey_brighter = false);
