@@ -219,14 +219,20 @@ void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMa
     out.brain_mask_after_n4 = report.mask_voxels;
 }
 
+}  // namespace
+
+bool head_reads_grey_brighter(const Grid<float>& image, const BrainMaskOptions& options) {
+    BrainMaskReport head;
+    return try_auto_brain_mask(image, nullptr, options, &head) && head.contrast == TissueContrast::kGreyBrighter;
+}
+
+namespace {
+
 // PreparedImage::grey_brighter on the image as given: the automatic brain mask's region read
 // (brain_contrast), or for a ROI from a file the head's reading (auto_brain_mask's): such a ROI may
 // be any shape, and a box astride a T1's cortex and scalp reads grey brighter.
 bool read_grey_brighter(const Grid<float>& image, const std::optional<Roi>& roi, const PreparedImage& out, const BrainMaskOptions& options) {
-    if (roi && !roi->brain_mask) {
-        BrainMaskReport head;
-        return try_auto_brain_mask(image, nullptr, options, &head) && head.contrast == TissueContrast::kGreyBrighter;
-    }
+    if (roi && !roi->brain_mask) return head_reads_grey_brighter(image, options);
     const Grid<std::uint8_t>* fit = out.fit(roi ? &roi->mask : nullptr);
     return fit && brain_contrast(image, *fit) == TissueContrast::kGreyBrighter;
 }

@@ -80,6 +80,10 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
 inline constexpr const char* kDefaultRoiHint =
     ": the automatic brain mask bounds the front by default on a head; open the image with --roi none to segment outside the brain";
 // auto_brain_mask(image, options, report, head), or nullopt when the image does not look like a head (no error).
+// Whether the image's head reads as grey brighter than white (a T2, a PD): auto_brain_mask's reading,
+// false where no head is found. How the contrast of an image segmented in a ROI from a file is known
+// (a ROI of any shape is not read itself: a box astride a T1's cortex and scalp reads grey brighter).
+bool head_reads_grey_brighter(const Grid<float>& image, const BrainMaskOptions& options);
 std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head = nullptr,
                                                       const BrainMaskOptions& options = {}, BrainMaskReport* report = nullptr);
 // {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".

@@ -34,6 +34,19 @@ nlohmann::json one_iteration(const fs::path& image, const fs::path& mask, const 
     return r.rc == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object();
 }
 
+// BrainWeb's labels as `value` (blurred 0.7 mm, noise σ 4 as magnitude), written to `name`.
+fs::path labels_image_file(const Grid<std::uint8_t>& labels, const float (&value)[10], const char* name) {
+    Grid<float> image(labels.lattice());
+    for (PointIndex i = 0; i < image.size(); ++i) image[i] = value[std::min<int>(labels[i], 9)];
+    image = gaussian_smooth(image, 0.7);
+    std::mt19937 rng(67);
+    std::normal_distribution<float> noise(0.0f, 4.0f);
+    for (float& v : image.values()) v = std::abs(v + noise(rng));
+    const fs::path path = roi_file_dir() / name;
+    write_image(image, path.string());
+    return path;
+}
+
 }  // namespace
 
 // A PD of low grey-white contrast (BrainWeb's labels: CSF 185, GM 162, WM 145, blurred 0.7 mm, noise
@@ -48,15 +61,9 @@ nlohmann::json one_iteration(const fs::path& image, const fs::path& mask, const 
 TEST(RoiFileCli, ABrainMaskGivenAsAFileIsReadForItsContrastBeforeN4) {
     const fs::path data = fs::path(LIVESET_DATA_DIR) / "brainweb", mask = data / "brain_mask.nii.gz";
     const Grid<std::uint8_t> labels = read_label_image((data / "labels_crisp.nii.gz").string());
-    const float value[10] = {0, 185, 162, 145, 165, 100, 120, 25, 165, 120};
-    Grid<float> pd(labels.lattice());
-    for (PointIndex i = 0; i < pd.size(); ++i) pd[i] = value[std::min<int>(labels[i], 9)];
-    pd = gaussian_smooth(pd, 0.7);
-    std::mt19937 rng(67);
-    std::normal_distribution<float> noise(0.0f, 4.0f);
-    for (float& v : pd.values()) v = std::abs(v + noise(rng));
-    const fs::path image = roi_file_dir() / "pd_low_contrast.nii", corrected = roi_file_dir() / "pd_corrected.nii";
-    write_image(pd, image.string());
+    const fs::path image = labels_image_file(labels, {0, 185, 162, 145, 165, 100, 120, 25, 165, 120}, "pd_low_contrast.nii"),
+                   corrected = roi_file_dir() / "pd_corrected.nii";
+    const Grid<float> pd = read_image(image.string());
     const Grid<std::uint8_t> brain = read_label_image(mask.string());
     ASSERT_EQ(brain_contrast(pd, brain), TissueContrast::kGreyBrighter);
 
@@ -86,4 +93,26 @@ TEST(RoiFileCli, ABrainMaskGivenAsAFileIsReadForItsContrastBeforeN4) {
     EXPECT_TRUE(t1["tissue_model"]["contrast"].is_null());
     EXPECT_TRUE(t1["tissue_model"]["floor"].is_null());
     EXPECT_EQ(t1["tissue_model"]["seed_class"]["name"], "GM");
+}
+
+// `liveset holes --roi FILE` reads the contrast as `segment` does: off the head. A PD (CSF 200, GM
+// 170, WM 140) whose grey matter is the sheet, BrainWeb's brain mask as the ROI: read as a T1 (as
+// before session 67) the model spent a class on the skull and took grey matter and CSF as one, the
+// sheet band ~156..214 reaching into CSF; now grey matter's band lies between white matter and CSF.
+TEST(RoiFileCli, HolesReadTheContrastOffTheHeadAsSegmentDoes) {
+    const fs::path data = fs::path(LIVESET_DATA_DIR) / "brainweb", mask = data / "brain_mask.nii.gz";
+    const Grid<std::uint8_t> labels = read_label_image((data / "labels_crisp.nii.gz").string());
+    const fs::path image = labels_image_file(labels, {0, 200, 170, 140, 170, 100, 120, 25, 170, 120}, "pd.nii");
+    Grid<std::uint8_t> grey(labels.lattice(), 0);
+    for (PointIndex i = 0; i < grey.size(); ++i) grey[i] = labels[i] == 2;
+    const fs::path sheet = roi_file_dir() / "pd_grey.nii";
+    write_label_image(grey, sheet.string());
+    const auto r = run_cli("holes " + sheet.string() + " --image " + image.string() + " --roi " + mask.string() + " --json");
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    const double lower = j["sheet_band"][0].get<double>(), upper = j["sheet_band"][1].get<double>();
+    std::printf("PD grey matter's sheet band in its brain mask: %.1f..%.1f (%s)\n", lower, upper, j["band_from"].get<std::string>().c_str());
+    EXPECT_EQ(j["band_from"], "tissue model");
+    EXPECT_GT(lower, 148.0);  // white matter (140) out
+    EXPECT_LT(upper, 195.0);  // CSF (200) out
 }
