@@ -11,10 +11,10 @@
 #include <random>
 
 #include "analytic_head.hpp"
+#include "labels_as.hpp"
 #include "cli_run.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/segment/brain_mask.hpp"
-#include "liveset/segment/smoothing.hpp"
 #include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
@@ -436,13 +436,7 @@ TEST(RoiAutoCli, AStrongBiasFieldIsCorrectedBeforeTheMaskIsFoundAgain) {
 // no mask found again.
 TEST(RoiAutoCli, ASecondLookThatReadsTheHeadOtherwiseIsNotKept) {
     const Grid<std::uint8_t> labels = read_label_image((fs::path(LIVESET_DATA_DIR) / "brainweb" / "labels_crisp.nii.gz").string());
-    const float value[10] = {0, 185, 162, 145, 165, 100, 120, 25, 165, 120};
-    Grid<float> pd(labels.lattice());
-    for (PointIndex i = 0; i < pd.size(); ++i) pd[i] = value[std::min<int>(labels[i], 9)];
-    pd = gaussian_smooth(pd, 0.7);
-    std::mt19937 rng(7);
-    std::normal_distribution<float> noise(0.0f, 4.0f);
-    for (float& v : pd.values()) v = std::abs(v + noise(rng));
+    const Grid<float> pd = liveset::testing::labels_as(labels, {0, 185, 162, 145, 165, 100, 120, 25, 165, 120});
     const fs::path image = work_dir() / "pd_low_contrast.nii", roi = work_dir() / "pd_roi.nii", corrected = work_dir() / "pd_corrected.nii";
     write_image(pd, image.string());
     const auto r = run_cli("segment " + image.string() + " --roi auto --out-roi " + roi.string() + " --out-corrected " + corrected.string() +

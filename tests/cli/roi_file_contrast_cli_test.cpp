@@ -6,13 +6,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
-#include <random>
 #include <string>
 
 #include "cli_run.hpp"
+#include "labels_as.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/segment/brain_mask.hpp"
-#include "liveset/segment/smoothing.hpp"
 #include "scratch_dir.hpp"
 
 namespace fs = std::filesystem;
@@ -34,16 +33,10 @@ nlohmann::json one_iteration(const fs::path& image, const fs::path& mask, const 
     return r.rc == 0 ? nlohmann::json::parse(r.out) : nlohmann::json::object();
 }
 
-// BrainWeb's labels as `value` (blurred 0.7 mm, noise σ 4 as magnitude), written to `name`.
+// BrainWeb's labels as `value` (labels_as.hpp: noise σ 4 as magnitude, seed 67), written to `name`.
 fs::path labels_image_file(const Grid<std::uint8_t>& labels, const float (&value)[10], const char* name) {
-    Grid<float> image(labels.lattice());
-    for (PointIndex i = 0; i < image.size(); ++i) image[i] = value[std::min<int>(labels[i], 9)];
-    image = gaussian_smooth(image, 0.7);
-    std::mt19937 rng(67);
-    std::normal_distribution<float> noise(0.0f, 4.0f);
-    for (float& v : image.values()) v = std::abs(v + noise(rng));
     const fs::path path = roi_file_dir() / name;
-    write_image(image, path.string());
+    write_image(liveset::testing::labels_as(labels, value, 0.0f, 67), path.string());
     return path;
 }
 

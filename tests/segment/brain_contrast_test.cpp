@@ -7,33 +7,21 @@
 #include <cstdio>
 #include <limits>
 #include <optional>
-#include <random>
 #include <string>
 #include <vector>
 
 #include "brain_mask_fixture.hpp"
+#include "labels_as.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/segment/brain_mask.hpp"
-#include "liveset/segment/smoothing.hpp"
 #include "liveset/segment/tissue_model.hpp"
 #include "liveset/segment/window.hpp"
 
 using namespace liveset;
 using namespace liveset::bm_test;
+using liveset::testing::labels_as;
 
 namespace {
-
-// BrainWeb's labels in another contrast: each label's value, blurred by 0.7 mm, Gaussian noise σ 4
-// as magnitude, or (rician > 0) Rician noise of that σ.
-Grid<float> labels_as(const Mask& labels, const float (&value)[10], float rician = 0.0f) {
-    Grid<float> image(labels.lattice());
-    for (PointIndex i = 0; i < image.size(); ++i) image[i] = value[std::min<int>(labels[i], 9)];
-    image = gaussian_smooth(image, 0.7);
-    std::mt19937 rng(7);
-    std::normal_distribution<float> noise(0.0f, rician > 0.0f ? rician : 4.0f);
-    for (float& v : image.values()) v = rician > 0.0f ? std::hypot(v + noise(rng), noise(rng)) : std::abs(v + noise(rng));
-    return image;
-}
 
 // The automatic mask of BrainWeb's labels as `value`, checked against the labels and printed.
 TruthCheck contrast_mask(const char* name, const float (&value)[10], BrainMaskReport& r, Grid<float>* image = nullptr,
