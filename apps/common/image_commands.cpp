@@ -194,11 +194,11 @@ namespace {
 // The automatic brain mask (ROI "auto", or the fit region without a ROI) found again on the corrected
 // image, in the head it was first found in (`head`; null: the head is found again too). A field N4
 // takes out changes neither a head's contrast nor its skull: a second look that loses the first's
-// grey-brighter reading (T2, PD), or takes for a stripped brain a head whose skull the first found,
+// grey-brighter reading (T2, PD) or its FLAIR reading, or takes for a stripped brain a head whose skull the first found,
 // was misled (N4 fitted in a PD's brain flattens its grey-white contrast, grey matter lying outside
 // white: the second look then read a T1 and took the whole head for a stripped brain;
 // docs/BENCHMARKS.md, session 66), and the first stays. (A first look misled by a field, read as a
-// T1, may be corrected.)
+// T1, may be corrected; one read as a FLAIR stays.)
 void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMaskHead* head, const BrainMaskOptions& options,
                       const BrainMaskReport* first, PreparedImage& out) {
     Grid<std::uint8_t>* automatic = roi ? (roi->brain_mask ? &roi->mask : nullptr) : out.fit_region ? &*out.fit_region : nullptr;
@@ -212,7 +212,7 @@ void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMa
         return;  // none found there: the first stays
     }
     if (first && ((first->contrast == TissueContrast::kGreyBrighter && report.contrast != first->contrast) ||
-                  (report.skull_stripped && !first->skull_stripped)))
+                  (first->flair && !report.flair) || (report.skull_stripped && !first->skull_stripped)))
         return;
     *automatic = std::move(again);
     if (roi) roi->brain_mask = report;
@@ -374,7 +374,8 @@ nlohmann::json roi_report(const Roi& roi) {
                      {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
                      {"deep_skew", b->deep_skew}, {"deep_above", b->deep_above}, {"deep_below", b->deep_below},
                      {"deep_grey_peak", std::isnan(b->deep_grey_peak) ? nlohmann::json(nullptr) : nlohmann::json(b->deep_grey_peak)},
-                     {"contrast", to_string(b->contrast)},
+                     {"contrast", to_string(b->contrast)}, {"flair", b->flair},
+                     {"flair_grey_peak", std::isnan(b->flair_grey_peak) ? nlohmann::json(nullptr) : nlohmann::json(b->flair_grey_peak)},
                      {"surface_contact", b->surface_contact}, {"head_voxels", b->head_voxels},
                      {"below_head_voxels", b->below_voxels}, {"inferior_exit_mm2", b->inferior_exit_mm2},
                      {"brain_extent_mm", b->brain_extent_mm}, {"cut_contact_mm2", b->cut_contact_mm2}, {"head_diameter_mm", b->head_diameter_mm},
@@ -388,6 +389,7 @@ std::string brain_mask_summary(const BrainMaskReport& b) {
     std::string s = fmt::format("{}, tissue window {:.1f}..{:.1f}", b.skull_stripped ? "skull-stripped input" : "full head",
                                 b.tissue_low, b.tissue_high);
     if (b.contrast == TissueContrast::kGreyBrighter) s += " (mirrored: grey matter brighter than white, as in a T2 or PD)";
+    if (b.flair) s += " (mirrored: grey matter brighter than white with CSF dark, as in a FLAIR)";
     if (!std::isnan(b.mid_range_fill)) s += fmt::format(", masked outside at {:g} within the tissue's range", b.mid_range_fill);
     if (b.head_threshold > b.background_threshold)
         s += fmt::format(", noisy air σ {:.1f}: head threshold {:.1f}", b.background_noise, b.head_threshold);

@@ -109,6 +109,89 @@ TEST(BrainMask, APdHeadIsMaskedWithTheWindowMirrored) {
     EXPECT_LE(c.extracranial, 0.07);  // 5.1 %: its scalp fat is as bright as grey matter
 }
 
+// A T2 under Rician noise σ 9 (session 68): its brain-tissue window's lower end, white matter's peak
+// less 3 σ, was read on the raw image (75 − 3·12) and applied to the smoothed one, where the noise is
+// a fraction of that: muscle (45, 55 with the noise's bias) fell inside, the mask ran through the
+// temporal muscle into the scalp, touched the head's surface and was read as skull-stripped (the
+// whole head, Dice 0.69). Read on the smoothed image (smoothed_white_floor: 63.5 where the raw reading
+// gave 41.9) the window starts above most of the muscle and the mask is the brain's (Dice 0.928; 12 %
+// of the scalp's fat, muscle and skin inside, by the left temporal muscle). The floor never lies below the raw image's.
+TEST(BrainMask, ANoisyT2sMuscleStaysOutOfItsMask) {
+    BrainMaskReport r;
+    const TruthCheck c = contrast_mask("t2 rician 9", {0, 250, 110, 75, 150, 45, 80, 8, 140, 100}, r, nullptr, 9.0f);
+    EXPECT_EQ(r.contrast, TissueContrast::kGreyBrighter);
+    EXPECT_FALSE(r.skull_stripped);
+    EXPECT_GT(r.tissue_low, r.wm_peak - 3.0 * r.wm_low_sigma + 10.0);  // raised well above the raw reading
+    EXPECT_LT(r.tissue_low, 75.0);                                      // and still below white matter
+    EXPECT_GE(c.dice, 0.91);
+    EXPECT_GE(c.gm, 0.97);
+    EXPECT_GE(c.wm, 0.99);
+    EXPECT_LE(c.extracranial, 0.15);
+}
+
+// BrainWeb's labels as a FLAIR (session 64's values: CSF 25, GM 120, WM 95, fat 130, muscle 50, skin
+// 100, skull 8, glial matter 150, connective tissue 90). Grey matter lies above white matter but the
+// dark CSF skews the deep head dark, so it read as a T1: the window from the CSF | muscle cut (48) to
+// WM + 4 σ (121) held the muscle and half of grey matter, the mask ran to the head's surface and was
+// read as skull-stripped (the whole head, Dice 0.68; GM Dice 0.52 by default). There, a prominent
+// peak above white matter's with 10 % of the deep head above it (flair_grey_peak) mirrors the window,
+// as a T2's, while the contrast stays a T1's for the tissue model (CSF, WM, GM from dark up; GM Dice
+// 0.83 in the true mask), and the bright-CSF step (a T2's, for CSF brighter than grey matter) is not taken.
+TEST(BrainMask, AFlairHeadIsMaskedWithTheWindowMirrored) {
+    const BrainWeb& bw = brainweb();
+    BrainMaskReport r;
+    Grid<float> flair;
+    const TruthCheck c = contrast_mask("flair", {0, 25, 120, 95, 130, 50, 100, 8, 150, 90}, r, &flair);
+    std::printf("flair grey peak %.1f (σ %.1f)\n", r.flair_grey_peak, r.flair_grey_sigma);
+    EXPECT_EQ(r.contrast, TissueContrast::kT1);
+    EXPECT_TRUE(r.flair);
+    EXPECT_NEAR(r.flair_grey_peak, 120.0, 6.0);
+    EXPECT_FALSE(r.skull_stripped);
+    EXPECT_EQ(r.csf_voxels, 0u);
+    EXPECT_GT(r.tissue_low, 50.0 + 15.0);  // muscle out
+    EXPECT_GT(r.tissue_high, 120.0);       // grey matter in
+    EXPECT_GE(c.dice, 0.90);
+    EXPECT_GE(c.gm, 0.97);
+    EXPECT_GE(c.wm, 0.99);
+    EXPECT_LE(c.extracranial, 0.08);
+    EXPECT_EQ(brain_contrast(flair, bw.brain_mask), TissueContrast::kT1);  // the model's reading: unchanged
+    BrainMaskReport t1;
+    auto_brain_mask(bw.t1, {}, &t1);
+    EXPECT_FALSE(t1.flair);
+    EXPECT_TRUE(std::isnan(t1.flair_grey_peak));
+    // BrainWeb's T1 under a ±25 % field (scripts/brainweb_variants.py's bias25) has such a peak too
+    // (bright white matter above a darkened part): its T1 window keeps off the head's surface and stays.
+    Grid<float> biased = bw.t1;
+    const Vec3i d = biased.dims();
+    const auto at = [](int i, int n) { return -1.0 + 2.0 * i / (n - 1); };
+    for (int z = 0; z < d.z; ++z)
+        for (int y = 0; y < d.y; ++y)
+            for (int x = 0; x < d.x; ++x) {
+                const double u = at(x, d.x), v = at(y, d.y), w = at(z, d.z);
+                biased({x, y, z}) *= static_cast<float>(std::exp(0.25 * (0.8 * u + 0.5 * v * v - 0.6 * w + 0.4 * u * w)));
+            }
+    BrainMaskReport b;
+    const TruthCheck cb = check_against_truth(auto_brain_mask(biased, {}, &b), bw.labels, biased);
+    std::printf("t1 bias 25 %%: flair grey peak %.1f, window %.1f..%.1f, dice %.4f\n", b.flair_grey_peak, b.tissue_low, b.tissue_high, cb.dice);
+    EXPECT_TRUE(std::isfinite(b.flair_grey_peak));
+    EXPECT_FALSE(b.flair);
+    EXPECT_EQ(b.contrast, TissueContrast::kT1);
+    EXPECT_FALSE(b.skull_stripped);
+    EXPECT_GE(cb.dice, 0.9);
+    // The same skull-stripped: its T1 mask touches the surface as every stripped brain's does, and it
+    // stays a stripped T1 (a head of a brain's size, under kFlairHeadMinMl, is never tried as a FLAIR;
+    // here no grey peak stands out in its deep half either).
+    Grid<float> stripped = biased;
+    for (PointIndex i = 0; i < stripped.size(); ++i)
+        if (bw.brain_mask[i] == 0) stripped[i] = 0.0f;
+    BrainMaskReport bs;
+    const TruthCheck cs = check_against_truth(auto_brain_mask(stripped, {}, &bs), bw.labels, stripped);
+    std::printf("t1 bias 25 %% stripped: flair grey peak %.1f, stripped %d, dice %.4f\n", bs.flair_grey_peak, bs.skull_stripped, cs.dice);
+    EXPECT_FALSE(bs.flair);
+    EXPECT_TRUE(bs.skull_stripped);
+    EXPECT_GE(cs.dice, 0.95);
+}
+
 // A T2's tissue model in a whole brain is named from dark to bright WM, GM, CSF (brain_contrast),
 // so its report, its seeds' class and its warnings say the tissue meant. In BrainWeb's brain mask
 // the T2's pure CSF class holds 2.9 % (its partial volume with grey matter the rest): thin, and the
@@ -275,6 +358,7 @@ TEST(BrainMask, TheBiasedCortexPhantomStaysAT1) {
         std::printf("phantom bias %.2f: deep skew %.3f, above %.4f, below %.4f\n", bias, r.deep_skew, r.deep_above, r.deep_below);
         EXPECT_EQ(r.contrast, TissueContrast::kT1) << bias;
         EXPECT_TRUE(std::isnan(r.deep_grey_peak)) << bias;
+        EXPECT_FALSE(r.flair) << bias;
         double floor = 0;
         EXPECT_EQ(brain_contrast(ph.image, brain, &floor), TissueContrast::kT1) << bias;
         EXPECT_FALSE(std::isfinite(floor)) << bias;

@@ -92,14 +92,15 @@ Peak peak_at(const std::vector<double>& s, int bin) {
     return p;
 }
 
-// The two most prominent peaks of smoothed histogram `s`, darker first, where both stand inside it
-// (no end bin) with a prominence of at least kSecondPeak of the tallest bin: a peak's height over
-// the higher of the two lowest points that part it from a taller peak or from the histogram's end.
 constexpr double kSecondPeak = 0.05;
 constexpr double kGreyShare = 0.1;  // T1 heads: ≤ 0.056 above; PDs and T2s measured: 0.25-0.57
-std::optional<std::pair<Peak, Peak>> two_peaks(const std::vector<double>& s) {
+
+// The peaks of smoothed histogram `s` that stand inside it (no end bin) with a prominence of at least
+// kSecondPeak of the tallest bin, most prominent first: (prominence, bin). A peak's prominence: its
+// height over the higher of the two lowest points that part it from a taller peak or from the end.
+std::vector<std::pair<double, int>> prominent_peaks(const std::vector<double>& s) {
     const double tallest_bin = *std::max_element(s.begin(), s.end());
-    std::vector<std::pair<double, int>> peaks;  // (prominence, bin)
+    std::vector<std::pair<double, int>> peaks;
     for (int b = 1; b + 1 < kBins; ++b) {
         const double v = s[static_cast<std::size_t>(b)];
         if (!(v > s[static_cast<std::size_t>(b - 1)] && v >= s[static_cast<std::size_t>(b + 1)])) continue;
@@ -108,21 +109,35 @@ std::optional<std::pair<Peak, Peak>> two_peaks(const std::vector<double>& s) {
         for (int i = b + 1; i < kBins && s[static_cast<std::size_t>(i)] <= v; ++i) right = std::min(right, s[static_cast<std::size_t>(i)]);
         if (const double prominence = v - std::max(left, right); prominence >= kSecondPeak * tallest_bin) peaks.emplace_back(prominence, b);
     }
-    if (peaks.size() < 2) return std::nullopt;
     std::sort(peaks.begin(), peaks.end(), [](const auto& x, const auto& y) { return x.first > y.first || (x.first == y.first && x.second < y.second); });
+    return peaks;
+}
+
+// The two most prominent peaks of smoothed histogram `s`, darker first.
+std::optional<std::pair<Peak, Peak>> two_peaks(const std::vector<double>& s) {
+    const std::vector<std::pair<double, int>> peaks = prominent_peaks(s);
+    if (peaks.size() < 2) return std::nullopt;
     const int a = std::min(peaks[0].second, peaks[1].second), b = std::max(peaks[0].second, peaks[1].second);
     return std::pair{peak_at(s, a), peak_at(s, b)};
 }
 
-}  // namespace
-
-double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r, bool grey_brighter) {
+// The deepest half of `head` by `depth`: its voxels at least half as deep as the deepest.
+Mask deep_half(const Mask& head, const Grid<float>& depth) {
     float deepest = 0;
     for (std::size_t i = 0; i < head.size(); ++i)
         if (head[static_cast<PointIndex>(i)] != 0) deepest = std::max(deepest, depth[static_cast<PointIndex>(i)]);
     Mask deep(head.lattice());
     for (std::size_t i = 0; i < head.size(); ++i)
         deep[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && depth[static_cast<PointIndex>(i)] >= 0.5f * deepest;
+    return deep;
+}
+
+}  // namespace
+
+double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r, bool grey_brighter) {
+    const Mask deep = deep_half(head, depth);
+    r.deep_grey_peak = r.flair_grey_peak = std::numeric_limits<double>::quiet_NaN();
+    r.flair_grey_sigma = 0;
     const std::optional<float> top = quantile_above(image, &head, r.background_threshold, 0.995);
     if (!top) throw std::invalid_argument("brain mask: no head found (nothing above the background inside the head)");
     if (!(*top > r.background_threshold)) throw std::invalid_argument("brain mask: no brain tissue found (the head has no contrast)");
@@ -167,7 +182,44 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
                 r = alt;
             }
         }
+    // A FLAIR: grey matter brighter than white with CSF dark, far below (the skew then reads a T1's).
+    // Not read as grey brighter, a prominent peak above the tallest (white matter's) with at least
+    // kGreyShare of the deep half 3 σ above that white matter reads as grey matter's, for the brain
+    // mask's tissue window only (BrainMaskReport::flair_grey_peak).
+    if (!grey_brighter && !std::isfinite(r.deep_grey_peak) && r.deep_above >= kGreyShare) {
+        const int wm = tallest(s).bin;
+        for (const auto& [prominence, bin] : prominent_peaks(s))
+            if (bin > wm) {
+                const Peak gm = peak_at(s, bin);
+                r.flair_grey_peak = h.centre(gm.bin);
+                r.flair_grey_sigma = std::max(h.width, (h.centre(gm.high) - r.flair_grey_peak) / 1.1774);
+                break;
+            }
+    }
     return *top;
+}
+
+double smoothed_white_floor(const Grid<float>& smooth, const Mask& head, const Grid<float>& depth, const BrainMaskReport& r, double top) {
+    const double lo = std::max(r.background_threshold, r.wm_peak - 3.0 * r.wm_low_sigma);
+    if (!(top > lo)) return lo;
+    const Histogram h = histogram(smooth, deep_half(head, depth), lo, top);
+    const std::vector<double> s = smoothed(h.counts, 2.0);
+    // The local maximum reached climbing from the raw white-matter peak's bin (not the tallest bin
+    // near it: a PD's grey matter may outnumber white matter there), within 2 σ of that peak.
+    const auto at = [&](int b) { return s[static_cast<std::size_t>(b)]; };
+    int best = std::clamp(static_cast<int>((r.wm_peak - h.lo) / h.width), 0, kBins - 1);
+    for (int next = best;; best = next) {
+        if (best + 1 < kBins && at(best + 1) > at(next)) next = best + 1;
+        if (best > 0 && at(best - 1) > at(next)) next = best - 1;
+        if (next == best) break;
+    }
+    if (best <= 0 || best == kBins - 1 || !(at(best) > 0) ||
+        std::abs(h.centre(best) - r.wm_peak) > 2.0 * std::max(r.wm_sigma, r.wm_low_sigma))
+        return lo;
+    const Peak p = peak_at(s, best);
+    if (p.low == 0) return lo;  // its lower side runs off the histogram: not read
+    const double sigma = std::max(h.width, (h.centre(p.bin) - h.centre(p.low)) / 1.1774);
+    return std::max(lo, h.centre(p.bin) - 3.0 * sigma);
 }
 
 TissueContrast deep_contrast(const BrainMaskReport& r, bool in_head) {

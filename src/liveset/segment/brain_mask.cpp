@@ -30,6 +30,7 @@ using brain_detail::histogram;
 using brain_detail::otsu3;
 using brain_detail::quantile_above;
 using brain_detail::smoothed;
+using brain_detail::smoothed_white_floor;
 using brain_detail::tallest;
 using brain_detail::white_matter_peak;
 
@@ -375,15 +376,20 @@ std::optional<std::pair<double, double>> grey_peak_above(const Grid<float>& imag
 
 // The brain-tissue window and the brain it gives. A T1: the CSF/skin | GM/muscle cut (3-class Otsu up
 // to WM) to WM + 4 σ. Grey matter brighter (T2, PD): WM − 3 σ of its darker side (muscle below) to grey
-// matter's peak + 4 σ (grey_peak_above; without one, the T1 window). r.contrast says which was taken.
-Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o,
-                       TissueContrast contrast, double top, BrainMaskReport& r) {
+// matter's peak + 4 σ (grey_peak_above; without one, the T1 window), its lower end read on the smoothed
+// image the window is applied to (smoothed_white_floor: a noisy T2's muscle below it; t2_ric9's mask
+// was the whole head). `flair` (a T1 reading): the same from flair_grey_peak, where there is one and
+// white matter stands 3 σ clear of the background. r.contrast and r.flair say which was taken.
+Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const Grid<float>& depth,
+                       const BrainMaskOptions& o, TissueContrast contrast, bool flair, double top, BrainMaskReport& r) {
     std::optional<std::pair<double, double>> gm;
     if (contrast == TissueContrast::kGreyBrighter)
         gm = std::isfinite(r.deep_grey_peak) ? std::pair{r.deep_grey_peak, r.deep_grey_sigma} : grey_peak_above(image, head, top, r);
     r.contrast = gm ? TissueContrast::kGreyBrighter : TissueContrast::kT1;
+    r.flair = flair && !gm && std::isfinite(r.flair_grey_peak) && r.wm_peak - 3 * r.wm_low_sigma > r.background_threshold;
+    if (r.flair) gm = std::pair{r.flair_grey_peak, r.flair_grey_sigma};  // mirrored; the CSF is dark, `contrast` a T1's
     if (gm) {
-        r.tissue_low = std::max(r.background_threshold, r.wm_peak - 3 * r.wm_low_sigma);
+        r.tissue_low = smoothed_white_floor(smooth, head, depth, r, top);
         r.tissue_high = gm->first + 4 * gm->second;
     } else {
         const Histogram h = histogram(image, head, r.background_threshold, r.wm_peak + 3 * r.wm_sigma);
@@ -445,6 +451,32 @@ Mask below_the_cut(const Grid<float>& image, const Grid<float>& smooth, const Ma
     return brain;
 }
 
+// A FLAIR read as a T1: its T1 window holds the muscle and the mask (`brain`) reaches the head's
+// surface. Only then is the window mirrored from a grey-matter peak above white matter's
+// (flair_grey_peak), and that mask kept where it keeps off the surface; and only in a head too large
+// for a skull-stripped brain (kFlairHeadMinMl): a strongly biased T1 has such a peak too (bright white
+// matter above a darkened part), and stripped, its T1 mask touches the surface as every stripped
+// brain's does, where the mirrored window would keep its white matter alone.
+constexpr double kFlairHeadMinMl = 2500.0;  // the largest adult intracranial volumes: about 2 L
+Mask flair_brain(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const Grid<float>& depth, const BrainMaskOptions& o,
+                 double top, Mask brain, BrainMaskReport& r) {
+    const Vec3d sp = image.lattice().spacing();
+    if (!std::isfinite(r.flair_grey_peak) || !(r.wm_peak - 3 * r.wm_low_sigma > r.background_threshold) ||
+        static_cast<double>(r.head_voxels) * sp.x * sp.y * sp.z < kFlairHeadMinMl * 1000.0)
+        return brain;
+    BrainMaskReport again = r;
+    Mask flair;
+    try {
+        flair = brain_of_contrast(image, smooth, head, depth, o, TissueContrast::kT1, true, top, again);
+    } catch (const std::invalid_argument&) {
+        return brain;  // nothing survives the erosion in that window: the T1 look stays
+    }
+    again.surface_contact = surface_contact(flair, depth, o.stripped_near_mm);
+    if (!again.flair || again.surface_contact >= o.stripped_fraction) return brain;
+    r = again;
+    return flair;
+}
+
 // The brain in the head within `extent_mm` of its top (0: all of it): the tissue window, the
 // extraction, the skull-stripped test, `r` filled in. An empty mask when none is found (under
 // min_head_share of that head, not skull-stripped).
@@ -454,8 +486,10 @@ Mask brain_within(const Grid<float>& image, const Grid<float>& smooth, const Mas
     r.brain_extent_mm = extent_mm;
     r.head_voxels = count(head);
     const double top = white_matter_peak(image, head, depth, r);
-    Mask brain = brain_of_contrast(image, smooth, head, o, deep_contrast(r, true), top, r);
+    const TissueContrast contrast = deep_contrast(r, true);
+    Mask brain = brain_of_contrast(image, smooth, head, depth, o, contrast, false, top, r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
+    if (contrast == TissueContrast::kT1 && r.surface_contact >= o.stripped_fraction) brain = flair_brain(image, smooth, head, depth, o, top, std::move(brain), r);
     r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
     if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);
     r.mask_voxels = count(brain);

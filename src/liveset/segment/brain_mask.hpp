@@ -110,6 +110,14 @@ struct BrainMaskReport {
     // darker is then the white-matter peak. NaN otherwise.
     double deep_grey_peak = std::numeric_limits<double>::quiet_NaN();
     double deep_grey_sigma = 0;
+    // Read as a T1 and yet a prominent peak above the white-matter peak with at least 10 % of the deep
+    // head 3 σ above it: grey matter brighter than white with CSF dark (a FLAIR; session 68), its peak
+    // and width (NaN otherwise). Where the T1 window's mask reaches the head's surface, the window is
+    // mirrored from it and kept if that mask does not (flair true); `contrast` stays a T1's, as the
+    // tissue model reads a FLAIR (CSF, white and grey matter from dark up).
+    double flair_grey_peak = std::numeric_limits<double>::quiet_NaN();
+    double flair_grey_sigma = 0;
+    bool flair = false;
     // The contrast read off the deep head (deep_contrast, brain_histogram.hpp) as the tissue window
     // was taken: a T1's, or mirrored for grey matter brighter than white (T2, PD; one that finds no
     // grey-matter peak for it falls back to a T1's).
