@@ -194,8 +194,8 @@ namespace {
 // The automatic brain mask (ROI "auto", or the fit region without a ROI) found again on the corrected
 // image, in the head it was first found in (`head`; null: the head is found again too). A field N4
 // takes out changes neither a head's contrast nor its skull: a second look that loses the first's
-// grey-brighter reading (T2, PD) or its FLAIR reading, or takes for a stripped brain a head whose skull the first found,
-// was misled (N4 fitted in a PD's brain flattens its grey-white contrast, grey matter lying outside
+// grey-brighter reading (T2, PD) or its FLAIR reading, or takes for a stripped brain a head whose
+// skull the first found, was misled (N4 fitted in a PD's brain flattens its grey-white contrast, grey matter lying outside
 // white: the second look then read a T1 and took the whole head for a stripped brain;
 // docs/BENCHMARKS.md, session 66), and the first stays. (A first look misled by a field, read as a
 // T1, may be corrected; one read as a FLAIR stays.)

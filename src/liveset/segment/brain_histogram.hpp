@@ -53,9 +53,10 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
                          bool grey_brighter = false);
 
 // White matter's lower edge on `smooth`, the smoothed image the brain-tissue window is applied to:
-// its peak there (the tallest of the deep half's smoothed histogram within 2 σ of r.wm_peak) less 3 of
-// its lower σ, and never below r.wm_peak − 3·r.wm_low_sigma (the raw image's). Smoothing narrows the
-// noise the raw σ holds (a T2 under Rician σ 9: raw lower edge 42, smoothed 70, muscle 45-60 between).
+// its peak there (the local maximum of the deep half's smoothed histogram climbed to from r.wm_peak,
+// within 2 σ of it) less 3 of its lower σ, and never below r.wm_peak − 3·r.wm_low_sigma (the raw
+// image's). Smoothing narrows the noise the raw σ holds (a T2 under Rician σ 9: raw lower edge 41.9,
+// smoothed 63.5, its muscle 45-60).
 double smoothed_white_floor(const Grid<float>& smooth, const Mask& head, const Grid<float>& depth, const BrainMaskReport& r, double top);
 // The contrast of a deep head (or brain) from white_matter_peak's figures. Grey matter brighter than
 // white (a T2, a PD): the deep part skewed bright, with a grey-matter peak (deep_grey_peak) or at

@@ -378,15 +378,15 @@ std::optional<std::pair<double, double>> grey_peak_above(const Grid<float>& imag
 // to WM) to WM + 4 σ. Grey matter brighter (T2, PD): WM − 3 σ of its darker side (muscle below) to grey
 // matter's peak + 4 σ (grey_peak_above; without one, the T1 window), its lower end read on the smoothed
 // image the window is applied to (smoothed_white_floor: a noisy T2's muscle below it; t2_ric9's mask
-// was the whole head). `flair` (a T1 reading): the same from flair_grey_peak, where there is one and
-// white matter stands 3 σ clear of the background. r.contrast and r.flair say which was taken.
+// was the whole head). `flair` (a T1 reading; flair_brain checks its peak): the same from
+// flair_grey_peak. r.contrast and r.flair say which was taken.
 Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const Grid<float>& depth,
                        const BrainMaskOptions& o, TissueContrast contrast, bool flair, double top, BrainMaskReport& r) {
     std::optional<std::pair<double, double>> gm;
     if (contrast == TissueContrast::kGreyBrighter)
         gm = std::isfinite(r.deep_grey_peak) ? std::pair{r.deep_grey_peak, r.deep_grey_sigma} : grey_peak_above(image, head, top, r);
     r.contrast = gm ? TissueContrast::kGreyBrighter : TissueContrast::kT1;
-    r.flair = flair && !gm && std::isfinite(r.flair_grey_peak) && r.wm_peak - 3 * r.wm_low_sigma > r.background_threshold;
+    r.flair = flair && !gm;
     if (r.flair) gm = std::pair{r.flair_grey_peak, r.flair_grey_sigma};  // mirrored; the CSF is dark, `contrast` a T1's
     if (gm) {
         r.tissue_low = smoothed_white_floor(smooth, head, depth, r, top);
@@ -472,7 +472,7 @@ Mask flair_brain(const Grid<float>& image, const Grid<float>& smooth, const Mask
         return brain;  // nothing survives the erosion in that window: the T1 look stays
     }
     again.surface_contact = surface_contact(flair, depth, o.stripped_near_mm);
-    if (!again.flair || again.surface_contact >= o.stripped_fraction) return brain;
+    if (again.surface_contact >= o.stripped_fraction) return brain;
     r = again;
     return flair;
 }
@@ -489,7 +489,8 @@ Mask brain_within(const Grid<float>& image, const Grid<float>& smooth, const Mas
     const TissueContrast contrast = deep_contrast(r, true);
     Mask brain = brain_of_contrast(image, smooth, head, depth, o, contrast, false, top, r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
-    if (contrast == TissueContrast::kT1 && r.surface_contact >= o.stripped_fraction) brain = flair_brain(image, smooth, head, depth, o, top, std::move(brain), r);
+    if (contrast == TissueContrast::kT1 && r.surface_contact >= o.stripped_fraction)
+        brain = flair_brain(image, smooth, head, depth, o, top, std::move(brain), r);
     r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
     if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);
     r.mask_voxels = count(brain);
