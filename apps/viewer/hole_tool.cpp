@@ -21,6 +21,7 @@ void HoleTool::reset() {
     job_ = {};
     image_.reset();
     roi_.reset();
+    region_.reset();
     session_ = nullptr;
     scan_.reset();
     verdicts_.clear();
@@ -33,9 +34,11 @@ void HoleTool::reset() {
 bool HoleTool::start(const Session& session, const HoleScanOptions& options) {
     if (job_.valid()) return false;
     options.validate();
-    if (session_ != &session || !image_) {  // the image and ROI never change within a session: copy them once
+    const SheetFit session_fit = session.sheet_fit();
+    if (session_ != &session || !image_) {  // the image, ROI and model region never change within a session: copy them once
         image_ = std::make_shared<const Grid<float>>(session.image());
         roi_ = session.roi() ? std::make_shared<const Grid<std::uint8_t>>(*session.roi()) : nullptr;
+        region_ = session_fit.region ? std::make_shared<const Grid<std::uint8_t>>(*session_fit.region) : nullptr;
         session_ = &session;
     }
     Grid<std::uint8_t> mask = session.mask();  // φ < 0 within the ROI, copied on this thread
@@ -43,14 +46,13 @@ bool HoleTool::start(const Session& session, const HoleScanOptions& options) {
     job_sites_ = aimed_;
     job_revision_ = session.revision();
     started_ = std::chrono::steady_clock::now();
-    HoleScanOptions o = options;
-    o.roi_is_brain = session.options().model_region_is_brain;  // an automatic brain mask as the ROI: a whole brain
-    o.grey_brighter = session.options().model_region_grey_brighter;
-    o.brain_mask = session.options().brain_mask;                // the image's orientation, as the session looked
-    job_ = std::async(std::launch::async, [image = image_, roi = roi_, mask = std::move(mask), o, before, sites = job_sites_]() mutable {
+    SheetFit fit = session_fit;  // the band from where the session's tissue model was fitted
+    job_ = std::async(std::launch::async, [image = image_, roi = roi_, region = region_, mask = std::move(mask), options, fit, before,
+                                           sites = job_sites_]() mutable {
         Result r;
         try {
-            r.scan = scan_holes(std::move(mask), *image, roi.get(), o);
+            fit.region = region.get();
+            r.scan = scan_holes(std::move(mask), *image, roi.get(), options, fit);
             if (before && !sites.empty()) {
                 const std::vector<HoleVerdict> v = hole_verdicts(sites, *before, *r.scan, *image, roi.get());
                 for (std::size_t k = 0; k < sites.size(); ++k) r.verdicts.push_back({sites[k], v[k]});

@@ -65,6 +65,7 @@ private:
 
     std::shared_ptr<const Grid<float>> image_;  // the session's image, copied once per image
     std::shared_ptr<const Grid<std::uint8_t>> roi_;
+    std::shared_ptr<const Grid<std::uint8_t>> region_;  // the session's model region (Session::sheet_fit), copied with them
     const Session* session_ = nullptr;
     std::future<Result> job_;
     std::chrono::steady_clock::time_point started_;

@@ -18,9 +18,7 @@ namespace {
 std::string model_window_for_level_set(const Session& s, ThresholdParams& p, bool& from_seeds) {
     std::vector<std::string> warnings;
     TissueModel model;
-    const std::optional<ModelWindow> w = sheet_window(s.image(), s.mask(), s.roi(), TissueModelOptions{}, warnings, &model,
-                                                              s.options().model_region_is_brain, s.options().brain_mask,
-                                                              s.options().model_region_grey_brighter);
+    const std::optional<ModelWindow> w = sheet_window(s.image(), s.mask(), s.roi(), TissueModelOptions{}, warnings, &model, s.sheet_fit());
     const IntensityScale& sc = s.scale();
     if (!w) {
         return fmt::format("µ, ε: no usable tissue model ({}); µ {:.4g}, ε {:.4g} (raw) are defaults: set them (panel or --mu-raw/--epsilon-raw)",

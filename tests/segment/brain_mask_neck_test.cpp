@@ -214,7 +214,7 @@ TEST(BrainMask, TheSheetWindowLooksForTheBrainAsItIsTold) {
     EXPECT_GT(static_cast<double>(differ), 0.05 * static_cast<double>(voxels));
     std::vector<std::string> warnings;
     const std::optional<ModelWindow> want = sheet_window(oriented, grey, nullptr, TissueModelOptions{}, warnings);
-    const std::optional<ModelWindow> got = sheet_window(coronal, grey_coronal, nullptr, TissueModelOptions{}, warnings, nullptr, false, from_head);
+    const std::optional<ModelWindow> got = sheet_window(coronal, grey_coronal, nullptr, TissueModelOptions{}, warnings, nullptr, SheetFit{.brain = from_head});
     ASSERT_TRUE(want && got);
     EXPECT_NEAR(got->lower, want->lower, 0.5);
     EXPECT_NEAR(got->upper, want->upper, 0.5);

@@ -202,7 +202,9 @@ TEST(BrainWeb, NoiseThatHidesATissueIsSeenThroughTheBlur) {
     for (PointIndex p = 0; p < labels.size(); ++p) sheet[p] = labels[p] == 2;
     std::vector<std::string> ignored;
     TissueModel sheet_model;
-    const std::optional<ModelWindow> band = sheet_window(loud, sheet, &s.brain, options, ignored, &sheet_model, true);
+    SheetFit whole_brain;  // the ROI is the automatic brain mask
+    whole_brain.region_is_brain = true;
+    const std::optional<ModelWindow> band = sheet_window(loud, sheet, &s.brain, options, ignored, &sheet_model, whole_brain);
     ASSERT_TRUE(band.has_value());
     EXPECT_EQ(sheet_model.classes.size(), 3u);
     EXPECT_EQ(band->seed_class, 1);

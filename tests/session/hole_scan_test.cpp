@@ -2,7 +2,8 @@
 // grey-matter truth has a hole drilled by hand, the tissue model's band finds the drill (its site
 // on the drilled voxels, all of them in the band in the candidate), the intact truth has no candidate there;
 // the verdict after the drilled voxels are put back is "closed" (exactly hole_verdict's counts by
-// brute force) and "no hole" at a site far from it; bad options throw.
+// brute force) and "no hole" at a site far from it; a session's band comes from its model region;
+// bad options throw.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 
 #include "hole_phantom.hpp"
 #include "liveset/session/hole_scan.hpp"
+#include "liveset/session/session.hpp"
 
 namespace liveset {
 namespace {
@@ -78,6 +80,52 @@ TEST(HoleScan, VerdictsAfterTheDrillIsFilled) {
     EXPECT_EQ(v[1].before, 0u);
     EXPECT_EQ(v[1].after, 0u);
     EXPECT_TRUE(hole_verdicts({}, before, after, d.phantom.image, nullptr).empty());
+}
+
+// A session's hole finder reads the band from where the session's tissue model was fitted (its
+// model region, e.g. the brain mask found before N4), not from a brain looked for again: the band
+// is sheet_window's with that region as the ROI (the mask lies inside it, so the same voxels vote),
+// and the model behind it is the session's own.
+TEST(HoleScan, TheBandComesFromTheSessionsModelRegion) {
+    const DrilledPhantom& d = drilled_phantom();
+    // CSF, GM and half of the WM: not what the automatic mask finds (the grey-matter sheet is all in it).
+    Grid<std::uint8_t> tissue(d.phantom.labels.lattice(), 0);
+    const int half = tissue.dims().x / 2;
+    for (PointIndex i = 0; i < tissue.size(); ++i) {
+        const std::uint8_t l = d.phantom.labels[i];
+        tissue[i] = l != kBackground && (l != kWhiteMatter || tissue.lattice().coord(i).x < half);
+    }
+    SessionOptions so;
+    so.model_region = tissue;
+    so.model_region_is_brain = true;
+    const Session session(d.phantom.image, so);
+    const HoleScan got = scan_holes(d.mask, d.phantom.image, nullptr, HoleScanOptions{}, session.sheet_fit());
+
+    std::vector<std::string> warnings;
+    TissueModel in_region, looked_for;
+    SheetFit as_roi;
+    as_roi.region_is_brain = true;
+    const std::optional<ModelWindow> want = sheet_window(d.phantom.image, d.mask, &tissue, TissueModelOptions{}, warnings, &in_region, as_roi);
+    ASSERT_TRUE(want.has_value());
+    EXPECT_EQ(got.finder.sheet_lower, want->lower);
+    EXPECT_EQ(got.finder.sheet_upper, want->upper);
+    ASSERT_TRUE(session.tissue_model().has_value());
+    ASSERT_EQ(session.tissue_model()->classes.size(), in_region.classes.size());
+    for (std::size_t k = 0; k < in_region.classes.size(); ++k) {
+        EXPECT_EQ(session.tissue_model()->classes[k].mean, in_region.classes[k].mean);
+        EXPECT_EQ(session.tissue_model()->classes[k].weight, in_region.classes[k].weight);
+    }
+    // Without the session's region, the model is fitted where model_region() looks: elsewhere.
+    ASSERT_TRUE(sheet_window(d.phantom.image, d.mask, nullptr, TissueModelOptions{}, warnings, &looked_for).has_value());
+    ASSERT_EQ(looked_for.classes.size(), in_region.classes.size());
+    double moved = 0;
+    for (std::size_t k = 0; k < in_region.classes.size(); ++k) moved += std::abs(looked_for.classes[k].weight - in_region.classes[k].weight);
+    EXPECT_GT(moved, 0.05);
+    // A model region of another size is an error, not a crash.
+    SheetFit small;
+    const Grid<std::uint8_t> other(Lattice({8, 8, 8}), 1);
+    small.region = &other;
+    EXPECT_THROW(scan_holes(d.mask, d.phantom.image, nullptr, HoleScanOptions{}, small), std::invalid_argument);
 }
 
 TEST(HoleScan, BadOptionsThrow) {

@@ -2,13 +2,13 @@
 // that tells a skull-stripped input from a full head.
 #include "liveset/segment/brain_mask.hpp"
 #include "liveset/segment/brain_histogram.hpp"
+#include "liveset/segment/head_geometry.hpp"
 #include "liveset/segment/intensity.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <numbers>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -25,6 +25,13 @@ using brain_detail::Histogram;
 using brain_detail::kBins;
 using brain_detail::Mask;
 using brain_detail::Peak;
+using brain_detail::Vertical;
+using brain_detail::cranial;
+using brain_detail::cut_contact_mm2;
+using brain_detail::head_diameter_mm;
+using brain_detail::head_top;
+using brain_detail::surface_contact;
+using brain_detail::vertical;
 using brain_detail::deep_contrast;
 using brain_detail::histogram;
 using brain_detail::otsu3;
@@ -186,29 +193,6 @@ Mask head_foreground(const Grid<float>& image, double threshold) {
     return f;
 }
 
-// The brain boundary's share that lies within `near_mm` of the head surface (boundary: mask voxels
-// with a 6-neighbour outside the mask inside the lattice).
-double surface_contact(const Mask& mask, const Grid<float>& head_depth, double near_mm) {
-    const Lattice& lat = mask.lattice();
-    const Vec3i d = lat.dims();
-    std::size_t boundary = 0, near = 0;
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x) {
-                if (mask({x, y, z}) == 0) continue;
-                bool edge = false;
-                for (int k = 0; k < 6 && !edge; ++k) {
-                    Vec3i q{x, y, z};
-                    q[k / 2] += k % 2 ? 1 : -1;
-                    edge = lat.contains(q) && mask(q) == 0;
-                }
-                if (!edge) continue;
-                ++boundary;
-                near += head_depth({x, y, z}) <= near_mm;
-            }
-    return boundary > 0 ? static_cast<double>(near) / static_cast<double>(boundary) : 0.0;
-}
-
 // A skull-stripped input: the filled largest component of everything above the background (the
 // lowest value when it fills at least 2 % of the image, as masking leaves it; else the head threshold).
 Mask stripped_foreground(const Grid<float>& image, double threshold) {
@@ -217,86 +201,6 @@ Mask stripped_foreground(const Grid<float>& image, double threshold) {
     Mask f(image.lattice());
     for (std::size_t i = 0; i < f.size(); ++i) f[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > floor;
     return fill_holes(largest_component(f));
-}
-
-// Which way is up in the image: height (mm) = g · voxel index, and the head's cross-section in the
-// array's face that looks most inferior (mm²), where a neck leaves the field of view.
-struct Vertical {
-    double g[3] = {0, 0, 0};
-    double exit_mm2 = 0;
-    double height(Vec3i p) const { return g[0] * p.x + g[1] * p.y + g[2] * p.z; }
-};
-
-// The head's highest point along `up`.
-double head_top(const Mask& head, const Vertical& up) {
-    const Vec3i d = head.dims();
-    double top = -std::numeric_limits<double>::infinity();
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x)
-                if (head({x, y, z}) != 0) top = std::max(top, up.height({x, y, z}));
-    return top;
-}
-
-// The solid head's voxels in the face `side` (0: index 0, 1: the last) of axis `a`, in mm².
-double face_exit_mm2(const Mask& head, int a, int side) {
-    const Vec3i d = head.dims();
-    const Vec3d sp = head.lattice().spacing();
-    const int dims[3] = {d.x, d.y, d.z};
-    const double area[3] = {sp.y * sp.z, sp.x * sp.z, sp.x * sp.y};
-    const int slice = side == 0 ? 0 : dims[a] - 1;
-    std::size_t n = 0;
-    for (int z = a == 2 ? slice : 0; z < (a == 2 ? slice + 1 : d.z); ++z)
-        for (int y = a == 1 ? slice : 0; y < (a == 1 ? slice + 1 : d.y); ++y)
-            for (int x = a == 0 ? slice : 0; x < (a == 0 ? slice + 1 : d.x); ++x) n += head({x, y, z}) != 0;
-    return static_cast<double>(n) * area[a];
-}
-
-// From the header: the world's superior axis (LPS z; the direction cosines included), the inferior
-// face the one whose axis runs most along it. From the head (a header without orientation): the face
-// the head leaves the field of view through most is inferior, up runs away from it.
-Vertical vertical(const Mask& head, bool from_header) {
-    Vertical v;
-    const Lattice& lat = head.lattice();
-    const Vec3d sp = lat.spacing();
-    const double step[3] = {sp.x, sp.y, sp.z};
-    if (from_header) {
-        const double z0 = lat.to_world({0, 0, 0}).z;
-        v.g[0] = lat.to_world({1, 0, 0}).z - z0;
-        v.g[1] = lat.to_world({0, 1, 0}).z - z0;
-        v.g[2] = lat.to_world({0, 0, 1}).z - z0;
-        int a = 0;  // the axis most along the superior axis (per millimetre)
-        for (int k = 1; k < 3; ++k)
-            if (std::abs(v.g[k]) / step[k] > std::abs(v.g[a]) / step[a]) a = k;
-        v.exit_mm2 = face_exit_mm2(head, a, v.g[a] > 0 ? 0 : 1);
-        return v;
-    }
-    int best_a = 2, best_side = 0;
-    for (int a = 0; a < 3; ++a)
-        for (int side = 0; side < 2; ++side) {
-            const double e = face_exit_mm2(head, a, side);
-            if (e > v.exit_mm2) v.exit_mm2 = e, best_a = a, best_side = side;
-        }
-    v.g[best_a] = best_side == 0 ? step[best_a] : -step[best_a];
-    return v;
-}
-
-// The head within `extent_mm` of its highest voxel along `up`; `below` counts what is left out.
-// 0: the whole head.
-Mask cranial(const Mask& head, const Vertical& up, double extent_mm, std::size_t& below) {
-    below = 0;
-    if (extent_mm <= 0) return head;
-    const Vec3i d = head.dims();
-    const double top = head_top(head, up);
-    Mask out = head;
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x)
-                if (out({x, y, z}) != 0 && up.height({x, y, z}) < top - extent_mm) {
-                    out({x, y, z}) = 0;
-                    ++below;
-                }
-    return out;
 }
 
 Mask intersect(Mask a, const Mask& b) {
@@ -345,24 +249,6 @@ Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Ma
     return brain;
 }
 
-// The head's widest cross-section across `up` within `depth_mm` of its top, as the diameter of the
-// disc of that area (mm): the volume of each layer of height, one slice thick.
-double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
-    const Vec3i d = head.dims();
-    const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
-    const double top = head_top(head, up);
-    std::vector<std::size_t> layer(static_cast<std::size_t>(std::lround(depth_mm / layer_mm)) + 1, 0);
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x) {
-                const auto k = static_cast<std::size_t>(std::lround((top - up.height({x, y, z})) / layer_mm));
-                if (head({x, y, z}) != 0 && k < layer.size()) ++layer[k];
-            }
-    const Vec3d sp = head.lattice().spacing();
-    const double widest = static_cast<double>(*std::max_element(layer.begin(), layer.end())) * sp.x * sp.y * sp.z / layer_mm;  // mm²
-    return 2.0 * std::sqrt(widest / std::numbers::pi);
-}
-
 // Grey matter's peak in the head above WM + 3 σ (the tallest there, standing inside that range, with
 // its σ from the upper half width), or nullopt.
 std::optional<std::pair<double, double>> grey_peak_above(const Grid<float>& image, const Mask& head, double top, const BrainMaskReport& r) {
@@ -397,25 +283,6 @@ Mask brain_of_contrast(const Grid<float>& image, const Grid<float>& smooth, cons
         r.tissue_high = r.wm_peak + 4 * r.wm_sigma;
     }
     return extract_brain(image, smooth, head, o, r);
-}
-
-// The brain's cross-section where the head is cut at height `cut` (mm²): its voxels within a slab
-// above the cut, per mm of height. The slab is whole slices of the array's most vertical axis, at
-// least 3 mm (a 6 mm slice: one), so that quantised heights count no slice twice.
-double cut_contact_mm2(const Mask& brain, const Vertical& up, double cut) {
-    const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
-    const double slab = layer_mm * std::ceil(3.0 / layer_mm - 1e-9);
-    const Vec3i d = brain.dims();
-    std::size_t n = 0;
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x)
-                if (brain({x, y, z}) != 0) {
-                    const double h = up.height({x, y, z});
-                    n += h >= cut && h < cut + slab;
-                }
-    const Vec3d s = brain.lattice().spacing();
-    return static_cast<double>(n) * s.x * s.y * s.z / slab;
 }
 
 // A head tilted in the field of view (pitched, rolled) reaches further below its top than an

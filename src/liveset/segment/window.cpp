@@ -248,10 +248,9 @@ WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& s
 
 std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                         const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
-                                        std::vector<std::string>& warnings, TissueModel* model, bool roi_is_brain,
-                                        const BrainMaskOptions& brain, bool known_grey_brighter) {
-    if (!(mask.dims() == image.dims()) || (roi && !(roi->dims() == image.dims())))
-        throw std::invalid_argument("sheet window: image, mask and ROI differ in size");
+                                        std::vector<std::string>& warnings, TissueModel* model, const SheetFit& fit) {
+    if (!(mask.dims() == image.dims()) || (roi && !(roi->dims() == image.dims())) || (fit.region && !(fit.region->dims() == image.dims())))
+        throw std::invalid_argument("sheet window: image, mask, ROI and model region differ in size");
     const auto inside = [&](PointIndex i) { return mask[i] && (!roi || (*roi)[i]); };
     bool any = false;
     for (PointIndex i = 0; i < mask.size() && !any; ++i) any = inside(i);
@@ -260,9 +259,9 @@ std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std
         return std::nullopt;
     }
     bool whole_brain = false;
-    const Grid<std::uint8_t> region = model_region(image, nullptr, roi, options.classes, &whole_brain, brain);
-    const std::optional<TissueModel> m =
-        fit_window_model(image, region, options, warnings, whole_brain || (roi && roi_is_brain), known_grey_brighter);
+    const Grid<std::uint8_t> region = model_region(image, fit.region, roi, options.classes, &whole_brain, fit.brain);
+    const std::optional<TissueModel> m = fit_window_model(image, region, options, warnings,
+                                                          whole_brain || fit.region_is_brain, fit.known_grey_brighter);
     if (!m || !m->usable()) return std::nullopt;
     if (model) *model = *m;
     // The voxels vote on the image the model was fitted on (blurred when noise hid a tissue).

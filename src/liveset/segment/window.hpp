@@ -70,18 +70,24 @@ WindowEstimate estimate_window(const Grid<float>& image, const IntensityScale& s
 // mean of more than one tissue class.
 std::vector<std::string> window_warnings(const TissueModel& model, double lower, double upper);
 
+// Where sheet_window fits its tissue model: as a segmentation fits it (SegmentRequest's
+// model_region, model_region_is_brain, model_region_grey_brighter, brain_mask), so that the hole
+// finder of a session reads the band from the region the session's window came from.
+struct SheetFit {
+    const Grid<std::uint8_t>* region = nullptr;  // none: the ROI, else model_region() looks for the brain
+    bool region_is_brain = false;      // that region (else the ROI) is an automatic brain mask: a whole brain
+    bool known_grey_brighter = false;  // as fit_window_model's (SessionOptions::model_region_grey_brighter)
+    BrainMaskOptions brain;            // how model_region looks for the brain (its header's orientation)
+};
+
 // The intensity band of the tissue a segmented sheet is made of (for the hole finder and the sheet
-// repair rule): the model window (model_window) of the class most of the mask's voxels fall in,
-// from the tissue model fitted in model_region(image, nullptr, roi, classes). nullopt, with the
-// reason in `warnings`, when the model cannot be used or the mask is empty. `model` (optional)
-// receives the fitted model. `roi_is_brain`: the ROI is an automatic brain mask (`--roi auto`), a
-// whole brain to fit_window_model as the mask model_region finds itself without a ROI. `brain`:
-// how model_region looks for that mask (its header's orientation). `known_grey_brighter`: as
-// fit_window_model's (SessionOptions::model_region_grey_brighter). Throws std::invalid_argument
-// when the sizes differ.
+// repair rule): the model window (model_window) of the class most of the mask's voxels (within
+// `roi`) fall in, from the tissue model fitted in model_region(image, fit.region, roi, classes).
+// nullopt, with the reason in `warnings`, when the model cannot be used or the mask is empty.
+// `model` (optional) receives the fitted model. Throws std::invalid_argument when the sizes differ.
 std::optional<ModelWindow> sheet_window(const Grid<float>& image, const Grid<std::uint8_t>& mask,
                                         const Grid<std::uint8_t>* roi, const TissueModelOptions& options,
-                                        std::vector<std::string>& warnings, TissueModel* model = nullptr, bool roi_is_brain = false,
-                                        const BrainMaskOptions& brain = {}, bool known_grey_brighter = false);
+                                        std::vector<std::string>& warnings, TissueModel* model = nullptr,
+                                        const SheetFit& fit = {});
 
 }  // namespace liveset

@@ -19,7 +19,8 @@ void HoleScanOptions::validate() const {
         throw std::invalid_argument("hole finder: the sheet band's lower end must be below its upper end");
 }
 
-HoleScan scan_holes(Grid<std::uint8_t> mask, const Grid<float>& image, const Grid<std::uint8_t>* roi, const HoleScanOptions& options) {
+HoleScan scan_holes(Grid<std::uint8_t> mask, const Grid<float>& image, const Grid<std::uint8_t>* roi, const HoleScanOptions& options,
+                    const SheetFit& fit) {
     const auto t0 = std::chrono::steady_clock::now();
     options.validate();
     if (!(mask.dims() == image.dims()) || (roi && !(roi->dims() == image.dims())))
@@ -32,8 +33,7 @@ HoleScan scan_holes(Grid<std::uint8_t> mask, const Grid<float>& image, const Gri
         s.finder.sheet_upper = *options.sheet_upper;
         s.band_from = "given";
     } else {
-        const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, s.warnings, nullptr, options.roi_is_brain,
-                                                              options.brain_mask, options.grey_brighter);
+        const std::optional<ModelWindow> w = sheet_window(image, mask, roi, TissueModelOptions{}, s.warnings, nullptr, fit);
         if (!w)
             throw std::invalid_argument("hole finder: cannot tell the sheet's tissue from the image (" +
                                         (s.warnings.empty() ? std::string("no tissue model") : s.warnings.back()) + "); give the sheet band");

@@ -14,7 +14,7 @@
 
 #include "liveset/eval/holes.hpp"
 #include "liveset/grid/grid.hpp"
-#include "liveset/segment/brain_mask.hpp"
+#include "liveset/segment/window.hpp"
 
 namespace liveset {
 
@@ -27,9 +27,6 @@ struct HoleScanOptions {
     // The sheet's band [lower, upper) in raw units; both absent: the tissue model's window for the
     // class most of the mask's voxels are in (sheet_window).
     std::optional<double> sheet_lower, sheet_upper;
-    bool roi_is_brain = false;  // the ROI is an automatic brain mask (sheet_window; SessionOptions::model_region_is_brain)
-    bool grey_brighter = false;  // read so before N4 (sheet_window; SessionOptions::model_region_grey_brighter)
-    BrainMaskOptions brain_mask;  // how sheet_window looks for the brain without a ROI (SessionOptions::brain_mask)
     void validate() const;  // std::invalid_argument with a one-line message
 };
 
@@ -42,11 +39,12 @@ struct HoleScan {
     double ms = 0.0;                 // wall time of the scan
 };
 
-// Scans `mask` (the segmentation, non-zero inside) of `image` (raw) within `roi` (optional).
+// Scans `mask` (the segmentation, non-zero inside) of `image` (raw) within `roi` (optional); without
+// a given band, the tissue model is fitted where `fit` says (a session's: Session::sheet_fit()).
 // Throws std::invalid_argument (one line) on bad options, other sizes, or when the tissue model
 // cannot tell the sheet's tissue and no band is given.
 HoleScan scan_holes(Grid<std::uint8_t> mask, const Grid<float>& image, const Grid<std::uint8_t>* roi,
-                    const HoleScanOptions& options);
+                    const HoleScanOptions& options, const SheetFit& fit = {});
 
 // The finder's verdict at each of `sites` (index space) from the scan before a repair to the scan
 // after it, both with before's band (hole_verdict with kHoleVerdictRadius, exactly as `liveset

@@ -194,14 +194,18 @@ const Grid<float>& Session::speed_image() const {
     return smoothed_->second;
 }
 
+SheetFit Session::sheet_fit() const {
+    return {options_.model_region ? &*options_.model_region : nullptr, options_.model_region_is_brain, options_.model_region_grey_brighter,
+            options_.brain_mask};
+}
+
 const std::optional<TissueModel>& Session::tissue_model() const {
     if (!model_) {
         std::vector<std::string> ignored;  // window_estimate() reports an unusable model
-        const Grid<std::uint8_t>* region = options_.model_region ? &*options_.model_region : nullptr;
+        const SheetFit f = sheet_fit();
         bool automatic = false;
-        const Grid<std::uint8_t> fit = model_region(image_, region, roi(), options_.window.model.classes, &automatic, options_.brain_mask);
-        model_ = fit_window_model(image_, fit, options_.window.model, ignored, automatic || options_.model_region_is_brain,
-                                  options_.model_region_grey_brighter);
+        const Grid<std::uint8_t> fit = model_region(image_, f.region, roi(), options_.window.model.classes, &automatic, f.brain);
+        model_ = fit_window_model(image_, fit, options_.window.model, ignored, automatic || f.region_is_brain, f.known_grey_brighter);
     }
     return *model_;
 }

@@ -101,6 +101,10 @@ public:
     const Grid<float>& speed_image() const;
     const IntensityScale& scale() const { return scale_; }
     const Grid<std::uint8_t>* roi() const { return roi_ ? &*roi_ : nullptr; }
+    // Where tissue_model() is fitted, for sheet_window and scan_holes (the hole finder reads the
+    // sheet's band from the region the session's window came from); its region points into this
+    // session's options.
+    SheetFit sheet_fit() const;
     const SparseField& field() const { return field_; }
     const FragmentMesher& mesher() const { return mesher_; }
     bool has_surface() const { return !field_.zero_layer().empty(); }
