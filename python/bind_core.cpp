@@ -284,7 +284,7 @@ std::string find_holes_json(const pyb::array& mask, const pyb::array& image, con
     } else {
         const BrainMaskOptions brain = brain_options_for(oriented);  // a ROI: the contrast read off the head, as segment's
         const std::optional<ModelWindow> w = sheet_window(img, m, r ? &*r : nullptr, TissueModelOptions{}, warnings, nullptr,
-                                                          SheetFit{.known_grey_brighter = r && cli::head_reads_grey_brighter(img, brain), .brain = brain});
+                                                          cli::fit_for_roi(img, r ? &*r : nullptr, brain));
         if (!w) throw std::invalid_argument("cannot tell the sheet's tissue from the image (" +
                                             (warnings.empty() ? std::string("no tissue model") : warnings.back()) +
                                             "); give sheet_band=(lower, upper)");

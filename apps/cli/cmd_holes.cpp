@@ -54,8 +54,7 @@ int run_holes(const HolesArgs& a, int threads) {
     } else {
         const BrainMaskOptions brain = brain_mask_options(header);  // a ROI from a file: the contrast read off the head, as segment's
         const std::optional<ModelWindow> w =
-            sheet_window(image, mask, r, TissueModelOptions{}, warnings, nullptr,
-                         SheetFit{.known_grey_brighter = r && head_reads_grey_brighter(image, brain), .brain = brain});
+            sheet_window(image, mask, r, TissueModelOptions{}, warnings, nullptr, fit_for_roi(image, r, brain));
         if (!w) throw UsageError(fmt::format("cannot tell the sheet's tissue from the image ({}); give --sheet-lower and --sheet-upper",
                                              warnings.empty() ? "no tissue model" : warnings.back()));
         fo.sheet_lower = w->lower;

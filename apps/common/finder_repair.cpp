@@ -68,8 +68,7 @@ std::optional<SheetBand> model_sheet_band(const Grid<float>& image, const Grid<s
     std::vector<std::string> warnings;
     TissueModel model;
     const std::optional<ModelWindow> w =
-        sheet_window(image, mask, roi, TissueModelOptions{}, warnings, &model,
-                     SheetFit{.known_grey_brighter = roi && head_reads_grey_brighter(image, brain), .brain = brain});
+        sheet_window(image, mask, roi, TissueModelOptions{}, warnings, &model, fit_for_roi(image, roi, brain));
     if (!w) return std::nullopt;
     return SheetBand{w->lower, w->upper, model.classes[static_cast<std::size_t>(w->seed_class)].mean};
 }

@@ -24,7 +24,7 @@ struct SheetBand {
 
 // The tissue model's window and class mean for the class most of `mask`'s voxels are in
 // (sheet_window, looking for the brain with `brain`: brain_mask_options(header); with a `roi`, the
-// contrast read off the head, head_reads_grey_brighter); nullopt when the model cannot tell the
+// ROI read as `segment` reads it, fit_for_roi); nullopt when the model cannot tell the
 // sheet's tissue.
 std::optional<SheetBand> model_sheet_band(const Grid<float>& image, const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* roi,
                                           const BrainMaskOptions& brain = {});

@@ -219,20 +219,49 @@ void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMa
     out.brain_mask_after_n4 = report.mask_voxels;
 }
 
+// A ROI from a file this close to the automatic brain mask (Dice) is a whole brain
+// (Roi::file_is_brain): another tool's brain mask agrees with ours to 0.9-0.99 on the
+// BrainWeb variants; a hemisphere's mask reaches 0.67 at most, a box about the brain (twice its
+// volume) 0.67 too.
+constexpr double kSameBrainDice = 0.8;
+
+double mask_dice(const Grid<std::uint8_t>& a, const Grid<std::uint8_t>& b) {
+    std::size_t both = 0, na = 0, nb = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const bool x = a[static_cast<PointIndex>(i)] != 0, y = b[static_cast<PointIndex>(i)] != 0;
+        both += x && y;
+        na += x;
+        nb += y;
+    }
+    return na + nb > 0 ? 2.0 * static_cast<double>(both) / static_cast<double>(na + nb) : 0.0;
+}
+
 }  // namespace
 
-bool head_reads_grey_brighter(const Grid<float>& image, const BrainMaskOptions& options) {
+SheetFit fit_for_roi(const Grid<float>& image, const Grid<std::uint8_t>* roi, const BrainMaskOptions& options) {
+    SheetFit f;
+    f.brain = options;
+    if (!roi) return f;
+    if (!(roi->dims() == image.dims())) throw std::invalid_argument("the ROI and the image differ in size");
     BrainMaskReport head;
-    return try_auto_brain_mask(image, nullptr, options, &head) && head.contrast == TissueContrast::kGreyBrighter;
+    const std::optional<Grid<std::uint8_t>> brain = try_auto_brain_mask(image, nullptr, options, &head);
+    f.known_grey_brighter = brain && head.contrast == TissueContrast::kGreyBrighter;
+    f.region_is_brain = brain && mask_dice(*brain, *roi) >= kSameBrainDice;
+    return f;
 }
 
 namespace {
 
 // PreparedImage::grey_brighter on the image as given: the automatic brain mask's region read
 // (brain_contrast), or for a ROI from a file the head's reading (auto_brain_mask's): such a ROI may
-// be any shape, and a box astride a T1's cortex and scalp reads grey brighter.
-bool read_grey_brighter(const Grid<float>& image, const std::optional<Roi>& roi, const PreparedImage& out, const BrainMaskOptions& options) {
-    if (roi && !roi->brain_mask) return head_reads_grey_brighter(image, options);
+// be any shape, and a box astride a T1's cortex and scalp reads grey brighter. The ROI from a file
+// is compared with the mask found there (Roi::file_is_brain).
+bool read_grey_brighter(const Grid<float>& image, std::optional<Roi>& roi, const PreparedImage& out, const BrainMaskOptions& options) {
+    if (roi && !roi->brain_mask) {
+        const SheetFit f = fit_for_roi(image, &roi->mask, options);
+        roi->file_is_brain = f.region_is_brain;
+        return f.known_grey_brighter;
+    }
     const Grid<std::uint8_t>* fit = out.fit(roi ? &roi->mask : nullptr);
     return fit && brain_contrast(image, *fit) == TissueContrast::kGreyBrighter;
 }
@@ -367,7 +396,7 @@ nlohmann::json roi_report(const Roi& roi) {
     std::size_t voxels = 0;
     for (std::uint8_t v : roi.mask.values()) voxels += v != 0;
     nlohmann::json j{{"source", roi.source}, {"voxels", voxels}, {"volume_mm3", static_cast<double>(voxels) * s.x * s.y * s.z},
-                     {"default", roi.by_default}};
+                     {"default", roi.by_default}, {"whole_brain", roi.brain_mask.has_value() || roi.file_is_brain}};
     if (const auto& b = roi.brain_mask)
         j["auto"] = {{"skull_stripped", b->skull_stripped}, {"background_threshold", b->background_threshold},
                      {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold},
@@ -403,7 +432,7 @@ void print_roi_summary(const Roi& roi) {
     const nlohmann::json j = roi_report(roi);
     const std::string how = roi.brain_mask ? fmt::format("auto brain mask{} ({})", roi.by_default ? " by default, --roi none for the whole image" : "",
                                                          brain_mask_summary(*roi.brain_mask))
-                                           : roi.source;
+                                           : roi.source + (roi.file_is_brain ? " (a whole brain: it agrees with the automatic brain mask)" : "");
     fmt::print("  roi          {}: {} voxels, {:.1f} ml\n", how, j["voxels"].get<std::size_t>(), j["volume_mm3"].get<double>() / 1000.0);
 }
 

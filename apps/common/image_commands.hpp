@@ -18,6 +18,7 @@
 #include "liveset/segment/brain_mask.hpp"
 #include "liveset/preprocess/bias_correction.hpp"
 #include "liveset/segment/pipeline.hpp"
+#include "liveset/segment/window.hpp"
 #include "liveset/session/session.hpp"
 
 namespace liveset::cli {
@@ -53,6 +54,12 @@ struct Roi {
     std::optional<BrainMaskReport> brain_mask;   // what auto_brain_mask found (auto only)
     std::shared_ptr<BrainMaskHead> head;         // the head it was found in (auto only): prepare_image looks again there
     bool by_default = false;                     // "auto" chosen by default, not asked for
+    // A mask from a file that is a whole brain: Dice ≥ 0.8 with the automatic brain mask of its head,
+    // found by prepare_image for its contrast (PreparedImage::grey_brighter). The tissue model then
+    // treats it as the automatic mask: its contrast read off it, and noise that hides a tissue seen
+    // through the blur (BrainWeb at Rician σ 18 in its own brain mask: 2 classes, GM Dice 0.695; as a
+    // whole brain 0.893; docs/BENCHMARKS.md, session 69). The report's roi.whole_brain.
+    bool file_is_brain = false;
 };
 // `arg` empty, the default: the automatic brain mask when the image is a full head (Roi::by_default),
 // else no ROI (a skull-stripped brain has no scalp, muscle or eyes to leak into; but one whose
@@ -80,13 +87,16 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
 inline constexpr const char* kDefaultRoiHint =
     ": the automatic brain mask bounds the front by default on a head; open the image with --roi none to segment outside the brain";
 // auto_brain_mask(image, options, report, head), or nullopt when the image does not look like a head (no error).
-// Whether the image's head reads as grey brighter than white (a T2, a PD): auto_brain_mask's reading,
-// false where no head is found. How the contrast of an image segmented in a ROI from a file is known
-// (a ROI of any shape is not read itself: a box astride a T1's cortex and scalp reads grey brighter).
-bool head_reads_grey_brighter(const Grid<float>& image, const BrainMaskOptions& options);
+// Where the tissue model of an image given with a ROI from a file (`roi`; none: no ROI) is fitted,
+// and how it is read, as `segment` reads it: the ROI, grey brighter than white (a T2, a PD) when its
+// head reads so (auto_brain_mask's reading; a ROI of any shape is not read itself: a box astride a
+// T1's cortex and scalp reads grey brighter), a whole brain when it agrees with the automatic brain
+// mask found there (Roi::file_is_brain); both false where no head is found. Without a ROI, nothing
+// is looked for here (sheet_window looks for the brain itself with `options`).
+SheetFit fit_for_roi(const Grid<float>& image, const Grid<std::uint8_t>* roi, const BrainMaskOptions& options);
 std::optional<Grid<std::uint8_t>> try_auto_brain_mask(const Grid<float>& image, BrainMaskHead* head = nullptr,
                                                       const BrainMaskOptions& options = {}, BrainMaskReport* report = nullptr);
-// {"source", "voxels", "volume_mm3"} plus the automatic mask's findings under "auto".
+// {"source", "voxels", "volume_mm3", "default", "whole_brain"} plus the automatic mask's findings under "auto".
 nlohmann::json roi_report(const Roi& roi);
 // One line: "  roi          auto brain mask (...): N voxels, V ml".
 void print_roi_summary(const Roi& roi);
@@ -129,8 +139,11 @@ struct PreparedImage {
     const Grid<std::uint8_t>* fit(const Grid<std::uint8_t>* roi) const { return roi ? roi : fit_region ? &*fit_region : nullptr; }
     // "roi", "auto brain mask" or "otsu": where N4 was fitted (the report's bias_correction.mask).
     std::string fit_name(const Grid<std::uint8_t>* roi) const { return roi ? "roi" : fit_region ? "auto brain mask" : "otsu"; }
-    // That region is an automatic brain mask (ROI "auto", or fit_region): SegmentRequest::model_region_is_brain.
-    bool fit_is_brain(const std::optional<Roi>& roi) const { return roi ? roi->brain_mask.has_value() : fit_region.has_value(); }
+    // That region is a whole brain (ROI "auto", a ROI from a file that is the brain, or fit_region):
+    // SegmentRequest::model_region_is_brain.
+    bool fit_is_brain(const std::optional<Roi>& roi) const {
+        return roi ? roi->brain_mask.has_value() || roi->file_is_brain : fit_region.has_value();
+    }
 };
 // N4 (BiasCorrectionOptions' defaults) on `image` per `mode`, fitted inside the ROI, else the
 // automatic brain mask, else Otsu's foreground. `interrupt`: Ctrl-C (the report then says

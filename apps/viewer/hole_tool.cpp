@@ -46,12 +46,12 @@ bool HoleTool::start(const Session& session, const HoleScanOptions& options) {
     job_sites_ = aimed_;
     job_revision_ = session.revision();
     started_ = std::chrono::steady_clock::now();
-    SheetFit fit = session_fit;  // the band from where the session's tissue model was fitted
+    SheetFit fit = session_fit;  // the band from where the session's tissue model was fitted, in the copy
+    fit.region = region_.get();
     job_ = std::async(std::launch::async, [image = image_, roi = roi_, region = region_, mask = std::move(mask), options, fit, before,
-                                           sites = job_sites_]() mutable {
+                                           sites = job_sites_]() {
         Result r;
         try {
-            fit.region = region.get();
             r.scan = scan_holes(std::move(mask), *image, roi.get(), options, fit);
             if (before && !sites.empty()) {
                 const std::vector<HoleVerdict> v = hole_verdicts(sites, *before, *r.scan, *image, roi.get());

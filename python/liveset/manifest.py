@@ -16,7 +16,7 @@ FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "smooth_mm", "
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
 CHOICES = {"window_from": ("model", "seeds")}
 BOOLS = ("bias_correct",)
-DEFAULTS_EPOCH = 68  # see Subject.fingerprint
+DEFAULTS_EPOCH = 69  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 

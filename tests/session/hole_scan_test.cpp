@@ -121,6 +121,10 @@ TEST(HoleScan, TheBandComesFromTheSessionsModelRegion) {
     double moved = 0;
     for (std::size_t k = 0; k < in_region.classes.size(); ++k) moved += std::abs(looked_for.classes[k].weight - in_region.classes[k].weight);
     EXPECT_GT(moved, 0.05);
+    std::vector<std::string> ignored;
+    const std::optional<ModelWindow> elsewhere = sheet_window(d.phantom.image, d.mask, nullptr, TissueModelOptions{}, ignored);
+    ASSERT_TRUE(elsewhere.has_value());
+    EXPECT_NE(elsewhere->lower, got.finder.sheet_lower);
     // A model region of another size is an error, not a crash.
     SheetFit small;
     const Grid<std::uint8_t> other(Lattice({8, 8, 8}), 1);

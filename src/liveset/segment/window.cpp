@@ -133,10 +133,11 @@ std::optional<TissueModel> fit_window_model(const Grid<float>& image, const Grid
                                             const TissueModelOptions& options, std::vector<std::string>& warnings,
                                             bool whole_brain, bool known_grey_brighter) {
     try {
-        // The contrast names the classes: a whole brain's read off it, another region's (a ROI, a
-        // brain mask from another tool) known from the head (`known_grey_brighter`; a PD in its brain
-        // mask given as a file was fitted as a T1: GM Dice 0.81; docs/BENCHMARKS.md, session 67) -
-        // a ROI is not read itself: a box astride a T1's cortex and scalp reads grey brighter.
+        // The contrast names the classes: a whole brain's read off it (the automatic brain mask, or a
+        // brain mask from another tool that agrees with it: session 69), another region's (a ROI of
+        // any shape) known from the head (`known_grey_brighter`; a PD in its brain mask given as a
+        // file was fitted as a T1: GM Dice 0.81; docs/BENCHMARKS.md, session 67) - such a ROI is not
+        // read itself: a box astride a T1's cortex and scalp reads grey brighter.
         // Where grey matter is brighter than white (a T2, a PD) white matter is the darkest tissue,
         // and the region's voxels below it (skull, dura, a rim of air) are a fourth population three
         // classes cannot hold: the fit spent a class on them and took grey matter and CSF as one (a

@@ -75,7 +75,7 @@ std::vector<std::string> window_warnings(const TissueModel& model, double lower,
 // finder of a session reads the band from the region the session's window came from.
 struct SheetFit {
     const Grid<std::uint8_t>* region = nullptr;  // none: the ROI, else model_region() looks for the brain
-    bool region_is_brain = false;      // that region (else the ROI) is an automatic brain mask: a whole brain
+    bool region_is_brain = false;      // that region (else the ROI) is a whole brain: the automatic brain mask, or a file that agrees with it
     bool known_grey_brighter = false;  // as fit_window_model's (SessionOptions::model_region_grey_brighter)
     BrainMaskOptions brain;            // how model_region looks for the brain (its header's orientation)
 };
