@@ -225,17 +225,6 @@ void find_brain_again(const Grid<float>& image, std::optional<Roi>& roi, BrainMa
 // volume) 0.67 too.
 constexpr double kSameBrainDice = 0.8;
 
-double mask_dice(const Grid<std::uint8_t>& a, const Grid<std::uint8_t>& b) {
-    std::size_t both = 0, na = 0, nb = 0;
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        const bool x = a[static_cast<PointIndex>(i)] != 0, y = b[static_cast<PointIndex>(i)] != 0;
-        both += x && y;
-        na += x;
-        nb += y;
-    }
-    return na + nb > 0 ? 2.0 * static_cast<double>(both) / static_cast<double>(na + nb) : 0.0;
-}
-
 }  // namespace
 
 SheetFit fit_for_roi(const Grid<float>& image, const Grid<std::uint8_t>* roi, const BrainMaskOptions& options) {
@@ -246,7 +235,7 @@ SheetFit fit_for_roi(const Grid<float>& image, const Grid<std::uint8_t>* roi, co
     BrainMaskReport head;
     const std::optional<Grid<std::uint8_t>> brain = try_auto_brain_mask(image, nullptr, options, &head);
     f.known_grey_brighter = brain && head.contrast == TissueContrast::kGreyBrighter;
-    f.region_is_brain = brain && mask_dice(*brain, *roi) >= kSameBrainDice;
+    f.region_is_brain = brain && compare_overlap(*brain, *roi).dice >= kSameBrainDice;
     return f;
 }
 
