@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 # BrainWeb with enlarged ventricles (atrophy, hydrocephalus; docs/BENCHMARKS.md, session 69): white
-# matter within D = 4..8 mm of the ventricles (CSF over 20 mm inside the brain mask, opened once)
+# matter within D = 4..12 mm of the ventricles (CSF over 20 mm inside the brain mask, opened once)
 # becomes CSF, its intensity drawn from the T1's own ventricle voxels. Writes
 # OUT/vent{D}/{t1,labels,mask}.nii.gz (labels: that white matter relabelled CSF).
 # Usage: /usr/bin/python3 scripts/brainweb_ventricle_variants.py OUT_DIR  (python3-nibabel, python3-scipy)
@@ -19,7 +19,7 @@ vent = ndi.binary_opening(vent, iterations=1)
 print('ventricle voxels', vent.sum(), 'csf mean', t1[vent].mean(), t1[vent].std())
 rng = np.random.default_rng(11)
 vals = t1[vent]
-for d in (4, 5, 6, 7, 8):
+for d in (4, 5, 6, 7, 8, 10, 12):
     grow = ndi.distance_transform_edt(~vent) <= d
     new = grow & (L == 3)
     t = t1.copy(); l = L.copy()

@@ -115,7 +115,9 @@ int run_segment(const SegmentArgs& a, int threads) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
         return 130;
     }
-    if (!prepared.bias_skipped.empty() && !a.quiet) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
+    if (!a.quiet)
+        for (const std::string* w : {&prepared.bias_skipped, &prepared.no_brain})
+            if (!w->empty()) fmt::print(stderr, "liveset: warning: {}\n", *w);
     const SeedFit seed_fit = fit_seeds_to_roi(roi, prepared, req.seeds, init ? &*init : nullptr, "--roi none");
     if (!a.quiet)
         for (const std::string& w : seed_fit.warnings) fmt::print(stderr, "liveset: warning: {}\n", w);

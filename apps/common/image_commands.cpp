@@ -102,6 +102,13 @@ std::optional<Roi> load_roi(const std::string& arg, const Grid<float>& image, co
     } catch (const std::invalid_argument& e) {
         if (arg.empty()) {  // not a head: the default is no ROI
             learnt(std::nullopt, nullptr);
+            if (lookup && dynamic_cast<const NoBrainFound*>(&e)) {  // a head, though: said, not silent
+                std::string_view why = e.what();
+                if (why.starts_with("brain mask: ")) why.remove_prefix(12);
+                lookup->no_brain = fmt::format("the default ROI: a head was found but no brain in it ({}); the whole image is "
+                                               "segmented: where it holds scalp, muscle or eyes, give {} a brain mask to keep the front out of them",
+                                               why, option);
+            }
             return std::nullopt;
         }
         throw UsageError(fmt::format("{} auto: {}", option, e.what()));
@@ -260,6 +267,7 @@ bool read_grey_brighter(const Grid<float>& image, std::optional<Roi>& roi, const
 PreparedImage prepare_image(Grid<float>& image, std::optional<Roi>& roi, BiasCorrection mode, const std::atomic<bool>* interrupt,
                             BrainLookup* lookup, const Grid<std::uint8_t>* no_data) {
     PreparedImage out;
+    if (lookup && !roi) out.no_brain = lookup->no_brain;
     const BrainMaskOptions options = lookup ? lookup->options : BrainMaskOptions{};
     BrainMaskHead own_head;  // the fit region's head, without a ROI
     BrainMaskHead* fit_head = &own_head;
@@ -355,6 +363,7 @@ void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, cons
         if (prepared.bias_offset != 0.0f) report["bias_correction"]["offset"] = prepared.bias_offset;
     }
     if (!prepared.bias_skipped.empty()) report["warnings"].push_back(prepared.bias_skipped);
+    if (!prepared.no_brain.empty()) report["warnings"].push_back(prepared.no_brain);
 }
 
 std::string leak_warning(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* brain_mask, std::string_view roi_hint) {
@@ -390,7 +399,7 @@ nlohmann::json roi_report(const Roi& roi) {
         j["auto"] = {{"skull_stripped", b->skull_stripped}, {"background_threshold", b->background_threshold},
                      {"background_noise", b->background_noise}, {"head_threshold", b->head_threshold},
                      {"tissue_low", b->tissue_low}, {"tissue_high", b->tissue_high}, {"wm_peak", b->wm_peak},
-                     {"deep_skew", b->deep_skew}, {"deep_above", b->deep_above}, {"deep_below", b->deep_below},
+                     {"deep_skew", b->deep_skew}, {"deep_above", b->deep_above}, {"deep_below", b->deep_below}, {"wm_swamped", b->wm_swamped},
                      {"deep_grey_peak", std::isnan(b->deep_grey_peak) ? nlohmann::json(nullptr) : nlohmann::json(b->deep_grey_peak)},
                      {"contrast", to_string(b->contrast)}, {"flair", b->flair},
                      {"flair_grey_peak", std::isnan(b->flair_grey_peak) ? nlohmann::json(nullptr) : nlohmann::json(b->flair_grey_peak)},
@@ -408,6 +417,7 @@ std::string brain_mask_summary(const BrainMaskReport& b) {
                                 b.tissue_low, b.tissue_high);
     if (b.contrast == TissueContrast::kGreyBrighter) s += " (mirrored: grey matter brighter than white, as in a T2 or PD)";
     if (b.flair) s += " (mirrored: grey matter brighter than white with CSF dark, as in a FLAIR)";
+    if (b.wm_swamped) s += ", white matter at the deep head's brightest peak (its tallest swamped: large ventricles?)";
     if (!std::isnan(b.mid_range_fill)) s += fmt::format(", masked outside at {:g} within the tissue's range", b.mid_range_fill);
     if (b.head_threshold > b.background_threshold)
         s += fmt::format(", noisy air σ {:.1f}: head threshold {:.1f}", b.background_noise, b.head_threshold);

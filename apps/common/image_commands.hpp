@@ -77,6 +77,9 @@ struct BrainLookup {
     std::shared_ptr<BrainMaskHead> head;     // where it found it
     std::optional<BrainMaskReport> report;   // how (with a mask)
     BrainMaskOptions options;
+    // Where the default found a head but no brain in it (NoBrainFound: ventricles over about 250 ml,
+    // docs/BENCHMARKS.md session 69): the warning that it segments the whole image (PreparedImage).
+    std::string no_brain;
 };
 // The automatic brain mask's options for an image with this header: where the header gives no
 // orientation, the head's top is found from the head (BrainMaskOptions::superior_from_header).
@@ -121,6 +124,7 @@ struct PreparedImage {
     std::optional<Grid<std::uint8_t>> fit_region;
     std::optional<BiasCorrectionReport> bias;  // N4's report when it ran
     std::string bias_skipped;                  // why the default correction did not run (a warning)
+    std::string no_brain;                      // BrainLookup::no_brain: the default ROI gave up on a head (a warning)
     // Voxels of the automatic brain mask found again on the corrected image (prepare_image), which
     // replaced the one N4 was fitted in; 0 when it was not.
     std::size_t brain_mask_after_n4 = 0;
@@ -177,7 +181,8 @@ struct SeedFit {
 SeedFit fit_seeds_to_roi(std::optional<Roi>& roi, PreparedImage& prepared, std::vector<SeedBall>& seeds, const Grid<std::uint8_t>* init,
                          std::string_view none_hint);
 // The report's "bias_correction" object (bias_correction_report and where it was fitted), or, when
-// the default correction was skipped, its warning appended to the report's "warnings".
+// the default correction was skipped, its warning appended to the report's "warnings"; so is
+// PreparedImage::no_brain.
 void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, const Grid<std::uint8_t>* roi);
 // Without a ROI on a head, `brain` is the automatic brain mask prepare_image found
 // (`prepared.fit(nullptr)`: null with a ROI or when none was found): a warning when more than kLeakShare of the

@@ -127,7 +127,8 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{}: {}", a.image, e.what()));
     }
-    if (!prepared.bias_skipped.empty()) fmt::print(stderr, "liveset: warning: {}\n", prepared.bias_skipped);
+    for (const std::string* w : {&prepared.bias_skipped, &prepared.no_brain})
+        if (!w->empty()) fmt::print(stderr, "liveset: warning: {}\n", *w);
     fit_start_seeds(a, image.lattice(), r, prepared);
     if (r && r->brain_mask)
         fmt::print(stderr, "liveset: note: {}: brain mask of {} voxels ({})\n",

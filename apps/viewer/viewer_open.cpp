@@ -25,6 +25,7 @@ struct Viewer::Opened {
     bool oriented = true;      // the header gave an orientation
     bool brain_roi = false;    // the automatic brain mask bounds the front (the default on a head)
     std::string bias_skipped;  // the default correction's warning, when it did not run
+    std::string no_brain;      // PreparedImage::no_brain: the default ROI gave up on a head
     std::string no_data;       // Scan::note: the image's NaN voxels, read as its outside
     std::string error;         // the image could not be opened
 };
@@ -62,6 +63,7 @@ bool Viewer::open_image(const std::string& path) {
             if (cancel->load()) return out;
             out->corrected = prepared.bias.has_value();
             out->bias_skipped = prepared.bias_skipped;
+            out->no_brain = prepared.no_brain;
             out->brain_roi = roi.has_value();
             SessionOptions with_region = options;
             with_region.model_region_is_brain = prepared.fit_is_brain(roi);
@@ -135,6 +137,7 @@ void Viewer::poll_open(bool wait) {
     attach_session();
     message_ = "opened " + path + (opened->brain_roi ? ", the front bounded by the automatic brain mask" : "") +
                (opened->bias_skipped.empty() ? "" : " (" + opened->bias_skipped + ")") +
+               (opened->no_brain.empty() ? "" : "; " + opened->no_brain) +
                (opened->no_data.empty() ? "" : "; " + opened->no_data);
     message_is_error_ = false;
     log_.add("open", {{"path", path}, {"bias_corrected", opened->corrected}, {"roi", config_.roi_path}});

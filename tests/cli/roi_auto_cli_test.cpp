@@ -502,3 +502,51 @@ TEST(RoiAutoCli, NoiseThatHidesATissueIsSeenThroughTheBlurInAnAutomaticBrainMask
     EXPECT_TRUE(k["tissue_model"].contains("fitted_smooth_mm"));
     EXPECT_LT(k["window"]["upper_raw"].get<double>(), wm);
 }
+
+// Where the default finds a head but no brain in it (NoBrainFound: here the cortex phantom under
+// 20 % noise, whose mask is a fragment of under 10 % of it), it segments the whole image as before,
+// but says so once, on stderr and in the report; `--roi auto` is an error naming it; an image with
+// no head at all (uniform noise) and `--roi none` say nothing of the kind.
+TEST(RoiAutoCli, AHeadWhereNoBrainIsFoundIsSaidNotSilentlySegmentedWhole) {
+    const fs::path dir = work_dir() / "nobrain";
+    const auto ph = run_cli("phantom --out " + dir.string() + " --size 64 --noise 0.2 -q");
+    ASSERT_EQ(ph.rc, 0) << ph.err;
+    const std::string image = (dir / "t1.nii.gz").string();
+    const std::string said = "the default ROI: a head was found but no brain in it (no brain found (the mask holds";
+    const std::string o = " --seed 32,32,32 --mu-raw 900 --epsilon-raw 300 --iterations 20 --no-bias-correct --out-mask ";
+    const auto count = [&](const std::string& s) {
+        std::size_t n = 0;
+        for (std::size_t at = s.find(said); at != std::string::npos; at = s.find(said, at + 1)) ++n;
+        return n;
+    };
+    const auto text = run_cli("--threads 2 segment " + image + o + (dir / "a.nii.gz").string());
+    EXPECT_EQ(text.rc, 0) << text.err;
+    EXPECT_EQ(count(text.err), 1u) << text.err;
+    EXPECT_NE(text.err.find("give --roi a brain mask"), std::string::npos) << text.err;
+    const auto json = run_cli("--threads 2 segment " + image + o + (dir / "b.nii.gz").string() + " --json");
+    ASSERT_EQ(json.rc, 0) << json.err;
+    const nlohmann::json j = nlohmann::json::parse(json.out);
+    EXPECT_FALSE(j.contains("roi"));
+    std::size_t in_report = 0;
+    for (const auto& w : j["warnings"]) in_report += count(w.get<std::string>());
+    EXPECT_EQ(in_report, 1u) << j["warnings"].dump();
+    const auto none = run_cli("--threads 2 segment " + image + " --roi none" + o + (dir / "c.nii.gz").string());
+    EXPECT_EQ(none.rc, 0) << none.err;
+    EXPECT_EQ(count(none.err), 0u) << none.err;
+    const Grid<std::uint8_t> a = read_label_image((dir / "a.nii.gz").string()), c = read_label_image((dir / "c.nii.gz").string());
+    EXPECT_TRUE(std::equal(a.values().begin(), a.values().end(), c.values().begin(), c.values().end()));
+    const auto asked = run_cli("--threads 2 segment " + image + " --roi auto" + o + (dir / "d.nii.gz").string());
+    EXPECT_NE(asked.rc, 0);
+    EXPECT_EQ(lines(asked.err), 1) << asked.err;
+    EXPECT_NE(asked.err.find("--roi auto: brain mask: no brain found"), std::string::npos) << asked.err;
+    Grid<float> n(Lattice({32, 32, 32}));
+    std::mt19937 rng(1);
+    std::uniform_real_distribution<float> u(0.0f, 100.0f);
+    for (float& v : n.values()) v = u(rng);
+    const fs::path noise = dir / "noise.nii.gz";
+    write_image(n, noise.string());
+    const auto headless = run_cli("--threads 2 segment " + noise.string() + " --seed 5,5,5 --mu-raw 50 --epsilon-raw 5 --iterations 5 "
+                                  "--no-bias-correct --out-mask " + (dir / "e.nii.gz").string());
+    EXPECT_EQ(headless.rc, 0) << headless.err;
+    EXPECT_EQ(headless.err.find("a head was found"), std::string::npos) << headless.err;
+}

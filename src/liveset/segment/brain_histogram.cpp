@@ -134,7 +134,8 @@ Mask deep_half(const Mask& head, const Grid<float>& depth) {
 
 }  // namespace
 
-double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r, bool grey_brighter) {
+double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r, bool grey_brighter,
+                         double swamped_share) {
     const Mask deep = deep_half(head, depth);
     r.deep_grey_peak = r.flair_grey_peak = std::numeric_limits<double>::quiet_NaN();
     r.flair_grey_sigma = 0;
@@ -158,12 +159,24 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
     // White matter: the tallest peak (a T1's deep head is mostly white matter).
     take(tallest(s), r);
     r.deep_grey_peak = std::numeric_limits<double>::quiet_NaN();
+    r.wm_swamped = false;
     // Which side of white matter grey matter and CSF lie on (deep_contrast): the deep voxels above the background.
     const std::optional<float> q10 = quantile_above(image, &deep, r.background_threshold, 0.1);
     if (!q10) return *top;
     const double q50 = *quantile_above(image, &deep, r.background_threshold, 0.5);
     const double q90 = *quantile_above(image, &deep, r.background_threshold, 0.9);
     r.deep_skew = q90 > *q10 ? (q90 + *q10 - 2.0 * q50) / (q90 - *q10) : 0.0;
+    // Swamped (the last look): the brightest prominent peak, in a deep head skewed dark as a T1's
+    // (a T2's or PD's brightest is its CSF).
+    if (!grey_brighter && swamped_share < 1.0 && r.deep_skew < 0.0 && r.deep_above > swamped_share) {
+        const int wm = tallest(s).bin;
+        int brightest = wm;
+        for (const auto& [prominence, bin] : prominent_peaks(s)) brightest = std::max(brightest, bin);
+        if (brightest > wm) {
+            take(peak_at(s, brightest), r);
+            r.wm_swamped = true;
+        }
+    }
     // Skewed bright with two peaks standing out: the darker white matter's, the brighter grey
     // matter's (a PD's grey matter can outnumber its white matter there, and a low grey-white
     // contrast puts it within 3 σ of it), where that reads as grey brighter: at least kGreyShare of
@@ -171,7 +184,7 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
     // clear of the background. Else the tallest stays. Known grey-brighter (a corrected image whose
     // field took part of that contrast), two peaks are read so whatever the shares: the tallest may
     // be grey matter's, and the floor below white matter (brain_contrast) would cut white matter.
-    if (r.deep_skew > 0.0 || grey_brighter)
+    if ((r.deep_skew > 0.0 || grey_brighter) && !r.wm_swamped)
         if (const auto two = two_peaks(s)) {
             BrainMaskReport alt = r;
             take(two->first, alt);
@@ -186,7 +199,7 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
     // Not read as grey brighter, a prominent peak above the tallest (white matter's) with at least
     // kGreyShare of the deep half 3 σ above that white matter reads as grey matter's, for the brain
     // mask's tissue window only (BrainMaskReport::flair_grey_peak).
-    if (!grey_brighter && !std::isfinite(r.deep_grey_peak) && r.deep_above >= kGreyShare) {
+    if (!grey_brighter && !r.wm_swamped && !std::isfinite(r.deep_grey_peak) && r.deep_above >= kGreyShare) {
         const int wm = tallest(s).bin;
         for (const auto& [prominence, bin] : prominent_peaks(s))
             if (bin > wm) {

@@ -49,8 +49,13 @@ Peak tallest(const std::vector<double>& s);
 // the head's 99.5th percentile above the background (the histograms' top). `grey_brighter`: known so
 // (read before N4, brain_contrast): two such peaks are read so without the share tests. Throws
 // std::invalid_argument where nothing lies above the background, or all of it at one value.
+// `swamped_share` < 1 (BrainMaskOptions::swamped_share, not with `grey_brighter`): where over that
+// share of the deep half lies 3 σ above the tallest peak and the half is skewed dark (deep_skew < 0,
+// as a T1's: a T2's or PD's brightest peak is its CSF), white matter is taken at the brightest
+// prominent peak above it instead (r.wm_swamped), and the grey-brighter and FLAIR reads are skipped
+// (a T1 whose ventricles' CSF outnumbers its deep white matter: CSF darkest, white matter brightest).
 double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<float>& depth, BrainMaskReport& r,
-                         bool grey_brighter = false);
+                         bool grey_brighter = false, double swamped_share = 1.0);
 
 // White matter's lower edge on `smooth`, the smoothed image the brain-tissue window is applied to:
 // its peak there (the local maximum of the deep half's smoothed histogram climbed to from r.wm_peak,

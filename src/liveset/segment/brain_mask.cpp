@@ -236,7 +236,7 @@ Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Ma
     const Mask core = largest_component(erode_mm(tissue, o.erosion_mm));
     r.core_voxels = count(core);
     if (r.core_voxels == 0)
-        throw std::invalid_argument("brain mask: the mask is empty (no brain tissue survives a " + std::to_string(o.erosion_mm) + " mm erosion)");
+        throw NoBrainFound("brain mask: the mask is empty (no brain tissue survives a " + std::to_string(o.erosion_mm) + " mm erosion)");
     Mask brain = fill_holes(largest_component(intersect(dilate_mm(core, o.erosion_mm + o.regrow_margin_mm), tissue)));
     brain = fill_holes(close_mm(brain, o.closing_mm));
     if (o.rim_mm > 0) {
@@ -348,11 +348,11 @@ Mask flair_brain(const Grid<float>& image, const Grid<float>& smooth, const Mask
 // extraction, the skull-stripped test, `r` filled in. An empty mask when none is found (under
 // min_head_share of that head, not skull-stripped).
 Mask brain_within(const Grid<float>& image, const Grid<float>& smooth, const Mask& whole_head, const Grid<float>& depth, const Vertical& up,
-                  double extent_mm, const BrainMaskOptions& o, BrainMaskReport& r) {
+                  double extent_mm, const BrainMaskOptions& o, BrainMaskReport& r, double swamped_share = 1.0) {
     const Mask head = cranial(whole_head, up, extent_mm, r.below_voxels);
     r.brain_extent_mm = extent_mm;
     r.head_voxels = count(head);
-    const double top = white_matter_peak(image, head, depth, r);
+    const double top = white_matter_peak(image, head, depth, r, false, swamped_share);
     const TissueContrast contrast = deep_contrast(r, true);
     Mask brain = brain_of_contrast(image, smooth, head, depth, o, contrast, false, top, r);
     r.surface_contact = surface_contact(brain, depth, o.stripped_near_mm);
@@ -361,7 +361,7 @@ Mask brain_within(const Grid<float>& image, const Grid<float>& smooth, const Mas
     r.skull_stripped = o.detect_skull_stripped && r.surface_contact >= o.stripped_fraction;
     if (r.skull_stripped) brain = stripped_foreground(image, r.head_threshold);
     r.mask_voxels = count(brain);
-    if (r.mask_voxels == 0) throw std::invalid_argument("brain mask: the mask is empty");
+    if (r.mask_voxels == 0) throw NoBrainFound("brain mask: the mask is empty");
     const double share = static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1));
     if (!r.skull_stripped && share < o.min_head_share) return Mask();
     return brain;
@@ -390,6 +390,7 @@ void validate(const BrainMaskOptions& o) {
     require(std::isfinite(o.adult_head_mm) && o.adult_head_mm >= 50 && o.adult_head_mm <= 500, "adult_head_mm must lie in [50, 500]");
     require(std::isfinite(o.neck_exit_mm2) && o.neck_exit_mm2 >= 0 && o.neck_exit_mm2 <= 1e6, "neck_exit_mm2 must lie in [0, 1e6]");
     require(std::isfinite(o.cut_contact_mm2) && o.cut_contact_mm2 >= 0 && o.cut_contact_mm2 <= 1e6, "cut_contact_mm2 must lie in [0, 1e6]");
+    require(std::isfinite(o.swamped_share) && o.swamped_share > 0 && o.swamped_share <= 1, "swamped_share must lie in (0, 1]");
     require(std::isfinite(o.stripped_near_mm) && o.stripped_near_mm > 0 && o.stripped_near_mm <= 50, "stripped_near_mm must lie in (0, 50]");
     require(std::isfinite(o.stripped_fraction) && o.stripped_fraction > 0 && o.stripped_fraction <= 1, "stripped_fraction must lie in (0, 1]");
 }
@@ -424,6 +425,15 @@ Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& 
             if (brain.size() > 0) first = again;
         }
     }
+    if (brain.size() == 0 && o.swamped_share < 1.0) {  // the last look: white matter's peak swamped
+        BrainMaskReport again = r;
+        try {
+            brain = brain_within(image, smooth, whole_head, depth, up, extent, o, again, o.swamped_share);
+        } catch (const std::invalid_argument&) {  // none there either: the first look's reason stands
+            brain = Mask();
+        }
+        if (brain.size() > 0) first = again;
+    }
     // Not after a child's scaled look: below it lies the neck the adult look failed on.
     if (brain.size() > 0 && !first.skull_stripped && first.brain_extent_mm == extent && extent > 0)
         brain = below_the_cut(image, smooth, whole_head, up, o, std::move(brain), first);
@@ -440,7 +450,7 @@ Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& 
         std::snprintf(why, sizeof why, "brain mask: no brain found (the mask holds %zu voxels, %.1f %% of the head, under %.1f %%)",
                       r.mask_voxels, 100.0 * static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1)),
                       100 * o.min_head_share);
-        throw std::invalid_argument(why);
+        throw NoBrainFound(why);
     }
     const Vec3d s = image.lattice().spacing();
     r.mask_volume_mm3 = static_cast<double>(r.mask_voxels) * s.x * s.y * s.z;
