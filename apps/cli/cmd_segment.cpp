@@ -104,8 +104,8 @@ int run_segment(const SegmentArgs& a, int threads) {
     lookup.options = brain_mask_options(header);
     std::optional<Roi> roi = load_roi(a.roi, image, "--roi", &lookup);
     if (!a.out_roi.empty() && !roi)
-        throw UsageError("--out-roi: no ROI to write (a skull-stripped brain, or an image where no head is found, gets none by default: give "
-                         "--roi auto or a mask)");
+        throw UsageError("--out-roi: no ROI to write (a skull-stripped brain, an image where no head is found, or a head where no brain is "
+                         "found gets none by default: give --roi auto or a mask)");
     SegmentRequest req = segment_request(a, image.lattice());
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.

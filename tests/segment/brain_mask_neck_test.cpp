@@ -347,6 +347,7 @@ TEST(BrainMask, VentriclesThatSwampTheWhiteMatterPeakAreLookedThrough) {
     EXPECT_GE(c.dice, 0.95);
     EXPECT_GE(c.gm, 0.99);
     EXPECT_LE(c.extracranial, 0.03);
+    EXPECT_EQ(brain_contrast(large, mask), TissueContrast::kT1);  // the region read as the tissue model reads it
     BrainMaskOptions no_last_look;
     no_last_look.swamped_share = 1;
     EXPECT_THROW(auto_brain_mask(large, no_last_look), NoBrainFound);

@@ -121,6 +121,15 @@ std::optional<std::pair<Peak, Peak>> two_peaks(const std::vector<double>& s) {
     return std::pair{peak_at(s, a), peak_at(s, b)};
 }
 
+// The brightest prominent peak of smoothed histogram `s` above its tallest, if any.
+std::optional<Peak> brightest_above_tallest(const std::vector<double>& s) {
+    const int wm = tallest(s).bin;
+    int brightest = wm;
+    for (const auto& [prominence, bin] : prominent_peaks(s)) brightest = std::max(brightest, bin);
+    if (brightest == wm) return std::nullopt;
+    return peak_at(s, brightest);
+}
+
 // The deepest half of `head` by `depth`: its voxels at least half as deep as the deepest.
 Mask deep_half(const Mask& head, const Grid<float>& depth) {
     float deepest = 0;
@@ -168,15 +177,11 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
     r.deep_skew = q90 > *q10 ? (q90 + *q10 - 2.0 * q50) / (q90 - *q10) : 0.0;
     // Swamped (the last look): the brightest prominent peak, in a deep head skewed dark as a T1's
     // (a T2's or PD's brightest is its CSF).
-    if (!grey_brighter && swamped_share < 1.0 && r.deep_skew < 0.0 && r.deep_above > swamped_share) {
-        const int wm = tallest(s).bin;
-        int brightest = wm;
-        for (const auto& [prominence, bin] : prominent_peaks(s)) brightest = std::max(brightest, bin);
-        if (brightest > wm) {
-            take(peak_at(s, brightest), r);
+    if (!grey_brighter && swamped_share < 1.0 && r.deep_skew < 0.0 && r.deep_above > swamped_share)
+        if (const std::optional<Peak> brightest = brightest_above_tallest(s)) {
+            take(*brightest, r);
             r.wm_swamped = true;
         }
-    }
     // Skewed bright with two peaks standing out: the darker white matter's, the brighter grey
     // matter's (a PD's grey matter can outnumber its white matter there, and a low grey-white
     // contrast puts it within 3 σ of it), where that reads as grey brighter: at least kGreyShare of

@@ -397,6 +397,49 @@ void validate(const BrainMaskOptions& o) {
 
 namespace {
 
+// What look_for_brain found: the brain (empty: none), whether a child's scaled look was taken, and
+// the first look's own reason where it threw (NoBrainFound: nothing survived the erosion).
+struct Looked {
+    Mask brain;
+    bool child = false;
+    std::string why;
+};
+
+// The brain looked for in turn, each look where those before found none: within `extent` of the
+// head's top, within a child's scaled extent, and the last look (white matter's peak swamped,
+// BrainMaskOptions::swamped_share) within `extent`, which is not kept where it reads the head as
+// skull-stripped (the looks before read a full head). `first` (in: r's fields) receives the
+// report of the look that found it, else the first look's.
+Looked look_for_brain(const Grid<float>& image, const Grid<float>& smooth, const Mask& whole_head, const Grid<float>& depth, const Vertical& up,
+                      double extent, const BrainMaskOptions& o, const BrainMaskReport& r, BrainMaskReport& first) {
+    Looked out;
+    const auto look = [&](double within, BrainMaskReport& into, double swamped_share) {
+        try {
+            return brain_within(image, smooth, whole_head, depth, up, within, o, into, swamped_share);
+        } catch (const NoBrainFound& e) {
+            if (out.why.empty()) out.why = e.what();
+            return Mask();
+        }
+    };
+    out.brain = look(extent, first, 1.0);
+    if (out.brain.size() == 0 && extent > 0) {  // a small head's neck inside an adult's extent: scaled to the head
+        const double scaled = extent * std::clamp(r.head_diameter_mm / o.adult_head_mm, 0.6, 1.0);
+        if (scaled < extent - 1.0) {
+            out.child = true;
+            BrainMaskReport again = r;
+            out.brain = look(scaled, again, 1.0);
+            if (out.brain.size() > 0) first = again;
+        }
+    }
+    if (out.brain.size() == 0 && o.swamped_share < 1.0) {  // the last look: white matter's peak swamped
+        BrainMaskReport again = r;
+        out.brain = look(extent, again, o.swamped_share);
+        if (out.brain.size() > 0 && !again.skull_stripped) first = again;
+        else out.brain = Mask();
+    }
+    return out;
+}
+
 // auto_brain_mask on an image whose outside, if masked, is already below the rest.
 Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport* report, BrainMaskHead* known) {
     const bool reuse = known != nullptr && known->solid.size() > 0;
@@ -416,26 +459,10 @@ Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& 
     const double extent = up.exit_mm2 >= o.neck_exit_mm2 ? o.brain_extent_mm : 0.0;
     if (extent > 0) r.head_diameter_mm = head_diameter_mm(whole_head, up, 0.65 * extent);
     BrainMaskReport first = r;
-    Mask brain = brain_within(image, smooth, whole_head, depth, up, extent, o, first);
-    if (brain.size() == 0 && extent > 0) {  // a small head's neck inside an adult's extent: scaled to the head
-        const double scaled = extent * std::clamp(r.head_diameter_mm / o.adult_head_mm, 0.6, 1.0);
-        if (scaled < extent - 1.0) {
-            BrainMaskReport again = r;
-            brain = brain_within(image, smooth, whole_head, depth, up, scaled, o, again);
-            if (brain.size() > 0) first = again;
-        }
-    }
-    if (brain.size() == 0 && o.swamped_share < 1.0) {  // the last look: white matter's peak swamped
-        BrainMaskReport again = r;
-        try {
-            brain = brain_within(image, smooth, whole_head, depth, up, extent, o, again, o.swamped_share);
-        } catch (const std::invalid_argument&) {  // none there either: the first look's reason stands
-            brain = Mask();
-        }
-        if (brain.size() > 0) first = again;
-    }
-    // Not after a child's scaled look: below it lies the neck the adult look failed on.
-    if (brain.size() > 0 && !first.skull_stripped && first.brain_extent_mm == extent && extent > 0)
+    Looked looked = look_for_brain(image, smooth, whole_head, depth, up, extent, o, r, first);
+    Mask brain = std::move(looked.brain);
+    // Not after a child's scaled look (nor a last look after it): below it lies the neck the adult look failed on.
+    if (brain.size() > 0 && !first.skull_stripped && !looked.child && extent > 0)
         brain = below_the_cut(image, smooth, whole_head, up, o, std::move(brain), first);
     if (brain.size() > 0 && !first.skull_stripped && first.contrast == TissueContrast::kGreyBrighter && o.csf_reach_mm > 0) {
         std::size_t below = 0;
@@ -446,6 +473,7 @@ Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& 
     }
     r = first;
     if (brain.size() == 0) {
+        if (!looked.why.empty()) throw NoBrainFound(looked.why);
         char why[160];
         std::snprintf(why, sizeof why, "brain mask: no brain found (the mask holds %zu voxels, %.1f %% of the head, under %.1f %%)",
                       r.mask_voxels, 100.0 * static_cast<double>(r.mask_voxels) / static_cast<double>(std::max<std::size_t>(r.head_voxels, 1)),

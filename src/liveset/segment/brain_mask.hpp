@@ -84,7 +84,8 @@ struct BrainMaskOptions {
     bool detect_skull_stripped = true;
     // A full head's brain fills a large part of it (BrainWeb: 46 %); a mask under this share of
     // the solid head is not a brain (e.g. a noisy scan without skull whose core shrank to a
-    // fragment) and is refused as "no brain found", so callers fall back as for no head.
+    // fragment) and is refused as "no brain found" (NoBrainFound: the default ROI then segments the
+    // whole image, and says so).
     double min_head_share = 0.1;
     // A last look where every other found no brain: where over this share of the deep head lies 3 σ
     // above its tallest peak, and the deep head is skewed dark as a T1's, that peak is not white
@@ -173,7 +174,8 @@ struct BrainMaskHead {
 };
 
 // What auto_brain_mask throws where it found a head but no brain in it (a mask under
-// min_head_share of the head, or none left after the erosion): the default ROI then tells the user
+// min_head_share of the head, or none left after the erosion, in every look; a head of one value
+// throughout is a plain std::invalid_argument, as no head): the default ROI then tells the user
 // it gave up (BrainLookup::no_brain, apps/common), where an image with no head at all is no head's.
 struct NoBrainFound : std::invalid_argument {
     using std::invalid_argument::invalid_argument;
