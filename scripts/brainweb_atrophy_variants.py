@@ -4,15 +4,13 @@
 # grown by 6 mm into white matter as in brainweb_ventricle_variants.py; the intensities drawn from
 # the T1's own CSF voxels. Writes OUT/atrophy{K}/{t1,labels,mask}.nii.gz (labels: relabelled CSF).
 # Usage: /usr/bin/python3 scripts/brainweb_atrophy_variants.py OUT_DIR  (python3-nibabel, python3-scipy)
-import os, sys, zlib, numpy as np, nibabel as nib
+import os, sys, numpy as np, nibabel as nib
 from scipy import ndimage as ndi
-here = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'data', 'brainweb')
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import brainweb_data
 out = sys.argv[1] if len(sys.argv) > 1 else 'brainweb-atrophy-variants'
-raw = open(os.path.join(here, 't1.mha'), 'rb').read()
-start = raw.index(b'ElementDataFile = LOCAL\n') + len(b'ElementDataFile = LOCAL\n')
-t1 = np.frombuffer(zlib.decompress(raw[start:]), dtype=np.uint8).reshape(180, 217, 181).transpose(2, 1, 0).astype(np.float32)
-lab = nib.load(os.path.join(here, 'labels_crisp.nii.gz')); L = np.asarray(lab.dataobj).astype(np.uint8)
-M = np.asarray(nib.load(os.path.join(here, 'brain_mask.nii.gz')).dataobj) > 0
+t1, L, M, affine = brainweb_data.load()
+M = M > 0
 depth = ndi.distance_transform_edt(M)
 vent = ndi.binary_opening((L == 1) & (depth > 20), iterations=1)
 sulcal = (L == 1) & (depth <= 20)
@@ -26,8 +24,8 @@ for k in (1, 2):
     t[grown] = rng.choice(vent_vals, grown.sum()); l[grown] = 1
     t[thin] = rng.choice(csf_vals, thin.sum()); l[thin] = 1
     o = os.path.join(out, 'atrophy%d' % k); os.makedirs(o, exist_ok=True)
-    nib.save(nib.Nifti1Image(t, lab.affine), os.path.join(o, 't1.nii.gz'))
-    nib.save(nib.Nifti1Image(l, lab.affine), os.path.join(o, 'labels.nii.gz'))
-    nib.save(nib.Nifti1Image(M.astype(np.uint8), lab.affine), os.path.join(o, 'mask.nii.gz'))
+    nib.save(nib.Nifti1Image(t, affine), os.path.join(o, 't1.nii.gz'))
+    nib.save(nib.Nifti1Image(l, affine), os.path.join(o, 'labels.nii.gz'))
+    nib.save(nib.Nifti1Image(M.astype(np.uint8), affine), os.path.join(o, 'mask.nii.gz'))
     print('atrophy%d: %d GM voxels -> CSF (%.0f ml), %d WM -> CSF (%.0f ml), GM left %d' %
           (k, thin.sum(), thin.sum() / 1000, grown.sum(), grown.sum() / 1000, (l == 2).sum()))

@@ -1,5 +1,6 @@
 """The bundled BrainWeb T1, its crisp labels, brain mask and affine, for the variant scripts
-(brainweb_variants.py, brainweb_geometry.py, brainweb_noise_variants.py). nibabel + numpy."""
+(brainweb_variants.py, brainweb_geometry.py, brainweb_noise_variants.py, brainweb_ventricle_variants.py,
+brainweb_atrophy_variants.py and the others). nibabel + numpy."""
 import os
 import zlib
 
