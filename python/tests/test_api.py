@@ -406,6 +406,28 @@ def test_segment_warns_when_a_front_without_roi_leaks_out_of_the_brain():
         liveset.segment(img, [(2, 2, 2)], roi="auto", **air)
 
 
+def test_a_head_where_no_brain_is_found_is_warned_about_by_default(tmp_path):
+    """The cortex phantom under 20 % noise: a head is found, but its brain mask is a fragment ("no
+    brain found"); by default the whole image is segmented, as roi="none", with a report warning
+    naming roi; roi="auto" is a ValueError; roi="none" says nothing of it (as the CLI,
+    RoiAutoCli.AHeadWhereNoBrainIsFoundIsSaidNotSilentlySegmentedWhole)."""
+    cli("phantom", "--out", tmp_path, "--size", 64, "--noise", 0.2, "--quiet")
+    img = liveset.read(str(tmp_path / "t1.nii.gz"))
+    kw = dict(mu_raw=900, epsilon_raw=300, iterations=20, bias_correct=False)
+    said = "the default ROI: a head was found but no brain in it"
+    by_default = liveset.segment(img, [(32, 32, 32)], **kw)
+    warned = [w for w in by_default.report["warnings"] if said in w]
+    assert len(warned) == 1 and "give roi a brain mask" in warned[0], by_default.report["warnings"]
+    assert "roi" not in by_default.report and by_default.roi is None
+    none = liveset.segment(img, [(32, 32, 32)], roi="none", **kw)
+    assert not any(said in w for w in none.report["warnings"])
+    assert np.array_equal(by_default.mask.array, none.mask.array)
+    with pytest.raises(ValueError, match="no brain found"):
+        liveset.segment(img, [(32, 32, 32)], roi="auto", **kw)
+    session = liveset.Session(img, bias_correct=False)
+    assert any(said in w for w in session.report["warnings"]), session.report
+
+
 def test_a_file_without_orientation_reaches_the_brain_mask_as_such(tmp_path):
     """A NIfTI with neither qform nor sform (as an Analyze file) is read as not oriented, by
     liveset.read and from nibabel, and segment, tissue_model and Session find the head's top from
