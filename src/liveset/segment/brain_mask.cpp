@@ -417,7 +417,7 @@ Looked look_for_brain(const Grid<float>& image, const Grid<float>& smooth, const
         try {
             return brain_within(image, smooth, whole_head, depth, up, within, o, into, swamped_share);
         } catch (const NoBrainFound& e) {
-            if (out.why.empty()) out.why = e.what();
+            if (&into == &first) out.why = e.what();  // the first look's reason stands
             return Mask();
         }
     };
