@@ -116,8 +116,7 @@ int run_segment(const SegmentArgs& a, int threads) {
         return 130;
     }
     if (!a.quiet)
-        for (const std::string* w : {&prepared.bias_skipped, &prepared.no_brain})
-            if (!w->empty()) fmt::print(stderr, "liveset: warning: {}\n", *w);
+        for (const std::string& w : prepared.warnings()) fmt::print(stderr, "liveset: warning: {}\n", w);
     const SeedFit seed_fit = fit_seeds_to_roi(roi, prepared, req.seeds, init ? &*init : nullptr, "--roi none");
     if (!a.quiet)
         for (const std::string& w : seed_fit.warnings) fmt::print(stderr, "liveset: warning: {}\n", w);

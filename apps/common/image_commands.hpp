@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "liveset/eval/holes.hpp"
 #include "cli_support.hpp"
@@ -125,6 +126,13 @@ struct PreparedImage {
     std::optional<BiasCorrectionReport> bias;  // N4's report when it ran
     std::string bias_skipped;                  // why the default correction did not run (a warning)
     std::string no_brain;                      // BrainLookup::no_brain: the default ROI gave up on a head (a warning)
+    // The warnings above that were given (bias_skipped, then no_brain).
+    std::vector<std::string> warnings() const {
+        std::vector<std::string> w;
+        for (const std::string* s : {&bias_skipped, &no_brain})
+            if (!s->empty()) w.push_back(*s);
+        return w;
+    }
     // Voxels of the automatic brain mask found again on the corrected image (prepare_image), which
     // replaced the one N4 was fitted in; 0 when it was not.
     std::size_t brain_mask_after_n4 = 0;

@@ -17,8 +17,7 @@ void add_bias_report(nlohmann::json& report, const PreparedImage& prepared, cons
         if (prepared.brain_mask_after_n4) report["bias_correction"]["brain_mask_after_voxels"] = prepared.brain_mask_after_n4;
         if (prepared.bias_offset != 0.0f) report["bias_correction"]["offset"] = prepared.bias_offset;
     }
-    if (!prepared.bias_skipped.empty()) report["warnings"].push_back(prepared.bias_skipped);
-    if (!prepared.no_brain.empty()) report["warnings"].push_back(prepared.no_brain);
+    for (const std::string& w : prepared.warnings()) report["warnings"].push_back(w);
 }
 
 std::string leak_warning(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>* brain_mask, std::string_view roi_hint) {

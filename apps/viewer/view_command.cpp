@@ -127,8 +127,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
     } catch (const std::invalid_argument& e) {
         throw UsageError(fmt::format("{}: {}", a.image, e.what()));
     }
-    for (const std::string* w : {&prepared.bias_skipped, &prepared.no_brain})
-        if (!w->empty()) fmt::print(stderr, "liveset: warning: {}\n", *w);
+    for (const std::string& w : prepared.warnings()) fmt::print(stderr, "liveset: warning: {}\n", w);
     fit_start_seeds(a, image.lattice(), r, prepared);
     if (r && r->brain_mask)
         fmt::print(stderr, "liveset: note: {}: brain mask of {} voxels ({})\n",

@@ -413,15 +413,18 @@ struct Looked {
 Looked look_for_brain(const Grid<float>& image, const Grid<float>& smooth, const Mask& whole_head, const Grid<float>& depth, const Vertical& up,
                       double extent, const BrainMaskOptions& o, const BrainMaskReport& r, BrainMaskReport& first) {
     Looked out;
-    const auto look = [&](double within, BrainMaskReport& into, double swamped_share) {
+    try {
+        out.brain = brain_within(image, smooth, whole_head, depth, up, extent, o, first);
+    } catch (const NoBrainFound& e) {
+        out.why = e.what();  // the first look's reason stands
+    }
+    const auto look = [&](double within, BrainMaskReport& into, double swamped_share) {  // a later look
         try {
             return brain_within(image, smooth, whole_head, depth, up, within, o, into, swamped_share);
-        } catch (const NoBrainFound& e) {
-            if (&into == &first) out.why = e.what();  // the first look's reason stands
+        } catch (const NoBrainFound&) {
             return Mask();
         }
     };
-    out.brain = look(extent, first, 1.0);
     if (out.brain.size() == 0 && extent > 0) {  // a small head's neck inside an adult's extent: scaled to the head
         const double scaled = extent * std::clamp(r.head_diameter_mm / o.adult_head_mm, 0.6, 1.0);
         if (scaled < extent - 1.0) {

@@ -236,12 +236,14 @@ double presence(const TissueModel& m, std::size_t c) {
 // Why a fitted model cannot be used, or "".
 std::string degeneracy(const TissueModel& m) {
     std::ostringstream os;
-    for (std::size_t c = 0; c < m.classes.size(); ++c)
-        if (!(presence(m, c) >= 0.01) || !(m.classes[c].weight >= kMinPure) || !std::isfinite(m.classes[c].mean)) {
+    for (std::size_t c = 0; c < m.classes.size(); ++c) {
+        const bool present = presence(m, c) >= 0.01;
+        if (!present || !(m.classes[c].weight >= kMinPure) || !std::isfinite(m.classes[c].mean)) {
             os << "tissue class " << c + 1 << " of " << m.classes.size()
-               << (presence(m, c) >= 0.01 ? " holds under 0.5 % of the voxels pure" : " holds under 1 % of the voxels");
+               << (present ? " holds under 0.5 % of the voxels pure" : " holds under 1 % of the voxels");
             return os.str();
         }
+    }
     for (std::size_t c = 0; c + 1 < m.classes.size(); ++c) {
         const TissueClass &a = m.classes[c], &b = m.classes[c + 1];
         // Two Gaussians of equal spread σ make two modes only when their means lie over 2σ apart;
