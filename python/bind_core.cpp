@@ -73,6 +73,7 @@ struct SegmentArgs {
     std::optional<double> smooth_mm;  // only with alpha (the automatic choice sets both), as --smooth
     std::optional<bool> bias_correct;  // unset: on, skipped with a warning where it cannot run (as the CLI's default)
     bool oriented = true;  // Image.oriented: the file gave an orientation (BrainMaskOptions::superior_from_header)
+    bool thin_fronts = false;  // StepOptions::thin_fronts, as --thin-fronts
 };
 
 // The automatic brain mask's lookup for an image whose file did (not) give an orientation, as the CLI's.
@@ -377,6 +378,7 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
         else if (k == "smooth_mm") a.smooth_mm = value.cast<std::optional<double>>();
         else if (k == "bias_correct") a.bias_correct = value.cast<std::optional<bool>>();
         else if (k == "oriented") a.oriented = value.cast<bool>();
+        else if (k == "thin_fronts") a.thin_fronts = value.cast<bool>();
         else throw std::invalid_argument("unknown segment option '" + k + "'");
     }
     if (a.classes < 2 || a.classes > 6) throw UsageError("classes must be in 2..6");

@@ -19,9 +19,14 @@ void add_threshold_options(CLI::App& cmd, ThresholdArgs& a) {
     cmd.add_option("--step", a.step, "level-set step: sleeping (converged stretches of front sleep until something near them changes) or exact (the whole band every step)")
         ->check(CLI::IsMember({"sleeping", "exact"}))
         ->capture_default_str();
+    cmd.add_flag("--thin-fronts", a.thin_fronts, "let the front carry into tissue one or two voxels thick, which the sparse field's front cannot enter otherwise (off by default: it can bridge a weak spot along its partial-volume rims; docs/ARCHITECTURE.md, \"Thin fronts\")");
 }
 
-StepOptions step_options(const ThresholdArgs& a) { return a.step == "exact" ? StepOptions{} : sleeping_step(); }
+StepOptions step_options(const ThresholdArgs& a) {
+    StepOptions o = a.step == "exact" ? StepOptions{} : sleeping_step();
+    o.thin_fronts = a.thin_fronts;
+    return o;
+}
 
 void check_threshold_args(const ThresholdArgs& a) {
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");

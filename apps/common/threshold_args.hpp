@@ -1,5 +1,5 @@
 // The threshold-speed options `liveset segment` and `liveset view` share (--mu, --epsilon, --mu-raw,
-// --epsilon-raw, --n, --alpha, --smooth, --step): one registration with the same help and checks, one rule for the
+// --epsilon-raw, --n, --alpha, --smooth, --step, --thin-fronts): one registration with the same help and checks, one rule for the
 // pairs, and the mapping of raw values to the normalised units the speed uses.
 #pragma once
 
@@ -20,9 +20,10 @@ struct ThresholdArgs {
     std::optional<double> alpha;  // unset: `segment` chooses it (alpha.hpp); `view` keeps the session's
     std::optional<double> smooth_mm;  // --smooth: only with --alpha (the automatic choice sets both)
     std::string step = "sleeping";  // --step: sleeping (segmentation.hpp, sleeping_step) or exact
+    bool thin_fronts = false;       // --thin-fronts: StepOptions::thin_fronts
 };
 
-// Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha, --smooth and --step on `cmd`.
+// Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha, --smooth, --step and --thin-fronts on `cmd`.
 void add_threshold_options(CLI::App& cmd, ThresholdArgs& a);
 // UsageError "give --mu or --mu-raw, not both" (and the same for ε), and for --smooth without --alpha.
 void check_threshold_args(const ThresholdArgs& a);
@@ -30,7 +31,8 @@ void check_threshold_args(const ThresholdArgs& a);
 // them); nullopt where not given.
 std::optional<double> unit_mu(const ThresholdArgs& a, const IntensityScale& scale);
 std::optional<double> unit_epsilon(const ThresholdArgs& a, const IntensityScale& scale);
-// The level-set step --step names: sleeping_step() (the default) or the exact full-band step.
+// The level-set step --step names: sleeping_step() (the default) or the exact full-band step; with
+// --thin-fronts, the thin-front rule on.
 StepOptions step_options(const ThresholdArgs& a);
 
 }  // namespace liveset::cli

@@ -72,7 +72,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
             mu_raw: Optional[float] = None, epsilon_raw: Optional[float] = None,
             window_from: str = "model", classes: int = 3, n: float = 4.0, alpha: Optional[float] = None,
             smooth_mm: Optional[float] = None, iterations: int = 2000, bias_correct: Optional[bool] = None,
-            progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
+            thin_fronts: bool = False, progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
     """Threshold level-set segmentation from seeds (paper Eq. 2-3), exactly as ``liveset segment``
     with the same options (the same image and options give the same mask, bit for bit).
 
@@ -94,7 +94,8 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
         automatic alpha chooses it, half the finest voxel side on a noisy scan). bias_correct: None (the default)
         runs N4 first as ``liveset segment`` does, skipped with a report warning where it cannot run
         (an image too small for its grid); True requires it (ValueError where it cannot run); False
-        turns it off.
+        turns it off. thin_fronts: let the front into tissue one or two voxels thick, as
+        ``--thin-fronts`` (off by default; docs/ARCHITECTURE.md, "Thin fronts").
     progress: called with a dict (iteration, zero_layer, band, awake, changed, flips, inside, dt, ms)
         after every step; an exception it raises stops the run and propagates.
 
@@ -106,7 +107,8 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
               epsilon_raw=epsilon_raw, window_from=window_from, classes=int(classes), n=float(n),
               alpha=None if alpha is None else float(alpha),
               smooth_mm=None if smooth_mm is None else float(smooth_mm), iterations=int(iterations),
-              bias_correct=None if bias_correct is None else bool(bias_correct), oriented=bool(img.oriented))
+              bias_correct=None if bias_correct is None else bool(bias_correct), oriented=bool(img.oriented),
+              thin_fronts=bool(thin_fronts))
     kw["roi"] = _mask_arg(roi, img, "roi", allow_auto=True)
     kw["init_mask"] = _mask_arg(init_mask, img, "init_mask")
     r = _liveset._segment(img.array, img.geometry, progress, **kw)

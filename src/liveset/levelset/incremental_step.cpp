@@ -86,17 +86,19 @@ StepResult SparseField::step_incremental(const Speed& speed, const StepOptions& 
     const bool dense = !edits.empty() && zero.size() <= options.dense_front_max && 5 * edits.size() >= 3 * zero.size();
     result.whole_band = dense;
     result.value_pass = dense && pass_next_;  // repair_dense's choice
-    result.changed = dense ? repair_dense(edits) : repair_band(edits, RepairScope::kLocal);
+    const FrontRule rule{speed, result.dt, options.cfl};
+    const FrontRule* const thin = options.thin_fronts ? &rule : nullptr;
+    result.changed = dense ? repair_dense(edits, thin) : repair_band(edits, RepairScope::kLocal, thin);
     last_update_ms_ = ms_since(start);
     return result;
 }
 
 // A dense step's repair (sparse_field.hpp): the same bits either way.
-ChangedPoints SparseField::repair_dense(std::span<const ZeroLayerEdit> edits) {
-    if (!pass_next_ || edits.empty()) return repair_band(edits, RepairScope::kGlobal);
+ChangedPoints SparseField::repair_dense(std::span<const ZeroLayerEdit> edits, const FrontRule* rule) {
+    if (!pass_next_ || edits.empty()) return repair_band(edits, RepairScope::kGlobal, rule);
     std::vector<RegionPoint>& region = region_.v;
     region.clear();
-    move_zero_layer(edits, region);
+    move_zero_layer(edits, region, rule);
     std::vector<PointIndex> pulled;  // X: the value pass's points, then the region's
     pulled.reserve(band_size() + region.size());
     relayer_changes(region, &pulled);

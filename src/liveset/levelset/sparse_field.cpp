@@ -217,7 +217,8 @@ StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& op
     result.awake = result.zero_layer;
     result.whole_band = true;
     const auto edits = compute_step(speed, options, &result.dt);
-    result.changed = commit(edits, RepairScope::kGlobal);
+    const FrontRule rule{speed, result.dt, options.cfl};
+    result.changed = commit(edits, RepairScope::kGlobal, options.thin_fronts ? &rule : nullptr);
     // The repair leaves the zero list in lattice order and the outer lists in the order the sweep
     // claimed them (near lattice order); every few steps all of them are put back in lattice order.
     if (++steps_since_sort_ >= 8) {
@@ -230,9 +231,9 @@ StepResult SparseField::step_full_band(const Speed& speed, const StepOptions& op
 // ---------------------------------------------------------------------------------------------
 // The shared repair
 
-ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
+ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairScope scope, const FrontRule* rule) {
     const auto start = std::chrono::steady_clock::now();
-    ChangedPoints changed = repair_band(edits, scope);
+    ChangedPoints changed = repair_band(edits, scope, rule);
     last_update_ms_ = ms_since(start);
     return changed;
 }
@@ -287,11 +288,11 @@ void classify_moves(const ZeroLayerEdit* edits, std::span<const std::uint32_t> l
 
 }  // namespace
 
-ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope) {
+ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope, const FrontRule* rule) {
     if (edits.empty()) return {{}, std::vector<PointIndex>{}};
     std::vector<RegionPoint>& region = region_.v;
     region.clear();
-    move_zero_layer(edits, region);
+    move_zero_layer(edits, region, rule);
 
     // 4-5. Outer layers from the new zero layer: a local update re-layers outwards from the
     //    changed points only (relayer_changes, relayer.cpp); a global one the whole band,
@@ -326,7 +327,8 @@ ChangedPoints SparseField::repair_band(std::span<const ZeroLayerEdit> edits, Rep
 // Steps 1-3 (sparse_field.hpp). The loops run over raw pointers and write the region through a
 // buffer sized first, without a branch on what a point does (unpredictable in a moving front):
 // each writes its entry and counts it or not.
-void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vector<RegionPoint>& region) {
+void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vector<RegionPoint>& region,
+                                  const FrontRule* rule) {
     const std::size_t n = edits.size();
     float* const phi = phi_.values().data();
     std::int8_t* const status = status_.values().data();
@@ -354,6 +356,7 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     // The movers, in edit order: each chunk's leaving edits but the blocked ones (compacted in
     // place: a mover is written at or before where it was read).
     std::size_t n_movers = 0;
+    std::vector<PointIndex> blocked;
     for (std::size_t c = 0; c < n_leaving.size(); ++c)
         for (std::size_t j = 0; j < n_leaving[c]; ++j) {
             const std::uint32_t k = movers[c * detail::kChunk + j];
@@ -361,17 +364,21 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
             if (m == 2 || m == -2) [[unlikely]] {
                 phi[edits[k].point] = m > 0 ? 0.5f : -0.5f;
                 move[k] = 0;
+                if (rule != nullptr) blocked.push_back(edits[k].point);
             }
             movers[n_movers] = k;
             n_movers += move[k] != 0 ? 1 : 0;
         }
+    // The thin-front rule's entries, from the zero layer's final new values.
+    const std::vector<FrontEntry> entries =
+        rule != nullptr ? rule_entries(*rule, edits, old_phi, std::move(blocked)) : std::vector<FrontEntry>{};
 
     // 3. The front passes to the neighbours on the other side: an L∓1 neighbour of a leaving point
     //    enters the zero layer (marked at once, so it enters once) with the value implied by the
     //    zero layer's new values: over its zero-layer neighbours (not those entering it here, whose
     //    status is no longer 0, so the order of entering changes no value), φ + 1 or φ − 1.
-    detail::reserve_growing(region, 6 * n_movers + n);
-    region.resize(6 * n_movers + n);
+    detail::reserve_growing(region, 6 * n_movers + entries.size() + n);
+    region.resize(6 * n_movers + entries.size() + n);
     RegionPoint* const out = region.data();
     std::size_t n_out = 0;
     const detail::Neighbors6 around(lat, decoder);  // its prefetch only
@@ -393,6 +400,7 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
         const PointIndex q = out[r].point;
         phi[q] = detail::layer_value(phi_, status_, q, decoder.coord(q), out[r].old_status > 0, is_zero);
     }
+    n_out += enter_zero_layer(entries, out + n_out);
     // Then the edited points: a point that keeps its layer and its bits changes nothing and is no
     // seed of the region; the others are marked pending on their side (status 0 before).
     constexpr std::int8_t pending[3] = {kPendNeg, kPendZero, kPendPos};

@@ -8,6 +8,8 @@
 //   1. zero-layer values change by Δ (|Δ| ≤ 0.5, the step bound);
 //   2. points leaving L0 (φ beyond ±0.5) pass the front to their neighbours in L∓1, which enter L0;
 //      two neighbours moving in opposite directions both stay (clamped to ±0.5), so no order matters;
+//      in a global step with StepOptions::thin_fronts, an L±1 point beside a zero-layer point that
+//      cannot pass the front on (FrontRule) enters L0 where its own rate brings it into L0's range;
 //   3. the outer layers are recomputed from the new zero layer, layer by layer (L±k from L±(k-1):
 //      φ = min/max over neighbours of φ ± 1, layer_value.hpp), as Jacobi sweeps over a region.
 // The layers are a pure function of the zero layer, its values and the points' signs, and each
@@ -97,6 +99,11 @@ struct StepOptions {
     // as a set; the same order on any thread count). 0: always use the threads there are. At most
     // 1 000 000 000.
     std::size_t parallel_band_min = 100'000;
+    // The thin-front rule (docs/ARCHITECTURE.md, "Thin fronts"; FrontRule): a front carries into
+    // structures one or two voxels across, which Whitaker's scheme cannot enter. Off by default:
+    // on the cortex phantom it carries the front around the weak spots along their partial-volume
+    // rims, leaving a handle and a pocket where a perforation was (docs/BENCHMARKS.md, session 71).
+    bool thin_fronts = false;
 };
 
 // Throws std::invalid_argument with a one-line message on an option out of range.
@@ -164,7 +171,8 @@ public:
     // give the same φ, statuses and change report (as a set); kIncremental costs what moved (the
     // band when most of a small front moves), kFullBand the band.
     StepResult step(const Speed& speed, const StepOptions& options = {});
-    // The Δφ a global step would apply (one edit per zero-layer point) and its time step.
+    // The Δφ a global step would apply (one edit per zero-layer point) and its time step; with
+    // StepOptions::thin_fronts a step may also take L±1 points into the zero layer (FrontRule).
     std::vector<ZeroLayerEdit> compute_step(const Speed& speed, const StepOptions& options, double* dt) const;
 
     // Applies edits to zero-layer points (duplicates are summed; each Δ is clamped to ±0.5) and
@@ -213,11 +221,44 @@ private:
     double parabolic_factor() const;  // the curvature's stability factor 1/h_min from the voxel sizes (time_step)
     StepResult step_full_band(const Speed& speed, const StepOptions& options);
     StepResult step_incremental(const Speed& speed, const StepOptions& options);  // incremental_step.cpp
-    ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope);  // timed repair_band
-    ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope);
+    // The thin-front rule of a global step with StepOptions::thin_fronts (docs/ARCHITECTURE.md,
+    // "Thin fronts"; thin_front.cpp): where a zero-layer point that moved cannot pass the front
+    // on - it is blocked (a neighbour leaves the other way), or pinned (its new value within 0.25
+    // of its side's edge and no neighbour half a voxel or more beyond it: its upwind |∇φ| has
+    // collapsed, as in a structure at most two voxels across) - its L±1 neighbours on the other
+    // side are stepped by their own rate (clamped to ±cfl), from the zero layer's new values, and
+    // enter the zero layer where that brings them into its range on their own side. Local edits
+    // take no such rule (they have no speed).
+    struct FrontRule {
+        const Speed& speed;
+        double dt;
+        double cfl;
+    };
+    struct FrontEntry {
+        PointIndex point;
+        float phi;  // the new value
+    };
+    bool pinned(PointIndex i) const;  // of a zero-layer point, by its current value
+    // The entries beside the stuck points `stuck` (any order, duplicates allowed), in lattice order.
+    std::vector<FrontEntry> front_entries(const FrontRule& rule, std::span<const PointIndex> stuck) const;
+    // The stuck points among a repair's edits: `blocked` (from step 2) and the pinned ones.
+    std::vector<PointIndex> stuck_points(std::span<const ZeroLayerEdit> edits, const float* old_phi,
+                                         std::vector<PointIndex> blocked) const;
+    // The rule's entries for a repair whose edits have their new values (`old_phi` their old ones)
+    // and whose blocked edits are `blocked`: reads only, except that a speed that throws leaves
+    // every edit's value as it was.
+    std::vector<FrontEntry> rule_entries(const FrontRule& rule, std::span<const ZeroLayerEdit> edits, const float* old_phi,
+                                         std::vector<PointIndex> blocked);
+    ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope,
+                         const FrontRule* rule = nullptr);  // timed repair_band
+    ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope, const FrontRule* rule = nullptr);
     // The repair's first steps: the zero layer's new values, the front handed over to the
-    // neighbours entering it, and the changed points marked pending, into the (empty) region.
-    void move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vector<RegionPoint>& region);
+    // neighbours entering it (with `rule`, also the thin-front rule's entries), and the changed
+    // points marked pending, into the (empty) region.
+    void move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vector<RegionPoint>& region, const FrontRule* rule);
+    // Takes the rule's entries that no hand-over took into the zero layer (pending), recording each
+    // at out[0], out[1], ...; returns how many.
+    std::size_t enter_zero_layer(std::span<const FrontEntry> entries, RegionPoint* out);
     // Re-layers level by level from the pending points in `region` (the zero layer's changes),
     // re-evaluating only what a change at the level below can reach; appends what it marks.
     // `pulled` (the dense form): only changes of layer propagate; every other point of each layer
@@ -229,7 +270,7 @@ private:
     // either way, with the same bits; by the dense form of relayer_changes when the last whole-band
     // repair changed the layer of under a tenth of the band (pass_next_), else as repair_band's
     // global repair (the push sweep).
-    ChangedPoints repair_dense(std::span<const ZeroLayerEdit> edits);
+    ChangedPoints repair_dense(std::span<const ZeroLayerEdit> edits, const FrontRule* rule);
     void collect_ball(PointIndex seed, std::vector<RegionPoint>& region);
     // Marks the whole band pending (appending what it marks); returns the new zero layer (held in
     // zero_next_, whose memory a relist swaps with the old zero list's, so none is allocated per step).

@@ -1,5 +1,6 @@
 // Speed terms for the level-set equation ∂φ/∂t = |∇φ| F (φ < 0 inside; F > 0 moves the front
-// inwards). A speed is evaluated only at zero-layer points, split into a propagation part
+// inwards). A speed is evaluated at zero-layer points (and, with the thin-front rule, at L±1 points
+// beside them: StepOptions::thin_fronts), split into a propagation part
 // (multiplied by the upwind |∇φ|) and a curvature part (multiplied by the central |∇φ|). Both |∇φ|
 // are per finest voxel (each axis's differences times h_min/h: 1 on an isotropic grid), so a front
 // moves alike in mm along every axis of an anisotropic one.
@@ -30,9 +31,10 @@ public:
     // that lets converged stretches sleep wakes everything when the speed is not the last one's.
     // A speed must therefore not change its behaviour after construction.
     std::uint64_t serial() const { return serial_; }
-    // F at zero-layer point p. Must be thread-safe (called concurrently) and deterministic.
+    // F at band point p (a zero-layer point, or an L±1 one for the thin-front rule). Must be
+    // thread-safe (called concurrently) and deterministic.
     virtual SpeedSample at(const Grid<float>& phi, Vec3i p) const = 0;
-    // The rate |∇φ|·F (what a step multiplies by dt) at each zero-layer point of `points` (lattice
+    // The rate |∇φ|·F (what a step multiplies by dt) at each band point of `points` (lattice
     // indices) into `out`, of the same size: at()'s propagation part times the Godunov upwind |∇φ|
     // plus its curvature part times the central |∇φ|, in double (rate_of). A speed may override
     // it with a faster form of exactly these bits (a batched curvature). Thread-safe like at().
@@ -40,6 +42,12 @@ public:
     // Upper bound of the coefficient w in the curvature part w·κ (κ per mm), for the parabolic
     // time-step bound dt ≤ h_min/(4w). Zero when the speed has no curvature part.
     virtual float curvature_weight() const = 0;
+    // at()'s propagation part alone at lattice index i: the thin-front rule's test of which way the
+    // propagation would move the front there, before it asks for a rate. By default at()'s; a speed
+    // that tabulates it (ThresholdSpeed) or has none (CurvatureSpeed) answers without the curvature.
+    virtual float propagation_part(const Grid<float>& phi, PointIndex i) const {
+        return at(phi, phi.lattice().coord(i)).propagation;
+    }
 
 private:
     static std::uint64_t next_serial();
@@ -78,6 +86,7 @@ public:
     }
     void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;
     float curvature_weight() const override { return weight_; }
+    float propagation_part(const Grid<float>&, PointIndex) const override { return 0.0f; }
 
 private:
     float weight_;

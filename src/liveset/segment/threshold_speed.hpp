@@ -46,6 +46,7 @@ public:
     SpeedSample at(const Grid<float>& phi, Vec3i p) const override;
     void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;
     float curvature_weight() const override { return static_cast<float>(0.5 * params_.alpha); }
+    float propagation_part(const Grid<float>&, PointIndex i) const override { return propagation_[i]; }
 
     const ThresholdParams& params() const { return params_; }
     // ½(1 − α)·D at a lattice point (+½ outside the ROI).

@@ -1,0 +1,31 @@
+"""``liveset.segment(..., thin_fronts=True)``: the front fills a sheet one voxel thick joined to a
+seeded cube, as ``liveset segment --thin-fronts`` does, bit for bit; without it the front stops early."""
+import nibabel as nib
+import numpy as np
+
+import liveset
+from conftest import cli
+
+
+def _sheet():
+    x, y, z = np.meshgrid(np.arange(64), np.arange(24), np.arange(24), indexing="ij")
+    cube = (x >= 2) & (x < 9) & (y >= 4) & (y < 20) & (z >= 8) & (z < 15)
+    sheet = cube | ((x >= 8) & (x < 60) & (y >= 4) & (y < 20) & (z == 12))
+    ripple = ((7 * x + 13 * y + 29 * z) % 5 - 2).astype(np.float32)  # ±2, as scripts/thin_structures.sh's noise
+    return sheet, np.where(sheet, 100.0, 0.0).astype(np.float32) + ripple
+
+
+def test_thin_fronts_fill_a_sheet_one_voxel_thick_as_the_cli_does(tmp_path):
+    sheet, image = _sheet()
+    opts = dict(roi="none", mu_raw=100, epsilon_raw=30, alpha=0, bias_correct=False)
+    without = liveset.segment((image, np.eye(4)), [(5, 11, 11)], **opts).mask.array > 0
+    thin = liveset.segment((image, np.eye(4)), [(5, 11, 11)], thin_fronts=True, **opts).mask.array > 0
+    assert not (thin & ~sheet).any() and not (without & ~sheet).any()
+    assert np.array_equal(thin, sheet)
+    assert np.nonzero(without.any(axis=(1, 2)))[0].max() < 20  # the front stops early without the rule
+    path = tmp_path / "sheet.nii.gz"
+    nib.save(nib.Nifti1Image(image, np.eye(4)), str(path))
+    out = tmp_path / "thin.nii.gz"
+    cli("segment", str(path), "--seed", "5,11,11", "--roi", "none", "--mu-raw", "100", "--epsilon-raw", "30",
+        "--alpha", "0", "--no-bias-correct", "--thin-fronts", "-q", "--out-mask", str(out))
+    assert np.array_equal(np.asarray(nib.load(str(out)).dataobj) > 0, thin)
