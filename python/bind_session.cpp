@@ -15,7 +15,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
                                       const pyb::object& model_region, bool region_is_brain, bool region_grey_brighter, double n,
                                       std::optional<double> alpha, std::optional<double> smooth_mm, int layers, int fragment_size, std::size_t history,
                                       int agents, double p, std::uint64_t seed, bool sleeping, const std::string& decision,
-                                      double edit_range, bool oriented) {
+                                      double edit_range, bool oriented, bool thin_fronts) {
     if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
     const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
     Grid<float> image = grid_from_array(v, l);
@@ -45,6 +45,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     o.repair.swarm.decision = *rule;
     o.repair.swarm.edit_range = edit_range;
     if (sleeping) o.segmentation.step = sleeping_step();
+    o.segmentation.step.thin_fronts = thin_fronts;
     pyb::gil_scoped_release nogil;
     auto s = std::make_unique<Session>(std::move(image), o, std::move(r));
     // Scripts read φ and the mask, never the viewer's fragment meshes: the mesher only collects
@@ -105,7 +106,8 @@ void register_session(pyb::module_& m) {
         .def(pyb::init(&make_session), pyb::arg("image"), pyb::arg("geometry"), pyb::arg("roi"), pyb::arg("model_region"),
              pyb::arg("region_is_brain"), pyb::arg("region_grey_brighter"), pyb::arg("n"),
              pyb::arg("alpha"), pyb::arg("smooth_mm"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
-             pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"), pyb::arg("oriented"))
+             pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"), pyb::arg("oriented"),
+             pyb::arg("thin_fronts"))
         .def("add_seed", [](Session& s, const std::vector<double>& c, double r) {
             if (!s.lattice().contains(point(c))) throw std::invalid_argument("the seed lies outside the image");
             s.add_seed({point(c), r});

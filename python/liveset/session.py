@@ -44,13 +44,16 @@ class Session:
     seed, ``set_params`` or the first step; ``params["alpha"]`` shows 0.1 until then) and again
     whenever the seeds move the window, with the pre-smoothing (``params["smooth_mm"]``: the σ in mm
     of the blur of the image the threshold term reads, half the finest voxel side on a noisy scan);
-    a number fixes it (0.1 is the paper's), and ``smooth_mm`` then sets the blur (default 0)."""
+    a number fixes it (0.1 is the paper's), and ``smooth_mm`` then sets the blur (default 0).
+    ``thin_fronts=True``: the front into tissue one or two voxels thick, as ``segment``'s
+    (``--thin-fronts``; off by default)."""
 
     def __init__(self, image, roi=None, *, n: float = 4.0, alpha: Optional[float] = None,
                  smooth_mm: Optional[float] = None, layers: int = 2,
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
-                 edit_range: Optional[float] = None, bias_correct: Optional[bool] = None):
+                 edit_range: Optional[float] = None, bias_correct: Optional[bool] = None,
+                 thin_fronts: bool = False):
         img = as_image(image)
         if decision not in ("intensity", "random", "cut") or int(agents) < 1:  # before N4's seconds
             raise ValueError("decision must be 'intensity', 'random' or 'cut', and agents at least 1")
@@ -68,7 +71,7 @@ class Session:
                                     None if smooth_mm is None else float(smooth_mm), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),
                                     bool(sleeping), str(decision),
-                                    float(_edit_range(decision, edit_range)), bool(img.oriented))
+                                    float(_edit_range(decision, edit_range)), bool(img.oriented), bool(thin_fronts))
 
     # seeds and parameters
     def add_seed(self, ijk: Sequence[float], radius: float = 2.0) -> None:

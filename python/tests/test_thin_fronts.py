@@ -1,5 +1,6 @@
-"""``liveset.segment(..., thin_fronts=True)``: the front fills a sheet one voxel thick joined to a
-seeded cube, as ``liveset segment --thin-fronts`` does, bit for bit; without it the front stops early."""
+"""``liveset.segment(..., thin_fronts=True)`` and ``Session(..., thin_fronts=True)``: the front fills a
+sheet one voxel thick joined to a seeded cube, as ``liveset segment --thin-fronts`` does, bit for bit;
+without it the front stops early."""
 import nibabel as nib
 import numpy as np
 
@@ -29,3 +30,15 @@ def test_thin_fronts_fill_a_sheet_one_voxel_thick_as_the_cli_does(tmp_path):
     cli("segment", str(path), "--seed", "5,11,11", "--roi", "none", "--mu-raw", "100", "--epsilon-raw", "30",
         "--alpha", "0", "--no-bias-correct", "--thin-fronts", "-q", "--out-mask", str(out))
     assert np.array_equal(np.asarray(nib.load(str(out)).dataobj) > 0, thin)
+
+
+def test_a_session_with_thin_fronts_gives_segments_mask():
+    sheet, image = _sheet()
+    seg = liveset.segment((image, np.eye(4)), [(5, 11, 11)], roi="none", mu_raw=100, epsilon_raw=30, alpha=0,
+                          bias_correct=False, thin_fronts=True)
+    s = liveset.Session((image, np.eye(4)), roi="none", alpha=0, bias_correct=False, thin_fronts=True)
+    s.set_params(mu=seg.report["mu"], epsilon=seg.report["epsilon"])  # the same window, normalised
+    s.add_seed((5, 11, 11))
+    s.run(2000)
+    assert np.array_equal(s.mask().array > 0, sheet)
+    assert np.array_equal(s.mask().array, seg.mask.array)
