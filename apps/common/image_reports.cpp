@@ -106,6 +106,8 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
     j["n"] = o.params.n;
     j["alpha"] = o.params.alpha;
     j["smooth_mm"] = o.params.smooth_mm;
+    j["step"] = o.step.sleep_after > 0 ? "sleeping" : "exact";
+    j["thin_fronts"] = o.step.thin_fronts;
     j["alpha_choice"] = {{"source", o.alpha.automatic ? "automatic" : "given"}};
     if (o.alpha.automatic) {
         j["alpha_choice"]["anisotropy"] = o.alpha.anisotropy;

@@ -45,7 +45,7 @@ class Session:
     whenever the seeds move the window, with the pre-smoothing (``params["smooth_mm"]``: the σ in mm
     of the blur of the image the threshold term reads, half the finest voxel side on a noisy scan);
     a number fixes it (0.1 is the paper's), and ``smooth_mm`` then sets the blur (default 0).
-    ``thin_fronts=True``: the front into tissue one or two voxels thick, as ``segment``'s
+    ``thin_fronts=True`` lets the front into tissue one or two voxels thick, as ``segment``'s
     (``--thin-fronts``; off by default)."""
 
     def __init__(self, image, roi=None, *, n: float = 4.0, alpha: Optional[float] = None,

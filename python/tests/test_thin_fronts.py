@@ -42,3 +42,13 @@ def test_a_session_with_thin_fronts_gives_segments_mask():
     s.run(2000)
     assert np.array_equal(s.mask().array > 0, sheet)
     assert np.array_equal(s.mask().array, seg.mask.array)
+
+
+def test_a_manifest_column_turns_thin_fronts_on_for_its_subject(tmp_path):
+    from liveset.manifest import read_manifest
+    m = tmp_path / "cohort.csv"
+    for name in ("a", "b"):
+        (tmp_path / f"{name}.nii.gz").write_bytes(b"")  # not read: check_images=False
+    m.write_text('subject,image,seeds,thin_fronts\na,a.nii.gz,"1,2,3",true\nb,b.nii.gz,"1,2,3",\n')
+    a, b = read_manifest(str(m), check_images=False)
+    assert a.options["thin_fronts"] is True and "thin_fronts" not in b.options  # empty: the default (off)

@@ -1,9 +1,14 @@
 // `liveset segment --thin-fronts` (StepOptions::thin_fronts): the front fills a sheet one voxel
-// thick joined to a seeded cube, which it stops early in without the flag (scripts/thin_structures.sh).
+// thick joined to a seeded cube, which it stops early in without the flag (scripts/thin_structures.sh);
+// the report says whether the rule ran.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "cli_run.hpp"
 #include "liveset/io/image_io.hpp"
@@ -38,9 +43,12 @@ TEST(ThinFrontsCli, TheFlagCarriesTheFrontToTheEndOfASheetOneVoxelThick) {
         SCOPED_TRACE(flag ? "--thin-fronts" : "without the flag");
         const fs::path out = dir / (flag ? "thin.nii.gz" : "plain.nii.gz");
         const auto r = run_cli("segment " + (dir / "sheet.nii.gz").string() +
-                               " --roi none --seed 5,11,11 --mu-raw 100 --epsilon-raw 30 --alpha 0 --no-bias-correct -q --out-mask " +
+                               " --roi none --seed 5,11,11 --mu-raw 100 --epsilon-raw 30 --alpha 0 --no-bias-correct --json --out-mask " +
                                out.string() + (flag ? " --thin-fronts" : ""));
         ASSERT_EQ(r.rc, 0) << r.err;
+        const nlohmann::json report = nlohmann::json::parse(r.out);  // the report says how it stepped
+        EXPECT_EQ(report["thin_fronts"], flag);
+        EXPECT_EQ(report["step"], "sleeping");
         const Grid<std::uint8_t> mask = read_label_image(out.string());
         int in = 0, outside = 0, last = 0;
         for (int z = 0; z < 24; ++z)

@@ -171,8 +171,9 @@ public:
     // give the same φ, statuses and change report (as a set); kIncremental costs what moved (the
     // band when most of a small front moves), kFullBand the band.
     StepResult step(const Speed& speed, const StepOptions& options = {});
-    // The Δφ a global step would apply (one edit per zero-layer point) and its time step; with
-    // StepOptions::thin_fronts a step may also take L±1 points into the zero layer (FrontRule).
+    // The Δφ a global step would apply (one edit per zero-layer point) and its time step. With
+    // StepOptions::thin_fronts, step() also applies the thin-front rule in its repair (FrontRule),
+    // which apply_edits never does: these edits applied are then not that step.
     std::vector<ZeroLayerEdit> compute_step(const Speed& speed, const StepOptions& options, double* dt) const;
 
     // Applies edits to zero-layer points (duplicates are summed; each Δ is clamped to ±0.5) and

@@ -116,6 +116,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     p.smooth_mm = out.alpha.smooth_mm;
     validate(p);
     out.params = p;
+    out.step = req.loop.step;
 
     const ThresholdSpeed speed(unit, p, req.roi);
     out.field = std::make_unique<SparseField>(image.lattice(), req.layers);

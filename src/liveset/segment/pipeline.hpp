@@ -57,6 +57,7 @@ struct SegmentRequest {
 struct SegmentOutcome {
     IntensityScale scale;
     ThresholdParams params;
+    StepOptions step;  // the request's (the report says which step and whether the thin-front rule ran)
     WindowSource window_source = WindowSource::kUser;
     AlphaChoice alpha;  // the α and smoothing params holds, and why
     std::optional<SeedStatistics> seed_stats;  // when the window was estimated
