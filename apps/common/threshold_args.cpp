@@ -19,7 +19,7 @@ void add_threshold_options(CLI::App& cmd, ThresholdArgs& a) {
     cmd.add_option("--step", a.step, "level-set step: sleeping (converged stretches of front sleep until something near them changes) or exact (the whole band every step)")
         ->check(CLI::IsMember({"sleeping", "exact"}))
         ->capture_default_str();
-    cmd.add_flag("--thin-fronts", a.thin_fronts, "let the front carry into tissue one or two voxels thick, which the sparse field's front cannot enter otherwise (off by default: it can bridge a weak spot along its partial-volume rims; docs/ARCHITECTURE.md, \"Thin fronts\")");
+    cmd.add_flag("--thin-fronts,!--no-thin-fronts", a.thin_fronts, "let the front carry into tissue one or two voxels thick, which the sparse field's front cannot enter otherwise (off by default: it can bridge a weak spot along its partial-volume rims; docs/ARCHITECTURE.md, \"Thin fronts\"; --no-thin-fronts: off, e.g. where a workspace was saved with it)");
 }
 
 StepOptions step_options(const ThresholdArgs& a) {
@@ -27,6 +27,8 @@ StepOptions step_options(const ThresholdArgs& a) {
     o.thin_fronts = a.thin_fronts;
     return o;
 }
+
+std::string step_name(const StepOptions& o) { return o.mode == StepMode::kIncremental && o.sleep_after > 0 ? "sleeping" : "exact"; }
 
 void check_threshold_args(const ThresholdArgs& a) {
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");

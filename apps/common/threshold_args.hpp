@@ -20,7 +20,7 @@ struct ThresholdArgs {
     std::optional<double> alpha;  // unset: `segment` chooses it (alpha.hpp); `view` keeps the session's
     std::optional<double> smooth_mm;  // --smooth: only with --alpha (the automatic choice sets both)
     std::string step = "sleeping";  // --step: sleeping (segmentation.hpp, sleeping_step) or exact
-    bool thin_fronts = false;       // --thin-fronts: StepOptions::thin_fronts
+    bool thin_fronts = false;       // --thin-fronts (--no-thin-fronts: false): StepOptions::thin_fronts
 };
 
 // Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha, --smooth, --step and --thin-fronts on `cmd`.
@@ -34,5 +34,8 @@ std::optional<double> unit_epsilon(const ThresholdArgs& a, const IntensityScale&
 // The level-set step --step names: sleeping_step() (the default) or the exact full-band step; with
 // --thin-fronts, the thin-front rule on.
 StepOptions step_options(const ThresholdArgs& a);
+// The --step name of a step (step_options' inverse, the thin-front rule aside): "sleeping" where
+// converged stretches of front sleep, else "exact" (the full-band step's bits).
+std::string step_name(const StepOptions& o);
 
 }  // namespace liveset::cli

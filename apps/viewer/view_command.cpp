@@ -2,8 +2,11 @@
 #include "view_command.hpp"
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "cli_support.hpp"
@@ -24,6 +27,7 @@ struct ViewArgs : ThresholdArgs {
     std::string image, mask, phi, roi, script, log_events, size = "1280x720", layout = "four";
     std::string workspace, seeds_file;
     bool n_given = false, alpha_given = false;
+    bool step_given = false, thin_fronts_given = false;  // --step; --thin-fronts or --no-thin-fronts
     std::vector<std::string> seeds;
     double seed_radius = 2.0;
     bool headless = false, bench = false, json = false;
@@ -39,6 +43,7 @@ struct ViewArgs : ThresholdArgs {
     bool bias_correct = true;           // N4 first, as `segment` (also for images opened from the panel)
     bool bias_given = false;            // --bias-correct or --no-bias-correct on the command line
     std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
+    std::optional<StepOptions> workspace_step;  // a continued workspace's step (continued_step)
     std::string workspace_warning;      // the workspace was refused, or its ROI is not the one it was saved with
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
     bool image_oriented = true;         // set by load_session: its header gave an orientation (saved masks say so too)
@@ -134,6 +139,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
                    a.roi_by_default ? "the front stays in the automatic brain mask by default (--roi none: the whole image)" : "--roi auto",
                    r->brain_mask->mask_voxels, brain_mask_summary(*r->brain_mask));
     SessionOptions so = session_options(a);
+    if (a.workspace_step) so.segmentation.step = *a.workspace_step;
     so.model_region_is_brain = prepared.fit_is_brain(r);
     so.model_region_grey_brighter = prepared.grey_brighter;
     so.brain_mask = lookup.options;
@@ -177,6 +183,23 @@ void refuse_workspace(ViewArgs& a, const std::exception& e) {
     a.workspace_warning = fmt::format("{}; opened without it", e.what());
 }
 
+// The step a continued workspace takes: the one it was saved with (an older file records none: the
+// command line's), but for what --step, --thin-fronts or --no-thin-fronts ask, which a note says
+// (from there it does not step as one run would).
+StepOptions continued_step(const ViewArgs& a, const viewer::Workspace& ws) {
+    ThresholdArgs t = a;
+    std::vector<std::string> asked;
+    if (ws.step && !a.step_given) t.step = *ws.step;
+    if (ws.step && t.step != *ws.step) asked.push_back(fmt::format("--step {} (saved with --step {})", t.step, *ws.step));
+    if (ws.thin_fronts && !a.thin_fronts_given) t.thin_fronts = *ws.thin_fronts;
+    if (ws.thin_fronts && t.thin_fronts != *ws.thin_fronts)
+        asked.push_back(t.thin_fronts ? "--thin-fronts (saved without)" : "--no-thin-fronts (saved with --thin-fronts)");
+    if (!asked.empty())
+        fmt::print(stderr, "liveset: note: workspace {} continues with {} as asked: from here it steps unlike one run\n", a.workspace,
+                   fmt::join(asked, " and "));
+    return step_options(t);
+}
+
 // --workspace W: read and check it; on any problem one line on stderr and the viewer opens
 // without it. Fills in the image and the ROI from it when the command line gives none.
 std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
@@ -191,6 +214,7 @@ std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
         if (a.image.empty()) a.image = ws.image;
         if (a.roi.empty()) a.roi = ws.roi;
         a.workspace_bias = ws.bias_corrected;
+        a.workspace_step = continued_step(a, ws);
         return ws;
     } catch (const std::runtime_error& e) {
         refuse_workspace(a, e);
@@ -211,7 +235,8 @@ std::unique_ptr<Session> open_session(ViewArgs& a, std::optional<viewer::Workspa
         } catch (const std::exception& e) {
             refuse_workspace(a, e);
             ws.reset();
-            a.workspace_bias.reset();  // the command line's setting again
+            a.workspace_bias.reset();  // the command line's settings again
+            a.workspace_step.reset();
             s = load_session(a);
         }
     }
@@ -369,6 +394,8 @@ void add_view_command(CLI::App& app, const int& threads) {
         va.n_given = v->count("--n") > 0;
         va.alpha_given = v->count("--alpha") > 0;
         va.bias_given = bias->count() > 0;
+        va.step_given = v->count("--step") > 0;
+        va.thin_fronts_given = v->count("--thin-fronts") > 0;
         const int rc = run_view(va, threads);
         if (rc != 0) std::exit(rc);
     });

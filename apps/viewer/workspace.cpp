@@ -14,6 +14,7 @@
 
 #include "liveset/base/atomic_file.hpp"
 #include "liveset/session/recovery.hpp"
+#include "threshold_args.hpp"
 
 namespace liveset::viewer {
 
@@ -194,6 +195,14 @@ Workspace parse_workspace(const json& j) {
     // Absent in workspaces written before the automatic α: their α was set by hand.
     ws.marks.alpha_automatic = p.contains("alpha_automatic") && field(p, "alpha_automatic").get<bool>();
     ws.marks.iterations = static_cast<int>(number(j, "iterations"));
+    if (j.contains("step")) {  // absent in workspaces written before the thin-front rule
+        const json& st = j["step"];
+        const std::string kind = field(st, "kind").get<std::string>();
+        if (kind != "sleeping" && kind != "exact") throw std::runtime_error(fmt::format("step kind '{}' is neither sleeping nor exact", kind));
+        if (!field(st, "thin_fronts").is_boolean()) throw std::runtime_error("field 'thin_fronts' is not true or false");
+        ws.step = kind;
+        ws.thin_fronts = st["thin_fronts"].get<bool>();
+    }
     ws.marks.pristine = false;
     ws.repair = swarm_from(field(j, "swarm"), ws.repair);
     if (!field(j, "target").is_null()) ws.target = vec3(j, "target");
@@ -260,6 +269,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
                        {"smooth_mm", m.params.smooth_mm}, {"window_from_seeds", m.window_from_seeds}, {"alpha_automatic", m.alpha_automatic},
                        {"mu_raw", session.scale().to_raw(m.params.mu)}, {"epsilon_raw", session.scale().raw_length(m.params.epsilon)}}},
            {"iterations", m.iterations},
+           {"step", {{"kind", cli::step_name(session.options().segmentation.step)}, {"thin_fronts", session.options().segmentation.step.thin_fronts}}},
            {"activity", activity_json(session.activity_snapshot())},
            {"swarm", swarm_json(session.repair_options())},
            {"target", session.target() ? vec(*session.target()) : json(nullptr)},

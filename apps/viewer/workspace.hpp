@@ -1,7 +1,7 @@
 // The viewer's workspace: everything needed to continue where the user left off, in one versioned
 // JSON file W (image and ROI paths, the image's geometry and a checksum of its voxels, seeds, µ, ε,
-// n, α, the iteration count, the sleeping step's wake stamps, swarm settings and target, camera,
-// cursor) plus φ and the sparse
+// n, α, the iteration count, the level-set step (--step, --thin-fronts) and the sleeping step's
+// wake stamps, swarm settings and target, camera, cursor) plus φ and the sparse
 // field's layers bit for bit in W.state next to it (the recovery file's checksummed binary format,
 // liveset/session/recovery.hpp). Both are written atomically, the state first; W records the
 // state's checksum, so a W paired with another state is refused. Every read is checked and refused
@@ -34,6 +34,10 @@ struct Workspace {
     bool roi_recorded = false;                   // the file records the ROI's checksum (not in older files)
     std::optional<std::uint64_t> roi_checksum;  // mask_checksum() of the session's ROI (absent: saved without one)
     SessionMarks marks;              // seeds, parameters, iterations
+    // The step it was saved stepping: its --step name ("sleeping" or "exact") and the thin-front
+    // rule (absent in older files: the command line's, as then).
+    std::optional<std::string> step;
+    std::optional<bool> thin_fronts;
     RepairOptions repair;            // swarm settings
     std::optional<Vec3d> target;     // the swarm's target (the swarm respawns there)
     WorkspaceView view;
@@ -66,7 +70,8 @@ void check_workspace_image(const Workspace& ws, const std::filesystem::path& pat
 std::string workspace_roi_warning(const Workspace& ws, const std::filesystem::path& path, const Session& session,
                                   const std::string& roi_source);
 // Continues the workspace in `session` (the image it was saved for): φ and the layers bit for bit,
-// seeds, parameters and iteration count, swarm settings and target. Throws std::invalid_argument.
+// seeds, parameters and iteration count, swarm settings and target (the step is the session's
+// options': `liveset view` builds the session with the workspace's). Throws std::invalid_argument.
 void apply_workspace(Session& session, const Workspace& ws);
 
 }  // namespace liveset::viewer

@@ -18,6 +18,7 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/repair_presets.hpp"
 #include "seed_file.hpp"
+#include "threshold_args.hpp"
 #include "workspace.hpp"
 #include "viewer_test_util.hpp"
 
@@ -124,6 +125,9 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     EXPECT_FALSE(ws.marks.window_from_seeds);
     EXPECT_FALSE(ws.marks.alpha_automatic);
     EXPECT_EQ(ws.marks.iterations, 25);
+    ASSERT_TRUE(ws.step && ws.thin_fronts);  // the session's step as the viewer names it
+    EXPECT_EQ(*ws.step, cli::step_name(original->options().segmentation.step));
+    EXPECT_EQ(*ws.thin_fronts, original->options().segmentation.step.thin_fronts);
     EXPECT_EQ(ws.repair.swarm.agents, 77u);
     EXPECT_EQ(ws.repair.swarm.act_probability, 0.3);
     EXPECT_EQ(ws.repair.swarm.edit_range, 6.5);
@@ -220,6 +224,17 @@ TEST(WorkspaceFile, BadWorkspacesAreRefusedWithOneClearLine) {
     j = nlohmann::json::parse(json_text);
     j["image"] = 5;
     expect_line(read(copy_as("badimage.json", j.dump())), "a field has the wrong type");
+    j = nlohmann::json::parse(json_text);
+    j["step"]["kind"] = "fast";
+    expect_line(read(copy_as("badstep.json", j.dump())), "step kind 'fast' is neither sleeping nor exact");
+    j = nlohmann::json::parse(json_text);
+    j["step"]["thin_fronts"] = 1;
+    expect_line(read(copy_as("badthin.json", j.dump())), "field 'thin_fronts' is not true or false");
+    j = nlohmann::json::parse(json_text);
+    j.erase("step");  // an older file: no step recorded, read as such
+    const fs::path older = copy_as("nostep.json", j.dump());
+    EXPECT_EQ(read(older), "(no error)");
+    EXPECT_FALSE(viewer::read_workspace(older).step.has_value());
 
     // The state file: missing, truncated, or from another save.
     const fs::path nostate = copy_as("nostate.json", json_text);

@@ -68,6 +68,33 @@ TEST(ThresholdSpeed, PropagationCurvatureAndRoi) {
     EXPECT_THROW(ThresholdSpeed(img, ThresholdParams{0.5, -0.1, 2, 0.3}), std::invalid_argument);
 }
 
+// The thin-front rule's sign table (2 bits a voxel) against the sign of the propagation part at
+// every voxel of a lattice whose size is no multiple of four: inside and outside the window, on
+// its edge (D exactly 0: |µ − I| = ε), outside the ROI (+½), and against Speed's own default,
+// which asks at().
+TEST(ThresholdSpeed, PropagationSignIsThePropagationsSignAtEveryVoxel) {
+    const Lattice lat({7, 5, 3});
+    Grid<float> img(lat, 0.0f);
+    Grid<std::uint8_t> roi(lat, 1);
+    const float levels[4] = {0.5f, 0.75f, 0.9f, 0.3f};  // inside, on the edge, outside, inside
+    for (PointIndex i = 0; i < lat.size(); ++i) {
+        img[i] = levels[(i * 7u) % 4u];
+        if (i % 5u == 3u) roi[i] = 0;
+    }
+    const ThresholdParams p{0.5, 0.25, 4.0, 0.2};
+    const ThresholdSpeed speed(img, p, &roi);
+    const Grid<float> phi(lat, 1.0f);
+    int seen[3] = {0, 0, 0};
+    for (PointIndex i = 0; i < lat.size(); ++i) {
+        const float f = speed.propagation(lat.coord(i));
+        const int want = static_cast<int>(f > 0.0f) - static_cast<int>(f < 0.0f);
+        EXPECT_EQ(speed.propagation_sign(phi, i), want) << "voxel " << i << ", propagation " << f;
+        EXPECT_EQ(speed.Speed::propagation_sign(phi, i), want) << "voxel " << i;
+        ++seen[want + 1];
+    }
+    for (const int n : seen) EXPECT_GT(n, 0);  // each sign occurs
+}
+
 // The batched rates (curvature, central and upwind |∇φ| four stencils at a time) against Speed's
 // formula sample by sample, bit for bit: random φ and image, a ROI with holes, every point (the
 // border's one-sided stencils included), in a scrambled order; and φ on plateaus (values in

@@ -42,11 +42,14 @@ public:
     // Upper bound of the coefficient w in the curvature part w·κ (κ per mm), for the parabolic
     // time-step bound dt ≤ h_min/(4w). Zero when the speed has no curvature part.
     virtual float curvature_weight() const = 0;
-    // at()'s propagation part alone at lattice index i: the thin-front rule's test of which way the
-    // propagation would move the front there, before it asks for a rate. By default at()'s; a speed
-    // that tabulates it (ThresholdSpeed) or has none (CurvatureSpeed) answers without the curvature.
-    virtual float propagation_part(const Grid<float>& phi, PointIndex i) const {
-        return at(phi, phi.lattice().coord(i)).propagation;
+    // The sign of at()'s propagation part at lattice index i (-1, 0 or +1): the thin-front rule's
+    // test of which way the propagation would move the front there, before it asks for a rate. By
+    // default from at(); a speed that tabulates it (ThresholdSpeed, in a table of 2 bits a voxel,
+    // which stays in cache where the rule asks tens of thousands of scattered points a step) or has
+    // none (CurvatureSpeed) answers without the curvature.
+    virtual int propagation_sign(const Grid<float>& phi, PointIndex i) const {
+        const float f = at(phi, phi.lattice().coord(i)).propagation;
+        return static_cast<int>(f > 0.0f) - static_cast<int>(f < 0.0f);
     }
 
 private:
@@ -86,7 +89,7 @@ public:
     }
     void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;
     float curvature_weight() const override { return weight_; }
-    float propagation_part(const Grid<float>&, PointIndex) const override { return 0.0f; }
+    int propagation_sign(const Grid<float>&, PointIndex) const override { return 0; }
 
 private:
     float weight_;

@@ -76,8 +76,8 @@ std::vector<SparseField::FrontEntry> SparseField::front_entries(const FrontRule&
         const std::int8_t other = phi_[i] < 0.0f ? std::int8_t{1} : std::int8_t{-1};
         detail::for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
             if (status_[q] != other) return;
-            const float f = rule.speed.propagation_part(phi_, q);
-            if (other > 0 ? f < 0.0f : f > 0.0f) ahead.push_back(q);
+            const int f = rule.speed.propagation_sign(phi_, q);
+            if (other > 0 ? f < 0 : f > 0) ahead.push_back(q);
         });
     }
     std::sort(ahead.begin(), ahead.end());

@@ -62,6 +62,19 @@ ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdPar
             propagation_[pi] = static_cast<float>(w * threshold_term(v, params));
         }
     });
+    // The sign table, a byte (four voxels) per index, so that no two tasks write one byte.
+    const std::span<const float> f = propagation_.values();
+    signs_.resize((f.size() + 3) / 4);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, signs_.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+            unsigned byte = 0;
+            for (std::size_t k = 0; k < 4 && 4 * b + k < f.size(); ++k) {
+                const float v = f[4 * b + k];
+                byte |= (v > 0.0f ? 1u : v < 0.0f ? 2u : 0u) << (2 * k);
+            }
+            signs_[b] = static_cast<std::uint8_t>(byte);
+        }
+    });
 }
 
 SpeedSample ThresholdSpeed::at(const Grid<float>& phi, Vec3i p) const {
