@@ -167,6 +167,54 @@ TEST(ThinFront, TheIncrementalStepEqualsTheFullBandStepBitwise) {
                 }
 }
 
+// The value pass (repair_dense where the last whole-band repair changed few layers) on steps where
+// the rule takes points in: a large ball creeping outwards at a hundredth of the speed (every one of
+// its zero-layer points moves each step, few change layer) keeps the steps dense while the front
+// runs down a tube one voxel across (whose outside contracts at a twentieth: at full speed its
+// converged faces change the layer of a tenth of the band every step, and no value pass is taken). The same bits as the full-band step, reports equal to a
+// brute-force diff with their sign changes, the invariants every step, on 1 and 2 threads.
+TEST(ThinFront, TheValuePassTakesTheRulesEntriesAsTheFullBandStep) {
+    class TubeAndSlowBall final : public Speed {
+    public:
+        SpeedSample at(const Grid<float>&, Vec3i p) const override {
+            if (p.z >= 28) return {-0.01f, 0.0f};  // the ball's half: it creeps outwards
+            return {tube_.contains(p) ? -1.0f : 0.05f, 0.0f};
+        }
+        float curvature_weight() const override { return 0.0f; }
+
+    private:
+        Thin tube_{1, false};
+    };
+    const TubeAndSlowBall speed;
+    const shapes::Sphere seed({5.0, 11.0, 11.0}, 2.0), ball({32.0, 16.0, 44.0}, 10.0);
+    for (int threads : {1, 2}) {
+        SCOPED_TRACE("threads " + std::to_string(threads));
+        tbb::task_arena(threads).execute([&] {
+            SparseField reference(Lattice({64, 32, 64}), 2);
+            reference.init_from_sdf([&](Vec3d p) { return std::min(seed(p), ball(p)); });
+            SparseField fast = reference;
+            SparseField without = reference;
+            int pass = 0;
+            for (int k = 1; k <= 160; ++k) {
+                const SparseField before = fast;
+                const StepResult r = reference.step(speed, thin_options(StepMode::kFullBand));
+                const StepResult f = fast.step(speed, thin_options(StepMode::kIncremental));
+                ASSERT_TRUE(same_state(reference, fast)) << "step " << k;
+                ASSERT_EQ(sorted(f.changed.points), brute_force_changes(before, fast)) << "step " << k;
+                ASSERT_EQ(sorted(r.changed.points), sorted(f.changed.points)) << "step " << k;
+                ASSERT_TRUE(reports_sign_changes(f.changed, before, fast)) << "step " << k;
+                const InvariantReport inv = check_invariants(fast);
+                ASSERT_TRUE(inv.ok()) << "step " << k << ": " << inv.summary();
+                without = before;
+                without.step(speed, thin_options(StepMode::kIncremental, false));
+                pass += f.value_pass && !same_state(without, fast) ? 1 : 0;
+            }
+            EXPECT_GT(pass, 20) << "value-pass steps where the rule took points in";
+            EXPECT_LT(fast.phi()({40, 12, 12}), 0.0f) << "the front runs down the tube";
+        });
+    }
+}
+
 // The same φ and statuses on 1 and 2 threads, either step, where the rule runs every step on a
 // front of over 8 192 points (the rule's passes split into chunks on 2 threads).
 TEST(ThinFront, OneAndTwoThreadsAgree) {
