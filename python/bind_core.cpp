@@ -73,7 +73,7 @@ struct SegmentArgs {
     std::optional<double> smooth_mm;  // only with alpha (the automatic choice sets both), as --smooth
     std::optional<bool> bias_correct;  // unset: on, skipped with a warning where it cannot run (as the CLI's default)
     bool oriented = true;  // Image.oriented: the file gave an orientation (BrainMaskOptions::superior_from_header)
-    bool thin_fronts = false;  // StepOptions::thin_fronts, as --thin-fronts
+    bool thin_fronts = segment_step().thin_fronts;  // StepOptions::thin_fronts, as --thin-fronts (the default) / --no-thin-fronts
 };
 
 // The automatic brain mask's lookup for an image whose file did (not) give an orientation, as the CLI's.

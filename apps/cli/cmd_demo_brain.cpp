@@ -134,7 +134,7 @@ int run_brain_demo(const BrainDemoArgs& a, int threads) {
     SegmentRequest req;
     for (const Vec3i& s : kBrainSeeds) req.seeds.push_back({{double(s.x), double(s.y), double(s.z)}, 2.0});
     req.roi = &roi;
-    req.loop.step = sleeping_step();  // as `liveset segment`
+    req.loop.step = segment_step();  // as `liveset segment`
     FoundHolesInput rin{t1, &roi, {}};
     if (a.repair) low_threshold(t1, roi, req, rin);
     const SegmentRun run = segment_with_progress(t1, req, a.quiet || a.json);

@@ -264,7 +264,7 @@ void fill_segment_request(SegmentRequest& req, const Options& a, const Lattice& 
     req.alpha = a.alpha;
     req.smooth_mm = a.smooth_mm;
     req.loop.max_iterations = a.iterations;
-    req.loop.step = sleeping_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
+    req.loop.step = segment_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
     req.loop.step.thin_fronts = a.thin_fronts;
     req.mu = a.mu;
     req.epsilon = a.epsilon;

@@ -19,11 +19,11 @@ void add_threshold_options(CLI::App& cmd, ThresholdArgs& a) {
     cmd.add_option("--step", a.step, "level-set step: sleeping (converged stretches of front sleep until something near them changes) or exact (the whole band every step)")
         ->check(CLI::IsMember({"sleeping", "exact"}))
         ->capture_default_str();
-    cmd.add_flag("--thin-fronts,!--no-thin-fronts", a.thin_fronts, "let the front carry into tissue one or two voxels thick, which the sparse field's front cannot enter otherwise (off by default: it can bridge a weak spot along its partial-volume rims; docs/ARCHITECTURE.md, \"Thin fronts\"; --no-thin-fronts: off, e.g. where a workspace was saved with it)");
+    cmd.add_flag("--thin-fronts,!--no-thin-fronts", a.thin_fronts, "the thin-front rule, on by default: the front carries into tissue one or two voxels thick, which the paper's sparse field cannot enter (a thinned cortex); --no-thin-fronts: the paper's sparse field, as the phantom demo steps (the rule can carry the front around a weak spot along its partial-volume rims; docs/ARCHITECTURE.md, \"Thin fronts\")");
 }
 
 StepOptions step_options(const ThresholdArgs& a) {
-    StepOptions o = a.step == "exact" ? StepOptions{} : sleeping_step();
+    StepOptions o = a.step == "exact" ? StepOptions{} : segment_step();
     o.thin_fronts = a.thin_fronts;
     return o;
 }

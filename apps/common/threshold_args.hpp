@@ -19,8 +19,8 @@ struct ThresholdArgs {
     double n = 4.0;
     std::optional<double> alpha;  // unset: `segment` chooses it (alpha.hpp); `view` keeps the session's
     std::optional<double> smooth_mm;  // --smooth: only with --alpha (the automatic choice sets both)
-    std::string step = "sleeping";  // --step: sleeping (segmentation.hpp, sleeping_step) or exact
-    bool thin_fronts = false;       // --thin-fronts (--no-thin-fronts: false): StepOptions::thin_fronts
+    std::string step = "sleeping";  // --step: sleeping (segmentation.hpp, segment_step) or exact
+    bool thin_fronts = segment_step().thin_fronts;  // --thin-fronts / --no-thin-fronts: StepOptions::thin_fronts
 };
 
 // Registers --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha, --smooth, --step and --thin-fronts on `cmd`.
@@ -31,8 +31,8 @@ void check_threshold_args(const ThresholdArgs& a);
 // them); nullopt where not given.
 std::optional<double> unit_mu(const ThresholdArgs& a, const IntensityScale& scale);
 std::optional<double> unit_epsilon(const ThresholdArgs& a, const IntensityScale& scale);
-// The level-set step --step names: sleeping_step() (the default) or the exact full-band step; with
-// --thin-fronts, the thin-front rule on.
+// The level-set step --step names: segment_step() (the default) or the exact full-band step; the
+// thin-front rule on or off as --thin-fronts / --no-thin-fronts say (on by default).
 StepOptions step_options(const ThresholdArgs& a);
 // The --step name of a step (step_options' inverse, the thin-front rule aside): "sleeping" where
 // converged stretches of front sleep, else "exact" (the full-band step's bits).

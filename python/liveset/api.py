@@ -72,7 +72,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
             mu_raw: Optional[float] = None, epsilon_raw: Optional[float] = None,
             window_from: str = "model", classes: int = 3, n: float = 4.0, alpha: Optional[float] = None,
             smooth_mm: Optional[float] = None, iterations: int = 2000, bias_correct: Optional[bool] = None,
-            thin_fronts: bool = False, progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
+            thin_fronts: bool = True, progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
     """Threshold level-set segmentation from seeds (paper Eq. 2-3), exactly as ``liveset segment``
     with the same options (the same image and options give the same mask, bit for bit).
 
@@ -94,8 +94,9 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
         automatic alpha chooses it, half the finest voxel side on a noisy scan). bias_correct: None (the default)
         runs N4 first as ``liveset segment`` does, skipped with a report warning where it cannot run
         (an image too small for its grid); True requires it (ValueError where it cannot run); False
-        turns it off. thin_fronts: let the front into tissue one or two voxels thick, as
-        ``--thin-fronts`` (off by default; docs/ARCHITECTURE.md, "Thin fronts").
+        turns it off. thin_fronts: the thin-front rule, which lets the front into tissue one or two
+        voxels thick (on by default since session 72, as the CLI's; ``False`` as ``--no-thin-fronts``,
+        the paper's sparse field; docs/ARCHITECTURE.md, "Thin fronts").
     progress: called with a dict (iteration, zero_layer, band, awake, changed, flips, inside, dt, ms)
         after every step; an exception it raises stops the run and propagates.
 

@@ -16,7 +16,7 @@ FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "smooth_mm", "
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
 CHOICES = {"window_from": ("model", "seeds")}
 BOOLS = ("bias_correct", "thin_fronts")
-DEFAULTS_EPOCH = 70  # see Subject.fingerprint
+DEFAULTS_EPOCH = 72  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -59,7 +59,7 @@ class Subject:
         # CSF about a T2's or PD's brain taken into its automatic mask, a ROI file read for its
         # contrast, and a grey-brighter reading before N4 kept; 69: a tissue class seen mostly mixed
         # kept, a ROI file that is a whole brain read as one; 70: the brain mask's last look, white
-        # matter's peak swamped by large ventricles), so a resumed
+        # matter's peak swamped by large ventricles; 72: the thin-front rule on by default), so a resumed
         # cohort recomputes what older defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)

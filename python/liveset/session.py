@@ -45,15 +45,15 @@ class Session:
     whenever the seeds move the window, with the pre-smoothing (``params["smooth_mm"]``: the σ in mm
     of the blur of the image the threshold term reads, half the finest voxel side on a noisy scan);
     a number fixes it (0.1 is the paper's), and ``smooth_mm`` then sets the blur (default 0).
-    ``thin_fronts=True`` lets the front into tissue one or two voxels thick, as ``segment``'s
-    (``--thin-fronts``; off by default)."""
+    ``thin_fronts`` (on by default since session 72, as ``segment``'s) lets the front into tissue one
+    or two voxels thick; ``False`` as ``--no-thin-fronts``."""
 
     def __init__(self, image, roi=None, *, n: float = 4.0, alpha: Optional[float] = None,
                  smooth_mm: Optional[float] = None, layers: int = 2,
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
                  edit_range: Optional[float] = None, bias_correct: Optional[bool] = None,
-                 thin_fronts: bool = False):
+                 thin_fronts: bool = True):
         img = as_image(image)
         if decision not in ("intensity", "random", "cut") or int(agents) < 1:  # before N4's seconds
             raise ValueError("decision must be 'intensity', 'random' or 'cut', and agents at least 1")

@@ -438,7 +438,9 @@ TEST(SegmentCli, BiasCorrectionIsTheDefaultAndSkipsWithAWarningWhereItCannotRun)
     // The phantom shifted below zero (an offset, as a z-scored image's): N4 fits it above its floor,
     // the air's value, and adds the floor back, so the corrected image is the phantom's corrected
     // image shifted (to within the air's own value, 1.3 of a range of 1 048) and the segmentation the
-    // unshifted one's.
+    // unshifted one's (to within a voxel in a thousand: the corrected images differ in their last
+    // bits, and the thin-front rule, on by default since session 72, can take a point in on one and
+    // not the other: 3 010 against 3 011 voxels).
     Grid<float> shifted = read_image(img);
     for (float& v : shifted.values()) v -= 5000.0f;
     const fs::path shifted_path = work_dir() / "shifted.nii.gz";
@@ -449,7 +451,7 @@ TEST(SegmentCli, BiasCorrectionIsTheDefaultAndSkipsWithAWarningWhereItCannotRun)
     EXPECT_GE(offset, -5000.0);
     EXPECT_LT(offset, -4990.0);
     EXPECT_FALSE(on["bias_correction"].contains("offset"));
-    EXPECT_EQ(negative["voxels"], on["voxels"]);
+    EXPECT_NEAR(negative["voxels"].get<double>(), on["voxels"].get<double>(), 1e-3 * on["voxels"].get<double>());
     const fs::path c_on = work_dir() / "shifted_c_on.nii.gz", c_neg = work_dir() / "shifted_c_neg.nii.gz";
     for (const auto& [in, out] : {std::pair{img, c_on}, std::pair{shifted_path.string(), c_neg}}) {
         const Result r = run_cli("segment " + in + ph.seeds + " --iterations 1 --out-mask " + mask.string() + " --out-corrected " + out.string());

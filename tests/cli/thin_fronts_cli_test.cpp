@@ -1,6 +1,7 @@
-// `liveset segment --thin-fronts` (StepOptions::thin_fronts): the front fills a sheet one voxel
-// thick joined to a seeded cube, which it stops early in without the flag (scripts/thin_structures.sh);
-// the report says whether the rule ran.
+// `liveset segment`'s thin-front rule (StepOptions::thin_fronts, on by default since session 72):
+// the front fills a sheet one voxel thick joined to a seeded cube, by default and with
+// --thin-fronts, and stops early in it with --no-thin-fronts (scripts/thin_structures.sh); the report
+// says whether the rule ran.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -27,7 +28,7 @@ bool in_sheet(int x, int y, int z) {
 
 }  // namespace
 
-TEST(ThinFrontsCli, TheFlagCarriesTheFrontToTheEndOfASheetOneVoxelThick) {
+TEST(ThinFrontsCli, TheDefaultCarriesTheFrontToTheEndOfASheetOneVoxelThick) {
     const fs::path dir = liveset::testing::scratch_dir("thin_fronts_cli");
     Grid<float> img(Lattice({64, 24, 24}), 0.0f);
     int sheet = 0;
@@ -39,12 +40,13 @@ TEST(ThinFrontsCli, TheFlagCarriesTheFrontToTheEndOfASheetOneVoxelThick) {
                 sheet += in_sheet(x, y, z) ? 1 : 0;
             }
     write_image(img, (dir / "sheet.nii.gz").string());
-    for (const bool flag : {false, true}) {
-        SCOPED_TRACE(flag ? "--thin-fronts" : "without the flag");
-        const fs::path out = dir / (flag ? "thin.nii.gz" : "plain.nii.gz");
+    for (const std::string option : {"", " --thin-fronts", " --no-thin-fronts"}) {
+        SCOPED_TRACE(option.empty() ? "the default" : option);
+        const bool flag = option != " --no-thin-fronts";
+        const fs::path out = dir / ("sheet" + std::to_string(option.size()) + ".nii.gz");
         const auto r = run_cli("segment " + (dir / "sheet.nii.gz").string() +
                                " --roi none --seed 5,11,11 --mu-raw 100 --epsilon-raw 30 --alpha 0 --no-bias-correct --json --out-mask " +
-                               out.string() + (flag ? " --thin-fronts" : ""));
+                               out.string() + option);
         ASSERT_EQ(r.rc, 0) << r.err;
         const nlohmann::json report = nlohmann::json::parse(r.out);  // the report says how it stepped
         EXPECT_EQ(report["thin_fronts"], flag);

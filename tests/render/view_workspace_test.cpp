@@ -91,25 +91,25 @@ TEST(ViewCommand, AWorkspaceContinuesBitForBit) {
 }
 
 // A workspace keeps the step it was saved with: saved after 30 steps of `--step exact
-// --thin-fronts`, reopened without either flag and stepped 20 more, φ is bit for bit 50 steps in one
-// run with them (and not the default step's 50, so the test sees the step); --no-thin-fronts over
-// it is honoured and said in a note.
+// --no-thin-fronts`, reopened without either flag and stepped 20 more, φ is bit for bit 50 steps in
+// one run with them (and not the default step's 50: sleeping, the rule on); --thin-fronts over it
+// is honoured and said in a note.
 TEST(ViewCommand, AWorkspaceKeepsItsStep) {
     const Fixture& f = fixture();
     const std::string w = (f.dir / "step.json").string(), cont = (f.dir / "step_cont.nii.gz").string();
     const std::string one = (f.dir / "step_one.nii.gz").string(), plain = (f.dir / "step_plain.nii.gz").string();
-    const std::string off = (f.dir / "step_off.nii.gz").string();
-    CliResult r = run_cli(fmt::format("view {} --seeds {} --step exact --thin-fronts --headless --script {}", f.image, f.seeds,
+    const std::string thin = (f.dir / "step_thin.nii.gz").string();
+    CliResult r = run_cli(fmt::format("view {} --seeds {} --step exact --no-thin-fronts --headless --script {}", f.image, f.seeds,
                                       script("st_a.json", R"([{"segment": 30}, {"save_workspace": ")" + w + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     const viewer::Workspace ws = viewer::read_workspace(w);
     ASSERT_TRUE(ws.step && ws.thin_fronts);
     EXPECT_EQ(*ws.step, "exact");
-    EXPECT_TRUE(*ws.thin_fronts);
+    EXPECT_FALSE(*ws.thin_fronts);
     r = run_cli(fmt::format("view --workspace {} --headless --script {}", w, script("st_b.json", R"([{"segment": 20}, {"save_phi": ")" + cont + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_EQ(r.err.find("continues with"), std::string::npos) << r.err;
-    r = run_cli(fmt::format("view {} --seeds {} --step exact --thin-fronts --headless --script {}", f.image, f.seeds,
+    r = run_cli(fmt::format("view {} --seeds {} --step exact --no-thin-fronts --headless --script {}", f.image, f.seeds,
                             script("st_c.json", R"([{"segment": 50}, {"save_phi": ")" + one + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
     r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds,
@@ -118,11 +118,11 @@ TEST(ViewCommand, AWorkspaceKeepsItsStep) {
     EXPECT_TRUE(same_bits(read_image(cont), read_image(one)));
     EXPECT_FALSE(same_bits(read_image(plain), read_image(one)));
 
-    r = run_cli(fmt::format("view --workspace {} --no-thin-fronts --headless --script {}", w,
-                            script("st_e.json", R"([{"segment": 20}, {"save_phi": ")" + off + R"("}])")));
+    r = run_cli(fmt::format("view --workspace {} --thin-fronts --headless --script {}", w,
+                            script("st_e.json", R"([{"segment": 20}, {"save_phi": ")" + thin + R"("}])")));
     ASSERT_EQ(r.rc, 0) << r.err;
-    EXPECT_NE(r.err.find("continues with --no-thin-fronts (saved with --thin-fronts) as asked"), std::string::npos) << r.err;
-    EXPECT_FALSE(same_bits(read_image(off), read_image(one)));
+    EXPECT_NE(r.err.find("continues with --thin-fronts (saved without) as asked"), std::string::npos) << r.err;
+    EXPECT_FALSE(same_bits(read_image(thin), read_image(one)));
 }
 
 // The viewer segments the image `liveset segment` does: N4-corrected by default (the workspace

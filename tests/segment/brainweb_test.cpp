@@ -66,7 +66,7 @@ double slab_dice(const Grid<float>& t1, std::optional<double> mu_raw, std::optio
     req.roi = &slab().brain;
     req.mu_raw = mu_raw;
     req.epsilon_raw = epsilon_raw;
-    req.loop.step = sleeping_step();  // the step `liveset segment` takes
+    req.loop.step = segment_step();  // the step `liveset segment` takes
     SegmentOutcome out = segment_image(t1, req);
     EXPECT_EQ(out.result.reason, StopReason::kConverged) << out.result.iterations;
     const double dice = compare_overlap(out.mask, slab().gm).dice;
@@ -99,8 +99,9 @@ TEST(BrainWeb, GreyMatterDiceInsideTheBrainMask) {
     EXPECT_GE(m.dice, 0.90) << "iterations " << out.result.iterations;
     EXPECT_LT(std::abs(m.volume_difference), 0.10);
 
-    // Issue 16 on real data: the step `liveset segment` takes (converged stretches of front
-    // sleeping) keeps the exact step's Dice within 0.002 and nearly its mask.
+    // Issue 16 on real data: the sleeping step (converged stretches of front sleeping; `liveset
+    // segment` takes it with the thin-front rule) keeps the exact step's Dice within 0.002 and
+    // nearly its mask.
     req.loop.step = sleeping_step();
     const SegmentOutcome fast = segment_image(t1, req);
     EXPECT_EQ(fast.result.reason, StopReason::kConverged) << fast.result.iterations;
@@ -261,7 +262,7 @@ TEST(BrainWeb, WholeBrainFromEightSeedsAlone) {
                           Vec3i{140, 86, 74}, Vec3i{38, 71, 26}, Vec3i{83, 23, 71}})
         req.seeds.push_back({{double(p.x), double(p.y), double(p.z)}, 2.0});
     req.roi = &brain;
-    req.loop.step = sleeping_step();  // as `liveset segment` runs it
+    req.loop.step = segment_step();  // as `liveset segment` runs it
     const SegmentOutcome out = segment_image(t1, req);
     const double dice = compare_overlap(out.mask, gm).dice;
     std::printf("BrainWeb whole brain, 8 seeds alone: window %.1f .. %.1f, dice %.4f, %d iterations\n",
@@ -307,15 +308,16 @@ SegmentOutcome segment_with(const Grid<float>& t1, const Grid<std::uint8_t>& bra
     req.seeds = seeds;
     req.roi = &brain;
     req.alpha = alpha;
-    req.loop.step = sleeping_step();
+    req.loop.step = segment_step();
     return segment_image(t1, req);
 }
 
 }  // namespace
 
 // The automatic curvature weight (alpha.hpp) against the former fixed 0.1, on ground truth: the
-// clean slab gets none and segments better; with noise σ 9 added it gets about 0.1 and segments no
-// worse; thick slices (1 x 1 x 3 mm) get none and gain the most.
+// clean slab gets none and segments no worse (0.9128 against 0.9122 with the thin-front rule, which
+// lets the curved front into thin cortex too; 0.005 better without it); with noise σ 9 added it gets
+// about 0.1 and segments no worse; thick slices (1 x 1 x 3 mm) get none and gain the most.
 TEST(BrainWeb, TheAutomaticCurvatureWeightFollowsNoiseAndVoxelShape) {
     const Slab& s = slab();
     const auto dice = [](const SegmentOutcome& o, const Grid<std::uint8_t>& gm) { return compare_overlap(o.mask, gm).dice; };
@@ -340,7 +342,7 @@ TEST(BrainWeb, TheAutomaticCurvatureWeightFollowsNoiseAndVoxelShape) {
     EXPECT_GT(loud.alpha.alpha, 0.06);
     EXPECT_NEAR(thick.alpha.anisotropy, 3.0, 1e-9);
     EXPECT_LT(thick.alpha.alpha, 0.005);
-    EXPECT_GE(dice(clean, s.gm), clean_fixed + 0.005);
+    EXPECT_GE(dice(clean, s.gm), clean_fixed);
     EXPECT_GE(dice(loud, s.gm), loud_fixed - 0.005);
     EXPECT_GE(dice(thick, t.gm), thick_fixed + 0.01);
 }

@@ -43,7 +43,7 @@ const Phantom& phantom48() {
 SessionOptions sleeping_options() {
     SessionOptions o;
     o.repair = demo_repair_options();
-    o.segmentation.step = sleeping_step();  // what `liveset segment` takes
+    o.segmentation.step = segment_step();  // what `liveset segment` takes
     return o;
 }
 
@@ -102,7 +102,7 @@ TEST(SessionRunner, ARunEqualsTheForegroundStepsAndLivesetSegment) {
 
     SegmentRequest req;  // `liveset segment`: the sleeping step from the same seeds
     for (const Vec3i& c : phantom48().seeds) req.seeds.push_back({c.cast<double>(), 2.0});
-    req.loop.step = sleeping_step();
+    req.loop.step = segment_step();
     req.alpha = 0.1;  // the session's α (it does not choose one: docs/ARCHITECTURE.md)
     const SegmentOutcome cli = segment_image(phantom48().image, req);
     ASSERT_EQ(cli.result.reason, StopReason::kConverged);

@@ -43,7 +43,7 @@ TEST(BrainWebRepair, TargetedPerforationsLowerTheHoleCountWithoutLosingDice) {
     req.mu_raw = 94.0;
     req.epsilon_raw = 22.0;
     req.alpha = 0.1;  // the paper's small curvature, as Figure 5's runs (the automatic α takes 0 here)
-    req.loop.step = sleeping_step();  // the step the README's `liveset segment` takes
+    req.loop.step = segment_step();  // the step the README's `liveset segment` takes
     SegmentOutcome o = segment_image(t1, req);
     const Topology truth = mask_topology(gm);
     const Topology before = mask_topology(o.mask);

@@ -78,7 +78,7 @@ struct StepOptions {
     // point changed sign within 2-3 points for `sleep_after` steps sleeps - its zero-layer points
     // are neither evaluated nor moved - until a sign change or an edit near it, or a new speed,
     // wakes it. 0 (the default) never sleeps: kIncremental is then the full-band step bit for bit.
-    // `liveset segment` uses 20 (sleeping_step(), segmentation.hpp). At most 1 000 000.
+    // `liveset segment` uses 20 (segment_step(), segmentation.hpp). At most 1 000 000.
     int sleep_after = 0;
     // kIncremental only: when at least 3/5 of a zero layer of at most this many points moves in a
     // step, the band is re-layered whole (the push sweep, its lists rebuilt from the sweep's
@@ -100,9 +100,11 @@ struct StepOptions {
     // 1 000 000 000.
     std::size_t parallel_band_min = 100'000;
     // The thin-front rule (docs/ARCHITECTURE.md, "Thin fronts"; FrontRule): a front carries into
-    // structures one or two voxels across, which Whitaker's scheme cannot enter. Off by default:
-    // on the cortex phantom it carries the front around the weak spots along their partial-volume
-    // rims, leaving a handle and a pocket where a perforation was (docs/BENCHMARKS.md, session 71).
+    // structures one or two voxels across, which Whitaker's scheme cannot enter. Off here (the
+    // paper's sparse field, as the phantom demo steps: on the cortex phantom the rule carries the
+    // front around the weak spots along their partial-volume rims, leaving a handle and a pocket
+    // where a perforation was, docs/BENCHMARKS.md session 71); on in segment_step(), the step
+    // `liveset segment` takes by default (session 72).
     bool thin_fronts = false;
 };
 

@@ -24,7 +24,7 @@ struct SegmentationOptions {
     // across the front at the edge of the threshold window cancel out).
     int window = 20;
     double tolerance = 1e-3;
-    // The step: the exact full-band step by default; `liveset segment` uses sleeping_step().
+    // The step: the exact full-band step by default; `liveset segment` uses segment_step().
     StepOptions step;
 };
 
@@ -32,13 +32,21 @@ struct SegmentationOptions {
 // steps without a sign change nearby as the convergence window looks back over.
 inline constexpr int kSegmentationSleepAfter = 20;
 
-// The step `liveset segment` takes: incremental, converged stretches of front sleeping after
-// `sleep_after` steps without a sign change near them (docs/ARCHITECTURE.md, "Activity"; BrainWeb
-// grey matter 4.5x faster than the exact step, Dice 0.9210 vs 0.9207).
+// The sleeping step: incremental, converged stretches of front sleeping after `sleep_after` steps
+// without a sign change near them (docs/ARCHITECTURE.md, "Activity"; BrainWeb grey matter 4.5x
+// faster than the exact step, Dice 0.9210 vs 0.9207).
 inline StepOptions sleeping_step(int sleep_after = kSegmentationSleepAfter) {
     StepOptions o;
     o.mode = StepMode::kIncremental;
     o.sleep_after = sleep_after;
+    return o;
+}
+
+// The step `liveset segment` and `view`, and Python's segment() and Session, take by default: the
+// sleeping step with the thin-front rule (since session 72; docs/ARCHITECTURE.md, "Thin fronts").
+inline StepOptions segment_step() {
+    StepOptions o = sleeping_step();
+    o.thin_fronts = true;
     return o;
 }
 
