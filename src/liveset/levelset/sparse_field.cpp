@@ -262,7 +262,9 @@ std::size_t move_values(const ZeroLayerEdit* edits, std::size_t b, std::size_t e
 }
 
 // Step 2 for the leaving edits `leaving` (see move_zero_layer): +1 leaves outwards, -1 inwards,
-// +2 / -2 would leave but is blocked. Reads only, after every value of step 1 is written.
+// +2 / -2 would leave but is blocked, +3 / -3 likewise and has no L∓1 neighbour on the other side
+// (which the thin-front rule would look at: it has nothing to hand over, and its neighbours are
+// read here anyway). Reads only, after every value of step 1 is written.
 void classify_moves(const ZeroLayerEdit* edits, std::span<const std::uint32_t> leaving, const float* phi,
                     const std::int8_t* status, const Lattice& lattice, const IndexDecoder& index_decoder,
                     std::int8_t* move) {
@@ -278,11 +280,14 @@ void classify_moves(const ZeroLayerEdit* edits, std::span<const std::uint32_t> l
         // a zero-layer neighbour beyond -0.5 (leaving inwards) blocks an outward move, and back.
         // On the other side's values, x > 0.5 is -x < -0.5 bit for bit.
         const float flip = up ? 1.0f : -1.0f;
-        unsigned blocked = 0;
+        const std::int8_t other = up ? std::int8_t{-1} : std::int8_t{1};
+        unsigned blocked = 0, ahead = 0;
         for_each_neighbor6(lat, decoder, i, [&](PointIndex q) {
             blocked |= static_cast<unsigned>(status[q] == 0) & static_cast<unsigned>(flip * phi[q] < -0.5f);
+            ahead |= static_cast<unsigned>(status[q] == other);
         });
-        move[k] = blocked != 0 ? static_cast<std::int8_t>(up ? 2 : -2) : static_cast<std::int8_t>(up ? 1 : -1);
+        const int m = blocked == 0 ? 1 : ahead != 0 ? 2 : 3;
+        move[k] = static_cast<std::int8_t>(up ? m : -m);
     }
 }
 
@@ -361,10 +366,10 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
         for (std::size_t j = 0; j < n_leaving[c]; ++j) {
             const std::uint32_t k = movers[c * detail::kChunk + j];
             const std::int8_t m = move[k];
-            if (m == 2 || m == -2) [[unlikely]] {
+            if (m >= 2 || m <= -2) [[unlikely]] {
                 phi[edits[k].point] = m > 0 ? 0.5f : -0.5f;
                 move[k] = 0;
-                if (rule != nullptr) blocked.push_back(edits[k].point);
+                if (rule != nullptr && (m == 2 || m == -2)) blocked.push_back(edits[k].point);
             }
             movers[n_movers] = k;
             n_movers += move[k] != 0 ? 1 : 0;

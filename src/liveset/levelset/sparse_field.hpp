@@ -244,7 +244,8 @@ private:
     bool pinned(PointIndex i) const;  // of a zero-layer point, by its current value
     // The entries beside the stuck points `stuck` (any order, duplicates allowed), in lattice order.
     std::vector<FrontEntry> front_entries(const FrontRule& rule, std::span<const PointIndex> stuck) const;
-    // The stuck points among a repair's edits: `blocked` (from step 2) and the pinned ones.
+    // The stuck points among a repair's edits: `blocked` (from step 2: those with an L∓1 neighbour
+    // on the other side, the only ones that can hand the front over) and the pinned ones.
     std::vector<PointIndex> stuck_points(std::span<const ZeroLayerEdit> edits, const float* old_phi,
                                          std::vector<PointIndex> blocked) const;
     // The rule's entries for a repair whose edits have their new values (`old_phi` their old ones)
