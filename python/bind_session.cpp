@@ -44,7 +44,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     if (!rule || *rule == EditDecision::kSheet) throw std::invalid_argument("decision must be 'intensity', 'random' or 'cut'");
     o.repair.swarm.decision = *rule;
     o.repair.swarm.edit_range = edit_range;
-    if (sleeping) o.segmentation.step = sleeping_step();
+    if (sleeping) o.segmentation.step = segment_step();  // as `liveset segment` (the rule as asked, below)
     o.segmentation.step.thin_fronts = thin_fronts;
     pyb::gil_scoped_release nogil;
     auto s = std::make_unique<Session>(std::move(image), o, std::move(r));

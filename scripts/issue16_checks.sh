@@ -31,8 +31,10 @@ S8=(--seed 35,83,113 --seed 35,125,38 --seed 44,164,92 --seed 71,74,53 --seed 12
 # --no-bias-correct: ITK's filter below runs on the raw T1, and so does liveset, to compare one front
 # (N4, the default since session 48, adds 0.5-0.8 s and changes the front: 716 iterations, Dice 0.939).
 # --alpha 0.1: ITK runs with the curvature weight 0.1 maps to; liveset's automatic weight (session 50)
-# would take 0 on this scan and make the two fronts differ.
-segment=(segment "$B/t1.mha" "${S8[@]}" --roi "$B/brain_mask.nii.gz" --mu-raw 94 --epsilon-raw 22 --alpha 0.1 --no-bias-correct --quiet)
+# would take 0 on this scan and make the two fronts differ. --no-thin-fronts: the paper's sparse field,
+# as ITK's (the thin-front rule, liveset's default since session 72, costs 1.13-1.56x per iteration
+# at equal front size and takes the front into thin cortex ITK's stops at: docs/BENCHMARKS.md).
+segment=(segment "$B/t1.mha" "${S8[@]}" --roi "$B/brain_mask.nii.gz" --mu-raw 94 --epsilon-raw 22 --alpha 0.1 --no-bias-correct --no-thin-fronts --quiet)
 load() { echo "-- load $(cut -d' ' -f1-3 /proc/loadavg), $(date -u +%H:%M:%S) UTC"; }
 summary() { /usr/bin/python3 -c 'import json, sys; d = json.load(sys.stdin); print({k: v for k, v in d.items() if not isinstance(v, (list, dict))})'; }
 

@@ -3,7 +3,8 @@
 # seeded, joined to a 52-voxel tube (W×W voxels) or sheet (16×W voxels) of the same intensity
 # (100, noise σ 2, background 0), window 100 ± 30, α 0, no ROI; prints the voxels reached of the
 # structure's, and the last slice reached (59 = the whole length). Further arguments go to
-# `segment` (e.g. --thin-fronts, --step exact).
+# `segment` (e.g. --no-thin-fronts: the paper's sparse field, which stops in 1-2 voxel structures;
+# --step exact).
 # Usage: bash scripts/thin_structures.sh BIN [OUT_DIR [segment options...]]   (python3-nibabel)
 set -eu
 BIN=$1; OUT=${2:-/tmp/thin_structures}; mkdir -p "$OUT"; shift; [ $# -gt 0 ] && shift

@@ -264,7 +264,9 @@ void fill_segment_request(SegmentRequest& req, const Options& a, const Lattice& 
     req.alpha = a.alpha;
     req.smooth_mm = a.smooth_mm;
     req.loop.max_iterations = a.iterations;
-    req.loop.step = segment_step();  // converged stretches of front sleep (docs/ARCHITECTURE.md)
+    // segment_step() (converged stretches of front sleep, docs/ARCHITECTURE.md) with the thin-front
+    // rule as asked; `liveset segment` then sets --step's (step_options), Python has no --step.
+    req.loop.step = segment_step();
     req.loop.step.thin_fronts = a.thin_fronts;
     req.mu = a.mu;
     req.epsilon = a.epsilon;

@@ -106,7 +106,7 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
     j["n"] = o.params.n;
     j["alpha"] = o.params.alpha;
     j["smooth_mm"] = o.params.smooth_mm;
-    j["step"] = o.step.sleep_after > 0 ? "sleeping" : "exact";
+    j["step"] = step_name(o.step);
     j["thin_fronts"] = o.step.thin_fronts;
     j["alpha_choice"] = {{"source", o.alpha.automatic ? "automatic" : "given"}};
     if (o.alpha.automatic) {

@@ -28,8 +28,6 @@ StepOptions step_options(const ThresholdArgs& a) {
     return o;
 }
 
-std::string step_name(const StepOptions& o) { return o.mode == StepMode::kIncremental && o.sleep_after > 0 ? "sleeping" : "exact"; }
-
 void check_threshold_args(const ThresholdArgs& a) {
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");
     if (a.epsilon && a.epsilon_raw) throw UsageError("give --epsilon or --epsilon-raw, not both");

@@ -34,8 +34,5 @@ std::optional<double> unit_epsilon(const ThresholdArgs& a, const IntensityScale&
 // The level-set step --step names: segment_step() (the default) or the exact full-band step; the
 // thin-front rule on or off as --thin-fronts / --no-thin-fronts say (on by default).
 StepOptions step_options(const ThresholdArgs& a);
-// The --step name of a step (step_options' inverse, the thin-front rule aside): "sleeping" where
-// converged stretches of front sleep, else "exact" (the full-band step's bits).
-std::string step_name(const StepOptions& o);
 
 }  // namespace liveset::cli

@@ -59,7 +59,7 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
     req.n = s->params().n;
     req.alpha = s->params().alpha;
     req.smooth_mm = s->params().smooth_mm;  // the session's blur, automatic or given
-    req.loop.step = s->options().segmentation.step;  // `view --step` as `segment --step` (default: sleeping)
+    req.loop.step = s->options().segmentation.step;  // `view --step` as `segment --step` (default: sleeping, the thin-front rule on)
     const auto c0 = Clock::now();
     const SegmentOutcome cli = segment_image(s->image(), req);
     const double cli_ms = ms_since(c0);
@@ -100,8 +100,8 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
         fmt::print("{}\n", j.dump());
     } else {
         fmt::print("liveset view --bench-mode segment ({}x{} window)\n", width, height);
-        fmt::print("  CLI (segment_image)  {:9.1f} ms  {} iterations ({} step)\n", cli_ms, cli.result.iterations,
-                   req.loop.step.sleep_after > 0 ? "sleeping" : "exact");
+        fmt::print("  CLI (segment_image)  {:9.1f} ms  {} iterations ({} step{})\n", cli_ms, cli.result.iterations,
+                   step_name(req.loop.step), req.loop.step.thin_fronts ? ", thin fronts" : "");
         fmt::print("  viewer (Run)         {:9.1f} ms  {} iterations  {} frames  frame median {:.1f} ms, worst {:.1f} ms, "
                    "steps/frame median {:.0f}\n",
                    viewer_ms, iterations, frame_ms.size(), f.median, f.worst, st.median);

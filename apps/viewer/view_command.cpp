@@ -44,6 +44,7 @@ struct ViewArgs : ThresholdArgs {
     bool bias_given = false;            // --bias-correct or --no-bias-correct on the command line
     std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
     std::optional<StepOptions> workspace_step;  // a continued workspace's step (continued_step)
+    std::string workspace_step_note;            // how it differs from the saved one, as asked
     std::string workspace_warning;      // the workspace was refused, or its ROI is not the one it was saved with
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
     bool image_oriented = true;         // set by load_session: its header gave an orientation (saved masks say so too)
@@ -183,10 +184,11 @@ void refuse_workspace(ViewArgs& a, const std::exception& e) {
     a.workspace_warning = fmt::format("{}; opened without it", e.what());
 }
 
-// The step a continued workspace takes: the one it was saved with (an older file records none: the
-// command line's), but for what --step, --thin-fronts or --no-thin-fronts ask, which a note says
-// (from there it does not step as one run would).
-StepOptions continued_step(const ViewArgs& a, const viewer::Workspace& ws) {
+// The step a continued workspace takes: the one it was saved with (an older file records only that
+// the rule was off: its --step is the command line's), but for what --step, --thin-fronts or
+// --no-thin-fronts ask, which `note` says (from there it does not step as one run would; printed
+// once the workspace is continued).
+StepOptions continued_step(const ViewArgs& a, const viewer::Workspace& ws, std::string& note) {
     ThresholdArgs t = a;
     std::vector<std::string> asked;
     if (ws.step && !a.step_given) t.step = *ws.step;
@@ -194,9 +196,9 @@ StepOptions continued_step(const ViewArgs& a, const viewer::Workspace& ws) {
     if (ws.thin_fronts && !a.thin_fronts_given) t.thin_fronts = *ws.thin_fronts;
     if (ws.thin_fronts && t.thin_fronts != *ws.thin_fronts)
         asked.push_back(t.thin_fronts ? "--thin-fronts (saved without)" : "--no-thin-fronts (saved with --thin-fronts)");
+    note.clear();
     if (!asked.empty())
-        fmt::print(stderr, "liveset: note: workspace {} continues with {} as asked: from here it steps unlike one run\n", a.workspace,
-                   fmt::join(asked, " and "));
+        note = fmt::format("workspace {} continues with {} as asked: from here it steps unlike one run", a.workspace, fmt::join(asked, " and "));
     return step_options(t);
 }
 
@@ -214,7 +216,7 @@ std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
         if (a.image.empty()) a.image = ws.image;
         if (a.roi.empty()) a.roi = ws.roi;
         a.workspace_bias = ws.bias_corrected;
-        a.workspace_step = continued_step(a, ws);
+        a.workspace_step = continued_step(a, ws, a.workspace_step_note);
         return ws;
     } catch (const std::runtime_error& e) {
         refuse_workspace(a, e);
@@ -232,6 +234,7 @@ std::unique_ptr<Session> open_session(ViewArgs& a, std::optional<viewer::Workspa
             viewer::apply_workspace(*s, *ws);
             a.workspace_warning = viewer::workspace_roi_warning(*ws, a.workspace, *s, a.roi);
             if (!a.workspace_warning.empty()) fmt::print(stderr, "liveset: warning: {}\n", a.workspace_warning);
+            if (!a.workspace_step_note.empty()) fmt::print(stderr, "liveset: note: {}\n", a.workspace_step_note);
         } catch (const std::exception& e) {
             refuse_workspace(a, e);
             ws.reset();
@@ -363,7 +366,7 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--window-from", va.window_from, "estimate the window from the tissue model (the seeds pick the class) or from the seeds' statistics, as `segment`")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     auto* bias = v->add_flag("--bias-correct,!--no-bias-correct", va.bias_correct, "correct the intensity non-uniformity first (N4), as `segment`. Default: on, skipped with a warning where it cannot run (asked for: an error); a continued workspace keeps its own setting");
     v->add_option("--seeds", va.seeds_file, "seed file: one I,J,K[:R] per line (the --seed format; the panel saves them)");
-    v->add_option("--workspace", va.workspace, "continue a saved workspace (image, ROI, phi, seeds, parameters, swarm, camera); the panel saves it");
+    v->add_option("--workspace", va.workspace, "continue a saved workspace (image, ROI, phi, seeds, parameters, step, swarm, camera); the panel saves it; --step, --thin-fronts or --no-thin-fronts override its step, with a note");
     add_threshold_options(*v, va);  // as `liveset segment`: --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
     v->get_option("--alpha")->description("curvature weight in [0,1), per millimetre (default: automatic, as `segment` chooses it for the window and re-chosen as seeds move it - said in the start note; or the workspace's)");
     v->add_option("--seed-radius", va.seed_radius, "default seed radius, voxels")->check(CLI::PositiveNumber)->capture_default_str();

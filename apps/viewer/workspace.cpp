@@ -14,7 +14,6 @@
 
 #include "liveset/base/atomic_file.hpp"
 #include "liveset/session/recovery.hpp"
-#include "threshold_args.hpp"
 
 namespace liveset::viewer {
 
@@ -195,7 +194,8 @@ Workspace parse_workspace(const json& j) {
     // Absent in workspaces written before the automatic α: their α was set by hand.
     ws.marks.alpha_automatic = p.contains("alpha_automatic") && field(p, "alpha_automatic").get<bool>();
     ws.marks.iterations = static_cast<int>(number(j, "iterations"));
-    if (j.contains("step")) {  // absent in workspaces written before the thin-front rule
+    ws.thin_fronts = false;  // a workspace written before session 72 records no step: the rule was off
+    if (j.contains("step")) {
         const json& st = j["step"];
         const std::string kind = field(st, "kind").get<std::string>();
         if (kind != "sleeping" && kind != "exact") throw std::runtime_error(fmt::format("step kind '{}' is neither sleeping nor exact", kind));
@@ -269,7 +269,7 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
                        {"smooth_mm", m.params.smooth_mm}, {"window_from_seeds", m.window_from_seeds}, {"alpha_automatic", m.alpha_automatic},
                        {"mu_raw", session.scale().to_raw(m.params.mu)}, {"epsilon_raw", session.scale().raw_length(m.params.epsilon)}}},
            {"iterations", m.iterations},
-           {"step", {{"kind", cli::step_name(session.options().segmentation.step)}, {"thin_fronts", session.options().segmentation.step.thin_fronts}}},
+           {"step", {{"kind", step_name(session.options().segmentation.step)}, {"thin_fronts", session.options().segmentation.step.thin_fronts}}},
            {"activity", activity_json(session.activity_snapshot())},
            {"swarm", swarm_json(session.repair_options())},
            {"target", session.target() ? vec(*session.target()) : json(nullptr)},

@@ -34,8 +34,9 @@ struct Workspace {
     bool roi_recorded = false;                   // the file records the ROI's checksum (not in older files)
     std::optional<std::uint64_t> roi_checksum;  // mask_checksum() of the session's ROI (absent: saved without one)
     SessionMarks marks;              // seeds, parameters, iterations
-    // The step it was saved stepping: its --step name ("sleeping" or "exact") and the thin-front
-    // rule (absent in older files: the command line's, as then).
+    // The step it was saved stepping: its --step name ("sleeping" or "exact"; absent in files
+    // written before session 72: the command line's) and the thin-front rule (false in those: it
+    // was off unless asked for).
     std::optional<std::string> step;
     std::optional<bool> thin_fronts;
     RepairOptions repair;            // swarm settings

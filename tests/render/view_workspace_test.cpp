@@ -73,7 +73,8 @@ TEST(ViewCommand, HelpListsTheWindowAndWorkspaceOptions) {
 
 // Segment 45 steps and save a workspace; reopen it and take 25 more: φ is bit for bit what 70
 // steps in one run give (the level set, the parameters, the iteration count and the sleeping step's
-// wake stamps continue: stretches of front are asleep by step 45 of the default sleeping step).
+// wake stamps continue: stretches of front are asleep by step 45 of the default step, sleeping with
+// the thin-front rule).
 TEST(ViewCommand, AWorkspaceContinuesBitForBit) {
     const Fixture& f = fixture();
     const std::string w = (f.dir / "cont.json").string(), p2 = (f.dir / "cont_phi.nii.gz").string(), p3 = (f.dir / "one_phi.nii.gz").string();
@@ -123,6 +124,14 @@ TEST(ViewCommand, AWorkspaceKeepsItsStep) {
     ASSERT_EQ(r.rc, 0) << r.err;
     EXPECT_NE(r.err.find("continues with --thin-fronts (saved without) as asked"), std::string::npos) << r.err;
     EXPECT_FALSE(same_bits(read_image(thin), read_image(one)));
+
+    // --step over it: honoured and said; the rule stays off as saved.
+    const std::string sleeping = (f.dir / "step_sleeping.nii.gz").string();
+    r = run_cli(fmt::format("view --workspace {} --step sleeping --headless --script {}", w,
+                            script("st_f.json", R"([{"segment": 20}, {"save_phi": ")" + sleeping + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("continues with --step sleeping (saved with --step exact) as asked"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("thin-fronts"), std::string::npos) << r.err;
 }
 
 // The viewer segments the image `liveset segment` does: N4-corrected by default (the workspace

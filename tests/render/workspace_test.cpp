@@ -18,7 +18,6 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/repair_presets.hpp"
 #include "seed_file.hpp"
-#include "threshold_args.hpp"
 #include "workspace.hpp"
 #include "viewer_test_util.hpp"
 
@@ -126,7 +125,7 @@ TEST(WorkspaceFile, RoundTripIsBitExactAndTheSessionContinuesExactly) {
     EXPECT_FALSE(ws.marks.alpha_automatic);
     EXPECT_EQ(ws.marks.iterations, 25);
     ASSERT_TRUE(ws.step && ws.thin_fronts);  // the session's step as the viewer names it
-    EXPECT_EQ(*ws.step, cli::step_name(original->options().segmentation.step));
+    EXPECT_EQ(*ws.step, step_name(original->options().segmentation.step));
     EXPECT_EQ(*ws.thin_fronts, original->options().segmentation.step.thin_fronts);
     EXPECT_EQ(ws.repair.swarm.agents, 77u);
     EXPECT_EQ(ws.repair.swarm.act_probability, 0.3);
@@ -231,10 +230,11 @@ TEST(WorkspaceFile, BadWorkspacesAreRefusedWithOneClearLine) {
     j["step"]["thin_fronts"] = 1;
     expect_line(read(copy_as("badthin.json", j.dump())), "field 'thin_fronts' is not true or false");
     j = nlohmann::json::parse(json_text);
-    j.erase("step");  // an older file: no step recorded, read as such
+    j.erase("step");  // a file written before session 72: no --step recorded, the rule off as then
     const fs::path older = copy_as("nostep.json", j.dump());
     EXPECT_EQ(read(older), "(no error)");
     EXPECT_FALSE(viewer::read_workspace(older).step.has_value());
+    EXPECT_EQ(viewer::read_workspace(older).thin_fronts, std::optional<bool>(false));
 
     // The state file: missing, truncated, or from another save.
     const fs::path nostate = copy_as("nostate.json", json_text);

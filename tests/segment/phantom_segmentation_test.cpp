@@ -49,7 +49,7 @@ TEST(PhantomSegmentation, DefaultsFromSeedsReachDiceAndLeaveHolesAtTheBias) {
 }
 
 TEST(PhantomSegmentation, SleepingFrontKeepsTheDiceOfTheExactStep) {
-    // Converged stretches of front sleeping (sleeping_step(), as `liveset segment` runs) against
+    // Converged stretches of front sleeping (sleeping_step(); `liveset segment` adds the thin-front rule) against
     // the exact step (the default, full band): the same Dice within 0.002.
     const Phantom ph = make_phantom();
     SegmentRequest req;

@@ -50,6 +50,12 @@ inline StepOptions segment_step() {
     return o;
 }
 
+// The name `liveset segment --step` gives a step (its report's "step", a workspace's): "sleeping"
+// where converged stretches of front sleep, else "exact" (the full-band step's bits).
+inline const char* step_name(const StepOptions& o) {
+    return o.mode == StepMode::kIncremental && o.sleep_after > 0 ? "sleeping" : "exact";
+}
+
 // Throws std::invalid_argument for non-positive limits, a negative/non-finite tolerance or bad step
 // options.
 void validate(const SegmentationOptions& options);
