@@ -2,10 +2,12 @@
 // and the region of interest.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "liveset/levelset/shapes.hpp"
@@ -71,7 +73,8 @@ TEST(ThresholdSpeed, PropagationCurvatureAndRoi) {
 // The thin-front rule's sign table (2 bits a voxel) against the sign of the propagation part at
 // every voxel of a lattice whose size is no multiple of four: inside and outside the window, on
 // its edge (D exactly 0: |µ − I| = ε), outside the ROI (+½), and against Speed's own default,
-// which asks at().
+// which asks at(). Asked in a scrambled order (as the rule's scattered points), in batches shorter
+// and longer than the distance it fetches ahead.
 TEST(ThresholdSpeed, PropagationSignIsThePropagationsSignAtEveryVoxel) {
     // 105 voxels, and 144 050 (the table built in several parallel chunks, the last byte partial).
     for (const Vec3i dims : {Vec3i{7, 5, 3}, Vec3i{67, 43, 50}}) {
@@ -86,13 +89,22 @@ TEST(ThresholdSpeed, PropagationSignIsThePropagationsSignAtEveryVoxel) {
         const ThresholdParams p{0.5, 0.25, 4.0, 0.2};
         const ThresholdSpeed speed(img, p, &roi);
         const Grid<float> phi(lat, 1.0f);
+        // Every voxel once, scrambled: 97 is coprime to both sizes (3·5·7 and 2·5²·43·67).
+        std::vector<PointIndex> order(lat.size());
+        for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<PointIndex>(k * 97 % lat.size());
+        std::vector<std::int8_t> sign(order.size(), 9), by_default(order.size(), 9);
+        for (std::size_t b = 0, len = 1; b < order.size(); b += len, len = len * 3 + 1) {
+            const std::size_t e = std::min(order.size(), b + len);
+            speed.propagation_signs(phi, std::span(order).subspan(b, e - b), std::span(sign).subspan(b, e - b));
+        }
+        if (lat.size() < 1000) speed.Speed::propagation_signs(phi, order, by_default);  // at(), with the curvature
         int seen[3] = {0, 0, 0}, wrong = 0;
-        for (PointIndex i = 0; i < lat.size(); ++i) {
-            const float f = speed.propagation(lat.coord(i));
+        for (std::size_t k = 0; k < order.size(); ++k) {
+            const float f = speed.propagation(lat.coord(order[k]));
             const int want = static_cast<int>(f > 0.0f) - static_cast<int>(f < 0.0f);
-            wrong += speed.propagation_sign(phi, i) != want ? 1 : 0;
-            if (lat.size() < 1000) {  // Speed's default asks at(), with the curvature
-                EXPECT_EQ(speed.Speed::propagation_sign(phi, i), want) << "voxel " << i;
+            wrong += sign[k] != want ? 1 : 0;
+            if (lat.size() < 1000) {
+                EXPECT_EQ(by_default[k], want) << "voxel " << order[k];
             }
             ++seen[want + 1];
         }

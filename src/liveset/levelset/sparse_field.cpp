@@ -240,14 +240,24 @@ ChangedPoints SparseField::commit(std::span<const ZeroLayerEdit> edits, RepairSc
 
 namespace {
 
+// Where a pinned point's value may lie (the thin-front rule, thin_front.cpp): within 0.25 of its
+// side's edge of the zero layer. Without a branch (a moving front's values are unpredictable).
+bool near_edge(float w) {
+    const float a = std::abs(w);
+    return static_cast<bool>(static_cast<unsigned>(a >= 0.25f) & static_cast<unsigned>(a <= 0.5f));
+}
+
 // Step 1 of the repair for edits [b, e) (see move_zero_layer): the new values, the old ones kept,
 // every move 0, and the edits whose new value leaves [-0.5, 0.5] listed in order from leaving[b];
-// returns how many. A store and a count each, no branch (whether a point leaves is unpredictable).
+// returns how many. With `near_edges` (the thin-front rule), the points whose value changed and
+// stays near its side's edge (near_edge: in the zero layer) are listed in order from near[b],
+// *n_near how many. A store and a count each, no branch (whether a point leaves is unpredictable).
 // Locals and parameters only: a store through std::int8_t may alias anything, so values read
 // through a closure would be reloaded after every store.
+template <bool near_edges>
 std::size_t move_values(const ZeroLayerEdit* edits, std::size_t b, std::size_t e, float* phi, float* old_phi,
-                        std::int8_t* move, std::uint32_t* leaving) {
-    std::size_t n = b;
+                        std::int8_t* move, std::uint32_t* leaving, PointIndex* near, std::size_t* n_near) {
+    std::size_t n = b, m = b;
     for (std::size_t k = b; k < e; ++k) {
         const PointIndex i = edits[k].point;
         const float v = phi[i];
@@ -257,7 +267,12 @@ std::size_t move_values(const ZeroLayerEdit* edits, std::size_t b, std::size_t e
         move[k] = 0;
         leaving[n] = static_cast<std::uint32_t>(k);
         n += std::abs(moved) > 0.5f ? 1 : 0;
+        if constexpr (near_edges) {
+            near[m] = i;
+            m += static_cast<unsigned>(near_edge(moved)) & static_cast<unsigned>(!detail::same_bits(moved, v));
+        }
     }
+    if constexpr (near_edges) *n_near = m - b;
     return n - b;
 }
 
@@ -348,9 +363,17 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
 
     // 1. New zero-layer values (all Δ were computed from the old state, so this is Jacobi), and
     //    each chunk's leaving edits (movers_ holds them at the chunk's offset until step 2 is done).
+    //    With the rule, also each chunk's candidates for its pinned test (near_edge_ at the chunk's
+    //    offset): a point that leaves ends a mover or blocked (clamped to ±0.5), and a blocked one
+    //    needs no such test (thin_front.cpp).
     std::vector<std::size_t> n_leaving((n + detail::kChunk - 1) / detail::kChunk);
+    std::vector<std::size_t> n_near(rule != nullptr ? n_leaving.size() : 0);
+    if (rule != nullptr && near_edge_.v.size() < n) near_edge_.v.resize(n);
+    PointIndex* const near = near_edge_.v.data();
     detail::for_chunks(n, [&](std::size_t b, std::size_t e) {
-        n_leaving[b / detail::kChunk] = move_values(edits.data(), b, e, phi, old_phi, move, movers);
+        const std::size_t c = b / detail::kChunk;
+        n_leaving[c] = rule != nullptr ? move_values<true>(edits.data(), b, e, phi, old_phi, move, movers, near, &n_near[c])
+                                       : move_values<false>(edits.data(), b, e, phi, old_phi, move, movers, nullptr, nullptr);
     });
     // 2. Classify the leaving edits (reads only). A point whose neighbour leaves the other way
     //    stays, clamped to ±0.5, so the front never jumps over a lattice edge.
@@ -361,7 +384,7 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     // The movers, in edit order: each chunk's leaving edits but the blocked ones (compacted in
     // place: a mover is written at or before where it was read).
     std::size_t n_movers = 0;
-    std::vector<PointIndex> blocked;
+    std::vector<StuckPoint> blocked;
     for (std::size_t c = 0; c < n_leaving.size(); ++c)
         for (std::size_t j = 0; j < n_leaving[c]; ++j) {
             const std::uint32_t k = movers[c * detail::kChunk + j];
@@ -369,14 +392,22 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
             if (m >= 2 || m <= -2) [[unlikely]] {
                 phi[edits[k].point] = m > 0 ? 0.5f : -0.5f;
                 move[k] = 0;
-                if (rule != nullptr && (m == 2 || m == -2)) blocked.push_back(edits[k].point);
+                if (rule != nullptr && (m == 2 || m == -2)) blocked.push_back({edits[k].point, m > 0 ? std::int8_t{-1} : std::int8_t{1}});
             }
             movers[n_movers] = k;
             n_movers += move[k] != 0 ? 1 : 0;
         }
-    // The thin-front rule's entries, from the zero layer's final new values.
+    // The thin-front rule's entries, from the zero layer's final new values (the candidates of its
+    // pinned test compacted in place, in edit order).
+    std::size_t n_near_all = 0;
+    for (std::size_t c = 0; c < n_near.size(); ++c) {
+        const PointIndex* const from = near + c * detail::kChunk;
+        if (from != near + n_near_all) std::copy(from, from + n_near[c], near + n_near_all);  // to before it
+        n_near_all += n_near[c];
+    }
     const std::vector<FrontEntry> entries =
-        rule != nullptr ? rule_entries(*rule, edits, old_phi, std::move(blocked)) : std::vector<FrontEntry>{};
+        rule != nullptr ? rule_entries(*rule, std::span<const PointIndex>(near, n_near_all), blocked, edits, old_phi)
+                        : std::vector<FrontEntry>{};
 
     // 3. The front passes to the neighbours on the other side: an L∓1 neighbour of a leaving point
     //    enters the zero layer (marked at once, so it enters once) with the value implied by the

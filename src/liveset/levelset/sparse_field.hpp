@@ -241,18 +241,23 @@ private:
         PointIndex point;
         float phi;  // the new value
     };
-    bool pinned(PointIndex i) const;  // of a zero-layer point, by its current value
-    // The entries beside the stuck points `stuck` (any order, duplicates allowed), in lattice order.
-    std::vector<FrontEntry> front_entries(const FrontRule& rule, std::span<const PointIndex> stuck) const;
-    // The stuck points among a repair's edits: `blocked` (from step 2: those with an L∓1 neighbour
-    // on the other side, the only ones that can hand the front over) and the pinned ones.
-    std::vector<PointIndex> stuck_points(std::span<const ZeroLayerEdit> edits, const float* old_phi,
-                                         std::vector<PointIndex> blocked) const;
-    // The rule's entries for a repair whose edits have their new values (`old_phi` their old ones)
-    // and whose blocked edits are `blocked`: reads only, except that a speed that throws leaves
-    // every edit's value as it was.
-    std::vector<FrontEntry> rule_entries(const FrontRule& rule, std::span<const ZeroLayerEdit> edits, const float* old_phi,
-                                         std::vector<PointIndex> blocked);
+    struct StuckPoint {
+        PointIndex point;
+        std::int8_t other;  // the status of its L±1 neighbours on the other side
+    };
+    // The entries the rule gives the points ahead `ahead` (points_ahead), in their (lattice) order.
+    std::vector<FrontEntry> front_entries(const FrontRule& rule, std::span<const PointIndex> ahead) const;
+    // The L±1 neighbours on the other side of a repair's stuck points - `blocked` (from step 2:
+    // those with an L∓1 neighbour on the other side, the only ones that can hand the front over)
+    // and the pinned ones among `near` (the edits whose value changed and stayed in the zero
+    // layer, now within 0.25 of their side's edge: step 1) - towards which the propagation part
+    // moves the front, once each, in lattice order.
+    std::vector<PointIndex> points_ahead(const FrontRule& rule, std::span<const PointIndex> near,
+                                         std::span<const StuckPoint> blocked) const;
+    // The rule's entries for such a repair: reads only, except that a speed that throws leaves
+    // every edit's value as it was (`old_phi`).
+    std::vector<FrontEntry> rule_entries(const FrontRule& rule, std::span<const PointIndex> near, std::span<const StuckPoint> blocked,
+                                         std::span<const ZeroLayerEdit> edits, const float* old_phi);
     ChangedPoints commit(std::span<const ZeroLayerEdit> edits, RepairScope scope,
                          const FrontRule* rule = nullptr);  // timed repair_band
     ChangedPoints repair_band(std::span<const ZeroLayerEdit> edits, RepairScope scope, const FrontRule* rule = nullptr);
@@ -355,6 +360,7 @@ private:
     Scratch<float> old_phi_;                       // move_zero_layer's values before the edits
     Scratch<std::int8_t> move_;                    // its moves, one per edit
     Scratch<std::uint32_t> movers_;                // its edits that leave the zero layer
+    Scratch<PointIndex> near_edge_;                // with the thin-front rule, its pinned test's candidates
     Kept<PointList> sweep_from_, sweep_next_;  // sweep_whole_band's levels
     Kept<PointList> zero_next_;                // collect_band's new zero layer (relist swaps it in)
     Scratch<PointList> level_claims_;  // its claims per level and side (2(k-1): outside, +1: inside)

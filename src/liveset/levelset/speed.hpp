@@ -42,14 +42,17 @@ public:
     // Upper bound of the coefficient w in the curvature part w·κ (κ per mm), for the parabolic
     // time-step bound dt ≤ h_min/(4w). Zero when the speed has no curvature part.
     virtual float curvature_weight() const = 0;
-    // The sign of at()'s propagation part at lattice index i (-1, 0 or +1): the thin-front rule's
-    // test of which way the propagation would move the front there, before it asks for a rate. By
-    // default from at(); a speed that tabulates it (ThresholdSpeed, in a table of 2 bits a voxel,
-    // which stays in cache where the rule asks tens of thousands of scattered points a step) or has
-    // none (CurvatureSpeed) answers without the curvature.
-    virtual int propagation_sign(const Grid<float>& phi, PointIndex i) const {
-        const float f = at(phi, phi.lattice().coord(i)).propagation;
-        return static_cast<int>(f > 0.0f) - static_cast<int>(f < 0.0f);
+    // The sign of at()'s propagation part (-1, 0 or +1) at each lattice index of `points` into
+    // `out`, of the same size: the thin-front rule's test of which way the propagation would move
+    // the front there, before it asks for a rate. By default from at(); a speed that tabulates it
+    // (ThresholdSpeed, in a table of 2 bits a voxel, which stays in cache where the rule asks tens
+    // of thousands of scattered points a step, fetched ahead along the batch) or has none
+    // (CurvatureSpeed) answers without the curvature. Thread-safe like at().
+    virtual void propagation_signs(const Grid<float>& phi, std::span<const PointIndex> points, std::span<std::int8_t> out) const {
+        for (std::size_t k = 0; k < points.size(); ++k) {
+            const float f = at(phi, phi.lattice().coord(points[k])).propagation;
+            out[k] = static_cast<std::int8_t>(static_cast<int>(f > 0.0f) - static_cast<int>(f < 0.0f));
+        }
     }
 
 private:
@@ -89,7 +92,9 @@ public:
     }
     void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;
     float curvature_weight() const override { return weight_; }
-    int propagation_sign(const Grid<float>&, PointIndex) const override { return 0; }
+    void propagation_signs(const Grid<float>&, std::span<const PointIndex>, std::span<std::int8_t> out) const override {
+        std::fill(out.begin(), out.end(), std::int8_t{0});
+    }
 
 private:
     float weight_;

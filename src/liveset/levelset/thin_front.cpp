@@ -2,7 +2,6 @@
 // zero-layer points that moved but cannot pass the front on, and the L±1 points beside them that
 // enter the zero layer by their own rate.
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <span>
@@ -17,74 +16,104 @@ namespace liveset {
 
 namespace {
 
-// Where a pinned point's value may lie: within 0.25 of its side's edge of the zero layer.
-bool near_edge(float w) { return (w <= -0.25f && w >= -0.5f) || (w >= 0.25f && w <= 0.5f); }
+// The stuck points' L±1 neighbours on their other side (the candidates of points_ahead), each with
+// that side's status. With `test_pinned` (stuck: the pinned test's candidates, on their side by
+// their value) a point counts only if no neighbour lies half a voxel or more beyond its value
+// (inside, w < 0: none as deep as w - 0.5, so every upwind difference from behind is under half a
+// voxel; outside mirrored): the pinned test; a front three voxels across or more has its L∓1
+// points about a voxel beyond. Without (stuck: blocked points, each with its other side), every
+// one counts. One visit of the six neighbours reads both tests' values, their lines fetched
+// kAhead points ahead (the points are scattered over the zero layer).
+template <bool test_pinned, class Stuck>
+void other_side(std::span<const Stuck> stuck, const float* phi, const std::int8_t* status, const detail::Neighbors6& around,
+                std::vector<PointIndex>& sides, std::vector<std::int8_t>& others) {
+    for (std::size_t j = 0; j < stuck.size(); ++j) {
+        PointIndex i;
+        std::int8_t other;
+        float w = 0.0f;
+        if constexpr (test_pinned) {
+            if (j + detail::kAhead < stuck.size()) around.prefetch(phi, status, stuck[j + detail::kAhead]);
+            i = stuck[j];
+            w = phi[i];
+            other = w < 0.0f ? std::int8_t{1} : std::int8_t{-1};
+        } else {
+            if (j + detail::kAhead < stuck.size()) around.prefetch(nullptr, status, stuck[j + detail::kAhead].point);
+            i = stuck[j].point;
+            other = stuck[j].other;
+        }
+        PointIndex side[6];
+        std::size_t n = 0;
+        bool deeper = false;
+        around.visit(i, [&](PointIndex q) {
+            side[n] = q;
+            n += status[q] == other ? 1 : 0;
+            if constexpr (test_pinned) deeper |= w < 0.0f ? phi[q] <= w - 0.5f : phi[q] >= w + 0.5f;
+        });
+        if (deeper) continue;
+        sides.insert(sides.end(), side, side + n);
+        others.insert(others.end(), n, other);
+    }
+}
 
 }  // namespace
 
-bool SparseField::pinned(PointIndex i) const {
+std::vector<PointIndex> SparseField::points_ahead(const FrontRule& rule, std::span<const PointIndex> near,
+                                                  std::span<const StuckPoint> blocked) const {
     const float* const phi = phi_.values().data();
-    const float w = phi[i];
-    if (!near_edge(w)) return false;
-    // Inside (w < 0): no neighbour as deep as w − 0.5, so every upwind difference from behind is
-    // under half a voxel; outside, the same mirrored. A front three voxels across or more has its
-    // L∓1 points about a voxel beyond.
-    bool deeper = false;
-    detail::for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
-        deeper |= w < 0.0f ? phi[q] <= w - 0.5f : phi[q] >= w + 0.5f;
-    });
-    return !deeper;
-}
-
-std::vector<PointIndex> SparseField::stuck_points(std::span<const ZeroLayerEdit> edits, const float* old_phi,
-                                                  std::vector<PointIndex> blocked) const {
-    // Pinned: among the edits whose value changed (a full-band step's edits also hold those that
-    // did not, which the incremental step leaves out), in chunk order.
-    struct Part {
-        std::vector<PointIndex> pinned;
+    const std::int8_t* const status = status_.values().data();
+    const detail::Neighbors6 around(lattice(), decoder_);
+    // A blocked point needs no pinned test (it is stuck either way, with the same neighbours
+    // ahead); one blocked without an L∓1 neighbour on the other side (step 2's ±3) has none. Of
+    // the candidates, those towards which the propagation part would move the front: F < 0 grows
+    // the inside, F > 0 the outside; elsewhere the front stops there by the speed, as at a
+    // converged edge, the common case (no rate is asked for). Blocked points' candidates first,
+    // then the pinned ones', each in chunks.
+    struct Ahead {
+        std::vector<PointIndex> ahead;
     };
-    auto parts = detail::ordered_chunks<Part>(edits.size(), [&](std::size_t b, std::size_t e, Part& out) {
-        for (std::size_t k = b; k < e; ++k) {
-            const PointIndex i = edits[k].point;
-            if (std::bit_cast<std::uint32_t>(phi_[i]) != std::bit_cast<std::uint32_t>(old_phi[k]) && pinned(i))
-                out.pinned.push_back(i);
+    const auto towards = [&](std::vector<PointIndex>& sides, const std::vector<std::int8_t>& others, Ahead& out) {
+        std::vector<std::int8_t> sign(sides.size());
+        rule.speed.propagation_signs(phi_, sides, sign);
+        for (std::size_t k = 0; k < sides.size(); ++k)
+            if (others[k] > 0 ? sign[k] < 0 : sign[k] > 0) out.ahead.push_back(sides[k]);
+    };
+    const std::size_t n_blocked = blocked.size();
+    auto parts = detail::ordered_chunks<Ahead>(n_blocked + near.size(), [&](std::size_t b, std::size_t e, Ahead& out) {
+        std::vector<PointIndex> sides;
+        std::vector<std::int8_t> others;
+        if (b < n_blocked)
+            other_side<false>(blocked.subspan(b, std::min(e, n_blocked) - b), phi, status, around, sides, others);
+        if (e > n_blocked) {
+            const std::size_t from = std::max(b, n_blocked) - n_blocked;
+            other_side<true>(near.subspan(from, e - n_blocked - from), phi, status, around, sides, others);
         }
+        towards(sides, others, out);
     });
-    detail::join_parts(parts, &Part::pinned, blocked);
-    return blocked;
+    // Once each, in lattice order (the same whatever order the stuck points came in).
+    std::vector<PointIndex> ahead;
+    detail::join_parts(parts, &Ahead::ahead, ahead);
+    std::sort(ahead.begin(), ahead.end());
+    ahead.erase(std::unique(ahead.begin(), ahead.end()), ahead.end());
+    return ahead;
 }
 
-std::vector<SparseField::FrontEntry> SparseField::rule_entries(const FrontRule& rule, std::span<const ZeroLayerEdit> edits,
-                                                               const float* old_phi, std::vector<PointIndex> blocked) {
+std::vector<SparseField::FrontEntry> SparseField::rule_entries(const FrontRule& rule, std::span<const PointIndex> near,
+                                                               std::span<const StuckPoint> blocked,
+                                                               std::span<const ZeroLayerEdit> edits, const float* old_phi) {
     try {
-        return front_entries(rule, stuck_points(edits, old_phi, std::move(blocked)));
+        return front_entries(rule, points_ahead(rule, near, blocked));
     } catch (...) {
         for (std::size_t k = 0; k < edits.size(); ++k) phi_[edits[k].point] = old_phi[k];
         throw;
     }
 }
 
-std::vector<SparseField::FrontEntry> SparseField::front_entries(const FrontRule& rule, std::span<const PointIndex> stuck) const {
+std::vector<SparseField::FrontEntry> SparseField::front_entries(const FrontRule& rule, std::span<const PointIndex> ahead) const {
     std::vector<FrontEntry> entries;
-    if (stuck.empty()) return entries;
-    // The other side's L±1 neighbours of every stuck point where the propagation part would move
-    // the front towards them (F < 0 grows the inside, F > 0 the outside; elsewhere the front stops
-    // there by the speed, as at a converged edge, the common case: no rate is asked for), once
-    // each, in lattice order (so the entries are the same whatever order the stuck points came in).
-    std::vector<PointIndex> ahead;
-    for (const PointIndex i : stuck) {
-        const std::int8_t other = phi_[i] < 0.0f ? std::int8_t{1} : std::int8_t{-1};
-        detail::for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
-            if (status_[q] != other) return;
-            const int f = rule.speed.propagation_sign(phi_, q);
-            if (other > 0 ? f < 0 : f > 0) ahead.push_back(q);
-        });
-    }
-    std::sort(ahead.begin(), ahead.end());
-    ahead.erase(std::unique(ahead.begin(), ahead.end()), ahead.end());
+    if (ahead.empty()) return entries;
     std::vector<double> rate(ahead.size());
     detail::for_chunks(ahead.size(), [&](std::size_t b, std::size_t e) {
-        rule.speed.rates(phi_, std::span<const PointIndex>(ahead).subspan(b, e - b), std::span(rate).subspan(b, e - b));
+        rule.speed.rates(phi_, ahead.subspan(b, e - b), std::span(rate).subspan(b, e - b));
     });
     // Each steps as a zero-layer point would (Δ clamped to ±cfl, the float sum of move_values) and
     // enters where that brings it into the zero layer's range on its own side: [0, 0.5) from L+1

@@ -77,6 +77,17 @@ ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdPar
     });
 }
 
+void ThresholdSpeed::propagation_signs(const Grid<float>&, std::span<const PointIndex> points, std::span<std::int8_t> out) const {
+    // The points are scattered (the thin-front rule's): each table byte fetched 16 points ahead.
+    constexpr std::size_t kAhead = 16;
+    const std::uint8_t* const table = signs_.data();
+    for (std::size_t k = 0; k < points.size(); ++k) {
+        if (k + kAhead < points.size()) __builtin_prefetch(table + points[k + kAhead] / 4, 0);
+        const PointIndex i = points[k];
+        out[k] = kSignOfCode[(table[i / 4] >> (2 * (i % 4))) & 3u];
+    }
+}
+
 SpeedSample ThresholdSpeed::at(const Grid<float>& phi, Vec3i p) const {
     const PointIndex i = phi.lattice().index(p);
     if (roi_ && (*roi_)[i] == 0) return {propagation_[i], 0.0f};

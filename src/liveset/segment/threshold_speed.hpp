@@ -47,9 +47,7 @@ public:
     SpeedSample at(const Grid<float>& phi, Vec3i p) const override;
     void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;
     float curvature_weight() const override { return static_cast<float>(0.5 * params_.alpha); }
-    int propagation_sign(const Grid<float>&, PointIndex i) const override {
-        return kSignOfCode[(signs_[i / 4] >> (2 * (i % 4))) & 3u];
-    }
+    void propagation_signs(const Grid<float>& phi, std::span<const PointIndex> points, std::span<std::int8_t> out) const override;
 
     const ThresholdParams& params() const { return params_; }
     // ½(1 − α)·D at a lattice point (+½ outside the ROI).
@@ -60,7 +58,7 @@ private:
     Grid<float> propagation_;             // ½(1 − α) D(p), or +½ outside the ROI
     // propagation_'s signs, 2 bits a voxel (four to a byte, the lowest first): 0 zero, 1 positive,
     // 2 negative.
-    static constexpr int kSignOfCode[4] = {0, 1, -1, 0};
+    static constexpr std::int8_t kSignOfCode[4] = {0, 1, -1, 0};
     std::vector<std::uint8_t> signs_;
     const Grid<std::uint8_t>* roi_;       // curvature applies only inside (null: everywhere)
 };
