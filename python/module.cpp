@@ -7,6 +7,7 @@
 #include "bindings.hpp"
 #include "cli_common.hpp"
 #include "liveset/io/image_io.hpp"
+#include "liveset/segment/segmentation.hpp"
 
 namespace {
 std::shared_ptr<void> g_thread_limit;  // tbb::global_control while a limit is set
@@ -34,6 +35,9 @@ PYBIND11_MODULE(_liveset, m) {
         g_thread_limit = liveset::cli::limit_threads(threads);
     }, pyb::arg("threads"));
     m.attr("__version__") = LIVESET_VERSION;
+    // The step `liveset segment` takes by default (segment_step(): the thin-front rule on or off),
+    // which segment() and Session default to.
+    m.attr("DEFAULT_THIN_FRONTS") = liveset::segment_step().thin_fronts;
     liveset::py::register_core(m);
     liveset::py::register_session(m);
 }

@@ -72,7 +72,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
             mu_raw: Optional[float] = None, epsilon_raw: Optional[float] = None,
             window_from: str = "model", classes: int = 3, n: float = 4.0, alpha: Optional[float] = None,
             smooth_mm: Optional[float] = None, iterations: int = 2000, bias_correct: Optional[bool] = None,
-            thin_fronts: bool = True, progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
+            thin_fronts: bool = _liveset.DEFAULT_THIN_FRONTS, progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
     """Threshold level-set segmentation from seeds (paper Eq. 2-3), exactly as ``liveset segment``
     with the same options (the same image and options give the same mask, bit for bit).
 

@@ -53,7 +53,7 @@ class Session:
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
                  edit_range: Optional[float] = None, bias_correct: Optional[bool] = None,
-                 thin_fronts: bool = True):
+                 thin_fronts: bool = _liveset.DEFAULT_THIN_FRONTS):
         img = as_image(image)
         if decision not in ("intensity", "random", "cut") or int(agents) < 1:  # before N4's seconds
             raise ValueError("decision must be 'intensity', 'random' or 'cut', and agents at least 1")

@@ -1,6 +1,8 @@
 """The thin-front rule, on by default since session 72 in ``liveset.segment`` and ``Session`` as in
 ``liveset segment``: the front fills a sheet one voxel thick joined to a seeded cube, as the CLI does,
 bit for bit; with ``thin_fronts=False`` (``--no-thin-fronts``) it stops early."""
+import inspect
+
 import nibabel as nib
 import numpy as np
 
@@ -26,11 +28,15 @@ def test_thin_fronts_fill_a_sheet_one_voxel_thick_as_the_cli_does(tmp_path):
     assert np.nonzero(without.any(axis=(1, 2)))[0].max() < 20  # the front stops early without the rule
     path = tmp_path / "sheet.nii.gz"
     nib.save(nib.Nifti1Image(image, np.eye(4)), str(path))
-    for flag, want in (("--thin-fronts", thin), ("--no-thin-fronts", without)):
+    # The CLI's default (no flag) is the Python default, both from the C++ segment_step().
+    for flag, want in (("--thin-fronts", thin), ("--no-thin-fronts", without), ("-q", thin)):
         out = tmp_path / ("out%s.nii.gz" % flag)
         cli("segment", str(path), "--seed", "5,11,11", "--roi", "none", "--mu-raw", "100", "--epsilon-raw", "30",
             "--alpha", "0", "--no-bias-correct", flag, "-q", "--out-mask", str(out))
         assert np.array_equal(np.asarray(nib.load(str(out)).dataobj) > 0, want), flag
+    assert liveset._liveset.DEFAULT_THIN_FRONTS is True
+    for f in (liveset.segment, liveset.Session):
+        assert inspect.signature(f).parameters["thin_fronts"].default is liveset._liveset.DEFAULT_THIN_FRONTS
 
 
 def test_a_session_gives_segments_mask_with_the_rule_on_by_default():
