@@ -239,41 +239,51 @@ TEST(ThinFront, OneAndTwoThreadsAgree) {
     }
 }
 
-// A speed that throws when asked for a rate beside the zero layer (the rule's call) leaves the
-// field as it was before the step: no value moved, no point entered.
+// A speed that throws when asked for a rate beside the zero layer (the rule's call), or for the
+// propagation's signs there (the rule's test before it), leaves the field as it was before the
+// step: no value moved, no point entered.
 TEST(ThinFront, ASpeedThatThrowsInTheRuleLeavesTheFieldAsItWas) {
     class Throwing final : public Speed {
     public:
-        Throwing(const Speed& inner, const SparseField& f) : inner_(inner), f_(f) {}
+        Throwing(const Speed& inner, const SparseField& f, bool in_signs) : inner_(inner), f_(f), in_signs_(in_signs) {}
         SpeedSample at(const Grid<float>& phi, Vec3i p) const override { return inner_.at(phi, p); }
         void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override {
-            for (PointIndex i : points)
-                if (f_.status()[i] != 0) throw std::runtime_error("no rate off the zero layer");
+            if (!in_signs_) off_the_zero_layer(points);
             inner_.rates(phi, points, out);
+        }
+        void propagation_signs(const Grid<float>& phi, std::span<const PointIndex> points, std::span<std::int8_t> out) const override {
+            if (in_signs_) off_the_zero_layer(points);
+            inner_.propagation_signs(phi, points, out);
         }
         float curvature_weight() const override { return inner_.curvature_weight(); }
 
     private:
+        void off_the_zero_layer(std::span<const PointIndex> points) const {
+            for (PointIndex i : points)
+                if (f_.status()[i] != 0) throw std::runtime_error("nothing asked off the zero layer");
+        }
         const Speed& inner_;
         const SparseField& f_;
+        bool in_signs_;
     };
     const Thin s{1, false};
     const ThinSpeed speed(s, false);
-    for (const StepMode mode : {StepMode::kFullBand, StepMode::kIncremental}) {
-        SparseField f = seeded(s, false);
-        int thrown = 0;
-        for (int k = 0; k < 120; ++k) {
-            SparseField trial = f;
-            const Throwing on_trial(speed, trial);
-            try {
-                trial.step(on_trial, thin_options(mode));
-            } catch (const std::runtime_error&) {
-                ++thrown;
-                ASSERT_TRUE(same_state(trial, f)) << "step " << k;
-                expect_valid(trial, "after the throw");
+    for (const bool in_signs : {false, true})
+        for (const StepMode mode : {StepMode::kFullBand, StepMode::kIncremental}) {
+            SparseField f = seeded(s, false);
+            int thrown = 0;
+            for (int k = 0; k < 120; ++k) {
+                SparseField trial = f;
+                const Throwing on_trial(speed, trial, in_signs);
+                try {
+                    trial.step(on_trial, thin_options(mode));
+                } catch (const std::runtime_error&) {
+                    ++thrown;
+                    ASSERT_TRUE(same_state(trial, f)) << "step " << k << (in_signs ? ", in the signs" : ", in the rates");
+                    expect_valid(trial, "after the throw");
+                }
+                f.step(speed, thin_options(mode));
             }
-            f.step(speed, thin_options(mode));
+            EXPECT_GT(thrown, 20) << (in_signs ? "in the signs" : "in the rates");
         }
-        EXPECT_GT(thrown, 20);
-    }
 }

@@ -364,8 +364,9 @@ void SparseField::move_zero_layer(std::span<const ZeroLayerEdit> edits, std::vec
     // 1. New zero-layer values (all Δ were computed from the old state, so this is Jacobi), and
     //    each chunk's leaving edits (movers_ holds them at the chunk's offset until step 2 is done).
     //    With the rule, also each chunk's candidates for its pinned test (near_edge_ at the chunk's
-    //    offset): a point that leaves ends a mover or blocked (clamped to ±0.5), and a blocked one
-    //    needs no such test (thin_front.cpp).
+    //    offset): a point that leaves ends a mover (beyond ±0.5) or clamped to ±0.5 by step 2 - as
+    //    ±2, blocked, stuck without the test (thin_front.cpp), or as ±3, with no L∓1 neighbour on
+    //    the other side to hand the front to - so only the points that stay are candidates.
     std::vector<std::size_t> n_leaving((n + detail::kChunk - 1) / detail::kChunk);
     std::vector<std::size_t> n_near(rule != nullptr ? n_leaving.size() : 0);
     if (rule != nullptr && near_edge_.v.size() < n) near_edge_.v.resize(n);

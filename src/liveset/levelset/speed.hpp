@@ -6,6 +6,7 @@
 // moves alike in mm along every axis of an anisotropic one.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 
