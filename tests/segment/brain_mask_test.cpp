@@ -3,12 +3,16 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <bit>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -16,6 +20,7 @@
 #include "liveset/io/image_io.hpp"
 #include "brain_mask_fixture.hpp"
 #include "noisy_phantom.hpp"
+#include "liveset/segment/brain_histogram.hpp"
 #include "liveset/segment/brain_mask.hpp"
 #include "liveset/segment/morphology.hpp"
 #include "liveset/segment/smoothing.hpp"
@@ -191,6 +196,45 @@ TEST(BrainMask, BackgroundThresholdIsTheDocumentedPercentileRule) {
         auto_brain_mask(*image, {}, &r);
         EXPECT_DOUBLE_EQ(r.background_threshold, p2 + 0.1 * (p98 - p2));
     }
+}
+
+// The brain mask's quantile (brain_histogram.hpp) against a sort of the kept values in the order
+// of their bits (−0 before +0): fractions from 0 to 1, inside a mask and not, above several floors
+// (NaN never kept), on an image with repeated values, ±0 and NaN; and none when nothing lies above.
+TEST(BrainMask, QuantileAboveIsTheSortedKeptValue) {
+    const Lattice lat({80, 70, 60});
+    Grid<float> image(lat, 0.0f);
+    Grid<std::uint8_t> mask(lat, 0);
+    std::mt19937 rng(73);
+    std::normal_distribution<float> value(40.0f, 30.0f);
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        const unsigned r = rng() % 100;
+        image[p] = r < 3 ? -0.0f : r < 6 ? 0.0f : r < 7 ? std::numeric_limits<float>::quiet_NaN() : r < 40 ? std::round(value(rng)) : value(rng);
+        mask[p] = rng() % 3 != 0;
+    }
+    const auto bits = [](float v) {
+        const auto u = std::bit_cast<std::uint32_t>(v);
+        return (u & 0x80000000u) != 0 ? ~u : (u | 0x80000000u);
+    };
+    for (const bool masked : {false, true})
+        for (const double above : {-std::numeric_limits<double>::infinity(), -0.5, 0.0, 40.0}) {
+            std::vector<float> kept;
+            for (std::size_t i = 0; i < image.size(); ++i) {
+                const float v = image[static_cast<PointIndex>(i)];
+                if ((!masked || mask[static_cast<PointIndex>(i)] != 0) && static_cast<double>(v) > above) kept.push_back(v);
+            }
+            std::sort(kept.begin(), kept.end(), [&](float a, float b) { return bits(a) < bits(b); });
+            ASSERT_GT(kept.size(), 1000u);
+            for (const double q : {0.0, 0.001, 0.02, 0.1, 0.5, 0.9, 0.98, 0.995, 1.0}) {
+                const float want = kept[static_cast<std::size_t>(q * static_cast<double>(kept.size() - 1))];
+                const std::optional<float> got = brain_detail::quantile_above(image, masked ? &mask : nullptr, above, q);
+                ASSERT_TRUE(got);
+                EXPECT_EQ(std::bit_cast<std::uint32_t>(*got), std::bit_cast<std::uint32_t>(want))
+                    << "q " << q << " above " << above << (masked ? " masked" : "");
+            }
+        }
+    EXPECT_FALSE(brain_detail::quantile_above(image, nullptr, 1e9, 0.5));
 }
 
 TEST(BrainMask, BrainWebVariantsAt2mm) {
