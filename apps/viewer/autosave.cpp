@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include <cstdlib>
+#include <string>
 #include <ctime>
 #include <system_error>
 #include <utility>
@@ -97,6 +98,7 @@ bool Autosave::restore() {
     try {
         if (!session_->load_recovered(offer_->phi, offer_->status, offer_->marks))
             message_ = "the recovery file's sparse field was inconsistent: restored from the signs of its phi";
+        continue_step();
     } catch (const std::exception& e) {
         message_ = fmt::format("cannot restore {}: {}", file_.string(), e.what());
         offer_.reset();
@@ -111,6 +113,21 @@ bool Autosave::restore() {
     written_revision_ = session_->revision();
     crash_.emplace(file_);
     return true;
+}
+
+void Autosave::continue_step() {
+    // The work continues with the step it was saved with (a file from before session 73 records
+    // none: the command line's), but for what --step, --thin-fronts or --no-thin-fronts ask.
+    if (!offer_->step) return;
+    const RecordedStep now = recorded_step(session_->options().segmentation.step), saved = *offer_->step;
+    const RecordedStep next{config_.step_given ? now.sleeping : saved.sleeping, config_.thin_fronts_given ? now.thin_fronts : saved.thin_fronts};
+    if (next != now) session_->set_step(step_options(next));
+    std::string note;
+    if (next != saved)
+        note = fmt::format("continued with {} as asked (saved with {}): from here it steps unlike the saved run", describe(next), describe(saved));
+    else if (next != now)
+        note = fmt::format("continued with its saved {}", describe(saved));
+    if (!note.empty()) message_ = message_.empty() ? note : message_ + "; " + note;
 }
 
 void Autosave::discard() {
@@ -133,7 +150,8 @@ void Autosave::tick() {
     }
     if (tracked_revision_ != revision) {
         try {
-            crash_->track(image_, session_->marks(), roi_checksum_, session_->field().phi(), session_->field().status());
+            crash_->track(image_, session_->marks(), roi_checksum_, recorded_step(session_->options().segmentation.step),
+                          session_->field().phi(), session_->field().status());
         } catch (const std::exception& e) {
             message_ = e.what();
         }
@@ -147,7 +165,8 @@ void Autosave::tick() {
 void Autosave::write(const char* why) {
     try {
         write_recovery(file_, RecoveryView(image_, 0, static_cast<std::int64_t>(std::time(nullptr)), session_->marks(), roi_checksum_,
-                                           session_->field().phi(), session_->field().status()));
+                                           recorded_step(session_->options().segmentation.step), session_->field().phi(),
+                                           session_->field().status()));
         message_ = fmt::format("{} unsaved work in {}", why, file_.string());
         routine_ = !exited_;
     } catch (const std::exception& e) {

@@ -22,6 +22,9 @@ struct AutosaveConfig {
     std::filesystem::path dir;      // empty: no autosave and no recovery offer
     double interval_seconds = 120;  // between periodic writes of unsaved work (0: at every change)
     bool recover = false;           // restore a recovery file without asking
+    // --step given, --thin-fronts or --no-thin-fronts given: a restored file continues with the
+    // command line's step kind or rule there, its saved ones elsewhere.
+    bool step_given = false, thin_fronts_given = false;
 };
 
 // $XDG_STATE_HOME/liveset/recovery, else ~/.local/state/liveset/recovery (empty without HOME).
@@ -65,6 +68,7 @@ public:
 
 private:
     bool dirty() const;
+    void continue_step();  // restore()'s: the saved step, or a note where the command line asked for another
     void write(const char* why);
     void remove_file();
 

@@ -302,6 +302,8 @@ int run_view(ViewArgs& a, int threads) {
                                                 : (a.headless ? std::filesystem::path() : viewer::default_recovery_dir());
     config.autosave.interval_seconds = a.autosave_every;
     config.autosave.recover = a.recover;
+    config.autosave.step_given = a.step_given;
+    config.autosave.thin_fronts_given = a.thin_fronts_given;
     const std::string name = a.image.empty() ? std::string() : std::filesystem::path(a.image).filename().string();
 
     if (a.headless) {

@@ -156,6 +156,48 @@ TEST(Autosave, ARestoreInAnotherROIIsNamed) {
     EXPECT_NE(other.err.find("saved with a ROI, opened without one"), std::string::npos) << other.err;
 }
 
+// The recovery file records the session's step: restored, the work continues with it (here the
+// exact step without the thin-front rule, in a viewer opened with the defaults), 30 more steps
+// giving what one uninterrupted run of that step gives; where the command line asks for the rule,
+// it continues with that, said, and ends elsewhere.
+TEST(Autosave, ARestoredWorkContinuesWithItsStep) {
+    const Fixture& f = fixture();
+    const std::string eval = R"({"eval": {"truth": ")" + f.truth + R"("}})";
+    const std::string exact = "--step exact --no-thin-fronts";
+    const fs::path once = f.dir / "rec_step_once";
+    fs::remove_all(once);
+    const CliResult whole =
+        run_cli(view(f, once, script(f.dir, "step_whole.json", "[" + f.seeds + R"({"segment": 10}, {"segment": 30}, )" + eval + "]"), exact));
+    ASSERT_EQ(whole.rc, 0) << whole.err;
+    for (const bool ask_rule : {false, true}) {
+        const fs::path rec = f.dir / (ask_rule ? "rec_step_asked" : "rec_step");
+        fs::remove_all(rec);
+        const CliResult first = run_cli(view(f, rec, script(f.dir, "step_first.json", "[" + f.seeds + R"({"segment": 10}])"), exact));
+        ASSERT_EQ(first.rc, 0) << first.err;
+        const auto files = recovery_files(rec);
+        ASSERT_EQ(files.size(), 1u);
+        const RecoveryState kept = read_recovery(files[0]);
+        ASSERT_TRUE(kept.step.has_value());
+        EXPECT_FALSE(kept.step->sleeping);
+        EXPECT_FALSE(kept.step->thin_fronts);
+        const CliResult next = run_cli(
+            view(f, rec, script(f.dir, "step_next.json", R"([{"segment": 30}, )" + eval + "]"), ask_rule ? "--recover --thin-fronts" : "--recover"));
+        ASSERT_EQ(next.rc, 0) << next.err;
+        const nlohmann::json want = first_eval(whole.out), got = first_eval(next.out);
+        ASSERT_FALSE(want.is_null() || got.is_null()) << next.out;
+        if (!ask_rule) {
+            EXPECT_NE(next.err.find("continued with its saved --step exact --no-thin-fronts"), std::string::npos) << next.err;
+            EXPECT_EQ(want["dice"], got["dice"]);
+            EXPECT_EQ(want["genus"], got["genus"]);
+            EXPECT_EQ(want["jaccard"], got["jaccard"]);
+        } else {
+            EXPECT_NE(next.err.find("continued with --step exact as asked (saved with --step exact --no-thin-fronts)"), std::string::npos)
+                << next.err;
+            EXPECT_NE(want["jaccard"], got["jaccard"]) << "the rule changed nothing here: the test cannot tell the steps apart";
+        }
+    }
+}
+
 TEST(Autosave, ATerminationSignalMidSegmentationWritesTheStateItHad) {
     const Fixture& f = fixture();
     const fs::path rec = f.dir / "rec2";

@@ -5,6 +5,8 @@
 // brain mask, as `view IMAGE` opens it.
 #include <gtest/gtest.h>
 
+#include <chrono>
+
 #include <filesystem>
 #include <string>
 
@@ -41,8 +43,11 @@ ViewerConfig headless() {
 }
 
 // Frames until the open finished (at most `limit`); false if it did not.
-bool frames_until_opened(Viewer& v, const render::Framebuffer& fb, int limit = 100000) {
-    for (int n = 0; n < limit && v.opening(); ++n) v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+// Frames until the worker's image is swapped in, for at most a minute of wall time (a count of
+// frames ran out on a loaded machine before the worker had read and prepared the image).
+bool frames_until_opened(Viewer& v, const render::Framebuffer& fb) {
+    const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+    while (v.opening() && std::chrono::steady_clock::now() < give_up) v.frame(fb.id(), 640, 480, 1.0 / 60.0);
     return !v.opening();
 }
 

@@ -28,6 +28,7 @@ inline RecoveryState sample_state() {
     s.marks.pristine = false;
     s.marks.iterations = 137;
     s.roi_checksum = 0x0123456789abcdefull;
+    s.step = RecordedStep{false, false};  // not the default: the exact step without the rule
     s.phi = Grid<float>(lattice);
     int k = 0;
     for (float& v : s.phi.values()) v = static_cast<float>(k++ % 11) * 0.37f - 1.5f;
@@ -56,6 +57,11 @@ inline void expect_same(const RecoveryState& a, const RecoveryState& b) {
     EXPECT_EQ(a.marks.iterations, b.marks.iterations);
     EXPECT_EQ(a.roi_recorded, b.roi_recorded);
     EXPECT_EQ(a.roi_checksum, b.roi_checksum);
+    EXPECT_EQ(a.step.has_value(), b.step.has_value());
+    if (a.step && b.step) {
+        EXPECT_EQ(a.step->sleeping, b.step->sleeping);
+        EXPECT_EQ(a.step->thin_fronts, b.step->thin_fronts);
+    }
     EXPECT_TRUE(a.phi.lattice().same_geometry(b.phi.lattice(), 0.0));
     ASSERT_EQ(a.phi.size(), b.phi.size());
     for (std::size_t i = 0; i < a.phi.size(); ++i)

@@ -49,13 +49,19 @@ std::size_t dims_offset(const RecoveryState& s) { return kPathLength + 4 + s.ima
 std::size_t spacing_offset(const RecoveryState& s) { return dims_offset(s) + 12; }
 std::size_t params_offset(const RecoveryState& s) { return spacing_offset(s) + 15 * 8; }
 std::size_t roi_offset(const RecoveryState& s) { return params_offset(s) + 5 * 8 + 1 + 4 + 4 + s.marks.seeds.size() * 32; }
-std::size_t voxels_offset(const RecoveryState& s) { return roi_offset(s) + 1 + 8; }
+std::size_t step_offset(const RecoveryState& s) { return roi_offset(s) + 1 + 8; }
+std::size_t voxels_offset(const RecoveryState& s) { return step_offset(s) + 2; }
 
-// The same state in an older layout: `version` 1-3 recorded no ROI, 1 and 2 had no smoothing σ after α.
+// The same state in an older layout: `version` 1-4 recorded no step, 1-3 no ROI, 1 and 2 had no
+// smoothing σ after α.
 std::vector<std::uint8_t> older(const RecoveryState& s, std::uint32_t version) {
     std::vector<std::uint8_t> bytes = encode_recovery(s);
-    const auto roi = bytes.begin() + static_cast<std::ptrdiff_t>(roi_offset(s));
-    bytes.erase(roi, roi + 9);
+    const auto step = bytes.begin() + static_cast<std::ptrdiff_t>(step_offset(s));
+    bytes.erase(step, step + 2);
+    if (version < 4) {
+        const auto roi = bytes.begin() + static_cast<std::ptrdiff_t>(roi_offset(s));
+        bytes.erase(roi, roi + 9);
+    }
     if (version < 3) {
         const auto at = bytes.begin() + static_cast<std::ptrdiff_t>(params_offset(s) + 32);
         bytes.erase(at, at + 8);
@@ -73,11 +79,19 @@ TEST(Recovery, EncodedStateDecodesBitForBit) {
     expect_same(s, decode_recovery(bytes.data(), bytes.size()));
 }
 
-TEST(Recovery, TheFuzzingSeedIsAValidFile) {
+TEST(Recovery, TheFuzzingSeedsAreValidFiles) {
+    const RecoveryState v5 = read_recovery(fs::path(LIVESET_SOURCE_DIR) / "fuzz/corpus/recovery/small_v5.lsrecovery");
+    ASSERT_TRUE(v5.step.has_value());  // today's version: the exact step with the rule
+    EXPECT_FALSE(v5.step->sleeping);
+    EXPECT_TRUE(v5.step->thin_fronts);
+    EXPECT_TRUE(v5.roi_recorded);
     const RecoveryState s = read_recovery(fs::path(LIVESET_SOURCE_DIR) / "fuzz/corpus/recovery/small.lsrecovery");
     EXPECT_EQ(s.phi.lattice().dims(), (Vec3i{4, 3, 2}));
     EXPECT_EQ(s.marks.seeds.size(), 1u);
     EXPECT_EQ(s.marks.iterations, 12);
+    EXPECT_FALSE(s.step.has_value());  // version 1
+    EXPECT_EQ(v5.phi.lattice().dims(), s.phi.lattice().dims());  // the same state, in today's layout
+    EXPECT_EQ(v5.marks.iterations, s.marks.iterations);
 }
 
 TEST(Recovery, EveryTruncationAndEveryFlippedByteIsRefused) {
@@ -113,7 +127,7 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
     auto f32 = [](float v) { std::vector<std::uint8_t> b(4); std::memcpy(b.data(), &v, 4); return b; };
     const std::vector<Case> cases{
         {"wrong magic", 0, {'N', 'I', 'F', 'T'}, "wrong magic"},
-        {"version 5", 8, u32(5), "version 5"},
+        {"version 6", 8, u32(6), "version 6"},
         {"version 0", 8, u32(0), "version 0"},
         {"path length beyond the file", kPathLength, u32(1000000), "too long"},
         {"zero dimension", dims_offset(s), i32(0), "invalid geometry"},
@@ -132,6 +146,8 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
         {"seed radius 0", params_offset(s) + 49 + 24, f64(0.0), "non-positive radius"},
         {"ROI flag 2", roi_offset(s), {2}, "invalid ROI flag"},
         {"a ROI checksum without a ROI", roi_offset(s), {0}, "without a ROI"},
+        {"step 2", step_offset(s), {2}, "invalid step"},
+        {"thin-front flag 2", step_offset(s) + 1, {2}, "invalid step"},
         {"voxel count off by one", voxels_offset(s), u64(s.phi.size() + 1), "voxel count"},
         {"NaN in phi", voxels_offset(s) + 8 + 4 * 17, f32(std::numeric_limits<float>::quiet_NaN()), "NaN"},
         {"infinity in phi", voxels_offset(s) + 8, f32(std::numeric_limits<float>::infinity()), "NaN or infinite"},
@@ -174,6 +190,7 @@ TEST(Recovery, VersionTwoFilesReadWithoutSmoothing) {
     expected.marks.params.smooth_mm = 0.0;
     expected.roi_recorded = false;
     expected.roi_checksum.reset();
+    expected.step.reset();
     expect_same(old, expected);  // everything else as saved, φ and statuses bit for bit
 }
 
@@ -185,6 +202,7 @@ TEST(Recovery, TheROIIsRecordedAndOlderFilesSayTheyRecordedNone) {
     RecoveryState expected = s;
     expected.roi_recorded = false;
     expected.roi_checksum.reset();
+    expected.step.reset();
     expect_same(decode_recovery(v3.data(), v3.size()), expected);
     s.roi_checksum.reset();
     const std::vector<std::uint8_t> none = encode_recovery(s);
@@ -203,6 +221,33 @@ TEST(Recovery, TheROIIsRecordedAndOlderFilesSayTheyRecordedNone) {
     EXPECT_EQ(roi_difference(mask_checksum(a), mask_checksum(b)), "saved with another ROI");
     EXPECT_EQ(roi_difference(std::nullopt, mask_checksum(a)), "saved without a ROI, opened with one");
     EXPECT_EQ(roi_difference(mask_checksum(a), std::nullopt), "saved with a ROI, opened without one");
+}
+
+// Version 5 records the session's step (sleeping or exact, the thin-front rule on or off); version 4
+// recorded none, and reads as such (the command line's step continues it), all else as saved. The
+// step as the command line builds it: sleeping_step() or StepOptions{}, with the rule or not.
+TEST(Recovery, TheStepIsRecordedAndOlderFilesSayTheyRecordedNone) {
+    const RecoveryState s = sample_state();
+    const std::vector<std::uint8_t> v4 = older(s, 4);
+    RecoveryState expected = s;
+    expected.step.reset();
+    expect_same(decode_recovery(v4.data(), v4.size()), expected);
+    for (const bool sleeping : {false, true})
+        for (const bool thin : {false, true}) {
+            RecoveryState t = s;
+            t.step = RecordedStep{sleeping, thin};
+            const std::vector<std::uint8_t> bytes = encode_recovery(t);
+            EXPECT_EQ(bytes[step_offset(t)], sleeping ? 1 : 0);
+            EXPECT_EQ(bytes[step_offset(t) + 1], thin ? 1 : 0);
+            expect_same(t, decode_recovery(bytes.data(), bytes.size()));
+            const StepOptions o = step_options(*t.step);
+            EXPECT_EQ(std::string(step_name(o)), sleeping ? "sleeping" : "exact");
+            EXPECT_EQ(o.thin_fronts, thin);
+            EXPECT_TRUE(recorded_step(o) == *t.step);
+        }
+    EXPECT_TRUE(recorded_step(segment_step()) == RecordedStep{});  // the default: sleeping, with the rule
+    EXPECT_EQ(describe(RecordedStep{false, false}), "--step exact --no-thin-fronts");
+    EXPECT_EQ(describe(RecordedStep{}), "--step sleeping");
 }
 
 TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {

@@ -8,9 +8,11 @@
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
+#include <string_view>
 #include <system_error>
 
 #include "liveset/base/atomic_file.hpp"
+#include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
 
 namespace liveset {
@@ -20,7 +22,7 @@ static_assert(std::endian::native == std::endian::little, "recovery files are wr
 namespace {
 
 constexpr char kMagic[8] = {'L', 'S', 'R', 'E', 'C', 'O', 'V', '1'};
-constexpr std::uint32_t kVersion = 4;  // 1: the flags byte held window_from_seeds only; 2: no smooth_mm; 3: no ROI
+constexpr std::uint32_t kVersion = 5;  // 1: the flags byte held window_from_seeds only; 2: no smooth_mm; 3: no ROI; 4: no step
 constexpr std::uint32_t kMaxPath = 4096;
 constexpr std::uint32_t kMaxSeeds = 100000;
 
@@ -36,7 +38,7 @@ void put(std::vector<std::uint8_t>& out, T value) {
 namespace recovery_format {
 
 std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum,
-                                        const Lattice& lattice) {
+                                        RecordedStep step, const Lattice& lattice) {
     if (image.size() > kMaxPath) throw std::runtime_error("recovery: the image path is too long");
     if (marks.seeds.size() > kMaxSeeds) throw std::runtime_error("recovery: too many seeds");
     std::vector<std::uint8_t> out;
@@ -61,6 +63,8 @@ std::vector<std::uint8_t> encode_header(const std::string& image, const SessionM
         for (double v : {b.center.x, b.center.y, b.center.z, b.radius}) put(out, v);
     put(out, static_cast<std::uint8_t>(roi_checksum ? 1 : 0));
     put(out, roi_checksum.value_or(0));
+    put(out, static_cast<std::uint8_t>(step.sleeping ? 1 : 0));
+    put(out, static_cast<std::uint8_t>(step.thin_fronts ? 1 : 0));
     put(out, static_cast<std::uint64_t>(lattice.size()));
     return out;
 }
@@ -109,6 +113,20 @@ private:
 
 }  // namespace
 
+RecordedStep recorded_step(const StepOptions& step) {
+    return {std::string_view(step_name(step)) == "sleeping", step.thin_fronts};
+}
+
+StepOptions step_options(const RecordedStep& step) {
+    StepOptions o = step.sleeping ? sleeping_step() : StepOptions{};
+    o.thin_fronts = step.thin_fronts;
+    return o;
+}
+
+std::string describe(const RecordedStep& step) {
+    return std::string("--step ") + (step.sleeping ? "sleeping" : "exact") + (step.thin_fronts ? "" : " --no-thin-fronts");
+}
+
 std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask) {
     Fnv h;
     for (const std::uint8_t v : mask.values()) {
@@ -141,7 +159,7 @@ std::filesystem::path recovery_path(const std::filesystem::path& dir, const std:
 
 std::vector<std::uint8_t> encode_recovery(const RecoveryView& state) {
     if (state.status.size() != state.phi.size()) throw std::runtime_error("recovery: status and phi differ in size");
-    std::vector<std::uint8_t> out = recovery_format::encode_header(state.image, state.marks, state.roi_checksum, state.phi.lattice());
+    std::vector<std::uint8_t> out = recovery_format::encode_header(state.image, state.marks, state.roi_checksum, state.step, state.phi.lattice());
     const auto sig = static_cast<std::uint32_t>(state.signal);
     std::memcpy(out.data() + kSignalOffset, &sig, sizeof sig);
     std::memcpy(out.data() + kTimeOffset, &state.unix_time, sizeof state.unix_time);
@@ -237,6 +255,12 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
         const std::uint64_t fnv = r.get<std::uint64_t>("ROI");
         if (has_roi) s.roi_checksum = fnv;
         else if (fnv != 0) throw std::runtime_error("a ROI checksum without a ROI");
+    }
+    if (version >= 5) {
+        const std::uint8_t sleeping = r.get<std::uint8_t>("step");
+        const std::uint8_t thin_fronts = r.get<std::uint8_t>("step");
+        if (sleeping > 1 || thin_fronts > 1) throw std::runtime_error("invalid step");
+        s.step = RecordedStep{sleeping == 1, thin_fronts == 1};
     }
     const std::uint64_t voxels = r.get<std::uint64_t>("voxel count");
     if (voxels != lattice.size()) throw std::runtime_error("the voxel count does not match the dimensions");

@@ -299,6 +299,11 @@ SessionUpdate Session::segment_step() {
 
 void Session::make_repair_loop() { repair_ = std::make_unique<RepairLoop>(field_, unit_, roi(), repair_options_); }
 
+void Session::set_step(const StepOptions& step) {
+    validate(step);
+    options_.segmentation.step = step;
+}
+
 void Session::set_repair_options(const RepairOptions& options) {
     validate(options);
     repair_options_ = options;

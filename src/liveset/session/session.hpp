@@ -158,6 +158,9 @@ public:
     // --- swarm repair -----------------------------------------------------------------------
     const RepairOptions& repair_options() const { return repair_options_; }
     const SessionOptions& options() const { return options_; }
+    // The global step from the next one on (a recovery file's, restored: StepOptions as `liveset
+    // view --step` builds them). Throws std::invalid_argument (changing nothing) on invalid options.
+    void set_step(const StepOptions& step);
     // The sleeping step's memory, saved with φ and the statuses (a workspace) so that a continued
     // session steps bit for bit as the uninterrupted one; restore it after load_recovered().
     ActivitySnapshot activity_snapshot() const { return field_.activity_snapshot(speed_ ? speed_->serial() : 0); }
