@@ -95,10 +95,14 @@ std::string Autosave::offer_summary() const {
 bool Autosave::restore() {
     if (!offer_ || !session_) return false;
     message_.clear();
+    bool step_changed = false;
     try {
+        const auto [step, note] = continued_step();  // decided and checked first: nothing after the load throws
         if (!session_->load_recovered(offer_->phi, offer_->status, offer_->marks))
             message_ = "the recovery file's sparse field was inconsistent: restored from the signs of its phi";
-        continue_step();
+        step_changed = step.has_value();
+        if (step) session_->set_step(*step);
+        if (!note.empty()) message_ = message_.empty() ? note : message_ + "; " + note;
     } catch (const std::exception& e) {
         message_ = fmt::format("cannot restore {}: {}", file_.string(), e.what());
         offer_.reset();
@@ -110,24 +114,29 @@ bool Autosave::restore() {
     restored_ = true;
     // The restored work is still unsaved: keep the file until the user saves.
     clean_revision_ = ~std::uint64_t{0};
-    written_revision_ = session_->revision();
+    // A changed step is written with the next autosave (the crash path takes it at once).
+    written_revision_ = step_changed ? ~std::uint64_t{0} : session_->revision();
     crash_.emplace(file_);
     return true;
 }
 
-void Autosave::continue_step() {
+std::pair<std::optional<StepOptions>, std::string> Autosave::continued_step() const {
     // The work continues with the step it was saved with (a file from before session 73 records
     // none: the command line's), but for what --step, --thin-fronts or --no-thin-fronts ask.
-    if (!offer_->step) return;
+    if (!offer_->step) return {};
     const RecordedStep now = recorded_step(session_->options().segmentation.step), saved = *offer_->step;
     const RecordedStep next{config_.step_given ? now.sleeping : saved.sleeping, config_.thin_fronts_given ? now.thin_fronts : saved.thin_fronts};
-    if (next != now) session_->set_step(step_options(next));
+    std::optional<StepOptions> step;
+    if (next != now) {
+        step = step_options(next);
+        validate(*step);
+    }
     std::string note;
     if (next != saved)
         note = fmt::format("continued with {} as asked (saved with {}): from here it steps unlike the saved run", describe(next), describe(saved));
     else if (next != now)
         note = fmt::format("continued with its saved {}", describe(saved));
-    if (!note.empty()) message_ = message_.empty() ? note : message_ + "; " + note;
+    return {step, note};
 }
 
 void Autosave::discard() {

@@ -68,7 +68,9 @@ public:
 
 private:
     bool dirty() const;
-    void continue_step();  // restore()'s: the saved step, or a note where the command line asked for another
+    // restore()'s step: the offer's (none where the session's is already the one to take) and the
+    // note that says so, or that the command line asked for another.
+    std::pair<std::optional<StepOptions>, std::string> continued_step() const;
     void write(const char* why);
     void remove_file();
 

@@ -191,10 +191,18 @@ TEST(Autosave, ARestoredWorkContinuesWithItsStep) {
             EXPECT_EQ(want["genus"], got["genus"]);
             EXPECT_EQ(want["jaccard"], got["jaccard"]);
         } else {
-            EXPECT_NE(next.err.find("continued with --step exact as asked (saved with --step exact --no-thin-fronts)"), std::string::npos)
+            EXPECT_NE(next.err.find("continued with --step exact --thin-fronts as asked (saved with --step exact --no-thin-fronts)"),
+                      std::string::npos)
                 << next.err;
             EXPECT_NE(want["jaccard"], got["jaccard"]) << "the rule changed nothing here: the test cannot tell the steps apart";
         }
+        // Kept at exit again: with the step it continued with.
+        const auto again = recovery_files(rec);
+        ASSERT_EQ(again.size(), 1u);
+        const RecoveryState after = read_recovery(again[0]);
+        ASSERT_TRUE(after.step.has_value());
+        EXPECT_FALSE(after.step->sleeping);
+        EXPECT_EQ(after.step->thin_fronts, ask_rule);
     }
 }
 

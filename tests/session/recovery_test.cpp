@@ -79,6 +79,8 @@ TEST(Recovery, EncodedStateDecodesBitForBit) {
     expect_same(s, decode_recovery(bytes.data(), bytes.size()));
 }
 
+// small_v5 is small (version 1) in today's layout: σ 0 and "no ROI" inserted, the exact step with
+// the rule, the version and checksum rewritten.
 TEST(Recovery, TheFuzzingSeedsAreValidFiles) {
     const RecoveryState v5 = read_recovery(fs::path(LIVESET_SOURCE_DIR) / "fuzz/corpus/recovery/small_v5.lsrecovery");
     ASSERT_TRUE(v5.step.has_value());  // today's version: the exact step with the rule
@@ -92,6 +94,12 @@ TEST(Recovery, TheFuzzingSeedsAreValidFiles) {
     EXPECT_FALSE(s.step.has_value());  // version 1
     EXPECT_EQ(v5.phi.lattice().dims(), s.phi.lattice().dims());  // the same state, in today's layout
     EXPECT_EQ(v5.marks.iterations, s.marks.iterations);
+    ASSERT_EQ(v5.phi.size(), s.phi.size());
+    for (std::size_t i = 0; i < s.phi.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(v5.phi[p]), std::bit_cast<std::uint32_t>(s.phi[p])) << i;
+        EXPECT_EQ(v5.status[p], s.status[p]) << i;
+    }
 }
 
 TEST(Recovery, EveryTruncationAndEveryFlippedByteIsRefused) {
@@ -247,7 +255,7 @@ TEST(Recovery, TheStepIsRecordedAndOlderFilesSayTheyRecordedNone) {
         }
     EXPECT_TRUE(recorded_step(segment_step()) == RecordedStep{});  // the default: sleeping, with the rule
     EXPECT_EQ(describe(RecordedStep{false, false}), "--step exact --no-thin-fronts");
-    EXPECT_EQ(describe(RecordedStep{}), "--step sleeping");
+    EXPECT_EQ(describe(RecordedStep{}), "--step sleeping --thin-fronts");
 }
 
 TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {

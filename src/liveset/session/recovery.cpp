@@ -124,7 +124,7 @@ StepOptions step_options(const RecordedStep& step) {
 }
 
 std::string describe(const RecordedStep& step) {
-    return std::string("--step ") + (step.sleeping ? "sleeping" : "exact") + (step.thin_fronts ? "" : " --no-thin-fronts");
+    return std::string("--step ") + (step.sleeping ? "sleeping" : "exact") + (step.thin_fronts ? " --thin-fronts" : " --no-thin-fronts");
 }
 
 std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask) {

@@ -40,7 +40,7 @@ struct RecordedStep {
 };
 RecordedStep recorded_step(const StepOptions& step);
 StepOptions step_options(const RecordedStep& step);  // as the command line builds it (sleeping_step or StepOptions{})
-std::string describe(const RecordedStep& step);      // "--step sleeping", "--step exact --no-thin-fronts", ...
+std::string describe(const RecordedStep& step);      // "--step sleeping --thin-fronts", "--step exact --no-thin-fronts", ...
 
 struct RecoveryState {
     std::string image;           // the image's path, as the viewer opened it
