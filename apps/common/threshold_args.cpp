@@ -22,11 +22,7 @@ void add_threshold_options(CLI::App& cmd, ThresholdArgs& a) {
     cmd.add_flag("--thin-fronts,!--no-thin-fronts", a.thin_fronts, "the thin-front rule, on by default: the front carries into tissue one or two voxels thick, which the paper's sparse field cannot enter (a thinned cortex); --no-thin-fronts: the paper's sparse field, as the phantom demo steps (the rule can carry the front around a weak spot along its partial-volume rims; docs/ARCHITECTURE.md, \"Thin fronts\")");
 }
 
-StepOptions step_options(const ThresholdArgs& a) {
-    StepOptions o = a.step == "exact" ? StepOptions{} : segment_step();
-    o.thin_fronts = a.thin_fronts;
-    return o;
-}
+StepOptions step_options(const ThresholdArgs& a) { return step_options(RecordedStep{a.step != "exact", a.thin_fronts}); }
 
 void check_threshold_args(const ThresholdArgs& a) {
     if (a.mu && a.mu_raw) throw UsageError("give --mu or --mu-raw, not both");

@@ -4,8 +4,8 @@
 #include <fmt/core.h>
 
 #include <cstdlib>
-#include <string>
 #include <ctime>
+#include <string>
 #include <system_error>
 #include <utility>
 

@@ -9,6 +9,7 @@
 #include <functional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
@@ -54,6 +55,25 @@ inline StepOptions segment_step() {
 // where converged stretches of front sleep, else "exact" (the full-band step's bits).
 inline const char* step_name(const StepOptions& o) {
     return o.mode == StepMode::kIncremental && o.sleep_after > 0 ? "sleeping" : "exact";
+}
+
+// A step as the command line names it (`--step sleeping|exact`, `--thin-fronts` /
+// `--no-thin-fronts`) and a recovery file records it; the default is segment_step()'s.
+struct RecordedStep {
+    bool sleeping = true;     // the sleeping step (incremental); false: the exact (full-band) one
+    bool thin_fronts = true;  // the thin-front rule
+    bool operator==(const RecordedStep&) const = default;
+};
+inline RecordedStep recorded_step(const StepOptions& o) { return {std::string_view(step_name(o)) == "sleeping", o.thin_fronts}; }
+// The StepOptions the command line builds: sleeping_step() or the exact StepOptions{}, the rule as named.
+inline StepOptions step_options(const RecordedStep& step) {
+    StepOptions o = step.sleeping ? sleeping_step() : StepOptions{};
+    o.thin_fronts = step.thin_fronts;
+    return o;
+}
+// "--step sleeping --thin-fronts", "--step exact --no-thin-fronts", ...
+inline std::string describe(const RecordedStep& step) {
+    return std::string("--step ") + (step.sleeping ? "sleeping" : "exact") + (step.thin_fronts ? " --thin-fronts" : " --no-thin-fronts");
 }
 
 // Throws std::invalid_argument for non-positive limits, a negative/non-finite tolerance or bad step

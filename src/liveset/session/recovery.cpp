@@ -8,11 +8,9 @@
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
-#include <string_view>
 #include <system_error>
 
 #include "liveset/base/atomic_file.hpp"
-#include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
 
 namespace liveset {
@@ -112,20 +110,6 @@ private:
 };
 
 }  // namespace
-
-RecordedStep recorded_step(const StepOptions& step) {
-    return {std::string_view(step_name(step)) == "sleeping", step.thin_fronts};
-}
-
-StepOptions step_options(const RecordedStep& step) {
-    StepOptions o = step.sleeping ? sleeping_step() : StepOptions{};
-    o.thin_fronts = step.thin_fronts;
-    return o;
-}
-
-std::string describe(const RecordedStep& step) {
-    return std::string("--step ") + (step.sleeping ? "sleeping" : "exact") + (step.thin_fronts ? " --thin-fronts" : " --no-thin-fronts");
-}
 
 std::uint64_t mask_checksum(const Grid<std::uint8_t>& mask) {
     Fnv h;

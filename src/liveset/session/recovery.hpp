@@ -26,21 +26,10 @@
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
-#include "liveset/levelset/sparse_field.hpp"
+#include "liveset/segment/segmentation.hpp"  // RecordedStep
 #include "liveset/session/edit_history.hpp"
 
 namespace liveset {
-
-// The global step a session stepped with, as a recovery file records it (`liveset view --step`,
-// --thin-fronts / --no-thin-fronts; segment_step() is the default, sleeping with the rule).
-struct RecordedStep {
-    bool sleeping = true;     // the sleeping step (incremental); false: the exact (full-band) one
-    bool thin_fronts = true;  // the thin-front rule
-    bool operator==(const RecordedStep&) const = default;
-};
-RecordedStep recorded_step(const StepOptions& step);
-StepOptions step_options(const RecordedStep& step);  // as the command line builds it (sleeping_step or StepOptions{})
-std::string describe(const RecordedStep& step);      // "--step sleeping --thin-fronts", "--step exact --no-thin-fronts", ...
 
 struct RecoveryState {
     std::string image;           // the image's path, as the viewer opened it
@@ -51,7 +40,7 @@ struct RecoveryState {
     // version 4; older files record nothing: roi_recorded false).
     bool roi_recorded = true;
     std::optional<std::uint64_t> roi_checksum;
-    std::optional<RecordedStep> step;  // the session's step (version 5; older files record none)
+    std::optional<RecordedStep> step;  // the session's global step (version 5; older files record none)
     Grid<float> phi;             // < 0 inside, with the image's geometry
     Grid<std::int8_t> status;    // the sparse field's layer of each point (same lattice)
 };
