@@ -4,8 +4,12 @@
 
 #include <tbb/global_control.h>
 
+#include <limits>
+
 #include "liveset/io/image_io.hpp"
+#include "liveset/segment/brain_histogram.hpp"
 #include "liveset/segment/brain_mask.hpp"
+#include "liveset/segment/morphology.hpp"
 
 using namespace liveset;
 
@@ -34,6 +38,35 @@ void BM_AutoBrainMask(benchmark::State& state) {
     state.counters["mask_ml"] = r.mask_volume_mm3 / 1000.0;
 }
 BENCHMARK(BM_AutoBrainMask)->Args({1, 0})->Args({2, 0})->Args({2, 1})->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3);
+
+// The brain mask's quantile over BrainWeb's whole image (its floor and percentiles; range(0) threads).
+void BM_QuantileAbove(benchmark::State& state) {
+    const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+    const Grid<float>& image = brainweb(false);
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(brain_detail::quantile_above(image, nullptr, -std::numeric_limits<double>::infinity(), 0.02));
+        benchmark::DoNotOptimize(brain_detail::quantile_above(image, nullptr, 20.0, 0.98));
+    }
+}
+BENCHMARK(BM_QuantileAbove)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Repetitions(5);
+
+// Dilation and erosion of BrainWeb's brain mask by a ball of range(0) mm (1 thread): the chords up
+// to their limit, the distance transform beyond.
+void BM_DilateErode(benchmark::State& state) {
+    const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, 1);
+    static const Grid<std::uint8_t> brain = [] {
+        const Grid<float> m = read_image(std::string(LIVESET_DATA_DIR) + "/brainweb/brain_mask.nii.gz");
+        Grid<std::uint8_t> b(m.lattice());
+        for (PointIndex i = 0; i < m.size(); ++i) b[i] = m[i] != 0.0f;
+        return b;
+    }();
+    const double r = static_cast<double>(state.range(0));
+    for (auto _ : state) {
+        benchmark::DoNotOptimize(dilate_mm(brain, r));
+        benchmark::DoNotOptimize(erode_mm(brain, r));
+    }
+}
+BENCHMARK(BM_DilateErode)->Arg(2)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Arg(12)->Arg(16)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3);
 
 }  // namespace
 

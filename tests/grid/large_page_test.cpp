@@ -1,11 +1,14 @@
 // Grid storage on huge pages: a grid of 4 MiB or more starts on a 2 MiB boundary and its memory is
-// advised MADV_HUGEPAGE (the kernel's "hg" flag in /proc/self/smaps); values survive copies and moves.
+// advised MADV_HUGEPAGE (the kernel's "hg" flag in /proc/self/smaps); values survive copies and moves;
+// a freed block serves the next request of its size, within the kept blocks' bounds, on any thread.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "liveset/grid/grid.hpp"
 
@@ -67,4 +70,77 @@ TEST(LargePageGrid, LargeGridsAreAdvisedForTransparentHugePages) {
     const std::string flags = vm_flags_at(g.values().data());
     ASSERT_FALSE(flags.empty()) << "no mapping holds the grid's data";
     EXPECT_NE(flags.find(" hg "), std::string::npos) << "VmFlags:" << flags;
+}
+
+TEST(LargePageGrid, AFreedBlockServesTheNextGridOfItsSizeWhichHoldsOnlyItsFill) {
+    if (!detail::recycles_blocks()) GTEST_SKIP() << "blocks are not kept under AddressSanitizer";
+    const Lattice lat({128, 128, 80});
+    const float* first = nullptr;
+    {
+        Grid<float> g(lat, 1.5f);
+        first = g.values().data();
+        g.fill(-7.0f);
+    }
+    const auto [blocks, bytes] = detail::recycled();
+    EXPECT_GE(blocks, 1u);
+    EXPECT_GE(bytes, lat.size() * sizeof(float));
+    {
+        const Grid<float> again(lat, 2.0f);
+        EXPECT_EQ(again.values().data(), first);  // the same block, taken back
+        for (std::size_t i = 0; i < again.size(); ++i) ASSERT_EQ(again[static_cast<PointIndex>(i)], 2.0f) << i;
+    }
+    // A request of another size (10 MiB against 6 MiB, in 2 MiB granules) gets another block.
+    const Grid<float> other(Lattice({128, 128, 160}), 0.0f);
+    EXPECT_NE(other.values().data(), first);
+}
+
+TEST(LargePageGrid, KeptBlocksStayWithinTheirBounds) {
+    if (!detail::recycles_blocks()) GTEST_SKIP() << "blocks are not kept under AddressSanitizer";
+    // More blocks than are kept, of several sizes, freed in turn (never touched: no memory used).
+    std::vector<std::pair<void*, std::size_t>> held;
+    for (std::size_t k = 0; k < 3 * detail::kRecycledBlocks; ++k) {
+        const std::size_t bytes = detail::kLargeBlock + (k % 5) * detail::kHugePage + 100;
+        held.emplace_back(detail::allocate_large(bytes), bytes);
+    }
+    for (const auto& [p, bytes] : held) {
+        detail::free_large(p, bytes);
+        const auto [blocks, kept] = detail::recycled();
+        ASSERT_LE(blocks, detail::kRecycledBlocks);
+        ASSERT_LE(kept, detail::kRecycledBytes);
+    }
+    // A block over the whole allowance is not kept: the blocks and bytes kept do not change.
+    const auto before = detail::recycled();
+    const std::size_t huge = detail::kRecycledBytes + detail::kHugePage;
+    detail::free_large(detail::allocate_large(huge), huge);
+    EXPECT_EQ(detail::recycled(), before);
+    // A block of half the allowance makes its room by letting the oldest blocks go, and is kept; the
+    // block freed just before it, the newest of the rest, is still there.
+    const std::size_t half = detail::kRecycledBytes / 2 + 1;
+    void* big = detail::allocate_large(half);
+    const auto [last, last_bytes] = held.back();
+    detail::free_large(big, half);
+    EXPECT_GE(detail::recycled().second, half);
+    EXPECT_LE(detail::recycled().second, detail::kRecycledBytes);
+    EXPECT_EQ(detail::allocate_large(last_bytes), last);  // the newest kept block of its size
+    EXPECT_EQ(detail::allocate_large(half), big);
+    detail::free_large(big, half);
+    detail::free_large(last, last_bytes);
+}
+
+TEST(LargePageGrid, BlocksTakenAndFreedOnSeveralThreadsAreNeverShared) {
+    // Each thread writes its own mark through the whole of every block it holds, then checks it:
+    // a block handed to two holders at once would show the other's mark.
+    std::vector<std::thread> threads;
+    std::vector<int> bad(4, 0);
+    for (int t = 0; t < 4; ++t)
+        threads.emplace_back([t, &bad] {
+            for (int round = 0; round < 40; ++round) {
+                const std::size_t n = (detail::kLargeBlock + static_cast<std::size_t>((round + t) % 3) * detail::kHugePage) / sizeof(std::uint32_t);
+                LargeVector<std::uint32_t> v(n, static_cast<std::uint32_t>(t * 1000 + round));
+                std::this_thread::yield();
+                for (std::size_t i = 0; i < n; i += 1021) bad[static_cast<std::size_t>(t)] += v[i] != static_cast<std::uint32_t>(t * 1000 + round);
+            }
+        });
+    for (std::thread& th : threads) th.join();
+    for (int t = 0; t < 4; ++t) EXPECT_EQ(bad[static_cast<std::size_t>(t)], 0) << "thread " << t;
 }

@@ -1,6 +1,8 @@
 // Automatic brain mask: BrainWeb against its tissue labels (and variants built from it: intensity
 // scaling, bias field, noise, 2 mm voxels, skull-stripped), an analytic head of spheres, bad input.
 #include <gtest/gtest.h>
+
+#include <tbb/task_arena.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -228,10 +230,13 @@ TEST(BrainMask, QuantileAboveIsTheSortedKeptValue) {
             ASSERT_GT(kept.size(), 1000u);
             for (const double q : {0.0, 0.001, 0.02, 0.1, 0.5, 0.9, 0.98, 0.995, 1.0}) {
                 const float want = kept[static_cast<std::size_t>(q * static_cast<double>(kept.size() - 1))];
-                const std::optional<float> got = brain_detail::quantile_above(image, masked ? &mask : nullptr, above, q);
-                ASSERT_TRUE(got);
-                EXPECT_EQ(std::bit_cast<std::uint32_t>(*got), std::bit_cast<std::uint32_t>(want))
-                    << "q " << q << " above " << above << (masked ? " masked" : "");
+                for (const int threads : {1, 3}) {  // blocks counted and gathered on any thread
+                    std::optional<float> got;
+                    tbb::task_arena(threads).execute([&] { got = brain_detail::quantile_above(image, masked ? &mask : nullptr, above, q); });
+                    ASSERT_TRUE(got);
+                    EXPECT_EQ(std::bit_cast<std::uint32_t>(*got), std::bit_cast<std::uint32_t>(want))
+                        << "q " << q << " above " << above << (masked ? " masked" : "") << " threads " << threads;
+                }
             }
         }
     EXPECT_FALSE(brain_detail::quantile_above(image, nullptr, 1e9, 0.5));

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <random>
+#include <vector>
 
 #include "liveset/segment/morphology.hpp"
 
@@ -85,7 +86,9 @@ TEST(Morphology, ErodeAndDilateMatchBruteForceWhateverTheBallAndThreads) {
     for (int z = 7; z < 15; ++z)
         for (int y = 8; y < 16; ++y)
             for (int x = 3; x < 7; ++x) m({x, y, z}) = (x + 2 * y + 3 * z) % 7 != 0;
-    for (double r : {0.4, 1.1, 3.3}) {  // 3.3 mm: 22 + 21 voxels along y and z, past the chord path's 40
+    // 0.4 and 1.1 mm: the byte chords (177 at 1.1 mm); 1.6 mm: over 200 chords, the separable form; 3.3 mm:
+    // 22 + 21 voxels along y and z, past the chords' 40, the distance transform.
+    for (double r : {0.4, 1.1, 1.6, 3.3}) {
         for (int threads : {1, 3}) {
             tbb::task_arena arena(threads);
             Mask e, g;
@@ -143,4 +146,48 @@ TEST(Morphology, LargestComponentAndFillHoles) {
     EXPECT_EQ(std::count(none.values().begin(), none.values().end(), 1), 0);
     EXPECT_THROW(erode_mm(m, -1.0), std::invalid_argument);
     EXPECT_THROW(dilate_mm(m, std::nan("")), std::invalid_argument);
+}
+
+// The chords' inner loop, 16 and 32 bytes at a time, against its definition on random rows: every
+// width the processor runs (the 32-byte loop only where it has AVX2).
+TEST(Morphology, ChordLoopsMatchTheirDefinition) {
+    namespace md = morphology_detail;
+    std::mt19937 rng(74);
+    for (int trial = 0; trial < 200; ++trial) {
+        const std::size_t n = md::kRowBytes * (1 + rng() % 8);
+        std::vector<std::uint8_t> d(n), acc(n);
+        for (std::size_t x = 0; x < n; ++x) {
+            d[x] = static_cast<std::uint8_t>(rng() % 4 == 0 ? 255 : rng() % 4 == 0 ? rng() % 256 : rng() % 12);
+            acc[x] = static_cast<std::uint8_t>(rng() % 3 == 0 ? 255 : rng() % 256);
+        }
+        const auto w = static_cast<std::uint8_t>(trial % 5 == 0 ? 254 : trial % 5 == 1 ? rng() % 255 : rng() % 10);
+        std::vector<std::uint8_t> want = acc;
+        for (std::size_t x = 0; x < n; ++x) want[x] = std::min<std::uint8_t>(want[x], d[x] > w ? static_cast<std::uint8_t>(d[x] - w) : 0);
+        std::vector<std::uint8_t> got16 = acc;
+        md::min_over_chord_16(got16.data(), d.data(), w, n);
+        ASSERT_EQ(got16, want) << "trial " << trial;
+        if (md::has_avx2()) {
+            std::vector<std::uint8_t> got32 = acc;
+            md::min_over_chord_32(got32.data(), d.data(), w, n);
+            ASSERT_EQ(got32, want) << "trial " << trial;
+        }
+    }
+}
+
+// Balls reaching up to 254 voxels along x (fine x spacing) take the byte distances to their limit;
+// one reaching 255 or more takes the separable form: the brute force either way, with features far
+// apart along the rows (so distances near the byte cap are met) and rows many 32-byte blocks long.
+TEST(Morphology, BallsAtAndBeyondTheByteDistancesAlongXAreExact) {
+    const Lattice lat({600, 5, 4}, {0.01, 1.0, 1.0});
+    Mask m(lat);
+    for (const Vec3i p : {Vec3i{3, 2, 1}, Vec3i{250, 0, 0}, Vec3i{420, 4, 3}, Vec3i{599, 1, 2}, Vec3i{300, 2, 2}}) m(p) = 1;
+    for (int x = 100; x < 180; ++x) m({x, 3, 0}) = 1;
+    for (double r : {1.3, 2.54, 2.55}) {  // 130, 254 and 255 voxels along x
+        const Mask e = erode_mm(m, r), g = dilate_mm(m, r);
+        for (PointIndex i = 0; i < m.size(); ++i) {
+            const Vec3i p = lat.coord(i);
+            ASSERT_EQ(e[i] != 0, m[i] != 0 && !any_within(m, p, r, 0)) << "r " << r << " at " << p;
+            ASSERT_EQ(g[i] != 0, any_within(m, p, r, 1)) << "r " << r << " at " << p;
+        }
+    }
 }

@@ -1,12 +1,18 @@
 // LargePageAllocator<T>: std::allocator for small arrays; an array of 4 MiB or more is placed on
 // 2 MiB boundaries and offered to the kernel for transparent huge pages (Linux, madvise mode), so
 // that first touching a whole-lattice grid takes one page fault per 2 MiB instead of per 4 KiB
-// (BrainWeb set-up: 1.3 s -> 0.7-1.0 s on a 2-core VM, docs/BENCHMARKS.md).
+// (BrainWeb set-up: 1.3 s -> 0.7-1.0 s on a 2-core VM, docs/BENCHMARKS.md). A freed block is kept
+// (up to kRecycledBlocks blocks and kRecycledBytes, the oldest let go first) for the next request
+// of its size: the automatic brain mask and N4 make and drop dozens of whole-lattice grids, each
+// of whose fresh pages the kernel would zero before the grid's own fill (16 % of a BrainWeb
+// preprocessing's samples, half of it saved; docs/BENCHMARKS.md, session 74). Not under
+// AddressSanitizer; every kept block is given back when an allocation fails.
 #pragma once
 
 #include <cstddef>
 #include <memory>
 #include <new>
+#include <utility>
 #include <vector>
 
 namespace liveset {
@@ -14,8 +20,12 @@ namespace liveset {
 namespace detail {
 inline constexpr std::size_t kHugePage = std::size_t{2} << 20;   // the blocks' alignment and granule
 inline constexpr std::size_t kLargeBlock = std::size_t{4} << 20;  // from here on: huge-page blocks
-void* allocate_large(std::size_t bytes);                          // throws std::bad_alloc
-void free_large(void* p) noexcept;
+inline constexpr std::size_t kRecycledBytes = std::size_t{256} << 20;
+inline constexpr std::size_t kRecycledBlocks = 12;
+void* allocate_large(std::size_t bytes);  // throws std::bad_alloc
+void free_large(void* p, std::size_t bytes) noexcept;  // bytes: as allocated
+bool recycles_blocks() noexcept;                        // false under AddressSanitizer
+std::pair<std::size_t, std::size_t> recycled() noexcept;  // blocks kept and their bytes
 }  // namespace detail
 
 template <class T>
@@ -32,7 +42,7 @@ struct LargePageAllocator {
         return static_cast<T*>(detail::allocate_large(n * sizeof(T)));
     }
     void deallocate(T* p, std::size_t n) noexcept {
-        if (large(n)) detail::free_large(p);
+        if (large(n)) detail::free_large(p, n * sizeof(T));
         else std::allocator<T>{}.deallocate(p, n);
     }
     template <class U>

@@ -1,6 +1,10 @@
 // Histogram helpers of the automatic brain mask and its reading of the deep head (brain_histogram.hpp).
 #include "liveset/segment/brain_histogram.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -15,28 +19,56 @@ namespace liveset::brain_detail {
 // null) that lie above `above` — element floor(q·(n − 1)), as std::nth_element places it — or
 // nullopt when there is none. By a histogram of the values' order-preserving bit patterns (their
 // top 16 bits) and a selection among the values of the one bin that holds the element: two passes
-// and no copy of the image.
+// (in parallel blocks) and no copy of the image.
 std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, double above, double q) {
-    const auto key = [](float v) {
-        const auto u = std::bit_cast<std::uint32_t>(v);
-        return (u & 0x80000000u) != 0 ? ~u : (u | 0x80000000u);
-    };
-    const auto kept = [&](std::size_t i) { return (mask == nullptr || (*mask)[static_cast<PointIndex>(i)] != 0) && image[static_cast<PointIndex>(i)] > above; };
-    std::vector<std::size_t> bins(std::size_t{1} << 16, 0);
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < image.size(); ++i)
-        if (kept(i)) {
-            ++bins[key(image[static_cast<PointIndex>(i)]) >> 16];
-            ++n;
+    const float* const value = image.values().data();
+    const std::uint8_t* const inside = mask != nullptr ? mask->values().data() : nullptr;
+    // Calls `visit(i, key)` for every kept voxel of [b, e) (in the mask, above `above`: never NaN), its
+    // value's order-preserving bit pattern as the key; the loops hold everything in locals.
+    const auto for_kept = [value, inside, above](std::size_t b, std::size_t e, auto&& visit) {
+        const auto key = [](float v) {
+            const auto u = std::bit_cast<std::uint32_t>(v);
+            return (u & 0x80000000u) != 0 ? ~u : (u | 0x80000000u);
+        };
+        if (inside == nullptr) {
+            for (std::size_t i = b; i < e; ++i)
+                if (value[i] > above) visit(i, key(value[i]));
+        } else {
+            for (std::size_t i = b; i < e; ++i)
+                if (inside[i] != 0 && value[i] > above) visit(i, key(value[i]));
         }
+    };
+    // Each thread counts its blocks in its own 32-bit bins (a lattice holds fewer than 2^32 points);
+    // the sums are exact whatever the blocks and threads.
+    static_assert(kMaxLatticePoints <= 0xFFFF'FFFFull);
+    constexpr std::size_t kBins = std::size_t{1} << 16, kBlock = std::size_t{1} << 16;
+    tbb::enumerable_thread_specific<std::vector<std::uint32_t>> local([] { return std::vector<std::uint32_t>(kBins, 0); });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, image.size(), kBlock), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::uint32_t* const bins = local.local().data();
+        for_kept(r.begin(), r.end(), [bins](std::size_t, std::uint32_t k) { ++bins[k >> 16]; });
+    });
+    std::vector<std::size_t> bins(kBins, 0);
+    for (const std::vector<std::uint32_t>& l : local)
+        for (std::size_t b = 0; b < kBins; ++b) bins[b] += l[b];
+    std::size_t n = 0;
+    for (std::size_t c : bins) n += c;
     if (n == 0) return std::nullopt;
     auto k = static_cast<std::size_t>(q * static_cast<double>(n - 1));
     std::size_t bin = 0;
     while (k >= bins[bin]) k -= bins[bin++];
+    // The bin's values, gathered per block in any order: the k-th of them is one value whatever the
+    // order (a bin never holds both zeros, whose keys differ in the top bit).
+    tbb::enumerable_thread_specific<std::vector<float>> found;
+    const auto wanted = static_cast<std::uint32_t>(bin);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, image.size(), kBlock), [&](const tbb::blocked_range<std::size_t>& r) {
+        std::vector<float>& f = found.local();
+        for_kept(r.begin(), r.end(), [&f, value, wanted](std::size_t i, std::uint32_t k) {
+            if (k >> 16 == wanted) f.push_back(value[i]);
+        });
+    });
     std::vector<float> in_bin;
     in_bin.reserve(bins[bin]);
-    for (std::size_t i = 0; i < image.size(); ++i)
-        if (kept(i) && key(image[static_cast<PointIndex>(i)]) >> 16 == bin) in_bin.push_back(image[static_cast<PointIndex>(i)]);
+    for (const std::vector<float>& f : found) in_bin.insert(in_bin.end(), f.begin(), f.end());
     std::nth_element(in_bin.begin(), in_bin.begin() + static_cast<std::ptrdiff_t>(k), in_bin.end());
     return in_bin[k];
 }

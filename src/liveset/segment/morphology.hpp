@@ -1,9 +1,11 @@
 // Binary morphology in millimetres on a lattice with (possibly anisotropic) spacing: erosion,
-// dilation and closing by a Euclidean ball (exact: by the ball's chords within the mask's box, or
-// through the distance transform for a ball over 40 voxels wide along y and z together), the largest
+// dilation and closing by a Euclidean ball (exact: by the ball's chords within the mask's box, as
+// byte distances for a ball of up to 200 chords, else separably, or through the distance transform
+// for a ball over 40 voxels wide along y and z together), the largest
 // connected component and hole filling — the building blocks of the automatic brain mask.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 #include "liveset/grid/grid.hpp"
@@ -36,5 +38,18 @@ Grid<std::uint8_t> fill_holes(const Grid<std::uint8_t>& mask);
 // the mask has no outside voxel).
 Grid<float> depth_mm(const Grid<std::uint8_t>& mask);
 // (The Gaussian blur in millimetres is gaussian_smooth(), smoothing.hpp.)
+
+namespace morphology_detail {
+// The chords' inner loop (morphology.cpp): acc[x] = min(acc[x], max(d[x] - w, 0)) for x < n, a
+// multiple of kRowBytes; 0 where a feature lies within w voxels along the row. 16 bytes at a time
+// (SSE2), or 32 (AVX2: only where has_avx2(), else the 16-byte loop); the same bytes either way.
+// min_over_chord() is the one the processor runs (checked once).
+inline constexpr std::size_t kRowBytes = 32;
+using MinOverChord = void (*)(std::uint8_t*, const std::uint8_t*, std::uint8_t, std::size_t);
+void min_over_chord_16(std::uint8_t* acc, const std::uint8_t* d, std::uint8_t w, std::size_t n);
+void min_over_chord_32(std::uint8_t* acc, const std::uint8_t* d, std::uint8_t w, std::size_t n);
+bool has_avx2() noexcept;
+MinOverChord min_over_chord() noexcept;
+}  // namespace morphology_detail
 
 }  // namespace liveset
