@@ -228,6 +228,16 @@ TEST(BrainMask, QuantileAboveIsTheSortedKeptValue) {
             }
             std::sort(kept.begin(), kept.end(), [&](float a, float b) { return bits(a) < bits(b); });
             ASSERT_GT(kept.size(), 1000u);
+            const std::vector<double> fractions{0.0, 0.001, 0.02, 0.1, 0.5, 0.9, 0.98, 0.995, 1.0, 0.5, 0.37};
+            for (const int threads : {1, 3}) {  // all at once, a fraction twice: the same values
+                std::vector<float> all;
+                tbb::task_arena(threads).execute([&] { all = brain_detail::quantiles_above(image, masked ? &mask : nullptr, above, fractions); });
+                ASSERT_EQ(all.size(), fractions.size());
+                for (std::size_t f = 0; f < fractions.size(); ++f)
+                    EXPECT_EQ(std::bit_cast<std::uint32_t>(all[f]),
+                              std::bit_cast<std::uint32_t>(kept[static_cast<std::size_t>(fractions[f] * static_cast<double>(kept.size() - 1))]))
+                        << "fraction " << fractions[f] << " above " << above << (masked ? " masked" : "") << " threads " << threads;
+            }
             for (const double q : {0.0, 0.001, 0.02, 0.1, 0.5, 0.9, 0.98, 0.995, 1.0}) {
                 const float want = kept[static_cast<std::size_t>(q * static_cast<double>(kept.size() - 1))];
                 for (const int threads : {1, 3}) {  // blocks counted and gathered on any thread
@@ -240,6 +250,7 @@ TEST(BrainMask, QuantileAboveIsTheSortedKeptValue) {
             }
         }
     EXPECT_FALSE(brain_detail::quantile_above(image, nullptr, 1e9, 0.5));
+    EXPECT_TRUE(brain_detail::quantiles_above(image, nullptr, 1e9, std::vector<double>{0.1, 0.5}).empty());
 }
 
 TEST(BrainMask, BrainWebVariantsAt2mm) {

@@ -6,10 +6,13 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "liveset/segment/tissue_model.hpp"
 
@@ -20,7 +23,7 @@ namespace liveset::brain_detail {
 // nullopt when there is none. By a histogram of the values' order-preserving bit patterns (their
 // top 16 bits) and a selection among the values of the one bin that holds the element: two passes
 // (in parallel blocks) and no copy of the image.
-std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, double above, double q) {
+std::vector<float> quantiles_above(const Grid<float>& image, const Mask* mask, double above, std::span<const double> fractions) {
     const float* const value = image.values().data();
     const std::uint8_t* const inside = mask != nullptr ? mask->values().data() : nullptr;
     // Calls `visit(i, key)` for every kept voxel of [b, e) (in the mask, above `above`: never NaN), its
@@ -52,25 +55,51 @@ std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, 
         for (std::size_t b = 0; b < kBins; ++b) bins[b] += l[b];
     std::size_t n = 0;
     for (std::size_t c : bins) n += c;
-    if (n == 0) return std::nullopt;
-    auto k = static_cast<std::size_t>(q * static_cast<double>(n - 1));
-    std::size_t bin = 0;
-    while (k >= bins[bin]) k -= bins[bin++];
-    // The bin's values, gathered per block in any order: the k-th of them is one value whatever the
-    // order (a bin never holds both zeros, whose keys differ in the top bit).
-    tbb::enumerable_thread_specific<std::vector<float>> found;
-    const auto wanted = static_cast<std::uint32_t>(bin);
+    if (n == 0) return {};
+    // Each fraction's bin and rank within it; the bins asked for numbered 1, 2, ... in `slot`.
+    std::vector<std::uint8_t> slot(kBins, 0);
+    std::vector<std::size_t> wanted;  // by slot - 1: the bin
+    std::vector<std::pair<std::size_t, std::size_t>> at;  // per fraction: slot - 1, rank in the bin
+    for (const double q : fractions) {
+        auto k = static_cast<std::size_t>(q * static_cast<double>(n - 1));
+        std::size_t bin = 0;
+        while (k >= bins[bin]) k -= bins[bin++];
+        if (slot[bin] == 0) {
+            if (wanted.size() == 255) throw std::invalid_argument("quantiles_above: at most 255 distinct bins");
+            wanted.push_back(bin);
+            slot[bin] = static_cast<std::uint8_t>(wanted.size());
+        }
+        at.emplace_back(slot[bin] - 1u, k);
+    }
+    // The asked bins' values, gathered per block in any order: the k-th of a bin is one value
+    // whatever the order (a bin never holds both zeros, whose keys differ in the top bit).
+    tbb::enumerable_thread_specific<std::vector<std::vector<float>>> found([&] { return std::vector<std::vector<float>>(wanted.size()); });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, image.size(), kBlock), [&](const tbb::blocked_range<std::size_t>& r) {
-        std::vector<float>& f = found.local();
-        for_kept(r.begin(), r.end(), [&f, value, wanted](std::size_t i, std::uint32_t k) {
-            if (k >> 16 == wanted) f.push_back(value[i]);
+        std::vector<std::vector<float>>& f = found.local();
+        const std::uint8_t* const to = slot.data();
+        for_kept(r.begin(), r.end(), [&f, value, to](std::size_t i, std::uint32_t k) {
+            if (const std::uint8_t s = to[k >> 16]; s != 0) f[s - 1u].push_back(value[i]);
         });
     });
-    std::vector<float> in_bin;
-    in_bin.reserve(bins[bin]);
-    for (const std::vector<float>& f : found) in_bin.insert(in_bin.end(), f.begin(), f.end());
-    std::nth_element(in_bin.begin(), in_bin.begin() + static_cast<std::ptrdiff_t>(k), in_bin.end());
-    return in_bin[k];
+    std::vector<std::vector<float>> in_bin(wanted.size());
+    for (std::size_t w = 0; w < wanted.size(); ++w) {
+        in_bin[w].reserve(bins[wanted[w]]);
+        for (const std::vector<std::vector<float>>& f : found) in_bin[w].insert(in_bin[w].end(), f[w].begin(), f[w].end());
+    }
+    std::vector<float> out;
+    out.reserve(fractions.size());
+    for (const auto& [w, k] : at) {
+        std::vector<float>& v = in_bin[w];
+        std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+        out.push_back(v[k]);
+    }
+    return out;
+}
+
+std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, double above, double q) {
+    const std::vector<float> v = quantiles_above(image, mask, above, std::span<const double>(&q, 1));
+    if (v.empty()) return std::nullopt;
+    return v[0];
 }
 
 Histogram histogram(const Grid<float>& image, const Mask& mask, double lo, double hi) {
@@ -202,11 +231,11 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
     r.deep_grey_peak = std::numeric_limits<double>::quiet_NaN();
     r.wm_swamped = false;
     // Which side of white matter grey matter and CSF lie on (deep_contrast): the deep voxels above the background.
-    const std::optional<float> q10 = quantile_above(image, &deep, r.background_threshold, 0.1);
-    if (!q10) return *top;
-    const double q50 = *quantile_above(image, &deep, r.background_threshold, 0.5);
-    const double q90 = *quantile_above(image, &deep, r.background_threshold, 0.9);
-    r.deep_skew = q90 > *q10 ? (q90 + *q10 - 2.0 * q50) / (q90 - *q10) : 0.0;
+    constexpr std::array<double, 3> kDeciles{0.1, 0.5, 0.9};
+    const std::vector<float> q = quantiles_above(image, &deep, r.background_threshold, kDeciles);
+    if (q.empty()) return *top;
+    const double q10 = q[0], q50 = q[1], q90 = q[2];
+    r.deep_skew = q90 > q10 ? (q90 + q10 - 2.0 * q50) / (q90 - q10) : 0.0;
     // Swamped (the last look): the brightest prominent peak, in a deep head skewed dark as a T1's
     // (a T2's or PD's brightest is its CSF).
     if (!grey_brighter && swamped_share < 1.0 && r.deep_skew < 0.0 && r.deep_above > swamped_share)

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -20,6 +21,9 @@ constexpr int kBins = 128;
 // null) that lie above `above` (element floor(q·(n − 1)), as std::nth_element places it), or
 // nullopt when there is none. Two passes, no copy of the image.
 std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, double above, double q);
+// quantile_above for several fractions in the same two passes (each value as quantile_above gives
+// it), in their order; empty when no voxel is kept. At most 255 distinct histogram bins among them.
+std::vector<float> quantiles_above(const Grid<float>& image, const Mask* mask, double above, std::span<const double> fractions);
 
 // A kBins-bin histogram over [lo, hi] of the image's voxels inside `mask` (values outside the range
 // are not counted).

@@ -6,6 +6,7 @@
 #include "liveset/segment/intensity.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -36,6 +37,7 @@ using brain_detail::deep_contrast;
 using brain_detail::histogram;
 using brain_detail::otsu3;
 using brain_detail::quantile_above;
+using brain_detail::quantiles_above;
 using brain_detail::smoothed;
 using brain_detail::smoothed_white_floor;
 using brain_detail::tallest;
@@ -162,13 +164,16 @@ double background_noise(const Grid<float>& image, double floor, double base, dou
 // raised to floor + noise_multiple·σ when the air is noisy enough to cross it (floor: the 0.1st
 // percentile, a constant fill left out; σ: background_noise).
 void thresholds(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport& r) {
-    double floor = 0.0;
+    double floor = 0.0, p2 = 0.0;
     if (const std::optional<float> fill = constant_fill(image)) {
         floor = quantile_above(image, nullptr, *fill, 0.001).value_or(0.0f);
+        p2 = *quantile_above(image, nullptr, -kInf, 0.02);
     } else {
-        floor = *quantile_above(image, nullptr, -kInf, 0.001);
+        constexpr std::array<double, 2> kFloorAndP2{0.001, 0.02};
+        const std::vector<float> q = quantiles_above(image, nullptr, -kInf, kFloorAndP2);
+        floor = q.at(0);
+        p2 = q.at(1);
     }
-    const double p2 = *quantile_above(image, nullptr, -kInf, 0.02);
     const std::optional<float> p98 = quantile_above(image, nullptr, p2, 0.98);
     if (!p98) throw std::invalid_argument("brain mask: no head found (98% of the voxels share the lowest value)");
     r.background_threshold = p2 + o.background_fraction * (*p98 - p2);
