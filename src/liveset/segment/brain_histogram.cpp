@@ -18,11 +18,11 @@
 
 namespace liveset::brain_detail {
 
-// The value at fraction q in [0, 1] of the sorted values of `image` inside `mask` (all voxels when
-// null) that lie above `above` — element floor(q·(n − 1)), as std::nth_element places it — or
-// nullopt when there is none. By a histogram of the values' order-preserving bit patterns (their
-// top 16 bits) and a selection among the values of the one bin that holds the element: two passes
-// (in parallel blocks) and no copy of the image.
+// For each fraction q in [0, 1], the value at q of the sorted values of `image` inside `mask` (all
+// voxels when null) that lie above `above` — element floor(q·(n − 1)), as std::nth_element places
+// it — or nothing when there is none. By a histogram of the values' order-preserving bit patterns
+// (their top 16 bits) and a selection among the values of the bins that hold the elements: two
+// passes (in parallel blocks) for all the fractions, and no copy of the image.
 std::vector<float> quantiles_above(const Grid<float>& image, const Mask* mask, double above, std::span<const double> fractions) {
     const float* const value = image.values().data();
     const std::uint8_t* const inside = mask != nullptr ? mask->values().data() : nullptr;
