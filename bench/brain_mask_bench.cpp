@@ -50,6 +50,20 @@ void BM_QuantileAbove(benchmark::State& state) {
 }
 BENCHMARK(BM_QuantileAbove)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Repetitions(5);
 
+// The depth below the surface (mm) of every voxel of BrainWeb's brain mask, as the brain mask's
+// contrast reading takes it (range(0) threads): the distance transform in single precision.
+void BM_Depth(benchmark::State& state) {
+    const tbb::global_control threads(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(state.range(0)));
+    static const Grid<std::uint8_t> brain = [] {
+        const Grid<float> m = read_image(std::string(LIVESET_DATA_DIR) + "/brainweb/brain_mask.nii.gz");
+        Grid<std::uint8_t> b(m.lattice());
+        for (PointIndex i = 0; i < m.size(); ++i) b[i] = m[i] != 0.0f;
+        return b;
+    }();
+    for (auto _ : state) benchmark::DoNotOptimize(depth_mm(brain));
+}
+BENCHMARK(BM_Depth)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->Repetitions(5);
+
 // Dilation and erosion of BrainWeb's brain mask by a ball of range(0) mm (1 thread): the chords up
 // to their limit, the distance transform beyond.
 void BM_DilateErode(benchmark::State& state) {

@@ -107,6 +107,64 @@ TEST(DistanceTransform, SingleSiteGivesExactDistances) {
     EXPECT_DOUBLE_EQ(d2({0, 5, 0}), 1.0 + 16.0 + 9.0);        // (1, 4, 3) mm
 }
 
+// The single-precision transform to a mask's outside against a brute force, at anisotropic spacings:
+// within a few float ulps.
+TEST(DistanceTransform, SinglePrecisionToTheOutsideMatchesBruteForce) {
+    const Lattice lat({13, 9, 7}, {0.7, 1.3, 2.9});
+    for (unsigned seed : {1u, 2u, 3u}) {
+        const Mask mask = random_mask(lat, seed, seed == 3 ? 99 : 92);  // the outside: 1-8 % of the voxels
+        std::vector<PointIndex> outside;
+        for (PointIndex i = 0; i < mask.size(); ++i)
+            if (mask[i] == 0) outside.push_back(i);
+        ASSERT_FALSE(outside.empty());
+        const Grid<float> d2 = squared_distance_to_outside_mm(mask);
+        for (PointIndex i = 0; i < mask.size(); ++i) {
+            double best = std::numeric_limits<double>::infinity();
+            for (PointIndex s : outside) best = std::min(best, distance_mm(lat, i, s));
+            ASSERT_NEAR(d2[i], best * best, 1e-6 * (1 + best * best)) << "seed " << seed << " voxel " << lat.coord(i);
+        }
+    }
+    const Grid<float> none = squared_distance_to_outside_mm(Mask(Lattice({4, 3, 2}), 1));  // no outside
+    for (float v : none.values()) EXPECT_TRUE(std::isinf(v));
+}
+
+// At integer spacings the single-precision transform gives the double one's values bit for bit
+// (depth_mm relies on it for the brain mask's same bits), on masks whose depths reach far past the
+// lattice's short sides: blobs, sparse and dense noise, one outside voxel in a long lattice.
+TEST(DistanceTransform, SinglePrecisionAtIntegerSpacingsIsTheDoubleTransform) {
+    std::mt19937 gen(7);
+    const auto complement = [](const Mask& m) {
+        Mask c(m.lattice());
+        for (PointIndex i = 0; i < m.size(); ++i) c[i] = m[i] == 0;
+        return c;
+    };
+    const auto check = [&](const Mask& mask, const char* what) {
+        const Grid<float> f = squared_distance_to_outside_mm(mask);
+        const Grid<double> d = squared_distance_transform_mm(complement(mask));
+        std::size_t inside = 0;
+        for (PointIndex i = 0; i < mask.size(); ++i) {
+            inside += mask[i] != 0;
+            ASSERT_EQ(f[i], static_cast<float>(d[i])) << what << " " << mask.lattice().spacing() << " at " << mask.lattice().coord(i);
+            ASSERT_EQ(d[i], std::floor(d[i])) << what;  // integers: the premise
+        }
+        EXPECT_GT(inside, 0u) << what;
+    };
+    for (const Vec3d spacing : {Vec3d{1, 1, 1}, Vec3d{1, 2, 3}, Vec3d{2, 1, 1}}) {
+        const Lattice lat({61, 47, 33}, spacing);
+        Mask blobs(lat, 1);  // a few holes: depths up to tens of voxels
+        for (int k = 0; k < 6; ++k) paint_ball_mm(blobs, {gen() % 61 * spacing.x, gen() % 47 * spacing.y, gen() % 33 * spacing.z}, 3.0, 0);
+        check(blobs, "blobs");
+        for (unsigned per_mille : {500u, 970u, 999u}) {  // the share inside
+            Mask noise(lat);
+            for (auto& v : noise.values()) v = (gen() % 1000u) < per_mille ? 1 : 0;
+            check(noise, "noise");
+        }
+    }
+    Mask line(Lattice({601, 3, 2}), 1);
+    line({0, 0, 0}) = 0;  // depths up to 600 mm: 360 000 + ... mm²
+    check(line, "line");
+}
+
 TEST(Boundary, InteriorVoxelsAreExcludedAndImageBorderCounts) {
     const Lattice lat({7, 7, 7});
     Mask m(lat);

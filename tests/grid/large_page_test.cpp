@@ -1,7 +1,10 @@
 // Grid storage on huge pages: a grid of 4 MiB or more starts on a 2 MiB boundary and its memory is
-// advised MADV_HUGEPAGE (the kernel's "hg" flag in /proc/self/smaps); values survive copies and moves;
-// a freed block serves the next request of its size, within the kept blocks' bounds, on any thread.
+// advised MADV_HUGEPAGE (the kernel's "hg" flag in /proc/self/smaps); values survive copies and moves, and a
+// whole grid is filled and copied on any thread count; a freed block serves the next request of its
+// size, within the kept blocks' bounds, on any thread.
 #include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
 
 #include <cstdint>
 #include <filesystem>
@@ -60,6 +63,41 @@ TEST(LargePageGrid, LargeGridsStartOnHugePageBoundariesAndKeepTheirValues) {
     // A small grid is an ordinary allocation and works the same.
     Grid<std::int8_t> small(Lattice({10, 10, 10}), std::int8_t{4});
     EXPECT_EQ(small[static_cast<PointIndex>(999)], 4);
+}
+
+// A whole-lattice grid is filled and copied on every thread (its first touch): every element, at
+// sizes that are not a multiple of the 2 MiB blocks, on 1 and 3 threads; a copy assigned to a grid
+// of its size keeps that grid's storage, to another size takes new storage; self-assignment is a
+// no-op; a grid of non-trivial elements (std::string) is filled and copied like any other.
+TEST(LargePageGrid, WholeLatticeGridsAreFilledAndCopiedWhole) {
+    for (const std::size_t threads : {1u, 3u}) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        const Lattice lat({131, 127, 83});  // 1.38 M: 5.3 MiB of floats, 10.5 MiB of doubles
+        Grid<float> g(lat, 2.5f);
+        for (std::size_t i = 0; i < g.size(); ++i) ASSERT_EQ(g[static_cast<PointIndex>(i)], 2.5f) << threads << " threads, " << i;
+        for (std::size_t i = 0; i < g.size(); ++i) g[static_cast<PointIndex>(i)] = static_cast<float>(i % 1000);
+        const Grid<float> copy = g;
+        for (std::size_t i = 0; i < g.size(); ++i) ASSERT_EQ(copy[static_cast<PointIndex>(i)], static_cast<float>(i % 1000)) << i;
+        Grid<float> same(lat, -1.0f);
+        const float* const storage = same.values().data();
+        same = copy;
+        EXPECT_EQ(same.values().data(), storage);
+        for (std::size_t i = 0; i < g.size(); ++i) ASSERT_EQ(same[static_cast<PointIndex>(i)], copy[static_cast<PointIndex>(i)]) << i;
+        Grid<float> other(Lattice({5, 5, 5}), 9.0f);
+        other = copy;
+        EXPECT_EQ(other.lattice().dims(), lat.dims());
+        for (std::size_t i = 0; i < g.size(); ++i) ASSERT_EQ(other[static_cast<PointIndex>(i)], copy[static_cast<PointIndex>(i)]) << i;
+        const Grid<float>& alias = other;
+        other = alias;
+        EXPECT_EQ(other[static_cast<PointIndex>(g.size() - 1)], copy[static_cast<PointIndex>(g.size() - 1)]);
+        const Grid<double> d(lat, 0.25);
+        for (std::size_t i = 0; i < d.size(); ++i) ASSERT_EQ(d[static_cast<PointIndex>(i)], 0.25) << i;
+        const Grid<std::uint8_t> bytes(Lattice({601, 113, 67}), std::uint8_t{7});  // 4.3 MiB
+        for (std::size_t i = 0; i < bytes.size(); ++i) ASSERT_EQ(bytes[static_cast<PointIndex>(i)], 7) << i;
+    }
+    const Grid<std::string> words(Lattice({64, 64, 64}), std::string(40, 'x'));  // 8 MiB of strings
+    const Grid<std::string> words_copy = words;
+    for (std::size_t i = 0; i < words.size(); i += 97) ASSERT_EQ(words_copy[static_cast<PointIndex>(i)], std::string(40, 'x')) << i;
 }
 
 TEST(LargePageGrid, LargeGridsAreAdvisedForTransparentHugePages) {

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -15,11 +16,10 @@ namespace liveset {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-
-// Scratch for one 1D transform of a line of n samples.
+// Scratch for one 1D transform of a line of n samples of type T (double or float).
+template <class T>
 struct LineScratch {
-    std::vector<double> d, z;
+    std::vector<T> d, z;
     std::vector<int> v;
     void resize(int n) {
         const auto un = static_cast<std::size_t>(n);
@@ -33,15 +33,18 @@ struct LineScratch {
 // s.d[q] = min_p (step·(q-p))² + f[p]. Samples with f = +inf or above `cutoff` are not sites; with
 // no site, d = +inf. Inside a run of zeros only the run's two ends are sites: an interior zero is
 // never the nearest site of a point outside the run, and inside it d is 0 (as the full envelope gives).
-void transform_line(const double* f, LineScratch& s, int n, double step, double cutoff) {
-    double* d = s.d.data();
+// The same arithmetic in either precision (T).
+template <class T>
+void transform_line(const T* f, LineScratch<T>& s, int n, T step, T cutoff) {
+    constexpr T kInf = std::numeric_limits<T>::infinity();
+    T* d = s.d.data();
     int* v = s.v.data();
-    double* z = s.z.data();
+    T* z = s.z.data();
     int k = -1;
     for (int q = 0; q < n; ++q) {
         if (f[q] == kInf || f[q] > cutoff) continue;
         if (f[q] == 0 && q > 0 && q + 1 < n && f[q - 1] == 0 && f[q + 1] == 0) continue;
-        const double xq = q * step;
+        const T xq = static_cast<T>(q) * step;
         if (k < 0) {
             k = 0;
             v[0] = q;
@@ -49,11 +52,11 @@ void transform_line(const double* f, LineScratch& s, int n, double step, double 
             z[1] = kInf;
             continue;
         }
-        double sq = 0;
+        T sq = 0;
         while (true) {
             const int p = v[k];
-            const double xp = p * step;
-            sq = ((f[q] + xq * xq) - (f[p] + xp * xp)) / (2.0 * (xq - xp));
+            const T xp = static_cast<T>(p) * step;
+            sq = ((f[q] + xq * xq) - (f[p] + xp * xp)) / (T(2) * (xq - xp));
             if (sq <= z[k]) {
                 --k;  // z[0] = -inf, so k never drops below 0 here
                 continue;
@@ -71,22 +74,23 @@ void transform_line(const double* f, LineScratch& s, int n, double step, double 
     }
     int j = 0;
     for (int q = 0; q < n; ++q) {
-        const double xq = q * step;
+        const T xq = static_cast<T>(q) * step;
         while (z[j + 1] < xq) ++j;
-        const double dx = xq - v[j] * step;
-        d[q] = f[q] == 0 ? 0.0 : dx * dx + f[v[j]];
+        const T dx = xq - static_cast<T>(v[j]) * step;
+        d[q] = f[q] == 0 ? T(0) : dx * dx + f[v[j]];
     }
 }
 
 // Runs the 1D transform in place along `axis` over every line of `grid`. Lines across x (y and z)
 // are taken kBlock neighbours in x at a time, so each gather and scatter reads whole cache lines
 // instead of one value per line: the same arithmetic per line.
-void transform_axis(Grid<double>& grid, int axis, double cutoff) {
+template <class T>
+void transform_axis(Grid<T>& grid, int axis, T cutoff) {
     constexpr int kBlock = 64;
     const Lattice& lat = grid.lattice();
     const Vec3i dims = lat.dims();
     const int n = dims[axis];
-    const double step = lat.spacing()[axis];
+    const T step = static_cast<T>(lat.spacing()[axis]);
     const std::size_t stride = axis == 0 ? 1 : (axis == 1 ? lat.stride_y() : lat.stride_z());
     // The other two axes, (a, b) with a fastest in memory; lines are enumerated over b in parallel.
     const int a_axis = axis == 0 ? 1 : 0;
@@ -94,20 +98,28 @@ void transform_axis(Grid<double>& grid, int axis, double cutoff) {
     const std::size_t a_stride = a_axis == 0 ? 1 : lat.stride_y();
     const std::size_t b_stride = b_axis == 1 ? lat.stride_y() : lat.stride_z();
     const int width = axis == 0 ? 1 : kBlock;  // lines per gather; a_stride is 1 when axis != 0
-    double* data = grid.values().data();
+    T* data = grid.values().data();
     tbb::parallel_for(tbb::blocked_range<int>(0, dims[b_axis]), [&](const tbb::blocked_range<int>& r) {
-        LineScratch s;
+        LineScratch<T> s;
         s.resize(n);
-        std::vector<double> block(static_cast<std::size_t>(n) * static_cast<std::size_t>(width));
+        std::vector<T> block(static_cast<std::size_t>(n) * static_cast<std::size_t>(width));
         for (int b = r.begin(); b < r.end(); ++b) {
             for (int a0 = 0; a0 < dims[a_axis]; a0 += width) {
                 const int w = std::min(width, dims[a_axis] - a0);
-                double* first = data + static_cast<std::size_t>(a0) * a_stride + static_cast<std::size_t>(b) * b_stride;
+                T* first = data + static_cast<std::size_t>(a0) * a_stride + static_cast<std::size_t>(b) * b_stride;
+                // A line of zeros (every point a feature, as outside a mask whose depth is taken)
+                // is its own transform: such lines, and a gather of nothing else, are left as they are.
+                std::array<unsigned char, kBlock> live{};
                 for (int q = 0; q < n; ++q)
-                    for (int l = 0; l < w; ++l)
-                        block[static_cast<std::size_t>(l * n + q)] = first[static_cast<std::size_t>(q) * stride + static_cast<std::size_t>(l)];
+                    for (int l = 0; l < w; ++l) {
+                        const T v = first[static_cast<std::size_t>(q) * stride + static_cast<std::size_t>(l)];
+                        block[static_cast<std::size_t>(l * n + q)] = v;
+                        live[static_cast<std::size_t>(l)] |= v != T(0) ? 1 : 0;
+                    }
+                if (std::none_of(live.begin(), live.begin() + w, [](unsigned char c) { return c != 0; })) continue;
                 for (int l = 0; l < w; ++l) {
-                    double* line = block.data() + static_cast<std::size_t>(l * n);
+                    if (live[static_cast<std::size_t>(l)] == 0) continue;
+                    T* line = block.data() + static_cast<std::size_t>(l * n);
                     transform_line(line, s, n, step, cutoff);
                     std::copy(s.d.begin(), s.d.begin() + n, line);
                 }
@@ -166,38 +178,55 @@ std::vector<PointIndex> boundary_voxels(const Grid<std::uint8_t>& mask) {
     return out;
 }
 
-// The transform along x of one row of binary features: (x·s − p·s)² to the nearest feature p of the
-// row (the left one on a tie), +infinity without one.
-void feature_row(const std::uint8_t* f, double* d, int n, double step) {
+namespace {
+
+// The transform along x of one row of binary features (a voxel is one where f is nonzero, or with
+// kZeroIsFeature where it is 0): (x·s − p·s)² to the nearest feature p of the row (the left one on
+// a tie), +infinity without one.
+template <class T, bool kZeroIsFeature>
+void feature_row(const std::uint8_t* f, T* d, int n, T step) {
+    constexpr T kInf = std::numeric_limits<T>::infinity();
+    const auto is_feature = [&](int x) { return kZeroIsFeature ? f[x] == 0 : f[x] != 0; };
     int last = -1;
     for (int x = 0; x < n; ++x) {
-        if (f[x] != 0) last = x;
-        d[x] = last < 0 ? kInf : x * step - last * step;
+        if (is_feature(x)) last = x;
+        d[x] = last < 0 ? kInf : static_cast<T>(x) * step - static_cast<T>(last) * step;
     }
     int next = -1;
     for (int x = n - 1; x >= 0; --x) {
-        if (f[x] != 0) next = x;
-        const double left = d[x];
-        const double right = next < 0 ? kInf : next * step - x * step;
-        const double nearest = right < left ? right : left;
+        if (is_feature(x)) next = x;
+        const T left = d[x];
+        const T right = next < 0 ? kInf : static_cast<T>(next) * step - static_cast<T>(x) * step;
+        const T nearest = right < left ? right : left;
         d[x] = nearest * nearest;
     }
 }
 
-Grid<double> squared_distance_transform_mm(const Grid<std::uint8_t>& features, double max_mm2) {
-    Grid<double> dist(features.lattice());
+template <class T, bool kZeroIsFeature>
+Grid<T> transform(const Grid<std::uint8_t>& features, T max_mm2) {
+    Grid<T> dist(features.lattice());
     if (dist.size() == 0) return dist;
     const Vec3i d = features.dims();
-    const double step = features.lattice().spacing().x;
+    const auto step = static_cast<T>(features.lattice().spacing().x);
     tbb::parallel_for(tbb::blocked_range<int>(0, d.z), [&](const tbb::blocked_range<int>& zs) {
         for (int z = zs.begin(); z < zs.end(); ++z)
             for (int y = 0; y < d.y; ++y) {
                 const std::size_t row = features.lattice().index({0, y, z});
-                feature_row(features.values().data() + row, dist.values().data() + row, d.x, step);
+                feature_row<T, kZeroIsFeature>(features.values().data() + row, dist.values().data() + row, d.x, step);
             }
     });
     for (int axis = 1; axis < 3; ++axis) transform_axis(dist, axis, max_mm2);
     return dist;
+}
+
+}  // namespace
+
+Grid<double> squared_distance_transform_mm(const Grid<std::uint8_t>& features, double max_mm2) {
+    return transform<double, false>(features, max_mm2);
+}
+
+Grid<float> squared_distance_to_outside_mm(const Grid<std::uint8_t>& mask) {
+    return transform<float, true>(mask, std::numeric_limits<float>::infinity());
 }
 
 SurfaceDistance surface_distance(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth) {

@@ -1,7 +1,11 @@
 // Blocks for LargePageAllocator: 2 MiB-aligned, advised for transparent huge pages where the
 // kernel offers them (the advice is only a hint; without THP the pages stay small), and a few
-// freed blocks kept for the next request of their size (see large_page_allocator.hpp).
+// freed blocks kept for the next request of their size (see large_page_allocator.hpp); a grid's
+// fill and copy over them on every thread (grid.hpp).
 #include <sys/mman.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <cstdlib>
 #include <mutex>
@@ -9,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "liveset/grid/grid.hpp"
 #include "liveset/grid/large_page_allocator.hpp"
 
 namespace liveset::detail {
@@ -106,6 +111,15 @@ void free_large(void* p, std::size_t bytes) noexcept {
         r.bytes = bytes_after;
     }
     for (void* e : evicted) std::free(e);
+}
+
+void for_grid_blocks(std::size_t n, std::size_t grain, void (*f)(void*, std::size_t, std::size_t), void* context) {
+    if (n < 2 * grain) {
+        f(context, 0, n);
+        return;
+    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
+                      [&](const tbb::blocked_range<std::size_t>& r) { f(context, r.begin(), r.end()); });
 }
 
 bool recycles_blocks() noexcept { return kRecycle; }

@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
@@ -453,10 +454,15 @@ Grid<std::uint8_t> fill_holes(const Grid<std::uint8_t>& mask) {
     return out;
 }
 
+// In single precision, in place (docs/BENCHMARKS.md, session 75): at integer spacings the same bits
+// as the double transform's root (the squared distances are the same integers, and a float's root
+// of one is the double root rounded, sqrt's double rounding being innocuous).
 Grid<float> depth_mm(const Grid<std::uint8_t>& mask) {
-    const Grid<double> d2 = squared_distance_transform_mm(complement(mask));
-    Grid<float> out(mask.lattice());
-    for (std::size_t i = 0; i < out.size(); ++i) out[static_cast<PointIndex>(i)] = static_cast<float>(std::sqrt(d2[static_cast<PointIndex>(i)]));
+    Grid<float> out = squared_distance_to_outside_mm(mask);
+    const std::span<float> v = out.values();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, v.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) v[i] = std::sqrt(v[i]);
+    });
     return out;
 }
 
