@@ -1,10 +1,14 @@
 // Head geometry for the automatic brain mask (see head_geometry.hpp).
 #include "liveset/segment/head_geometry.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 namespace liveset::brain_detail {
@@ -27,35 +31,46 @@ double face_exit_mm2(const Mask& head, int a, int side) {
 
 }  // namespace
 
+// Slices z in parallel (counts and maxima: the same whatever the order).
 double surface_contact(const Mask& mask, const Grid<float>& head_depth, double near_mm) {
     const Lattice& lat = mask.lattice();
     const Vec3i d = lat.dims();
-    std::size_t boundary = 0, near = 0;
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x) {
-                if (mask({x, y, z}) == 0) continue;
-                bool edge = false;
-                for (int k = 0; k < 6 && !edge; ++k) {
-                    Vec3i q{x, y, z};
-                    q[k / 2] += k % 2 ? 1 : -1;
-                    edge = lat.contains(q) && mask(q) == 0;
-                }
-                if (!edge) continue;
-                ++boundary;
-                near += head_depth({x, y, z}) <= near_mm;
-            }
-    return boundary > 0 ? static_cast<double>(near) / static_cast<double>(boundary) : 0.0;
+    using Counts = std::pair<std::size_t, std::size_t>;  // boundary voxels, those near the surface
+    const Counts counts = tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, d.z), Counts{0, 0},
+        [&](const tbb::blocked_range<int>& zs, Counts c) {
+            for (int z = zs.begin(); z < zs.end(); ++z)
+                for (int y = 0; y < d.y; ++y)
+                    for (int x = 0; x < d.x; ++x) {
+                        if (mask({x, y, z}) == 0) continue;
+                        bool edge = false;
+                        for (int k = 0; k < 6 && !edge; ++k) {
+                            Vec3i q{x, y, z};
+                            q[k / 2] += k % 2 ? 1 : -1;
+                            edge = lat.contains(q) && mask(q) == 0;
+                        }
+                        if (!edge) continue;
+                        ++c.first;
+                        c.second += head_depth({x, y, z}) <= near_mm;
+                    }
+            return c;
+        },
+        [](Counts a, Counts b) { return Counts{a.first + b.first, a.second + b.second}; });
+    return counts.first > 0 ? static_cast<double>(counts.second) / static_cast<double>(counts.first) : 0.0;
 }
 
 double head_top(const Mask& head, const Vertical& up) {
     const Vec3i d = head.dims();
-    double top = -std::numeric_limits<double>::infinity();
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x)
-                if (head({x, y, z}) != 0) top = std::max(top, up.height({x, y, z}));
-    return top;
+    return tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, d.z), -std::numeric_limits<double>::infinity(),
+        [&](const tbb::blocked_range<int>& zs, double top) {
+            for (int z = zs.begin(); z < zs.end(); ++z)
+                for (int y = 0; y < d.y; ++y)
+                    for (int x = 0; x < d.x; ++x)
+                        if (head({x, y, z}) != 0) top = std::max(top, up.height({x, y, z}));
+            return top;
+        },
+        [](double a, double b) { return std::max(a, b); });
 }
 
 Vertical vertical(const Mask& head, bool from_header) {
