@@ -130,7 +130,8 @@ TEST(DistanceTransform, SinglePrecisionToTheOutsideMatchesBruteForce) {
 
 // At integer spacings the single-precision transform gives the double one's values bit for bit
 // (depth_mm relies on it for the brain mask's same bits), on masks whose depths reach far past the
-// lattice's short sides: blobs, sparse and dense noise, one outside voxel in a long lattice.
+// lattice's short sides: blobs, sparse and dense noise, one outside voxel in a long lattice along
+// each axis, two in a wide one.
 TEST(DistanceTransform, SinglePrecisionAtIntegerSpacingsIsTheDoubleTransform) {
     std::mt19937 gen(7);
     const auto complement = [](const Mask& m) {
@@ -160,9 +161,18 @@ TEST(DistanceTransform, SinglePrecisionAtIntegerSpacingsIsTheDoubleTransform) {
             check(noise, "noise");
         }
     }
-    Mask line(Lattice({601, 3, 2}), 1);
-    line({0, 0, 0}) = 0;  // depths up to 600 mm: 360 000 + ... mm²
-    check(line, "line");
+    // Long lines along each axis at 3 mm (the y and z passes' envelopes over 601 points, depths to
+    // 1 800 mm), and a case whose break points a float computation moved (a helper's review found
+    // 1 793 818 against 1 793 817 mm² there when the passes computed in float).
+    for (const Vec3i dims : {Vec3i{601, 3, 2}, Vec3i{3, 601, 2}, Vec3i{2, 3, 601}}) {
+        Mask line(Lattice(dims, {3, 3, 3}), 1);
+        line({0, 0, 0}) = 0;
+        check(line, "line");
+    }
+    Mask far(Lattice({1300, 1400, 1}, {1, 3, 1}), 1);
+    far({6, 1199, 0}) = 0;
+    far({353, 1391, 0}) = 0;
+    check(far, "far");
 }
 
 TEST(Boundary, InteriorVoxelsAreExcludedAndImageBorderCounts) {

@@ -16,10 +16,12 @@ namespace liveset {
 
 namespace {
 
-// Scratch for one 1D transform of a line of n samples of type T (double or float).
+// Scratch for one 1D transform of a line of n samples stored as T (double or float); the
+// envelope's break points are doubles either way.
 template <class T>
 struct LineScratch {
-    std::vector<T> d, z;
+    std::vector<T> d;
+    std::vector<double> z;
     std::vector<int> v;
     void resize(int n) {
         const auto un = static_cast<std::size_t>(n);
@@ -33,18 +35,20 @@ struct LineScratch {
 // s.d[q] = min_p (step·(q-p))² + f[p]. Samples with f = +inf or above `cutoff` are not sites; with
 // no site, d = +inf. Inside a run of zeros only the run's two ends are sites: an interior zero is
 // never the nearest site of a point outside the run, and inside it d is 0 (as the full envelope gives).
-// The same arithmetic in either precision (T).
+// The arithmetic is in double whatever T: a float line is the double transform of the same values,
+// each result rounded once to float.
 template <class T>
-void transform_line(const T* f, LineScratch<T>& s, int n, T step, T cutoff) {
-    constexpr T kInf = std::numeric_limits<T>::infinity();
+void transform_line(const T* f, LineScratch<T>& s, int n, double step, double cutoff) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
     T* d = s.d.data();
     int* v = s.v.data();
-    T* z = s.z.data();
+    double* z = s.z.data();
     int k = -1;
     for (int q = 0; q < n; ++q) {
-        if (f[q] == kInf || f[q] > cutoff) continue;
-        if (f[q] == 0 && q > 0 && q + 1 < n && f[q - 1] == 0 && f[q + 1] == 0) continue;
-        const T xq = static_cast<T>(q) * step;
+        const double fq = f[q];
+        if (fq == kInf || fq > cutoff) continue;
+        if (fq == 0 && q > 0 && q + 1 < n && f[q - 1] == 0 && f[q + 1] == 0) continue;
+        const double xq = q * step;
         if (k < 0) {
             k = 0;
             v[0] = q;
@@ -52,11 +56,11 @@ void transform_line(const T* f, LineScratch<T>& s, int n, T step, T cutoff) {
             z[1] = kInf;
             continue;
         }
-        T sq = 0;
+        double sq = 0;
         while (true) {
             const int p = v[k];
-            const T xp = static_cast<T>(p) * step;
-            sq = ((f[q] + xq * xq) - (f[p] + xp * xp)) / (T(2) * (xq - xp));
+            const double xp = p * step;
+            sq = ((fq + xq * xq) - (static_cast<double>(f[p]) + xp * xp)) / (2.0 * (xq - xp));
             if (sq <= z[k]) {
                 --k;  // z[0] = -inf, so k never drops below 0 here
                 continue;
@@ -69,15 +73,15 @@ void transform_line(const T* f, LineScratch<T>& s, int n, T step, T cutoff) {
         z[k + 1] = kInf;
     }
     if (k < 0) {
-        std::fill(d, d + n, kInf);
+        std::fill(d, d + n, std::numeric_limits<T>::infinity());
         return;
     }
     int j = 0;
     for (int q = 0; q < n; ++q) {
-        const T xq = static_cast<T>(q) * step;
+        const double xq = q * step;
         while (z[j + 1] < xq) ++j;
-        const T dx = xq - static_cast<T>(v[j]) * step;
-        d[q] = f[q] == 0 ? T(0) : dx * dx + f[v[j]];
+        const double dx = xq - v[j] * step;
+        d[q] = f[q] == 0 ? T(0) : static_cast<T>(dx * dx + static_cast<double>(f[v[j]]));
     }
 }
 
@@ -85,12 +89,14 @@ void transform_line(const T* f, LineScratch<T>& s, int n, T step, T cutoff) {
 // are taken kBlock neighbours in x at a time, so each gather and scatter reads whole cache lines
 // instead of one value per line: the same arithmetic per line.
 template <class T>
-void transform_axis(Grid<T>& grid, int axis, T cutoff) {
+void transform_axis(Grid<T>& grid, int axis, double cutoff) {
     constexpr int kBlock = 64;
     const Lattice& lat = grid.lattice();
     const Vec3i dims = lat.dims();
     const int n = dims[axis];
-    const T step = static_cast<T>(lat.spacing()[axis]);
+    const double step = lat.spacing()[axis];
+    // A line of zeros is its own transform while zeros are sites (a cutoff not below 0).
+    const bool skip_zero_lines = !(cutoff < 0.0);
     const std::size_t stride = axis == 0 ? 1 : (axis == 1 ? lat.stride_y() : lat.stride_z());
     // The other two axes, (a, b) with a fastest in memory; lines are enumerated over b in parallel.
     const int a_axis = axis == 0 ? 1 : 0;
@@ -116,9 +122,9 @@ void transform_axis(Grid<T>& grid, int axis, T cutoff) {
                         block[static_cast<std::size_t>(l * n + q)] = v;
                         live[static_cast<std::size_t>(l)] |= v != T(0) ? 1 : 0;
                     }
-                if (std::none_of(live.begin(), live.begin() + w, [](unsigned char c) { return c != 0; })) continue;
+                if (skip_zero_lines && std::none_of(live.begin(), live.begin() + w, [](unsigned char c) { return c != 0; })) continue;
                 for (int l = 0; l < w; ++l) {
-                    if (live[static_cast<std::size_t>(l)] == 0) continue;
+                    if (skip_zero_lines && live[static_cast<std::size_t>(l)] == 0) continue;
                     T* line = block.data() + static_cast<std::size_t>(l * n);
                     transform_line(line, s, n, step, cutoff);
                     std::copy(s.d.begin(), s.d.begin() + n, line);
@@ -182,37 +188,37 @@ namespace {
 
 // The transform along x of one row of binary features (a voxel is one where f is nonzero, or with
 // kZeroIsFeature where it is 0): (x·s − p·s)² to the nearest feature p of the row (the left one on
-// a tie), +infinity without one.
+// a tie), +infinity without one; in double (`left`: a row of scratch), each result rounded once to T.
 template <class T, bool kZeroIsFeature>
-void feature_row(const std::uint8_t* f, T* d, int n, T step) {
-    constexpr T kInf = std::numeric_limits<T>::infinity();
+void feature_row(const std::uint8_t* f, T* d, double* left, int n, double step) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
     const auto is_feature = [&](int x) { return kZeroIsFeature ? f[x] == 0 : f[x] != 0; };
     int last = -1;
     for (int x = 0; x < n; ++x) {
         if (is_feature(x)) last = x;
-        d[x] = last < 0 ? kInf : static_cast<T>(x) * step - static_cast<T>(last) * step;
+        left[x] = last < 0 ? kInf : x * step - last * step;
     }
     int next = -1;
     for (int x = n - 1; x >= 0; --x) {
         if (is_feature(x)) next = x;
-        const T left = d[x];
-        const T right = next < 0 ? kInf : static_cast<T>(next) * step - static_cast<T>(x) * step;
-        const T nearest = right < left ? right : left;
-        d[x] = nearest * nearest;
+        const double right = next < 0 ? kInf : next * step - x * step;
+        const double nearest = right < left[x] ? right : left[x];
+        d[x] = static_cast<T>(nearest * nearest);
     }
 }
 
 template <class T, bool kZeroIsFeature>
-Grid<T> transform(const Grid<std::uint8_t>& features, T max_mm2) {
+Grid<T> transform(const Grid<std::uint8_t>& features, double max_mm2) {
     Grid<T> dist(features.lattice());
     if (dist.size() == 0) return dist;
     const Vec3i d = features.dims();
-    const auto step = static_cast<T>(features.lattice().spacing().x);
+    const double step = features.lattice().spacing().x;
     tbb::parallel_for(tbb::blocked_range<int>(0, d.z), [&](const tbb::blocked_range<int>& zs) {
+        std::vector<double> left(static_cast<std::size_t>(d.x));
         for (int z = zs.begin(); z < zs.end(); ++z)
             for (int y = 0; y < d.y; ++y) {
                 const std::size_t row = features.lattice().index({0, y, z});
-                feature_row<T, kZeroIsFeature>(features.values().data() + row, dist.values().data() + row, d.x, step);
+                feature_row<T, kZeroIsFeature>(features.values().data() + row, dist.values().data() + row, left.data(), d.x, step);
             }
     });
     for (int axis = 1; axis < 3; ++axis) transform_axis(dist, axis, max_mm2);
@@ -226,7 +232,7 @@ Grid<double> squared_distance_transform_mm(const Grid<std::uint8_t>& features, d
 }
 
 Grid<float> squared_distance_to_outside_mm(const Grid<std::uint8_t>& mask) {
-    return transform<float, true>(mask, std::numeric_limits<float>::infinity());
+    return transform<float, true>(mask, std::numeric_limits<double>::infinity());
 }
 
 SurfaceDistance surface_distance(const Grid<std::uint8_t>& mask, const Grid<std::uint8_t>& truth) {

@@ -25,12 +25,12 @@ std::vector<PointIndex> boundary_voxels(const Grid<std::uint8_t>& mask);
 // the passes then skip the sites beyond it.
 Grid<double> squared_distance_transform_mm(const Grid<std::uint8_t>& features,
                                            double max_mm2 = std::numeric_limits<double>::infinity());
-// The same transform in single precision, to the voxels where `mask` is 0 (its complement as the
-// features, without building it): half the memory, which a brain mask's depth reads in (depth_mm).
-// At 1 mm (any integer spacing) every value is the double transform's: the squared distances are
-// integers, exact in a float below 2^24 mm², and where rounding moves an envelope's break point
-// (by under a float's ulp) the two parabolas meeting there give the same integer at the
-// lattice point. At other spacings the values agree to a few float ulps.
+// The same transform stored in single precision, to the voxels where `mask` is 0 (its complement
+// as the features, without building it): half the memory, which a brain mask's depth reads in
+// (depth_mm). Each pass computes in double, as the transform above, and rounds its values once to
+// float; so at integer spacings every value is the double transform's (squared distances are
+// integers, exact in a float below 2^24 mm², distances under 4 m), and at others each pass's
+// rounding moves a value by at most a float's half ulp.
 Grid<float> squared_distance_to_outside_mm(const Grid<std::uint8_t>& mask);
 
 struct SurfaceDistance {

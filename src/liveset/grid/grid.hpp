@@ -48,6 +48,10 @@ void for_grid_blocks(std::size_t n, std::size_t grain, void (*f)(void*, std::siz
 
 template <class T>
 class Grid {
+    // Filled and copied by assignment over default-initialised elements (GridAllocator).
+    static_assert(std::is_default_constructible_v<T> && std::is_copy_assignable_v<T>,
+                  "a grid's elements are default-constructible and copy-assignable");
+
 public:
     Grid() = default;
     explicit Grid(const Lattice& lattice, T fill = T{}) : lattice_(lattice), data_(lattice.size()) {

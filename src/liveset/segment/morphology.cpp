@@ -456,7 +456,8 @@ Grid<std::uint8_t> fill_holes(const Grid<std::uint8_t>& mask) {
 
 // In single precision, in place (docs/BENCHMARKS.md, session 75): at integer spacings the same bits
 // as the double transform's root (the squared distances are the same integers, and a float's root
-// of one is the double root rounded, sqrt's double rounding being innocuous).
+// of one is the double root rounded, sqrt's double rounding being innocuous); at others the values
+// may differ from that by a float's rounding.
 Grid<float> depth_mm(const Grid<std::uint8_t>& mask) {
     Grid<float> out = squared_distance_to_outside_mm(mask);
     const std::span<float> v = out.values();
