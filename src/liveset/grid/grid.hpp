@@ -54,10 +54,7 @@ class Grid {
 
 public:
     Grid() = default;
-    explicit Grid(const Lattice& lattice, T fill = T{}) : lattice_(lattice), data_(lattice.size()) {
-        T* const d = data_.data();
-        in_blocks([d, &fill](std::size_t b, std::size_t e) { std::fill(d + b, d + e, fill); });
-    }
+    explicit Grid(const Lattice& lattice, T value = T{}) : lattice_(lattice), data_(lattice.size()) { fill(value); }
     Grid(const Grid& other) : lattice_(other.lattice_), data_(other.size()) { copy_from(other); }
     Grid(Grid&&) noexcept = default;
     Grid& operator=(const Grid& other) {
@@ -101,7 +98,11 @@ public:
 
     std::span<T> values() { return data_; }
     std::span<const T> values() const { return data_; }
-    void fill(T v) { std::fill(data_.begin(), data_.end(), v); }
+    // In parallel 2 MiB blocks for a whole-lattice grid (in_blocks), as the constructor fills.
+    void fill(T v) {
+        T* const d = data_.data();
+        in_blocks([d, &v](std::size_t b, std::size_t e) { std::fill(d + b, d + e, v); });
+    }
 
 private:
     // f(begin, end) over the elements, in parallel for a whole-lattice grid (detail::kLargeBlock up).
