@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "liveset/segment/tissue_model.hpp"
+#include "liveset/segment/voxel_loops.hpp"
 
 namespace liveset::brain_detail {
 
@@ -107,11 +108,12 @@ Histogram histogram(const Grid<float>& image, const Mask& mask, double lo, doubl
     Histogram h;
     h.lo = lo;
     h.width = (hi - lo) / kBins;
-    for (std::size_t i = 0; i < image.size(); ++i) {
+    const std::vector<std::size_t> counts = voxel_loops::histogram(image.size(), kBins, [&](std::size_t i) {
         const double v = image[static_cast<PointIndex>(i)];
-        if (mask[static_cast<PointIndex>(i)] == 0 || v < lo || v > hi) continue;
-        h.counts[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((v - lo) / h.width)))] += 1.0;
-    }
+        if (mask[static_cast<PointIndex>(i)] == 0 || !(v >= lo && v <= hi)) return std::size_t{kBins};  // NaN too
+        return static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>((v - lo) / h.width)));
+    });
+    for (int k = 0; k < kBins; ++k) h.counts[static_cast<std::size_t>(k)] = static_cast<double>(counts[static_cast<std::size_t>(k)]);
     return h;
 }
 
@@ -230,11 +232,15 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
         into.wm_low_sigma = std::max(h.width, (into.wm_peak - h.centre(p.low)) / 1.1774);
         into.deep_above = into.deep_below = 0;
         const double narrow = std::min(into.wm_sigma, into.wm_low_sigma);
-        double n = 0, above = 0, below = 0;
-        for (std::size_t k = 0; k < deep.size(); ++k)
-            if (const double x = image[static_cast<PointIndex>(k)]; deep[static_cast<PointIndex>(k)] != 0 && x > r.background_threshold)
-                n += 1, above += x > into.wm_peak + 3 * narrow, below += x < into.wm_peak - 3 * narrow;
-        if (n > 0) into.deep_above = above / n, into.deep_below = below / n;
+        // The deep voxels above the background (bin 0), of them those above and below 3 σ (bins 1, 2).
+        const double hi = into.wm_peak + 3 * narrow, lo = into.wm_peak - 3 * narrow;
+        const std::vector<std::size_t> c = voxel_loops::histogram(deep.size(), 4, [&](std::size_t k) -> std::size_t {
+            const double x = image[static_cast<PointIndex>(k)];
+            if (deep[static_cast<PointIndex>(k)] == 0 || !(x > r.background_threshold)) return 4;
+            return x > hi ? 1 : x < lo ? 2 : 3;
+        });
+        const double n = static_cast<double>(c[1] + c[2] + c[3]);
+        if (n > 0) into.deep_above = static_cast<double>(c[1]) / n, into.deep_below = static_cast<double>(c[2]) / n;
     };
     // White matter: the tallest peak (a T1's deep head is mostly white matter).
     take(tallest(s), r);

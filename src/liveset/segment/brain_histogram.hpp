@@ -26,7 +26,7 @@ std::optional<float> quantile_above(const Grid<float>& image, const Mask* mask, 
 std::vector<float> quantiles_above(const Grid<float>& image, const Mask* mask, double above, std::span<const double> fractions);
 
 // A kBins-bin histogram over [lo, hi] of the image's voxels inside `mask` (values outside the range
-// are not counted).
+// and NaN are not counted).
 struct Histogram {
     double lo = 0, width = 1;
     std::vector<double> counts = std::vector<double>(kBins, 0.0);

@@ -17,6 +17,7 @@
 
 #include "liveset/segment/morphology.hpp"
 #include "liveset/segment/smoothing.hpp"
+#include "liveset/segment/voxel_loops.hpp"
 
 namespace liveset {
 
@@ -46,9 +47,7 @@ using brain_detail::white_matter_peak;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::size_t count(const Mask& m) {
-    std::size_t n = 0;
-    for (std::uint8_t v : m.values()) n += v != 0;
-    return n;
+    return voxel_loops::count_if(m.size(), [&](std::size_t i) { return m[static_cast<PointIndex>(i)] != 0; });
 }
 
 void check_image(const Grid<float>& image) {
@@ -102,15 +101,16 @@ std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
     const float lowest = *std::min_element(image.values().begin(), image.values().end());
     if (!(lowest < mode)) return std::nullopt;  // constant_fill's case
     Mask inside(image.lattice());
-    for (std::size_t i = 0; i < inside.size(); ++i) inside[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != mode;
+    voxel_loops::for_each(inside.size(), [&](std::size_t i) { inside[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != mode; });
     inside = fill_holes(inside);
     const std::size_t n_inside = count(inside);
     if (static_cast<double>(inside.size() - n_inside) < 0.02 * static_cast<double>(image.size())) return std::nullopt;
-    std::size_t darker = 0;  // within the tissue's range: a share of the inside lies below it, not a few
-    for (std::size_t i = 0; i < inside.size(); ++i) darker += inside[static_cast<PointIndex>(i)] != 0 && image[static_cast<PointIndex>(i)] < mode;
+    // Within the tissue's range: a share of the inside lies below it, not a few.
+    const std::size_t darker = voxel_loops::count_if(
+        inside.size(), [&](std::size_t i) { return inside[static_cast<PointIndex>(i)] != 0 && image[static_cast<PointIndex>(i)] < mode; });
     if (static_cast<double>(darker) < 0.05 * static_cast<double>(n_inside)) return std::nullopt;  // air at 0 and a resampler's undershoot
     outside = std::move(inside);
-    for (std::uint8_t& v : outside.values()) v = v == 0;
+    voxel_loops::for_each(outside.size(), [&](std::size_t i) { outside[static_cast<PointIndex>(i)] = outside[static_cast<PointIndex>(i)] == 0; });
     return mode;
 }
 
@@ -135,11 +135,11 @@ double background_noise(const Grid<float>& image, double floor, double base, dou
     if (!(base > floor) || !(top > base)) return 0.0;
     const double width = (base - floor) / 64;
     const int bins = static_cast<int>(std::min(1024.0, std::ceil((top - floor) / width)));
-    std::vector<double> c(static_cast<std::size_t>(bins), 0.0);
-    for (float v : image.values()) {
-        const double k = (v - floor) / width;
-        if (k >= 0 && k < bins) c[static_cast<std::size_t>(k)] += 1.0;
-    }
+    const std::vector<std::size_t> n = voxel_loops::histogram(image.size(), static_cast<std::size_t>(bins), [&](std::size_t i) {
+        const double k = (image[static_cast<PointIndex>(i)] - floor) / width;
+        return k >= 0 && k < bins ? static_cast<std::size_t>(k) : static_cast<std::size_t>(bins);
+    });
+    const std::vector<double> c(n.begin(), n.end());
     const std::vector<double> s = smoothed(c, 2.0);
     const auto at = [&](int i) { return s[static_cast<std::size_t>(i)]; };
     for (int peak = 1; peak < 64 && 3 * peak + 1 < bins; ++peak) {  // a mode above `base` is no background
@@ -189,7 +189,7 @@ double max_spacing(const Lattice& l) { return std::max({l.spacing().x, l.spacing
 // voxels that a few mm of erosion removes).
 Mask head_foreground(const Grid<float>& image, double threshold) {
     Mask f(image.lattice());
-    for (std::size_t i = 0; i < f.size(); ++i) f[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > threshold;
+    voxel_loops::for_each(f.size(), [&](std::size_t i) { f[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > threshold; });
     f = large_components(f, 0.1);
     const std::size_t n = count(f);
     const double r = std::max(3.0, 2.0 * max_spacing(image.lattice()));
@@ -204,12 +204,12 @@ Mask stripped_foreground(const Grid<float>& image, double threshold) {
     const std::optional<float> fill = constant_fill(image);
     const double floor = fill ? *fill : threshold;
     Mask f(image.lattice());
-    for (std::size_t i = 0; i < f.size(); ++i) f[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > floor;
+    voxel_loops::for_each(f.size(), [&](std::size_t i) { f[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > floor; });
     return fill_holes(largest_component(f));
 }
 
 Mask intersect(Mask a, const Mask& b) {
-    for (std::size_t i = 0; i < a.size(); ++i) a[static_cast<PointIndex>(i)] &= b[static_cast<PointIndex>(i)] != 0;
+    voxel_loops::for_each(a.size(), [&](std::size_t i) { a[static_cast<PointIndex>(i)] &= b[static_cast<PointIndex>(i)] != 0; });
     return a;
 }
 
@@ -221,22 +221,22 @@ Mask intersect(Mask a, const Mask& b) {
 // widened the brain's cross-section there and the head read as tilted, its neck taken in.
 Mask with_bright_csf(const Mask& brain, const Mask& head, const Grid<float>& smooth, double above, double reach_mm) {
     Mask grown = dilate_mm(brain, reach_mm);
-    for (std::size_t i = 0; i < grown.size(); ++i) {
+    voxel_loops::for_each(grown.size(), [&](std::size_t i) {
         const auto p = static_cast<PointIndex>(i);
         grown[p] = brain[p] != 0 || (grown[p] != 0 && head[p] != 0 && smooth[p] > above);
-    }
+    });
     grown = largest_component(grown);
-    for (std::size_t i = 0; i < grown.size(); ++i) grown[static_cast<PointIndex>(i)] |= brain[static_cast<PointIndex>(i)];  // nothing lost
+    voxel_loops::for_each(grown.size(), [&](std::size_t i) { grown[static_cast<PointIndex>(i)] |= brain[static_cast<PointIndex>(i)]; });  // nothing lost
     return fill_holes(grown);
 }
 
 // Tissue window → erosion → largest component → regrowth inside the window → fill → close → rim.
 Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Mask& head, const BrainMaskOptions& o, BrainMaskReport& r) {
     Mask tissue(image.lattice());
-    for (std::size_t i = 0; i < tissue.size(); ++i) {
+    voxel_loops::for_each(tissue.size(), [&](std::size_t i) {
         const double v = smooth[static_cast<PointIndex>(i)];
         tissue[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && v >= r.tissue_low && v <= r.tissue_high;
-    }
+    });
     r.tissue_voxels = count(tissue);
     const Mask core = largest_component(erode_mm(tissue, o.erosion_mm));
     r.core_voxels = count(core);
@@ -246,9 +246,10 @@ Mask extract_brain(const Grid<float>& image, const Grid<float>& smooth, const Ma
     brain = fill_holes(close_mm(brain, o.closing_mm));
     if (o.rim_mm > 0) {
         Mask rim = dilate_mm(brain, o.rim_mm);
-        for (std::size_t i = 0; i < rim.size(); ++i)
-            rim[static_cast<PointIndex>(i)] &= head[static_cast<PointIndex>(i)] != 0 && image[static_cast<PointIndex>(i)] > r.background_threshold;
-        for (std::size_t i = 0; i < rim.size(); ++i) rim[static_cast<PointIndex>(i)] |= brain[static_cast<PointIndex>(i)];
+        voxel_loops::for_each(rim.size(), [&](std::size_t i) {
+            const auto p = static_cast<PointIndex>(i);
+            rim[p] = static_cast<std::uint8_t>(brain[p] | (rim[p] & (head[p] != 0 && image[p] > r.background_threshold)));
+        });
         brain = fill_holes(rim);
     }
     return brain;

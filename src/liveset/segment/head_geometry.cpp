@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numbers>
 #include <utility>
@@ -105,13 +106,19 @@ Mask cranial(const Mask& head, const Vertical& up, double extent_mm, std::size_t
     const Vec3i d = head.dims();
     const double top = head_top(head, up);
     Mask out = head;
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x)
-                if (out({x, y, z}) != 0 && up.height({x, y, z}) < top - extent_mm) {
-                    out({x, y, z}) = 0;
-                    ++below;
-                }
+    below = tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, d.z), std::size_t{0},
+        [&](const tbb::blocked_range<int>& zs, std::size_t n) {
+            for (int z = zs.begin(); z < zs.end(); ++z)
+                for (int y = 0; y < d.y; ++y)
+                    for (int x = 0; x < d.x; ++x)
+                        if (out({x, y, z}) != 0 && up.height({x, y, z}) < top - extent_mm) {
+                            out({x, y, z}) = 0;
+                            ++n;
+                        }
+            return n;
+        },
+        std::plus<>());
     return out;
 }
 
@@ -119,13 +126,23 @@ double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
     const Vec3i d = head.dims();
     const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
     const double top = head_top(head, up);
-    std::vector<std::size_t> layer(static_cast<std::size_t>(std::lround(depth_mm / layer_mm)) + 1, 0);
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x) {
-                const auto k = static_cast<std::size_t>(std::lround((top - up.height({x, y, z})) / layer_mm));
-                if (head({x, y, z}) != 0 && k < layer.size()) ++layer[k];
-            }
+    using Layers = std::vector<std::size_t>;  // voxels per layer below the top (counts: any order)
+    const Layers layer = tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, d.z), Layers(static_cast<std::size_t>(std::lround(depth_mm / layer_mm)) + 1, 0),
+        [&](const tbb::blocked_range<int>& zs, Layers n) {
+            for (int z = zs.begin(); z < zs.end(); ++z)
+                for (int y = 0; y < d.y; ++y)
+                    for (int x = 0; x < d.x; ++x) {
+                        if (head({x, y, z}) == 0) continue;
+                        const auto k = static_cast<std::size_t>(std::lround((top - up.height({x, y, z})) / layer_mm));
+                        if (k < n.size()) ++n[k];
+                    }
+            return n;
+        },
+        [](Layers a, const Layers& b) {
+            for (std::size_t k = 0; k < a.size(); ++k) a[k] += b[k];
+            return a;
+        });
     const Vec3d sp = head.lattice().spacing();
     const double widest = static_cast<double>(*std::max_element(layer.begin(), layer.end())) * sp.x * sp.y * sp.z / layer_mm;  // mm²
     return 2.0 * std::sqrt(widest / std::numbers::pi);
@@ -135,14 +152,19 @@ double cut_contact_mm2(const Mask& brain, const Vertical& up, double cut) {
     const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
     const double slab = layer_mm * std::ceil(3.0 / layer_mm - 1e-9);
     const Vec3i d = brain.dims();
-    std::size_t n = 0;
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y)
-            for (int x = 0; x < d.x; ++x)
-                if (brain({x, y, z}) != 0) {
-                    const double h = up.height({x, y, z});
-                    n += h >= cut && h < cut + slab;
-                }
+    const std::size_t n = tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, d.z), std::size_t{0},
+        [&](const tbb::blocked_range<int>& zs, std::size_t c) {
+            for (int z = zs.begin(); z < zs.end(); ++z)
+                for (int y = 0; y < d.y; ++y)
+                    for (int x = 0; x < d.x; ++x)
+                        if (brain({x, y, z}) != 0) {
+                            const double h = up.height({x, y, z});
+                            c += h >= cut && h < cut + slab;
+                        }
+            return c;
+        },
+        std::plus<>());
     const Vec3d s = brain.lattice().spacing();
     return static_cast<double>(n) * s.x * s.y * s.z / slab;
 }

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "liveset/grid/large_page_allocator.hpp"
+#include "liveset/segment/voxel_loops.hpp"
 
 namespace liveset {
 
@@ -101,7 +102,7 @@ Grid<float> normalise(const Grid<float>& image, const IntensityScale& scale) {
     Grid<float> out(image.lattice());
     const std::span<const float> in = image.values();
     const std::span<float> o = out.values();
-    for (std::size_t i = 0; i < in.size(); ++i) o[i] = static_cast<float>(scale.to_unit(in[i]));
+    voxel_loops::for_each(in.size(), [&](std::size_t i) { o[i] = static_cast<float>(scale.to_unit(in[i])); });
     return out;
 }
 

@@ -3,6 +3,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #if defined(__SSE2__)
@@ -23,6 +24,7 @@
 #include "liveset/eval/surface_distance.hpp"
 #include "liveset/eval/topology.hpp"
 #include "liveset/grid/uninit_allocator.hpp"
+#include "liveset/segment/voxel_loops.hpp"
 
 namespace liveset {
 
@@ -83,7 +85,7 @@ void check_radius(double r) {
 
 Grid<std::uint8_t> complement(const Grid<std::uint8_t>& mask) {
     Grid<std::uint8_t> out(mask.lattice());
-    for (std::size_t i = 0; i < mask.size(); ++i) out[static_cast<PointIndex>(i)] = mask[static_cast<PointIndex>(i)] == 0;
+    voxel_loops::for_each(mask.size(), [&](std::size_t i) { out[static_cast<PointIndex>(i)] = mask[static_cast<PointIndex>(i)] == 0; });
     return out;
 }
 
@@ -122,19 +124,27 @@ struct Box {
 // The bounding box of the nonzero voxels (empty when there is none).
 Box bounding_box(const Grid<std::uint8_t>& mask) {
     const Vec3i d = mask.dims();
-    Box b{d, {0, 0, 0}};
     const std::uint8_t* v = mask.values().data();
-    for (int z = 0; z < d.z; ++z)
-        for (int y = 0; y < d.y; ++y) {
-            const std::uint8_t* row = v + (static_cast<std::size_t>(z) * static_cast<std::size_t>(d.y) + static_cast<std::size_t>(y)) * static_cast<std::size_t>(d.x);
-            int first = 0, last = d.x - 1;
-            while (first < d.x && row[first] == 0) ++first;
-            if (first == d.x) continue;
-            while (row[last] == 0) --last;
-            b.lo = {std::min(b.lo.x, first), std::min(b.lo.y, y), std::min(b.lo.z, z)};
-            b.hi = {std::max(b.hi.x, last + 1), std::max(b.hi.y, y + 1), std::max(b.hi.z, z + 1)};
-        }
-    return b;
+    const Box none{d, {0, 0, 0}};
+    return tbb::parallel_reduce(
+        tbb::blocked_range<int>(0, d.z), none,
+        [&](const tbb::blocked_range<int>& zs, Box b) {
+            for (int z = zs.begin(); z < zs.end(); ++z)
+                for (int y = 0; y < d.y; ++y) {
+                    const std::uint8_t* row = v + (static_cast<std::size_t>(z) * static_cast<std::size_t>(d.y) + static_cast<std::size_t>(y)) * static_cast<std::size_t>(d.x);
+                    int first = 0, last = d.x - 1;
+                    while (first < d.x && row[first] == 0) ++first;
+                    if (first == d.x) continue;
+                    while (row[last] == 0) --last;
+                    b.lo = {std::min(b.lo.x, first), std::min(b.lo.y, y), std::min(b.lo.z, z)};
+                    b.hi = {std::max(b.hi.x, last + 1), std::max(b.hi.y, y + 1), std::max(b.hi.z, z + 1)};
+                }
+            return b;
+        },
+        [](const Box& a, const Box& b) {
+            return Box{{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y), std::min(a.lo.z, b.lo.z)},
+                       {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y), std::max(a.hi.z, b.hi.z)}};
+        });
 }
 
 Box grown(const Box& b, Vec3i k, Vec3i dims) {
@@ -371,16 +381,13 @@ Grid<std::uint8_t> within_by_transform(const Grid<std::uint8_t>& features, const
     const double r2 = b.limit;
     const Grid<double> d2 = squared_distance_transform_mm(features, r2);
     Grid<std::uint8_t> out(features.lattice());
-    for (std::size_t i = 0; i < out.size(); ++i) {
-        const double v = d2[static_cast<PointIndex>(i)];
-        out[static_cast<PointIndex>(i)] = v <= r2;
-    }
+    voxel_loops::for_each(out.size(), [&](std::size_t i) { out[static_cast<PointIndex>(i)] = d2[static_cast<PointIndex>(i)] <= r2; });
     return out;
 }
 
 Grid<std::uint8_t> binarised(const Grid<std::uint8_t>& mask) {
     Grid<std::uint8_t> out(mask.lattice());
-    for (std::size_t i = 0; i < mask.size(); ++i) out[static_cast<PointIndex>(i)] = mask[static_cast<PointIndex>(i)] != 0;
+    voxel_loops::for_each(mask.size(), [&](std::size_t i) { out[static_cast<PointIndex>(i)] = mask[static_cast<PointIndex>(i)] != 0; });
     return out;
 }
 
@@ -393,7 +400,9 @@ Grid<std::uint8_t> erode_mm(const Grid<std::uint8_t>& mask, double radius_mm) {
     const Ball b = ball(mask.lattice(), radius_mm);
     Grid<std::uint8_t> out = by_chords(b) ? near_features(mask, false, bounding_box(mask), b)
                                           : within_by_transform(complement(mask), b);
-    for (std::size_t i = 0; i < out.size(); ++i) out[static_cast<PointIndex>(i)] = mask[static_cast<PointIndex>(i)] != 0 && out[static_cast<PointIndex>(i)] == 0;
+    voxel_loops::for_each(out.size(), [&](std::size_t i) {
+        out[static_cast<PointIndex>(i)] = mask[static_cast<PointIndex>(i)] != 0 && out[static_cast<PointIndex>(i)] == 0;
+    });
     return out;
 }
 
@@ -407,7 +416,7 @@ Grid<std::uint8_t> dilate_mm(const Grid<std::uint8_t>& mask, double radius_mm) {
 
 Grid<std::uint8_t> close_mm(const Grid<std::uint8_t>& mask, double radius_mm) {
     Grid<std::uint8_t> out = erode_mm(dilate_mm(mask, radius_mm), radius_mm);
-    for (std::size_t i = 0; i < out.size(); ++i) out[static_cast<PointIndex>(i)] |= mask[static_cast<PointIndex>(i)] != 0;
+    voxel_loops::for_each(out.size(), [&](std::size_t i) { out[static_cast<PointIndex>(i)] |= mask[static_cast<PointIndex>(i)] != 0; });
     return out;
 }
 

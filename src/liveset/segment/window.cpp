@@ -3,6 +3,7 @@
 
 #include "liveset/segment/brain_mask.hpp"
 #include "liveset/segment/smoothing.hpp"
+#include "liveset/segment/voxel_loops.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -49,7 +50,7 @@ Grid<std::uint8_t> model_region(const Grid<float>& image, const Grid<std::uint8_
     // Background and the tissue classes: the lowest threshold separates the background.
     const std::vector<double> t = otsu_thresholds(image.values(), std::min(classes + 1, 6));
     Grid<std::uint8_t> fg(image.lattice(), 0);
-    for (std::size_t i = 0; i < image.size(); ++i) fg[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > t[0];
+    voxel_loops::for_each(image.size(), [&](std::size_t i) { fg[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] > t[0]; });
     return fg;
 }
 
