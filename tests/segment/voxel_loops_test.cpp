@@ -4,11 +4,13 @@
 
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "liveset/segment/brain_histogram.hpp"
@@ -53,6 +55,38 @@ TEST(VoxelLoops, MapCountAndHistogramAreTheSerialLoops) {
             EXPECT_EQ(h, serial_hist) << threads << " threads";
             EXPECT_EQ(voxel_loops::count_if(0, [](std::size_t) { return true; }), 0u);
             EXPECT_EQ(voxel_loops::histogram(0, 4, [](std::size_t) { return std::size_t{0}; }), std::vector<std::size_t>(4, 0));
+        });
+}
+
+// A reduction's parts: min(kMaxParts, n / grain) of them (at least one), consecutive, covering
+// [0, n), set by n and grain alone and folded in order, on any thread count.
+TEST(VoxelLoops, ReductionsFoldFixedPartsInOrder) {
+    using Parts = std::vector<std::pair<std::size_t, std::size_t>>;
+    const auto parts = [](std::size_t n, std::size_t grain) {
+        return voxel_loops::reduce(
+            n, grain, Parts{},
+            [](std::size_t b, std::size_t e, Parts p) {
+                p.emplace_back(b, e);
+                return p;
+            },
+            [](Parts a, const Parts& b) {
+                a.insert(a.end(), b.begin(), b.end());
+                return a;
+            });
+    };
+    for (const int threads : {1, 3})
+        on_threads(threads, [&] {
+            for (const auto& [n, grain] : std::vector<std::pair<std::size_t, std::size_t>>{{0, 1}, {5, 10}, {37, 10}, {1000, 10}, {kN, voxel_loops::kBlock}}) {
+                const Parts p = parts(n, grain);
+                const std::size_t expected = std::clamp<std::size_t>(n / grain, 1, voxel_loops::kMaxParts);
+                ASSERT_EQ(p.size(), expected) << n << " / " << grain << ", " << threads << " threads";
+                EXPECT_EQ(p.front().first, 0u);
+                EXPECT_EQ(p.back().second, n);
+                for (std::size_t k = 1; k < p.size(); ++k) {
+                    EXPECT_EQ(p[k].first, p[k - 1].second);
+                    EXPECT_GE(p[k].second - p[k].first, n / expected);  // no part below the average's floor
+                }
+            }
         });
 }
 

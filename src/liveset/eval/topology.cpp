@@ -2,6 +2,7 @@
 #include "liveset/eval/topology.hpp"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -13,6 +14,7 @@
 #include <stdexcept>
 #include <string>
 #include <utility>
+#include <vector>
 
 namespace liveset {
 
@@ -142,19 +144,32 @@ RunComponents component_runs(const Grid<std::uint8_t>& mask, int connectivity, b
     const std::uint8_t* in = mask.values().data();
     RunComponents c;
     c.row_begin.assign(static_cast<std::size_t>(d.y) * static_cast<std::size_t>(d.z) + 1, 0);
-    for (std::size_t r = 0; r + 1 < c.row_begin.size(); ++r) {
-        const std::uint8_t* row = in + r * static_cast<std::size_t>(d.x);
-        for (int x = 0; x < d.x;) {
-            if ((row[x] != 0) != foreground) {
-                ++x;
-                continue;
+    // The runs of each plane on every thread (its rows' run counts in row_begin, then summed),
+    // joined in plane order: the serial scan's runs.
+    std::vector<std::vector<VoxelRun>> plane_runs(static_cast<std::size_t>(d.z));
+    tbb::parallel_for(tbb::blocked_range<int>(0, d.z), [&](const tbb::blocked_range<int>& zs) {
+        for (int z = zs.begin(); z < zs.end(); ++z) {
+            std::vector<VoxelRun>& runs = plane_runs[static_cast<std::size_t>(z)];
+            for (int y = 0; y < d.y; ++y) {
+                const std::size_t r = static_cast<std::size_t>(z) * static_cast<std::size_t>(d.y) + static_cast<std::size_t>(y);
+                const std::uint8_t* row = in + r * static_cast<std::size_t>(d.x);
+                const std::size_t before = runs.size();
+                for (int x = 0; x < d.x;) {
+                    if ((row[x] != 0) != foreground) {
+                        ++x;
+                        continue;
+                    }
+                    const int x0 = x;
+                    while (x < d.x && (row[x] != 0) == foreground) ++x;
+                    runs.push_back({x0, x});
+                }
+                c.row_begin[r + 1] = runs.size() - before;
             }
-            const int x0 = x;
-            while (x < d.x && (row[x] != 0) == foreground) ++x;
-            c.runs.push_back({x0, x});
         }
-        c.row_begin[r + 1] = c.runs.size();
-    }
+    });
+    for (std::size_t r = 1; r < c.row_begin.size(); ++r) c.row_begin[r] += c.row_begin[r - 1];
+    c.runs.reserve(c.row_begin.back());
+    for (const std::vector<VoxelRun>& runs : plane_runs) c.runs.insert(c.runs.end(), runs.begin(), runs.end());
     LabelForest forest;  // run k is label k + 1
     std::vector<std::uint32_t> parent(c.runs.size() + 1);
     std::iota(parent.begin(), parent.end(), std::uint32_t{0});

@@ -4,7 +4,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <array>
@@ -195,21 +194,19 @@ std::optional<Peak> brightest_above_tallest(const std::vector<double>& s) {
 }
 
 // The deepest half of `head` by `depth`: its voxels at least half as deep as the deepest.
-// In parallel blocks (a maximum: the same whatever the order).
+// In parallel blocks (a maximum over fixed parts: the same on any thread count).
 Mask deep_half(const Mask& head, const Grid<float>& depth) {
-    const tbb::blocked_range<std::size_t> all(0, head.size(), std::size_t{1} << 16);
-    const float deepest = tbb::parallel_reduce(
-        all, 0.0f,
-        [&](const tbb::blocked_range<std::size_t>& r, float d) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i)
+    const float deepest = voxel_loops::reduce(
+        head.size(), voxel_loops::kBlock, 0.0f,
+        [&](std::size_t b, std::size_t e, float d) {
+            for (std::size_t i = b; i != e; ++i)
                 if (head[static_cast<PointIndex>(i)] != 0) d = std::max(d, depth[static_cast<PointIndex>(i)]);
             return d;
         },
         [](float a, float b) { return std::max(a, b); });
     Mask deep(head.lattice());
-    tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i)
-            deep[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && depth[static_cast<PointIndex>(i)] >= 0.5f * deepest;
+    voxel_loops::for_each(head.size(), [&](std::size_t i) {
+        deep[static_cast<PointIndex>(i)] = head[static_cast<PointIndex>(i)] != 0 && depth[static_cast<PointIndex>(i)] >= 0.5f * deepest;
     });
     return deep;
 }

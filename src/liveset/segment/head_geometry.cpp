@@ -1,16 +1,14 @@
 // Head geometry for the automatic brain mask (see head_geometry.hpp).
 #include "liveset/segment/head_geometry.hpp"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_reduce.h>
-
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <numbers>
 #include <utility>
 #include <vector>
+
+#include "liveset/segment/voxel_loops.hpp"
 
 namespace liveset::brain_detail {
 
@@ -32,15 +30,15 @@ double face_exit_mm2(const Mask& head, int a, int side) {
 
 }  // namespace
 
-// Slices z in parallel (counts and maxima: the same whatever the order).
+// Slices z in parallel (counts and maxima over fixed parts: the same on any thread count).
 double surface_contact(const Mask& mask, const Grid<float>& head_depth, double near_mm) {
     const Lattice& lat = mask.lattice();
     const Vec3i d = lat.dims();
     using Counts = std::pair<std::size_t, std::size_t>;  // boundary voxels, those near the surface
-    const Counts counts = tbb::parallel_reduce(
-        tbb::blocked_range<int>(0, d.z), Counts{0, 0},
-        [&](const tbb::blocked_range<int>& zs, Counts c) {
-            for (int z = zs.begin(); z < zs.end(); ++z)
+    const Counts counts = voxel_loops::reduce(
+        static_cast<std::size_t>(d.z), 1, Counts{0, 0},
+        [&](std::size_t zb, std::size_t ze, Counts c) {
+            for (auto z = static_cast<int>(zb); z < static_cast<int>(ze); ++z)
                 for (int y = 0; y < d.y; ++y)
                     for (int x = 0; x < d.x; ++x) {
                         if (mask({x, y, z}) == 0) continue;
@@ -62,10 +60,10 @@ double surface_contact(const Mask& mask, const Grid<float>& head_depth, double n
 
 double head_top(const Mask& head, const Vertical& up) {
     const Vec3i d = head.dims();
-    return tbb::parallel_reduce(
-        tbb::blocked_range<int>(0, d.z), -std::numeric_limits<double>::infinity(),
-        [&](const tbb::blocked_range<int>& zs, double top) {
-            for (int z = zs.begin(); z < zs.end(); ++z)
+    return voxel_loops::reduce(
+        static_cast<std::size_t>(d.z), 1, -std::numeric_limits<double>::infinity(),
+        [&](std::size_t zb, std::size_t ze, double top) {
+            for (auto z = static_cast<int>(zb); z < static_cast<int>(ze); ++z)
                 for (int y = 0; y < d.y; ++y)
                     for (int x = 0; x < d.x; ++x)
                         if (head({x, y, z}) != 0) top = std::max(top, up.height({x, y, z}));
@@ -106,10 +104,10 @@ Mask cranial(const Mask& head, const Vertical& up, double extent_mm, std::size_t
     const Vec3i d = head.dims();
     const double top = head_top(head, up);
     Mask out = head;
-    below = tbb::parallel_reduce(
-        tbb::blocked_range<int>(0, d.z), std::size_t{0},
-        [&](const tbb::blocked_range<int>& zs, std::size_t n) {
-            for (int z = zs.begin(); z < zs.end(); ++z)
+    below = voxel_loops::reduce(
+        static_cast<std::size_t>(d.z), 1, std::size_t{0},
+        [&](std::size_t zb, std::size_t ze, std::size_t n) {
+            for (auto z = static_cast<int>(zb); z < static_cast<int>(ze); ++z)
                 for (int y = 0; y < d.y; ++y)
                     for (int x = 0; x < d.x; ++x)
                         if (out({x, y, z}) != 0 && up.height({x, y, z}) < top - extent_mm) {
@@ -118,7 +116,7 @@ Mask cranial(const Mask& head, const Vertical& up, double extent_mm, std::size_t
                         }
             return n;
         },
-        std::plus<>());
+        [](std::size_t a, std::size_t b) { return a + b; });
     return out;
 }
 
@@ -127,10 +125,10 @@ double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
     const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
     const double top = head_top(head, up);
     using Layers = std::vector<std::size_t>;  // voxels per layer below the top (counts: any order)
-    const Layers layer = tbb::parallel_reduce(
-        tbb::blocked_range<int>(0, d.z), Layers(static_cast<std::size_t>(std::lround(depth_mm / layer_mm)) + 1, 0),
-        [&](const tbb::blocked_range<int>& zs, Layers n) {
-            for (int z = zs.begin(); z < zs.end(); ++z)
+    const Layers layer = voxel_loops::reduce(
+        static_cast<std::size_t>(d.z), 1, Layers(static_cast<std::size_t>(std::lround(depth_mm / layer_mm)) + 1, 0),
+        [&](std::size_t zb, std::size_t ze, Layers n) {
+            for (auto z = static_cast<int>(zb); z < static_cast<int>(ze); ++z)
                 for (int y = 0; y < d.y; ++y)
                     for (int x = 0; x < d.x; ++x) {
                         if (head({x, y, z}) == 0) continue;
@@ -152,10 +150,10 @@ double cut_contact_mm2(const Mask& brain, const Vertical& up, double cut) {
     const double layer_mm = std::max({std::abs(up.g[0]), std::abs(up.g[1]), std::abs(up.g[2])});
     const double slab = layer_mm * std::ceil(3.0 / layer_mm - 1e-9);
     const Vec3i d = brain.dims();
-    const std::size_t n = tbb::parallel_reduce(
-        tbb::blocked_range<int>(0, d.z), std::size_t{0},
-        [&](const tbb::blocked_range<int>& zs, std::size_t c) {
-            for (int z = zs.begin(); z < zs.end(); ++z)
+    const std::size_t n = voxel_loops::reduce(
+        static_cast<std::size_t>(d.z), 1, std::size_t{0},
+        [&](std::size_t zb, std::size_t ze, std::size_t c) {
+            for (auto z = static_cast<int>(zb); z < static_cast<int>(ze); ++z)
                 for (int y = 0; y < d.y; ++y)
                     for (int x = 0; x < d.x; ++x)
                         if (brain({x, y, z}) != 0) {
@@ -164,7 +162,7 @@ double cut_contact_mm2(const Mask& brain, const Vertical& up, double cut) {
                         }
             return c;
         },
-        std::plus<>());
+        [](std::size_t a, std::size_t b) { return a + b; });
     const Vec3d s = brain.lattice().spacing();
     return static_cast<double>(n) * s.x * s.y * s.z / slab;
 }

@@ -3,7 +3,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 
 #if defined(__SSE2__)
@@ -126,10 +125,10 @@ Box bounding_box(const Grid<std::uint8_t>& mask) {
     const Vec3i d = mask.dims();
     const std::uint8_t* v = mask.values().data();
     const Box none{d, {0, 0, 0}};
-    return tbb::parallel_reduce(
-        tbb::blocked_range<int>(0, d.z), none,
-        [&](const tbb::blocked_range<int>& zs, Box b) {
-            for (int z = zs.begin(); z < zs.end(); ++z)
+    return voxel_loops::reduce(
+        static_cast<std::size_t>(d.z), 1, none,
+        [&](std::size_t zb, std::size_t ze, Box b) {
+            for (auto z = static_cast<int>(zb); z < static_cast<int>(ze); ++z)
                 for (int y = 0; y < d.y; ++y) {
                     const std::uint8_t* row = v + (static_cast<std::size_t>(z) * static_cast<std::size_t>(d.y) + static_cast<std::size_t>(y)) * static_cast<std::size_t>(d.x);
                     int first = 0, last = d.x - 1;

@@ -1,20 +1,21 @@
-// Whole-image loops of the preprocessing on every thread (oneTBB), in blocks of 64 Ki elements:
-// maps that write each element from its own index only, integer counts and histograms, minima and
-// maxima - results that are the serial loop's bit for bit whatever the thread count or the order.
+// Whole-image loops of the preprocessing on every thread (oneTBB): maps that write each element
+// from its own index only, and reductions over fixed parts folded in order - integer counts and
+// histograms, minima and maxima - whose results are the serial loop's bit for bit whatever the
+// thread count or the scheduling.
 #pragma once
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_reduce.h>
 
 #include <algorithm>
 #include <cstddef>
-#include <functional>
+#include <utility>
 #include <vector>
 
 namespace liveset::voxel_loops {
 
-inline constexpr std::size_t kBlock = std::size_t{1} << 16;
+inline constexpr std::size_t kBlock = std::size_t{1} << 16;  // voxels per task of a whole-image loop
+inline constexpr std::size_t kMaxParts = 64;                 // parts of a reduction
 
 // f(i) for every i in [0, n).
 template <class F>
@@ -24,16 +25,30 @@ void for_each(std::size_t n, const F& f) {
     });
 }
 
+// [0, n) in min(kMaxParts, n / grain) parts (at least one) of consecutive items, set by n and
+// grain alone: part p = body(begin, end, zero) for each, in parallel, then fold(fold(part 0,
+// part 1), part 2)... in part order. The fold runs whenever there are two parts, on any thread
+// count (so a test of a wrong fold fails on one thread too).
+template <class T, class Body, class Fold>
+T reduce(std::size_t n, std::size_t grain, const T& zero, const Body& body, const Fold& fold) {
+    const std::size_t parts = std::clamp<std::size_t>(n / std::max<std::size_t>(grain, 1), 1, kMaxParts);
+    std::vector<T> part(parts, zero);
+    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t p) { part[p] = body(n * p / parts, n * (p + 1) / parts, std::move(part[p])); });
+    T out = std::move(part.front());
+    for (std::size_t p = 1; p < parts; ++p) out = fold(std::move(out), part[p]);
+    return out;
+}
+
 // How many i in [0, n) satisfy pred(i).
 template <class P>
 std::size_t count_if(std::size_t n, const P& pred) {
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, n, kBlock), std::size_t{0},
-        [&](const tbb::blocked_range<std::size_t>& r, std::size_t c) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) c += pred(i) ? 1 : 0;
+    return reduce(
+        n, kBlock, std::size_t{0},
+        [&](std::size_t b, std::size_t e, std::size_t c) {
+            for (std::size_t i = b; i != e; ++i) c += pred(i) ? 1 : 0;
             return c;
         },
-        std::plus<>());
+        [](std::size_t a, std::size_t b) { return a + b; });
 }
 
 // Counts per bin over [0, n): bin(i) gives i's bin, or a value ≥ bins for none. Integer counts,
@@ -42,10 +57,10 @@ std::size_t count_if(std::size_t n, const P& pred) {
 template <class B>
 std::vector<std::size_t> histogram(std::size_t n, std::size_t bins, const B& bin) {
     using Counts = std::vector<std::size_t>;
-    return tbb::parallel_reduce(
-        tbb::blocked_range<std::size_t>(0, n, kBlock), Counts(bins, 0),
-        [&](const tbb::blocked_range<std::size_t>& r, Counts c) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+    return reduce(
+        n, kBlock, Counts(bins, 0),
+        [&](std::size_t b, std::size_t e, Counts c) {
+            for (std::size_t i = b; i != e; ++i) {
                 const std::size_t k = bin(i);
                 if (k < bins) ++c[k];
             }
