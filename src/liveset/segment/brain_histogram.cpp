@@ -229,15 +229,15 @@ double white_matter_peak(const Grid<float>& image, const Mask& head, const Grid<
         into.wm_low_sigma = std::max(h.width, (into.wm_peak - h.centre(p.low)) / 1.1774);
         into.deep_above = into.deep_below = 0;
         const double narrow = std::min(into.wm_sigma, into.wm_low_sigma);
-        // The deep voxels above the background (bin 0), of them those above and below 3 σ (bins 1, 2).
+        // The deep voxels above the background: 3 σ above (bin 0), 3 σ below (1), between (2).
         const double hi = into.wm_peak + 3 * narrow, lo = into.wm_peak - 3 * narrow;
-        const std::vector<std::size_t> c = voxel_loops::histogram(deep.size(), 4, [&](std::size_t k) -> std::size_t {
+        const std::vector<std::size_t> c = voxel_loops::histogram(deep.size(), 3, [&](std::size_t k) -> std::size_t {
             const double x = image[static_cast<PointIndex>(k)];
-            if (deep[static_cast<PointIndex>(k)] == 0 || !(x > r.background_threshold)) return 4;
-            return x > hi ? 1 : x < lo ? 2 : 3;
+            if (deep[static_cast<PointIndex>(k)] == 0 || !(x > r.background_threshold)) return 3;
+            return x > hi ? 0 : x < lo ? 1 : 2;
         });
-        const double n = static_cast<double>(c[1] + c[2] + c[3]);
-        if (n > 0) into.deep_above = static_cast<double>(c[1]) / n, into.deep_below = static_cast<double>(c[2]) / n;
+        const double n = static_cast<double>(c[0] + c[1] + c[2]);
+        if (n > 0) into.deep_above = static_cast<double>(c[0]) / n, into.deep_below = static_cast<double>(c[1]) / n;
     };
     // White matter: the tallest peak (a T1's deep head is mostly white matter).
     take(tallest(s), r);

@@ -137,10 +137,7 @@ double head_diameter_mm(const Mask& head, const Vertical& up, double depth_mm) {
                     }
             return n;
         },
-        [](Layers a, const Layers& b) {
-            for (std::size_t k = 0; k < a.size(); ++k) a[k] += b[k];
-            return a;
-        });
+        voxel_loops::add_counts);
     const Vec3d sp = head.lattice().spacing();
     const double widest = static_cast<double>(*std::max_element(layer.begin(), layer.end())) * sp.x * sp.y * sp.z / layer_mm;  // mm²
     return 2.0 * std::sqrt(widest / std::numbers::pi);

@@ -51,6 +51,12 @@ std::size_t count_if(std::size_t n, const P& pred) {
         [](std::size_t a, std::size_t b) { return a + b; });
 }
 
+// a + b bin by bin (the fold of per-part counts; b no longer than a).
+inline std::vector<std::size_t> add_counts(std::vector<std::size_t> a, const std::vector<std::size_t>& b) {
+    for (std::size_t k = 0; k < b.size(); ++k) a[k] += b[k];
+    return a;
+}
+
 // Counts per bin over [0, n): bin(i) gives i's bin, or a value ≥ bins for none. Integer counts,
 // so a caller's histogram of doubles built from them (each count exact below 2^53) holds the
 // serial loop's `+= 1.0` sums.
@@ -66,10 +72,7 @@ std::vector<std::size_t> histogram(std::size_t n, std::size_t bins, const B& bin
             }
             return c;
         },
-        [](Counts a, const Counts& b) {
-            for (std::size_t k = 0; k < a.size(); ++k) a[k] += b[k];
-            return a;
-        });
+        add_counts);
 }
 
 }  // namespace liveset::voxel_loops
