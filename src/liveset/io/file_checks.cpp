@@ -242,6 +242,25 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite_values
     return result;
 }
 
+bool nifti_float_data_complete(const std::string& path) {
+    std::string header_path = path, data_path = path;
+    const bool pair = pair_files(path, header_path, data_path);
+    std::unique_ptr<gzFile_s, GzClose> file(gzopen(header_path.c_str(), "rb"));
+    if (!file) return false;
+    const std::optional<NiftiLayout> layout = read_nifti_layout(file.get(), pair);
+    if (!layout || (layout->datatype != 16 && layout->datatype != 64)) return false;  // FLOAT32, FLOAT64
+    if (pair) file.reset(gzopen(data_path.c_str(), "rb"));
+    if (!file) return false;
+    const std::uint64_t end = layout->offset + layout->data_bytes;
+    if (gzdirect(file.get()) != 0) {
+        std::error_code ec;
+        const std::uint64_t size = fs::file_size(data_path, ec);
+        return !ec && size >= end;
+    }
+    std::uint32_t isize = 0;
+    return gzip_isize(data_path, isize) && isize == static_cast<std::uint32_t>(end);
+}
+
 DataCheck check_metaimage_data(const std::string& path, std::uint64_t raw_bytes) {
     DataCheck result;
     std::ifstream in(path, std::ios::binary);

@@ -11,12 +11,15 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <limits>
 #include <new>
 #include <sstream>
 #include <type_traits>
 #include <vector>
+
+#include <tbb/task_group.h>
 
 #include <itkGDCMImageIO.h>
 #include <itkGDCMSeriesFileNames.h>
@@ -377,13 +380,50 @@ void check_finite(const std::string& path, std::span<const float> values) {
     if (bad) fail_read(path, voxels_are_non_finite(bad));
 }
 
-// `nan_at` (NanVoxels::keep): receives where a NIfTI's NaN values lie (niftilib reads them as 0).
-void verify_data(const Source& src, std::vector<std::uint8_t>* nan_at = nullptr) {
-    if (!src.io) return;
-    const io_detail::DataCheck check = check_data(*src.io, src.path, true, nan_at);
+// The data check's verdict (see read_checked).
+void judge_data(const Source& src, const io_detail::DataCheck& check, const std::vector<std::uint8_t>* nan_at) {
     if (check.truncated) fail_read(src.path, "file is corrupt or truncated (" + check.detail + ")");
     if (nan_at == nullptr && check.non_finite) fail_read(src.path, voxels_are_non_finite(check.non_finite));
     if (const std::uint64_t inf = check.non_finite - check.nan; inf) fail_read(src.path, voxels_are_infinite(inf));
+}
+
+// Reads the file's voxels through `read()` with its data checked (io_detail::check_data: damage
+// ITK's readers hide, NaN and infinite values). Where the check would stream a NIfTI's float data
+// once more and the data is all there by the file's size or gzip trailer, it runs beside the read
+// on another thread (a .nii.gz decompressed twice at once: 0.4 s less on a 0.7 mm head); else
+// before it, so that ITK never reads a short file. `nan_at` (NanVoxels::keep): receives where a
+// NIfTI's NaN values lie (niftilib reads them as 0). Either way a damaged file gets the check's
+// one line, before any error of the read.
+template <class Read>
+void read_checked(const Source& src, std::vector<std::uint8_t>* nan_at, Read&& read) {
+    if (!src.io) {
+        read();
+        return;
+    }
+    if (!io_detail::data_check_may_overlap(*src.io, src.path)) {
+        judge_data(src, io_detail::check_data(*src.io, src.path, true, nan_at), nan_at);
+        read();
+        return;
+    }
+    io_detail::DataCheck check;
+    std::exception_ptr check_failed, read_failed;
+    tbb::task_group both;  // one thread (--threads 1): the check runs in wait(), after the read
+    both.run([&] {
+        try {
+            check = io_detail::check_data(*src.io, src.path, true, nan_at);
+        } catch (...) {
+            check_failed = std::current_exception();
+        }
+    });
+    try {
+        read();
+    } catch (...) {
+        read_failed = std::current_exception();
+    }
+    both.wait();
+    if (check_failed) std::rethrow_exception(check_failed);
+    judge_data(src, check, nan_at);
+    if (read_failed) std::rethrow_exception(read_failed);
 }
 
 // NanVoxels::keep: NaN where the file holds it (`nan_at`, a NIfTI's, or NaN the reader kept);
@@ -409,7 +449,6 @@ Grid<float> read_image(const std::string& path, std::uint64_t max_bytes, ImageHe
     if (header != nullptr) *header = src.header;
     const Lattice lattice = validate(src, max_bytes);
     std::vector<std::uint8_t> nan_at;
-    verify_data(src, nan == NanVoxels::keep ? &nan_at : nullptr);
     Grid<float> grid;
     try {
         grid = Grid<float>(lattice);
@@ -417,13 +456,15 @@ Grid<float> read_image(const std::string& path, std::uint64_t max_bytes, ImageHe
         fail_read(path, "not enough memory for " + dims_text(src.size) + " voxels");
     }
     std::span<float> out = grid.values();
-    if (src.io && src.io->GetComponentType() == Component::FLOAT) {
-        read_file_pixels(src, out.data());  // no conversion: straight into the grid
-    } else {
-        with_pixels(src, out.size(), [&](const auto* values, std::size_t n) {
-            std::transform(values, values + n, out.begin(), [](auto v) { return static_cast<float>(v); });
-        });
-    }
+    read_checked(src, nan == NanVoxels::keep ? &nan_at : nullptr, [&] {
+        if (src.io && src.io->GetComponentType() == Component::FLOAT) {
+            read_file_pixels(src, out.data());  // no conversion: straight into the grid
+        } else {
+            with_pixels(src, out.size(), [&](const auto* values, std::size_t n) {
+                std::transform(values, values + n, out.begin(), [](auto v) { return static_cast<float>(v); });
+            });
+        }
+    });
     if (nan == NanVoxels::keep) keep_nan(path, out, nan_at);
     else check_finite(path, out);
     return grid;
@@ -433,7 +474,6 @@ Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_b
     const Source src = open_source(path);
     if (header != nullptr) *header = src.header;
     const Lattice lattice = validate(src, max_bytes);
-    verify_data(src);
     Grid<std::uint8_t> grid;
     try {
         grid = Grid<std::uint8_t>(lattice);
@@ -441,38 +481,40 @@ Grid<std::uint8_t> read_label_image(const std::string& path, std::uint64_t max_b
         fail_read(path, "not enough memory for " + dims_text(src.size) + " voxels");
     }
     std::span<std::uint8_t> out = grid.values();
-    with_pixels(src, out.size(), [&](const auto* values, std::size_t n) {
-        using T = std::remove_cv_t<std::remove_pointer_t<decltype(values)>>;
-        std::size_t non_finite = 0, bad = 0, first_bad = n;
-        for (std::size_t i = 0; i < n; ++i) {
-            const T v = values[i];
-            bool ok;
-            if constexpr (std::is_floating_point_v<T>) {
-                if (!std::isfinite(v)) {
-                    ++non_finite;
+    read_checked(src, nullptr, [&] {
+        with_pixels(src, out.size(), [&](const auto* values, std::size_t n) {
+            using T = std::remove_cv_t<std::remove_pointer_t<decltype(values)>>;
+            std::size_t non_finite = 0, bad = 0, first_bad = n;
+            for (std::size_t i = 0; i < n; ++i) {
+                const T v = values[i];
+                bool ok;
+                if constexpr (std::is_floating_point_v<T>) {
+                    if (!std::isfinite(v)) {
+                        ++non_finite;
+                        continue;
+                    }
+                    ok = v >= 0 && v <= 255 && v == std::floor(v);
+                } else if constexpr (std::is_signed_v<T>) {
+                    ok = v >= 0 && v <= 255;
+                } else {
+                    ok = v <= 255;
+                }
+                if (!ok) {
+                    if (!bad++) first_bad = i;
                     continue;
                 }
-                ok = v >= 0 && v <= 255 && v == std::floor(v);
-            } else if constexpr (std::is_signed_v<T>) {
-                ok = v >= 0 && v <= 255;
-            } else {
-                ok = v <= 255;
+                out[i] = static_cast<std::uint8_t>(v);
             }
-            if (!ok) {
-                if (!bad++) first_bad = i;
-                continue;
+            if (non_finite) fail_read(path, voxels_are_non_finite(non_finite));
+            if (bad) {
+                std::ostringstream os;
+                os.precision(9);
+                os << "is not a label image: " << bad << (bad == 1 ? " voxel is" : " voxels are")
+                   << " not an integer in 0..255 (e.g. " << +values[first_bad] << " at voxel "
+                   << lattice.coord(static_cast<PointIndex>(first_bad)) << ")";
+                fail_read(path, os.str());
             }
-            out[i] = static_cast<std::uint8_t>(v);
-        }
-        if (non_finite) fail_read(path, voxels_are_non_finite(non_finite));
-        if (bad) {
-            std::ostringstream os;
-            os.precision(9);
-            os << "is not a label image: " << bad << (bad == 1 ? " voxel is" : " voxels are")
-               << " not an integer in 0..255 (e.g. " << +values[first_bad] << " at voxel "
-               << lattice.coord(static_cast<PointIndex>(first_bad)) << ")";
-            fail_read(path, os.str());
-        }
+        });
     });
     return grid;
 }

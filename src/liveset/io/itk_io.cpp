@@ -89,4 +89,8 @@ DataCheck check_data(const itk::ImageIOBase& io, const std::string& file, bool c
     return {};
 }
 
+bool data_check_may_overlap(const itk::ImageIOBase& io, const std::string& file) {
+    return std::string(io.GetNameOfClass()) == "NiftiImageIO" && nifti_float_data_complete(file);
+}
+
 }  // namespace liveset::io_detail

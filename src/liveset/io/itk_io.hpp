@@ -38,5 +38,8 @@ void prepare_io(itk::ImageIOBase& io);
 // check_nifti_data's.
 DataCheck check_data(const itk::ImageIOBase& io, const std::string& file, bool count_non_finite,
                      std::vector<std::uint8_t>* nan_at = nullptr);
+// Whether check_data(io, file, true) may run beside ITK's read of `file`: it would decompress or
+// stream a NIfTI's float data once more, and that data is all there (nifti_float_data_complete).
+bool data_check_may_overlap(const itk::ImageIOBase& io, const std::string& file);
 
 }  // namespace liveset::io_detail
