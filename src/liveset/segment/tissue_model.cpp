@@ -1,6 +1,8 @@
 // Tissue intensity model: histogram, multi-level Otsu start, EM with partial-volume classes, window.
 #include "liveset/segment/tissue_model.hpp"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -431,9 +433,14 @@ TissueModel fit_tissue_model(std::span<const float> values, const TissueModelOpt
     // part again. The peak start's fit is kept where it is sound and clearly more likely (a T2's
     // brain: +0.038 nats per voxel); near-equal optima (a noisy T1: ±0.0001, means a unit apart) keep
     // Otsu's, as before.
-    TissueModel m = fit_from(bins, split_start(bins, otsu_splits(bins, o.classes), total), true, total, var_floor, o);
-    if (const std::optional<TissueModel> peaks = peak_start(smooth, bins, o.classes, total)) {
-        TissueModel other = fit_from(bins, *peaks, false, total, var_floor, o);
+    // The two fits are independent (each a serial EM over the bins): run side by side.
+    const std::optional<TissueModel> peaks = peak_start(smooth, bins, o.classes, total);
+    TissueModel m, other;
+    tbb::parallel_invoke([&] { m = fit_from(bins, split_start(bins, otsu_splits(bins, o.classes), total), true, total, var_floor, o); },
+                         [&] {
+                             if (peaks) other = fit_from(bins, *peaks, false, total, var_floor, o);
+                         });
+    if (peaks) {
         // Each class a peak of its own, as it was started, and no narrower than the histogram's
         // smoothing: a spike is a value an intensity normalisation pinned (FreeSurfer's white matter
         // at 110), whose likelihood would outweigh every tissue's (BrainWeb so pinned with Rician
