@@ -60,6 +60,8 @@ protected:
         write_bytes("garbage.nii", "this is not an image at all");
         const std::string good = read_bytes(path("good.nii.gz"));
         write_bytes("truncated.nii.gz", good.substr(0, good.size() / 3));
+        // Cut short with its gzip trailer kept: the data check runs beside ITK's read (image_io.cpp).
+        write_bytes("cut_with_trailer.nii.gz", good.substr(0, good.size() / 2) + good.substr(good.size() - 8));
         write_bytes("bad_magic.nii.gz", "XXXX" + good);
         metaimage("two_d.mha", 2, "8 8", "1 1", 8 * 8 * 4);
         metaimage("four_d.mha", 4, "4 4 4 3", "1 1 1 1", 4 * 4 * 4 * 3 * 4);
@@ -137,6 +139,7 @@ const std::vector<BrokenFile> kBrokenFiles = {
     {"empty.nii.gz", "file is empty"},
     {"garbage.nii", "unknown image format or damaged header"},
     {"truncated.nii.gz", "corrupt or truncated"},
+    {"cut_with_trailer.nii.gz", "corrupt or truncated"},
     {"bad_magic.nii.gz", "unknown image format or damaged header"},
     {"two_d.mha", "is a 2D image"},
     {"four_d.mha", "is a 4D image"},

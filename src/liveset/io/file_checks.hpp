@@ -28,9 +28,10 @@ DataCheck check_nifti_data(const std::string& path, bool count_non_finite, std::
 
 // Whether check_nifti_data(path, true) would stream float data (float32/float64) that is all
 // there by the file's size or, compressed, by its gzip trailer (the uncompressed size modulo 2^32):
-// the one case where the check decompresses the data once more, and where it can run beside
-// ITK's read without ITK meeting a short file. False for anything else (the check is then cheap,
-// or may find damage that ITK must not read first).
+// where the check reads data known to be complete, so that it can run beside ITK's read without
+// ITK meeting a short file (damage the trailer cannot show, a corrupt middle, is still the check's
+// to report). False for anything else (the check is then cheap, or may find a short file that ITK
+// must not read first).
 bool nifti_float_data_complete(const std::string& path);
 
 // MetaImage (.mha with LOCAL data, .mhd with one data file): the data file holds `raw_bytes`
