@@ -74,6 +74,7 @@ struct SegmentArgs {
     std::optional<bool> bias_correct;  // unset: on, skipped with a warning where it cannot run (as the CLI's default)
     bool oriented = true;  // Image.oriented: the file gave an orientation (BrainMaskOptions::superior_from_header)
     bool thin_fronts = segment_step().thin_fronts;  // StepOptions::thin_fronts, as --thin-fronts (the default) / --no-thin-fronts
+    std::string coarse_start = "auto";  // as --coarse-start (coarse_start.hpp)
 };
 
 // The automatic brain mask's lookup for an image whose file did (not) give an orientation, as the CLI's.
@@ -132,7 +133,8 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
             return interrupt.poll_with([&]() -> pyb::object {
                 return pyb::dict(pyb::arg("iteration") = p.iteration, pyb::arg("zero_layer") = p.zero_layer,
                                  pyb::arg("band") = p.band, pyb::arg("awake") = p.awake, pyb::arg("changed") = p.changed, pyb::arg("flips") = p.flips,
-                                 pyb::arg("inside") = p.inside, pyb::arg("dt") = p.dt, pyb::arg("ms") = p.ms);
+                                 pyb::arg("inside") = p.inside, pyb::arg("dt") = p.dt, pyb::arg("ms") = p.ms,
+                                 pyb::arg("level") = p.level == 1 ? "coarse" : "fine");
             });
         };
         if (!prepared.bias || !prepared.bias->interrupted) out.emplace(segment_image(image, req, hook, &interrupt.flag()));
@@ -379,9 +381,12 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
         else if (k == "bias_correct") a.bias_correct = value.cast<std::optional<bool>>();
         else if (k == "oriented") a.oriented = value.cast<bool>();
         else if (k == "thin_fronts") a.thin_fronts = value.cast<bool>();
+        else if (k == "coarse_start") a.coarse_start = value.cast<std::string>();
         else throw std::invalid_argument("unknown segment option '" + k + "'");
     }
     if (a.classes < 2 || a.classes > 6) throw UsageError("classes must be in 2..6");
+    if (a.coarse_start != "auto" && a.coarse_start != "on" && a.coarse_start != "off")
+        throw UsageError("coarse_start must be 'auto', 'on' or 'off'");
     return a;
 }
 

@@ -30,6 +30,7 @@ struct SegmentArgs : ThresholdArgs {
     double seed_radius = 2.0;
     std::string init_mask, roi;
     std::string window_from = "model";
+    std::string coarse_start = "auto";  // --coarse-start: coarse_start.hpp
     int classes = 3;
     int iterations = 2000;
     std::string out_mask, out_phi, out_mesh, out_roi, log;
@@ -53,6 +54,8 @@ void check_segment_args(const SegmentArgs& a) {
     check_threshold_args(a);
     if (a.seeds.empty() && a.seeds_mm.empty() && a.init_mask.empty())
         throw UsageError("give at least one --seed I,J,K[:R] (or --seed-mm, or --init-mask)");
+    if (a.coarse_start == "on" && !a.init_mask.empty())
+        throw UsageError("--coarse-start on starts from the seeds: it cannot start from --init-mask");
 }
 
 // The segmentation request the options describe (seeds parsed and checked inside the image).
@@ -231,7 +234,8 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     add_threshold_options(*seg, sa);  // --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
     seg->add_option("--window-from", sa.window_from, "estimate the window from the tissue model of the image (the seeds pick the class) or from the seeds' statistics")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     seg->add_option("--classes", sa.classes, "tissue classes of the model (T1 brain: CSF, GM, WM)")->check(CLI::Range(2, 6))->capture_default_str();
-    seg->add_option("--iterations", sa.iterations, "iteration limit")->check(CLI::Range(1, 10'000'000))->capture_default_str();
+    seg->add_option("--coarse-start", sa.coarse_start, fmt::format("converge first on the image averaged over 2x2x2 voxels, then refine from there: auto (where every voxel side is at most {} mm and the front starts from seeds), on or off", kCoarseStartMaxSpacing))->check(CLI::IsMember({"auto", "on", "off"}))->capture_default_str();
+    seg->add_option("--iterations", sa.iterations, "iteration limit (of each stage with a coarse start)")->check(CLI::Range(1, 10'000'000))->capture_default_str();
     seg->add_option("--out-mask", sa.out_mask, "output mask (0/1, uint8), e.g. seg.nii.gz")->required();
     seg->add_option("--out-phi", sa.out_phi, "output level-set function phi (float, <0 inside)");
     seg->add_option("--out-mesh", sa.out_mesh, "output surface mesh (.ply/.obj/.stl, LPS mm)");

@@ -376,10 +376,11 @@ SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest&
     std::string log;
     const SegmentationHook hook = [&](const SegmentationProgress& p, const ChangedPoints&) {
         if (!log_path.empty())
-            log += fmt::format("{{\"iteration\":{},\"zero_layer\":{},\"band\":{},\"awake\":{},\"changed\":{},\"flips\":{},\"inside\":{},\"dt\":{:.6g},\"ms\":{:.3f}}}\n",
-                               p.iteration, p.zero_layer, p.band, p.awake, p.changed, p.flips, p.inside, p.dt, p.ms);
-        progress.update(fmt::format("segmenting: iteration {}/{}  zero layer {}  band {}  changed {}  flips {}", p.iteration,
-                                    limit, p.zero_layer, p.band, p.changed, p.flips));
+            log += fmt::format("{{\"iteration\":{},\"zero_layer\":{},\"band\":{},\"awake\":{},\"changed\":{},\"flips\":{},\"inside\":{},\"dt\":{:.6g},\"ms\":{:.3f}{}}}\n",
+                               p.iteration, p.zero_layer, p.band, p.awake, p.changed, p.flips, p.inside, p.dt, p.ms,
+                               p.level == 1 ? ",\"level\":\"coarse\"" : "");
+        progress.update(fmt::format("segmenting{}: iteration {}/{}  zero layer {}  band {}  changed {}  flips {}", p.level == 1 ? " (coarse start)" : "",
+                                    p.iteration, limit, p.zero_layer, p.band, p.changed, p.flips));
         return true;
     };
     SegmentRun run{segment_image(image, request, hook, &interrupt.flag()), false};

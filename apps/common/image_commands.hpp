@@ -274,6 +274,7 @@ void fill_segment_request(SegmentRequest& req, const Options& a, const Lattice& 
     req.epsilon_raw = a.epsilon_raw;
     req.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
     req.window.model.classes = a.classes;
+    req.coarse_start = parse_coarse_start(a.coarse_start);
 }
 
 }  // namespace liveset::cli

@@ -128,6 +128,14 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
     j["voxels"] = inside;
     j["volume_mm3"] = static_cast<double>(inside) * voxel_mm3;
     j["zero_layer"] = o.field->zero_layer().size();
+    if (o.coarse) {  // the coarse start: its grid, run, and whether the fine run started from it
+        const CoarseStartReport& c = *o.coarse;
+        j["coarse_start"] = {{"dims", {c.dims.x, c.dims.y, c.dims.z}}, {"spacing", {c.spacing.x, c.spacing.y, c.spacing.z}},
+                             {"iterations", c.result.iterations}, {"stop", to_string(c.result.reason)},
+                             {"seconds", c.result.seconds}, {"used", c.used}, {"start_voxels", c.upsampled}};
+    } else {
+        j["coarse_start"] = nullptr;
+    }
     return j;
 }
 
@@ -180,6 +188,13 @@ void print_segmentation_summary(const nlohmann::json& j) {
                    b["field_min"].get<double>(), b["field_max"].get<double>(),
                    b["mask"].get<std::string>() == "otsu" ? "Otsu foreground" : b["mask"].get<std::string>(), b["ms"].get<double>() / 1000.0,
                    b["shrunk_dims"][0].get<int>(), b["shrunk_dims"][1].get<int>(), b["shrunk_dims"][2].get<int>());
+    }
+    if (j.contains("coarse_start") && j["coarse_start"].is_object()) {
+        const nlohmann::json& c = j["coarse_start"];
+        fmt::print("  coarse start {} iterations ({}), {:.2f} s on the image averaged to {}x{}x{} ({:.3g} x {:.3g} x {:.3g} mm){}\n",
+                   c["iterations"].get<int>(), c["stop"].get<std::string>(), c["seconds"].get<double>(), c["dims"][0].get<int>(),
+                   c["dims"][1].get<int>(), c["dims"][2].get<int>(), c["spacing"][0].get<double>(), c["spacing"][1].get<double>(),
+                   c["spacing"][2].get<double>(), c["used"].get<bool>() ? "" : "; its front vanished: started from the seeds");
     }
     fmt::print("  segmentation {} iterations ({}), {:.2f} s, {:.2f} ms/iteration\n", j["iterations"].get<int>(),
                j["stop"].get<std::string>(), j["seconds"].get<double>(), j["ms_per_iteration"].get<double>());

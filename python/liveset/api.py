@@ -72,7 +72,8 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
             mu_raw: Optional[float] = None, epsilon_raw: Optional[float] = None,
             window_from: str = "model", classes: int = 3, n: float = 4.0, alpha: Optional[float] = None,
             smooth_mm: Optional[float] = None, iterations: int = 2000, bias_correct: Optional[bool] = None,
-            thin_fronts: bool = _liveset.DEFAULT_THIN_FRONTS, progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
+            thin_fronts: bool = _liveset.DEFAULT_THIN_FRONTS, coarse_start: str = "auto",
+            progress: Optional[Callable[[dict], None]] = None) -> Segmentation:
     """Threshold level-set segmentation from seeds (paper Eq. 2-3), exactly as ``liveset segment``
     with the same options (the same image and options give the same mask, bit for bit).
 
@@ -96,9 +97,14 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
         (an image too small for its grid); True requires it (ValueError where it cannot run); False
         turns it off. thin_fronts: the thin-front rule, which lets the front into tissue one or two
         voxels thick (on by default since session 72, as the CLI's; ``False`` as ``--no-thin-fronts``,
-        the paper's sparse field; docs/ARCHITECTURE.md, "Thin fronts").
-    progress: called with a dict (iteration, zero_layer, band, awake, changed, flips, inside, dt, ms)
-        after every step; an exception it raises stops the run and propagates.
+        the paper's sparse field; docs/ARCHITECTURE.md, "Thin fronts"). coarse_start: as
+        ``--coarse-start``: ``"auto"`` (the default) lets the front from seeds on a grid whose voxel
+        sides are all at most 0.85 mm converge first on the image averaged over 2x2x2 voxels and
+        refine from there; ``"on"`` wherever it starts from seeds; ``"off"`` never (the report's
+        "coarse_start" says what ran; docs/ARCHITECTURE.md, "Coarse start").
+    progress: called with a dict (iteration, zero_layer, band, awake, changed, flips, inside, dt, ms,
+        level: "coarse" for the coarse start's steps, else "fine") after every step; an exception it
+        raises stops the run and propagates.
 
     The GIL is released while it runs; Ctrl-C raises KeyboardInterrupt within a step. Bad input
     raises ValueError (ImageIOError for files) with a one-line message."""
@@ -109,7 +115,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
               alpha=None if alpha is None else float(alpha),
               smooth_mm=None if smooth_mm is None else float(smooth_mm), iterations=int(iterations),
               bias_correct=None if bias_correct is None else bool(bias_correct), oriented=bool(img.oriented),
-              thin_fronts=bool(thin_fronts))
+              thin_fronts=bool(thin_fronts), coarse_start=str(coarse_start))
     kw["roi"] = _mask_arg(roi, img, "roi", allow_auto=True)
     kw["init_mask"] = _mask_arg(init_mask, img, "init_mask")
     r = _liveset._segment(img.array, img.geometry, progress, **kw)

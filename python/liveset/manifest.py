@@ -14,9 +14,9 @@ REQUIRED = ("subject", "image", "seeds")
 FILES = ("roi", "truth", "init_mask")
 FLOATS = ("mu", "epsilon", "mu_raw", "epsilon_raw", "n", "alpha", "smooth_mm", "seed_radius")
 INTS = {"label": (0, 255), "classes": (2, 6), "iterations": (1, 10_000_000)}
-CHOICES = {"window_from": ("model", "seeds")}
+CHOICES = {"window_from": ("model", "seeds"), "coarse_start": ("auto", "on", "off")}
 BOOLS = ("bias_correct", "thin_fronts")
-DEFAULTS_EPOCH = 72  # see Subject.fingerprint
+DEFAULTS_EPOCH = 78  # see Subject.fingerprint
 KNOWN = set(REQUIRED) | set(FILES) | set(FLOATS) | set(INTS) | set(CHOICES) | set(BOOLS) | {"seeds_mm"}
 _SUBJECT = re.compile(r"^[A-Za-z0-9][A-Za-z0-9._+-]*$")
 
@@ -59,8 +59,9 @@ class Subject:
         # CSF about a T2's or PD's brain taken into its automatic mask, a ROI file read for its
         # contrast, and a grey-brighter reading before N4 kept; 69: a tissue class seen mostly mixed
         # kept, a ROI file that is a whole brain read as one; 70: the brain mask's last look, white
-        # matter's peak swamped by large ventricles; 72: the thin-front rule on by default), so a resumed
-        # cohort recomputes what older defaults made.
+        # matter's peak swamped by large ventricles; 72: the thin-front rule on by default; 78: the
+        # coarse start on grids of voxels at most 0.85 mm), so a resumed cohort recomputes what older
+        # defaults made.
         blob = json.dumps([self.image, self.seeds, self.seeds_mm, self.roi, self.truth, self.label,
                            self.init_mask, sorted(self.options.items()), stats, DEFAULTS_EPOCH], default=str)
         return hashlib.sha256(blob.encode()).hexdigest()[:16]

@@ -330,6 +330,8 @@ TEST(SegmentCli, BadInputIsOneLineNonZeroAndLeavesNothing) {
         {"segment " + img + " --seed 32,32,32 --alpha 0.1 --smooth -1" + o, "--smooth"},
         {"segment " + img + " --seed 32,32,32 --alpha 0.1 --smooth 50" + o, "--smooth"},
         {"segment " + img + " --seed 32,32,32 --mu nan" + o, ""},
+        {"segment " + img + " --seed 32,32,32 --coarse-start maybe" + o, "--coarse-start"},
+        {"segment " + img + " --init-mask " + img + " --mu 0.5 --epsilon 0.1 --coarse-start on" + o, "cannot start from --init-mask"},
         // ("the image", not eval's "truth": the message names what the mask must overlay)
         {"segment " + img + " --seed 32,32,32 --roi " + (work_dir() / "small_mask.nii.gz").string() + o, "differ from image dims"},
         {"segment " + img + " --seed 32,32,32 --no-bias-correct --out-corrected " + corrected.string() + o, "needs the bias correction"},
@@ -630,4 +632,50 @@ TEST(SegmentCli, TheDefaultIterationLimitReachedBeforeConvergenceIsWarnedAbout) 
     const Result asked = run_cli(cmd + " --iterations 50");
     ASSERT_EQ(asked.rc, 0) << asked.err;
     EXPECT_EQ(asked.err.find("had not converged"), std::string::npos) << asked.err;
+}
+
+// --coarse-start: off by default on the phantom's 1 mm grid (the report's "coarse_start" null), on
+// when asked: the report gives the coarse grid and run, the log's coarse steps come first, marked,
+// as many as the report counts, and the mask is the direct run's but for a few voxels of the rim.
+TEST(SegmentCli, CoarseStartIsReportedAndLogged) {
+    const PhantomFiles& ph = phantom64();
+    const std::string img = (ph.dir / "t1.nii.gz").string();
+    const fs::path direct_mask = work_dir() / "coarse_off.nii.gz", coarse_mask = work_dir() / "coarse_on.nii.gz";
+    const fs::path log = work_dir() / "coarse_on.jsonl";
+    const Result direct = run_cli("segment " + img + ph.seeds + " --json --out-mask " + direct_mask.string());
+    ASSERT_EQ(direct.rc, 0) << direct.err;
+    const auto d = nlohmann::json::parse(direct.out);
+    EXPECT_TRUE(d["coarse_start"].is_null());
+    const Result coarse =
+        run_cli("segment " + img + ph.seeds + " --coarse-start on --json --log " + log.string() + " --out-mask " + coarse_mask.string());
+    ASSERT_EQ(coarse.rc, 0) << coarse.err;
+    const auto c = nlohmann::json::parse(coarse.out);
+    ASSERT_TRUE(c["coarse_start"].is_object()) << c;
+    EXPECT_EQ(c["coarse_start"]["dims"], nlohmann::json::array({32, 32, 32}));
+    EXPECT_EQ(c["coarse_start"]["spacing"][0], 2.0);
+    EXPECT_EQ(c["coarse_start"]["used"], true);
+    const int coarse_its = c["coarse_start"]["iterations"].get<int>();
+    EXPECT_GT(coarse_its, 0);
+    std::ifstream rows(log);
+    int marked = 0, fine = 0;
+    for (std::string line; std::getline(rows, line);) {
+        const auto row = nlohmann::json::parse(line);
+        if (row.contains("level")) {
+            EXPECT_EQ(row["level"], "coarse");
+            EXPECT_EQ(fine, 0) << "a coarse step after the fine grid's";
+            ++marked;
+        } else {
+            ++fine;
+        }
+    }
+    EXPECT_EQ(marked, coarse_its);
+    EXPECT_EQ(fine, c["iterations"].get<int>());
+    const Grid<std::uint8_t> a = read_label_image(direct_mask.string()), b = read_label_image(coarse_mask.string());
+    std::size_t both = 0, na = 0, nb = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        both += a[static_cast<PointIndex>(i)] && b[static_cast<PointIndex>(i)];
+        na += a[static_cast<PointIndex>(i)] != 0;
+        nb += b[static_cast<PointIndex>(i)] != 0;
+    }
+    EXPECT_GT(2.0 * static_cast<double>(both) / static_cast<double>(na + nb), 0.97);
 }

@@ -125,6 +125,20 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
         for (std::size_t i = 0; i < req.initial_mask->size(); ++i) inside += (*req.initial_mask)[static_cast<PointIndex>(i)] != 0;
         if (inside == 0) throw std::invalid_argument("the initial mask is empty");
         out.field->init_from_mask(*req.initial_mask);
+    } else if (coarse_start_applies(req.coarse_start, image.lattice())) {
+        out.coarse.emplace();
+        const std::optional<Grid<std::uint8_t>> start =
+            run_coarse_start(unit, p, req.roi, req.seeds, req.loop, req.layers, hook, interrupt, *out.coarse);
+        if (start) {
+            out.field->init_from_mask(*start);
+        } else {
+            init_from_seeds(*out.field, req.seeds);
+            if (out.coarse->result.reason == StopReason::kInterrupted) {
+                out.result.reason = StopReason::kInterrupted;
+                out.mask = inside_mask(out.field->phi(), req.roi);
+                return out;
+            }
+        }
     } else {
         init_from_seeds(*out.field, req.seeds);
     }

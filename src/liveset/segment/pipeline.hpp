@@ -11,6 +11,7 @@
 
 #include "liveset/levelset/sparse_field.hpp"
 #include "liveset/segment/alpha.hpp"
+#include "liveset/segment/coarse_start.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
@@ -52,6 +53,9 @@ struct SegmentRequest {
     ScaleOptions scale;
     SegmentationOptions loop;
     int layers = 2;
+    // From seeds on a fine grid (auto: every voxel side ≤ kCoarseStartMaxSpacing mm), the front first
+    // converges on the image averaged over 2x2x2 voxels and starts from there (coarse_start.hpp).
+    CoarseStart coarse_start = CoarseStart::kAuto;
 };
 
 struct SegmentOutcome {
@@ -64,7 +68,8 @@ struct SegmentOutcome {
     std::optional<TissueModel> model;          // when it could be fitted (seeds given)
     std::optional<ModelWindow> model_window;   // when the window came from the model
     std::vector<std::string> warnings;         // one line each: model fallback, seeds in two classes, ...
-    SegmentationResult result;
+    SegmentationResult result;  // the run on the image's grid (after the coarse start's, when there was one)
+    std::optional<CoarseStartReport> coarse;  // when the run started coarse
     std::unique_ptr<SparseField> field;
     Grid<std::uint8_t> mask;  // φ < 0 within the ROI
 };

@@ -90,6 +90,9 @@ struct SegmentationProgress {
     std::size_t inside = 0;      // points inside after the step
     double dt = 0.0;
     double ms = 0.0;             // wall time of the step
+    // 1: a step of the coarse start's half-resolution run (coarse_start.hpp), whose X and counts are
+    // that grid's; 0: the image's own grid.
+    int level = 0;
 };
 
 enum class StopReason { kConverged, kIterationLimit, kInterrupted, kVanished };

@@ -1,0 +1,157 @@
+// The coarse-to-fine start: 2x2x2 block averages, the coarse run, and its front upsampled.
+#include "liveset/segment/coarse_start.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "liveset/levelset/sparse_field.hpp"
+#include "liveset/segment/voxel_loops.hpp"
+
+namespace liveset {
+
+namespace {
+
+// The fine voxels of block c along one axis: [2c, min(2c + 2, d)).
+struct Span {
+    int lo, hi;
+};
+Span block(int c, int d) { return {2 * c, std::min(2 * c + 2, d)}; }
+
+// f(sum of the block's values as double, voxel count) for every coarse point, in parallel (each
+// coarse point written from its own block only: the same bits on any thread count).
+template <class T, class U, class F>
+Grid<U> reduce_blocks(const Grid<T>& fine, const F& f) {
+    const Lattice coarse = coarse_lattice(fine.lattice());
+    Grid<U> out(coarse);
+    const Vec3i cd = coarse.dims(), fd = fine.dims();
+    voxel_loops::for_each(coarse.size(), [&](std::size_t i) {
+        const int cx = static_cast<int>(i % static_cast<std::size_t>(cd.x));
+        const int cy = static_cast<int>(i / static_cast<std::size_t>(cd.x) % static_cast<std::size_t>(cd.y));
+        const int cz = static_cast<int>(i / coarse.stride_z());
+        const Span x = block(cx, fd.x), y = block(cy, fd.y), z = block(cz, fd.z);
+        double sum = 0.0;
+        int n = 0;
+        for (int k = z.lo; k < z.hi; ++k)
+            for (int j = y.lo; j < y.hi; ++j)
+                for (int a = x.lo; a < x.hi; ++a, ++n) sum += static_cast<double>(fine(Vec3i{a, j, k}));
+        out[static_cast<PointIndex>(i)] = f(sum, n);
+    });
+    return out;
+}
+
+// Trilinear weights along one axis for fine index i: coarse coordinate (i - 0.5) / 2, clamped.
+struct Lerp {
+    int a, b;
+    float t;
+};
+Lerp lerp_at(int i, int coarse_dim) {
+    const double c = std::clamp((i - 0.5) / 2.0, 0.0, static_cast<double>(coarse_dim - 1));
+    const int a = std::min(static_cast<int>(std::floor(c)), coarse_dim - 1);
+    return {a, std::min(a + 1, coarse_dim - 1), static_cast<float>(c - a)};
+}
+
+}  // namespace
+
+std::string to_string(CoarseStart mode) {
+    switch (mode) {
+        case CoarseStart::kAuto: return "auto";
+        case CoarseStart::kOn: return "on";
+        case CoarseStart::kOff: return "off";
+    }
+    return "auto";
+}
+
+CoarseStart parse_coarse_start(const std::string& name) {
+    if (name == "auto") return CoarseStart::kAuto;
+    if (name == "on") return CoarseStart::kOn;
+    if (name == "off") return CoarseStart::kOff;
+    throw std::invalid_argument("the coarse start must be auto, on or off, got '" + name + "'");
+}
+
+bool coarse_start_applies(CoarseStart mode, const Lattice& lattice) {
+    const Vec3i d = lattice.dims();
+    if (mode == CoarseStart::kOff || std::min({d.x, d.y, d.z}) < kCoarseStartMinDim) return false;
+    const Vec3d s = lattice.spacing();
+    return mode == CoarseStart::kOn || std::max({s.x, s.y, s.z}) <= kCoarseStartMaxSpacing;
+}
+
+Lattice coarse_lattice(const Lattice& fine) {
+    const Vec3i d = fine.dims();
+    const Vec3d s = fine.spacing();
+    return Lattice({(d.x + 1) / 2, (d.y + 1) / 2, (d.z + 1) / 2}, {2 * s.x, 2 * s.y, 2 * s.z}, fine.to_world(Vec3d{0.5, 0.5, 0.5}),
+                   fine.direction());
+}
+
+Grid<float> downsample_mean(const Grid<float>& fine) {
+    return reduce_blocks<float, float>(fine, [](double sum, int n) { return static_cast<float>(sum / n); });
+}
+
+Grid<std::uint8_t> downsample_majority(const Grid<std::uint8_t>& fine) {
+    // The sum of 0/1 values: non-zero voxels counted as one.
+    Grid<std::uint8_t> ones(fine.lattice());
+    voxel_loops::for_each(fine.size(), [&](std::size_t i) { ones[static_cast<PointIndex>(i)] = fine[static_cast<PointIndex>(i)] != 0; });
+    return reduce_blocks<std::uint8_t, std::uint8_t>(ones, [](double sum, int n) { return static_cast<std::uint8_t>(2.0 * sum >= n); });
+}
+
+SeedBall coarse_seed(const SeedBall& fine) {
+    const Vec3d c = fine.center;
+    return {{(c.x - 0.5) / 2.0, (c.y - 0.5) / 2.0, (c.z - 0.5) / 2.0}, fine.radius / 2.0};
+}
+
+Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice& fine, const Grid<std::uint8_t>* roi) {
+    if (roi && !(roi->dims() == fine.dims())) throw std::invalid_argument("the ROI does not match the grid the coarse start refines");
+    const Vec3i cd = coarse_phi.dims(), fd = fine.dims();
+    std::vector<Lerp> lx(static_cast<std::size_t>(fd.x)), ly(static_cast<std::size_t>(fd.y)), lz(static_cast<std::size_t>(fd.z));
+    for (int i = 0; i < fd.x; ++i) lx[static_cast<std::size_t>(i)] = lerp_at(i, cd.x);
+    for (int i = 0; i < fd.y; ++i) ly[static_cast<std::size_t>(i)] = lerp_at(i, cd.y);
+    for (int i = 0; i < fd.z; ++i) lz[static_cast<std::size_t>(i)] = lerp_at(i, cd.z);
+    Grid<std::uint8_t> out(fine);
+    const std::size_t rows = static_cast<std::size_t>(fd.y) * static_cast<std::size_t>(fd.z);
+    voxel_loops::for_each(rows, [&](std::size_t r) {  // one fine row each
+        const Lerp& y = ly[r % static_cast<std::size_t>(fd.y)];
+        const Lerp& z = lz[r / static_cast<std::size_t>(fd.y)];
+        const auto at = [&](int a, int b, int c) { return coarse_phi(Vec3i{a, b, c}); };
+        for (int i = 0; i < fd.x; ++i) {
+            const Lerp& x = lx[static_cast<std::size_t>(i)];
+            const auto along_x = [&](int b, int c) { return at(x.a, b, c) + x.t * (at(x.b, b, c) - at(x.a, b, c)); };
+            const auto along_y = [&](int c) { return along_x(y.a, c) + y.t * (along_x(y.b, c) - along_x(y.a, c)); };
+            const float v = along_y(z.a) + z.t * (along_y(z.b) - along_y(z.a));
+            const auto p = static_cast<PointIndex>(r * static_cast<std::size_t>(fd.x) + static_cast<std::size_t>(i));
+            out[p] = v < 0.0f && (!roi || (*roi)[p] != 0);
+        }
+    });
+    return out;
+}
+
+std::optional<Grid<std::uint8_t>> run_coarse_start(const Grid<float>& unit_image, const ThresholdParams& params,
+                                                   const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
+                                                   const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
+                                                   const std::atomic<bool>* interrupt, CoarseStartReport& report) {
+    const Grid<float> unit = downsample_mean(unit_image);
+    std::optional<Grid<std::uint8_t>> coarse_roi;
+    if (roi) coarse_roi = downsample_majority(*roi);
+    report.dims = unit.dims();
+    report.spacing = unit.lattice().spacing();
+    const ThresholdSpeed speed(unit, params, coarse_roi ? &*coarse_roi : nullptr);
+    SparseField field(unit.lattice(), layers);
+    std::vector<SeedBall> balls;
+    for (const SeedBall& s : seeds) balls.push_back(coarse_seed(s));
+    init_from_seeds(field, balls);
+    SegmentationHook coarse_hook;
+    if (hook)
+        coarse_hook = [&](const SegmentationProgress& p, const ChangedPoints& x) {
+            SegmentationProgress q = p;
+            q.level = 1;
+            return hook(q, x);
+        };
+    report.result = run_segmentation(field, speed, loop, coarse_hook, interrupt);
+    if (report.result.reason == StopReason::kInterrupted) return std::nullopt;
+    Grid<std::uint8_t> start = upsample_inside(field.phi(), unit_image.lattice(), roi);
+    report.upsampled = voxel_loops::count_if(start.size(), [&](std::size_t i) { return start[static_cast<PointIndex>(i)] != 0; });
+    report.used = report.upsampled > 0;
+    if (!report.used) return std::nullopt;
+    return start;
+}
+
+}  // namespace liveset

@@ -1,0 +1,68 @@
+// The coarse-to-fine start of a finely sampled scan (issue 16, docs/ARCHITECTURE.md "Coarse start"):
+// the front first runs to convergence from the seeds on the image averaged over 2x2x2 voxels, and
+// that result, upsampled onto the image's own grid, is where the front starts there.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "liveset/grid/grid.hpp"
+#include "liveset/segment/intensity.hpp"
+#include "liveset/segment/segmentation.hpp"
+#include "liveset/segment/threshold_speed.hpp"
+
+namespace liveset {
+
+// kAuto (the default) starts coarse where every voxel side is at most kCoarseStartMaxSpacing mm and
+// the run starts from seeds; kOn wherever it starts from seeds; kOff never.
+enum class CoarseStart { kAuto, kOn, kOff };
+
+// A 0.7 mm (HCP-like) grid's front travels twice the voxels of a 1.4 mm one's at half the time
+// step; on a 1 mm grid the coarse start gains nothing (docs/BENCHMARKS.md, sessions 77-78).
+inline constexpr double kCoarseStartMaxSpacing = 0.85;
+// No coarse start on a grid with an axis shorter than this (its coarse grid would be a few voxels).
+inline constexpr int kCoarseStartMinDim = 16;
+
+// "auto", "on", "off" as the command line and Python name them; parse throws std::invalid_argument.
+std::string to_string(CoarseStart mode);
+CoarseStart parse_coarse_start(const std::string& name);
+
+// Whether a run from seeds on `lattice` starts coarse under `mode`.
+bool coarse_start_applies(CoarseStart mode, const Lattice& lattice);
+
+// The grid of 2x2x2 blocks: dims ceil(d / 2), spacing doubled, the first point at the centre of the
+// first block (fine index 0.5 on each axis). Coarse point c lies at fine index 2c + 0.5.
+Lattice coarse_lattice(const Lattice& fine);
+// Each block's mean (a block cut by an odd border: the mean of the voxels it holds).
+Grid<float> downsample_mean(const Grid<float>& fine);
+// 1 where at least half of a block's voxels are non-zero.
+Grid<std::uint8_t> downsample_majority(const Grid<std::uint8_t>& fine);
+// A seed ball in the coarse grid's index space (centre mapped, radius halved).
+SeedBall coarse_seed(const SeedBall& fine);
+// Inside (1) where the coarse φ, trilinear at each fine voxel's centre (clamped to the coarse grid),
+// is negative, and the ROI (when given, `fine`'s lattice) allows it.
+Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice& fine, const Grid<std::uint8_t>* roi = nullptr);
+
+// What the coarse stage did (a segmentation's report).
+struct CoarseStartReport {
+    Vec3i dims{0, 0, 0};
+    Vec3d spacing{0, 0, 0};
+    SegmentationResult result;   // the coarse run's iterations, stop reason and seconds
+    std::size_t upsampled = 0;   // inside points of the fine start
+    bool used = false;           // false: the coarse front vanished; the fine run started from the seeds
+};
+
+// The coarse stage: the front from `seeds` (the fine grid's index space) under the threshold speed
+// with `params` on `unit_image` averaged over 2x2x2 voxels (the ROI by majority), run as `loop`
+// says; the hook sees its steps with level 1. Returns the fine start (upsample_inside), or nothing
+// when the run was interrupted (report.result.reason) or the front vanished (report.used false).
+std::optional<Grid<std::uint8_t>> run_coarse_start(const Grid<float>& unit_image, const ThresholdParams& params,
+                                                   const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
+                                                   const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
+                                                   const std::atomic<bool>* interrupt, CoarseStartReport& report);
+
+}  // namespace liveset

@@ -1,0 +1,216 @@
+// The coarse-to-fine start: the block grid's placement, block means and majorities and the upsampled
+// front against brute force and exact linear answers; on a finely sampled cortex-like shell, the
+// fine run from the coarse result against the direct run and the truth, on 1 and 2 threads.
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <stdexcept>
+
+#include "liveset/segment/coarse_start.hpp"
+#include "liveset/segment/pipeline.hpp"
+
+using namespace liveset;
+
+namespace {
+
+// An odd-sized, anisotropic, rotated lattice.
+Lattice odd_lattice() {
+    const Mat3d rot{0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0};
+    return Lattice({7, 6, 5}, {0.7, 0.8, 0.6}, {-10.0, 4.0, 2.5}, rot);
+}
+
+TEST(CoarseStart, BlockGridSitsAtTheBlocksCentres) {
+    const Lattice fine = odd_lattice();
+    const Lattice coarse = coarse_lattice(fine);
+    EXPECT_EQ(coarse.dims(), (Vec3i{4, 3, 3}));
+    EXPECT_DOUBLE_EQ(coarse.spacing().x, 1.4);
+    EXPECT_DOUBLE_EQ(coarse.spacing().y, 1.6);
+    EXPECT_DOUBLE_EQ(coarse.spacing().z, 1.2);
+    for (const Vec3d c : {Vec3d{0, 0, 0}, Vec3d{3, 2, 1}, Vec3d{1.5, 0.25, 2}}) {
+        const Vec3d want = fine.to_world({2 * c.x + 0.5, 2 * c.y + 0.5, 2 * c.z + 0.5});
+        const Vec3d got = coarse.to_world(c);
+        EXPECT_NEAR(norm(got - want), 0.0, 1e-9);
+    }
+    const SeedBall s = coarse_seed({{4.5, 2.5, 0.5}, 3.0});
+    EXPECT_DOUBLE_EQ(s.center.x, 2.0);
+    EXPECT_DOUBLE_EQ(s.center.y, 1.0);
+    EXPECT_DOUBLE_EQ(s.center.z, 0.0);
+    EXPECT_DOUBLE_EQ(s.radius, 1.5);
+}
+
+TEST(CoarseStart, BlockMeansAndMajoritiesMatchBruteForce) {
+    const Lattice fine = odd_lattice();
+    Grid<float> image(fine);
+    Grid<std::uint8_t> mask(fine);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-5.0f, 20.0f);
+    for (std::size_t i = 0; i < image.size(); ++i) {
+        image[static_cast<PointIndex>(i)] = u(rng);
+        mask[static_cast<PointIndex>(i)] = static_cast<std::uint8_t>(rng() % 3 == 0 ? 0 : rng() % 4);  // 0 or a non-zero label
+    }
+    const Grid<float> mean = downsample_mean(image);
+    const Grid<std::uint8_t> majority = downsample_majority(mask);
+    ASSERT_EQ(mean.dims(), (Vec3i{4, 3, 3}));
+    const Vec3i d = fine.dims();
+    int checked = 0, inside = 0;
+    for (int cz = 0; cz < 3; ++cz)
+        for (int cy = 0; cy < 3; ++cy)
+            for (int cx = 0; cx < 4; ++cx) {
+                double sum = 0.0;
+                int n = 0, set = 0;
+                for (int z = 2 * cz; z < 2 * cz + 2; ++z)
+                    for (int y = 2 * cy; y < 2 * cy + 2; ++y)
+                        for (int x = 2 * cx; x < 2 * cx + 2; ++x) {
+                            if (x >= d.x || y >= d.y || z >= d.z) continue;
+                            sum += image({x, y, z});
+                            set += mask({x, y, z}) != 0;
+                            ++n;
+                        }
+                EXPECT_NEAR(mean({cx, cy, cz}), sum / n, 1e-5) << cx << "," << cy << "," << cz;
+                EXPECT_EQ(majority({cx, cy, cz}), 2 * set >= n ? 1 : 0) << cx << "," << cy << "," << cz;
+                inside += majority({cx, cy, cz});
+                ++checked;
+            }
+    EXPECT_EQ(checked, 36);
+    EXPECT_GT(inside, 0);
+    EXPECT_LT(inside, 36);
+}
+
+// Trilinear interpolation is exact for a linear φ: inside where the plane, at the fine voxel's
+// coarse coordinate (i - 0.5) / 2, is negative (within the coarse grid: no clamping there).
+TEST(CoarseStart, UpsampledFrontIsTheLinearPlanesSide) {
+    const Lattice fine({20, 18, 16}, {0.7, 0.7, 0.7});
+    const Lattice coarse = coarse_lattice(fine);
+    Grid<float> phi(coarse);
+    const auto plane = [](double x, double y, double z) { return 0.9 * x - 0.35 * y + 0.2 * z - 3.3; };
+    for (int z = 0; z < coarse.dims().z; ++z)
+        for (int y = 0; y < coarse.dims().y; ++y)
+            for (int x = 0; x < coarse.dims().x; ++x) phi({x, y, z}) = static_cast<float>(plane(x, y, z));
+    Grid<std::uint8_t> roi(fine, 1);
+    roi({5, 5, 5}) = 0;  // inside the plane's negative side
+    const Grid<std::uint8_t> up = upsample_inside(phi, fine, &roi);
+    int inside = 0, compared = 0;
+    for (int z = 1; z < 15; ++z)
+        for (int y = 1; y < 17; ++y)
+            for (int x = 1; x < 19; ++x) {
+                const double v = plane((x - 0.5) / 2, (y - 0.5) / 2, (z - 0.5) / 2);
+                if (std::abs(v) < 1e-4) continue;
+                const int want = v < 0 && !(x == 5 && y == 5 && z == 5);
+                EXPECT_EQ(up({x, y, z}), want) << x << "," << y << "," << z;
+                inside += want;
+                ++compared;
+            }
+    EXPECT_GT(inside, 500);
+    EXPECT_LT(inside, compared - 500);
+    const Grid<std::uint8_t> wrong(coarse, 1);  // an ROI of another grid
+    EXPECT_THROW(upsample_inside(phi, fine, &wrong), std::invalid_argument);
+}
+
+TEST(CoarseStart, AutoRuleAndNames) {
+    EXPECT_TRUE(coarse_start_applies(CoarseStart::kAuto, Lattice({200, 200, 200}, {0.7, 0.7, 0.7})));
+    EXPECT_TRUE(coarse_start_applies(CoarseStart::kAuto, Lattice({200, 200, 200}, {0.85, 0.8, 0.8})));
+    EXPECT_FALSE(coarse_start_applies(CoarseStart::kAuto, Lattice({200, 200, 200}, {0.7, 0.7, 1.0})));
+    EXPECT_FALSE(coarse_start_applies(CoarseStart::kAuto, Lattice({200, 200, 200}, {1.0, 1.0, 1.0})));
+    EXPECT_TRUE(coarse_start_applies(CoarseStart::kOn, Lattice({200, 200, 200}, {1.0, 1.0, 1.0})));
+    EXPECT_FALSE(coarse_start_applies(CoarseStart::kOff, Lattice({200, 200, 200}, {0.5, 0.5, 0.5})));
+    EXPECT_FALSE(coarse_start_applies(CoarseStart::kOn, Lattice({200, 200, kCoarseStartMinDim - 1}, {0.5, 0.5, 0.5})));
+    for (const CoarseStart m : {CoarseStart::kAuto, CoarseStart::kOn, CoarseStart::kOff}) EXPECT_EQ(parse_coarse_start(to_string(m)), m);
+    EXPECT_THROW(parse_coarse_start("yes"), std::invalid_argument);
+}
+
+// A cortex-like shell sampled at 0.5 mm: a ball of radius 21 mm, a dark rim (40) from 19 mm, grey
+// (100) from 12 mm with two dark sulci one voxel (0.5 mm) wide cut into it, a bright core (160);
+// Gaussian noise σ 10. Averaged over 1 mm blocks the sulci blur into the grey: the refinement opens them.
+constexpr int kShell = 88;
+struct Shell {
+    Grid<float> image{Lattice({kShell, kShell, kShell}, {0.5, 0.5, 0.5}), 0.0f};
+    Grid<std::uint8_t> roi{image.lattice(), 0}, truth{image.lattice(), 0};
+};
+
+const Shell& shell() {
+    static const Shell s = [] {
+        Shell out;
+        std::mt19937 rng(11);
+        std::normal_distribution<float> noise(0.0f, 10.0f);
+        const double c = (kShell - 1) / 2.0;
+        for (int z = 0; z < kShell; ++z)
+            for (int y = 0; y < kShell; ++y)
+                for (int x = 0; x < kShell; ++x) {
+                    const Vec3d p{(x - c) * 0.5, (y - c) * 0.5, (z - c) * 0.5};
+                    const double r = norm(p);
+                    if (r >= 21.0) continue;
+                    const bool sulcus = r >= 15.0 && ((p.x > 0.0 && p.x < 0.5) || (p.y > 0.0 && p.y < 0.5));
+                    const float v = r >= 19.0 || (sulcus && r < 19.0) ? 40.0f : (r < 12.0 ? 160.0f : 100.0f);
+                    out.image({x, y, z}) = v + noise(rng);
+                    out.roi({x, y, z}) = 1;
+                    out.truth({x, y, z}) = v == 100.0f;
+                }
+        return out;
+    }();
+    return s;
+}
+
+SegmentOutcome segment_shell(CoarseStart mode) {
+    const Shell& s = shell();
+    SegmentRequest req;
+    const double c = (kShell - 1) / 2.0;
+    req.seeds = {{{c + 31.0, c + 5.0, c + 5.0}, 2.0}};  // 15.5 mm out along x: in the grey shell
+    req.roi = &s.roi;
+    req.mu_raw = 100.0;
+    req.epsilon_raw = 25.0;
+    req.loop.step = segment_step();
+    req.coarse_start = mode;
+    return segment_image(s.image, req);
+}
+
+double shell_dice(const Grid<std::uint8_t>& a, const Grid<std::uint8_t>& b) {
+    std::size_t both = 0, na = 0, nb = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const bool x = a[static_cast<PointIndex>(i)] != 0, y = b[static_cast<PointIndex>(i)] != 0;
+        both += x && y;
+        na += x;
+        nb += y;
+    }
+    return 2.0 * static_cast<double>(both) / static_cast<double>(na + nb);
+}
+
+TEST(CoarseStart, FineShellFromTheCoarseStartMatchesTheDirectRun) {
+    const SegmentOutcome direct = segment_shell(CoarseStart::kOff);
+    const SegmentOutcome coarse = segment_shell(CoarseStart::kAuto);  // 0.5 mm: auto starts coarse
+    EXPECT_FALSE(direct.coarse.has_value());
+    ASSERT_TRUE(coarse.coarse.has_value());
+    EXPECT_TRUE(coarse.coarse->used);
+    EXPECT_EQ(coarse.coarse->dims, (Vec3i{44, 44, 44}));
+    EXPECT_EQ(coarse.coarse->result.reason, StopReason::kConverged);
+    EXPECT_EQ(direct.result.reason, StopReason::kConverged);
+    EXPECT_EQ(coarse.result.reason, StopReason::kConverged);
+    EXPECT_GT(coarse.coarse->upsampled, 0u);
+    const double truth_direct = shell_dice(direct.mask, shell().truth), truth_coarse = shell_dice(coarse.mask, shell().truth);
+    EXPECT_GT(truth_direct, 0.93);
+    EXPECT_GT(truth_coarse, truth_direct - 0.01);
+    EXPECT_GT(shell_dice(direct.mask, coarse.mask), 0.98);
+    // The fine grid's iterations: a few dozen refining ones instead of the whole way from the seed.
+    EXPECT_LT(coarse.result.iterations * 2, direct.result.iterations);
+}
+
+TEST(CoarseStart, SameBitsOnOneAndTwoThreads) {
+    const auto run = [](int threads) {
+        tbb::global_control gc(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+        return segment_shell(CoarseStart::kOn);
+    };
+    const SegmentOutcome one = run(1), two = run(2);
+    ASSERT_TRUE(one.coarse && two.coarse);
+    EXPECT_EQ(one.coarse->result.iterations, two.coarse->result.iterations);
+    EXPECT_EQ(one.result.iterations, two.result.iterations);
+    const auto a = one.field->phi().values(), b = two.field->phi().values();
+    ASSERT_EQ(a.size(), b.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) differ += std::bit_cast<std::uint32_t>(a[i]) != std::bit_cast<std::uint32_t>(b[i]);
+    EXPECT_EQ(differ, 0u);
+}
+
+}  // namespace
