@@ -387,6 +387,7 @@ SegmentArgs segment_args(const pyb::kwargs& kw) {
     if (a.classes < 2 || a.classes > 6) throw UsageError("classes must be in 2..6");
     if (a.coarse_start != "auto" && a.coarse_start != "on" && a.coarse_start != "off")
         throw UsageError("coarse_start must be 'auto', 'on' or 'off'");
+    if (a.coarse_start == "on" && !a.init_mask.is_none()) throw UsageError("coarse_start='on' starts from the seeds: it cannot start from init_mask");
     return a;
 }
 

@@ -132,7 +132,11 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.quiet) scan.print_note(a.image);  // the inputs are good
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) {
-        if (!a.quiet) fmt::print(stderr, "liveset: interrupted after {} iterations; nothing written\n", run.outcome.result.iterations);
+        const SegmentOutcome& o = run.outcome;
+        const bool coarse = o.coarse && o.result.iterations == 0;  // stopped in the coarse start
+        if (!a.quiet)
+            fmt::print(stderr, "liveset: interrupted after {} iterations{}; nothing written\n",
+                       coarse ? o.coarse->result.iterations : o.result.iterations, coarse ? " of the coarse start" : "");
         return 130;
     }
     const SegmentOutcome& o = run.outcome;
@@ -234,7 +238,7 @@ void add_segment_commands(CLI::App& app, const int& threads) {
     add_threshold_options(*seg, sa);  // --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
     seg->add_option("--window-from", sa.window_from, "estimate the window from the tissue model of the image (the seeds pick the class) or from the seeds' statistics")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     seg->add_option("--classes", sa.classes, "tissue classes of the model (T1 brain: CSF, GM, WM)")->check(CLI::Range(2, 6))->capture_default_str();
-    seg->add_option("--coarse-start", sa.coarse_start, fmt::format("converge first on the image averaged over 2x2x2 voxels, then refine from there: auto (where every voxel side is at most {} mm and the front starts from seeds), on or off", kCoarseStartMaxSpacing))->check(CLI::IsMember({"auto", "on", "off"}))->capture_default_str();
+    seg->add_option("--coarse-start", sa.coarse_start, fmt::format("converge first on a grid of 2x2x2-voxel blocks, then refine from there: auto (where every voxel side is at most {} mm), on or off; only from seeds, on a grid of at least {} voxels an axis", kCoarseStartMaxSpacing, kCoarseStartMinDim))->check(CLI::IsMember({"auto", "on", "off"}))->capture_default_str();
     seg->add_option("--iterations", sa.iterations, "iteration limit (of each stage with a coarse start)")->check(CLI::Range(1, 10'000'000))->capture_default_str();
     seg->add_option("--out-mask", sa.out_mask, "output mask (0/1, uint8), e.g. seg.nii.gz")->required();
     seg->add_option("--out-phi", sa.out_phi, "output level-set function phi (float, <0 inside)");

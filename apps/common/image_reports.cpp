@@ -194,7 +194,7 @@ void print_segmentation_summary(const nlohmann::json& j) {
         fmt::print("  coarse start {} iterations ({}), {:.2f} s on the image averaged to {}x{}x{} ({:.3g} x {:.3g} x {:.3g} mm){}\n",
                    c["iterations"].get<int>(), c["stop"].get<std::string>(), c["seconds"].get<double>(), c["dims"][0].get<int>(),
                    c["dims"][1].get<int>(), c["dims"][2].get<int>(), c["spacing"][0].get<double>(), c["spacing"][1].get<double>(),
-                   c["spacing"][2].get<double>(), c["used"].get<bool>() ? "" : "; its front vanished: started from the seeds");
+                   c["spacing"][2].get<double>(), c["used"].get<bool>() ? "" : "; nothing of its front was left in the ROI: started from the seeds");
     }
     fmt::print("  segmentation {} iterations ({}), {:.2f} s, {:.2f} ms/iteration\n", j["iterations"].get<int>(),
                j["stop"].get<std::string>(), j["seconds"].get<double>(), j["ms_per_iteration"].get<double>());

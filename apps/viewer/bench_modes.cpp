@@ -60,6 +60,7 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
     req.alpha = s->params().alpha;
     req.smooth_mm = s->params().smooth_mm;  // the session's blur, automatic or given
     req.loop.step = s->options().segmentation.step;  // `view --step` as `segment --step` (default: sleeping, the thin-front rule on)
+    req.coarse_start = CoarseStart::kOff;  // the session evolves on the image's grid from the seeds
     const auto c0 = Clock::now();
     const SegmentOutcome cli = segment_image(s->image(), req);
     const double cli_ms = ms_since(c0);

@@ -31,7 +31,8 @@ class Session:
     (ValueError where it cannot run); False takes the image as given (pass False for an image that
     is already corrected, e.g. ``segment(...).corrected``). Without a ROI the tissue model is
     fitted in the automatic brain mask (found again on the corrected image), as ``segment`` fits it, so the same seeds give
-    ``segment``'s mask. ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
+    ``segment``'s mask (``coarse_start="off"``'s on a grid of voxels at most 0.85 mm: a Session
+    evolves on the image's own grid). ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
     a head, else none), ``"auto"``, ``"none"`` or a mask (Image, nibabel image or array) the front
     may not leave. ``image`` is the
     image the session works on (the corrected one when N4 ran; NaN voxels, a masked image's "no

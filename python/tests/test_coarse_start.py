@@ -1,6 +1,7 @@
 """The coarse start (``coarse_start``, as ``liveset segment --coarse-start``): off by default on the
 phantom's 1 mm grid, on when asked, with its steps reported first through ``progress`` (level
-"coarse") and the same mask as the CLI's, bit for bit; a bad value is a ValueError."""
+"coarse") and the same mask as the CLI's, bit for bit; a bad value, or "on" with an initial mask,
+is a ValueError."""
 import nibabel as nib
 import numpy as np
 import pytest
@@ -28,3 +29,5 @@ def test_coarse_start_as_the_cli_runs_it(phantom, tmp_path):
     assert np.array_equal(np.asarray(nib.load(str(out)).dataobj) > 0, b)
     with pytest.raises(ValueError, match="coarse_start"):
         liveset.segment(img, phantom["seeds"], coarse_start="yes")
+    with pytest.raises(ValueError, match="init_mask"):  # as the CLI's --coarse-start on --init-mask
+        liveset.segment(img, phantom["seeds"], init_mask=plain.mask, coarse_start="on")

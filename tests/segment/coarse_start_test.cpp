@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -35,26 +36,39 @@ TEST(CoarseStart, BlockGridSitsAtTheBlocksCentres) {
         const Vec3d got = coarse.to_world(c);
         EXPECT_NEAR(norm(got - want), 0.0, 1e-9);
     }
-    const SeedBall s = coarse_seed({{4.5, 2.5, 0.5}, 3.0});
+    const SeedBall s = coarse_seed({{4.5, 2.5, 0.5}, 3.0}, coarse);
     EXPECT_DOUBLE_EQ(s.center.x, 2.0);
     EXPECT_DOUBLE_EQ(s.center.y, 1.0);
     EXPECT_DOUBLE_EQ(s.center.z, 0.0);
     EXPECT_DOUBLE_EQ(s.radius, 1.5);
+    // Seeds on the border (the first voxel; the last of an even axis, 5 on y) stay on the coarse grid.
+    const SeedBall b = coarse_seed({{0.0, 5.0, 4.0}, 2.0}, coarse);
+    EXPECT_DOUBLE_EQ(b.center.x, 0.0);
+    EXPECT_DOUBLE_EQ(b.center.y, 2.0);
+    EXPECT_DOUBLE_EQ(b.center.z, 1.75);
 }
 
-TEST(CoarseStart, BlockMeansAndMajoritiesMatchBruteForce) {
+// The coarse image's D at each block is the mean of the fine D over the block (+1 outside the
+// ROI), and the ROI's majority the brute-force count's.
+TEST(CoarseStart, BlockThresholdTermsAndMajoritiesMatchBruteForce) {
     const Lattice fine = odd_lattice();
     Grid<float> image(fine);
     Grid<std::uint8_t> mask(fine);
     std::mt19937 rng(3);
-    std::uniform_real_distribution<float> u(-5.0f, 20.0f);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (std::size_t i = 0; i < image.size(); ++i) {
         image[static_cast<PointIndex>(i)] = u(rng);
-        mask[static_cast<PointIndex>(i)] = static_cast<std::uint8_t>(rng() % 3 == 0 ? 0 : rng() % 4);  // 0 or a non-zero label
+        mask[static_cast<PointIndex>(i)] = static_cast<std::uint8_t>(rng() % 3 == 0 ? 0 : 1 + rng() % 4);  // 0 or a label
     }
-    const Grid<float> mean = downsample_mean(image);
+    ThresholdParams params;
+    params.mu = 0.45;
+    params.epsilon = 0.2;
+    params.n = 4.0;
+    params.alpha = 0.2;
+    const ThresholdSpeed speed(image, params, &mask);
+    const Grid<float> coarse = block_threshold_image(speed, fine);
     const Grid<std::uint8_t> majority = downsample_majority(mask);
-    ASSERT_EQ(mean.dims(), (Vec3i{4, 3, 3}));
+    ASSERT_EQ(coarse.dims(), (Vec3i{4, 3, 3}));
     const Vec3i d = fine.dims();
     int checked = 0, inside = 0;
     for (int cz = 0; cz < 3; ++cz)
@@ -66,11 +80,12 @@ TEST(CoarseStart, BlockMeansAndMajoritiesMatchBruteForce) {
                     for (int y = 2 * cy; y < 2 * cy + 2; ++y)
                         for (int x = 2 * cx; x < 2 * cx + 2; ++x) {
                             if (x >= d.x || y >= d.y || z >= d.z) continue;
-                            sum += image({x, y, z});
-                            set += mask({x, y, z}) != 0;
+                            const bool in = mask({x, y, z}) != 0;
+                            sum += in ? threshold_term(image({x, y, z}), params) : 1.0;
+                            set += in;
                             ++n;
                         }
-                EXPECT_NEAR(mean({cx, cy, cz}), sum / n, 1e-5) << cx << "," << cy << "," << cz;
+                EXPECT_NEAR(threshold_term(coarse({cx, cy, cz}), params), sum / n, 1e-4) << cx << "," << cy << "," << cz;
                 EXPECT_EQ(majority({cx, cy, cz}), 2 * set >= n ? 1 : 0) << cx << "," << cy << "," << cz;
                 inside += majority({cx, cy, cz});
                 ++checked;
@@ -214,3 +229,94 @@ TEST(CoarseStart, SameBitsOnOneAndTwoThreads) {
 }
 
 }  // namespace
+
+namespace {
+
+// A block and, apart from it, a plate three voxels thick at 0.7 mm, which 2x2x2 blocks blur half
+// out of the window: the plate's own coarse front dies, the block's lives. A ripple of ±2.
+constexpr int kPlateSize = 64;
+bool in_plate(int x, int y, int z) { return x >= 9 && x <= 11 && y >= 4 && y < 60 && z < 60; }
+bool in_block(int x, int y, int z) { return x >= 24 && x < 60 && y >= 4 && y < 60 && z >= 4 && z < 60; }
+
+const Grid<float>& plate_and_block() {
+    static const Grid<float> g = [] {
+        Grid<float> img(Lattice({kPlateSize, kPlateSize, kPlateSize}, {0.7, 0.7, 0.7}), 0.0f);
+        for (int z = 0; z < kPlateSize; ++z)
+            for (int y = 0; y < kPlateSize; ++y)
+                for (int x = 0; x < kPlateSize; ++x)
+                    img({x, y, z}) = (in_plate(x, y, z) || in_block(x, y, z) ? 100.0f : 0.0f) +
+                                     static_cast<float>((7 * x + 13 * y + 29 * z) % 5 - 2);
+        return img;
+    }();
+    return g;
+}
+
+SegmentRequest plate_request(CoarseStart mode) {
+    SegmentRequest req;
+    req.seeds = {{{44.0, 30.0, 30.0}, 2.0}, {{10.0, 30.0, 0.0}, 1.0}};  // the block; the plate, on the image's first slice
+    req.mu_raw = 100.0;
+    req.epsilon_raw = 25.0;
+    req.alpha = 0.05;
+    req.loop.step = segment_step();
+    req.coarse_start = mode;
+    return req;
+}
+
+std::size_t count_in(const Grid<std::uint8_t>& mask, bool (*region)(int, int, int)) {
+    std::size_t n = 0;
+    for (int z = 0; z < kPlateSize; ++z)
+        for (int y = 0; y < kPlateSize; ++y)
+            for (int x = 0; x < kPlateSize; ++x) n += mask({x, y, z}) != 0 && region(x, y, z);
+    return n;
+}
+
+}  // namespace
+
+// A seed whose coarse front died keeps its ball in the fine start, so its region is segmented as
+// the direct run segments it; a seed on the image's first slice is placed on the coarse grid.
+TEST(CoarseStart, ASeedWhoseCoarseFrontDiedIsNotLost) {
+    const SegmentOutcome direct = segment_image(plate_and_block(), plate_request(CoarseStart::kOff));
+    const SegmentOutcome coarse = segment_image(plate_and_block(), plate_request(CoarseStart::kOn));
+    ASSERT_TRUE(coarse.coarse && coarse.coarse->used);
+    const std::size_t plate = 3 * 56 * 60, block = 36 * 56 * 56;
+    EXPECT_GT(count_in(direct.mask, in_plate), plate * 9 / 10);
+    EXPECT_GT(count_in(coarse.mask, in_plate), plate * 9 / 10);
+    EXPECT_GT(count_in(coarse.mask, in_block), block * 9 / 10);
+}
+
+// Nothing of the coarse front left in the ROI (a plane one voxel thick: no 2x2x2 block is half in
+// it): the fine run starts from the seeds, the direct run's φ bit for bit.
+TEST(CoarseStart, AnEmptyCoarseFrontFallsBackToTheSeeds) {
+    Grid<std::uint8_t> roi(plate_and_block().lattice(), 0);
+    for (int y = 4; y < 60; ++y)
+        for (int x = 24; x < 60; ++x) roi({x, y, 30}) = 1;
+    SegmentRequest off = plate_request(CoarseStart::kOff), on = plate_request(CoarseStart::kOn);
+    off.seeds = on.seeds = {{{44.0, 30.0, 30.0}, 2.0}};
+    off.roi = on.roi = &roi;
+    const SegmentOutcome direct = segment_image(plate_and_block(), off), fallback = segment_image(plate_and_block(), on);
+    ASSERT_TRUE(fallback.coarse.has_value());
+    EXPECT_FALSE(fallback.coarse->used);
+    EXPECT_GT(fallback.coarse->result.iterations, 0);
+    EXPECT_EQ(fallback.result.iterations, direct.result.iterations);
+    const auto a = direct.field->phi().values(), b = fallback.field->phi().values();
+    ASSERT_EQ(a.size(), b.size());
+    EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) { return std::bit_cast<std::uint32_t>(x) == std::bit_cast<std::uint32_t>(y); }));
+    EXPECT_GT(count_in(direct.mask, in_block), 0u);
+}
+
+// The hook stops the run during the coarse start: interrupted there, no fine step taken.
+TEST(CoarseStart, AnInterruptDuringTheCoarseStartStopsTheRun) {
+    int coarse_steps = 0, fine_steps = 0;
+    const SegmentationHook hook = [&](const SegmentationProgress& p, const ChangedPoints&) {
+        ++(p.level == 1 ? coarse_steps : fine_steps);
+        return p.level != 1 || p.iteration < 3;
+    };
+    const SegmentOutcome o = segment_image(plate_and_block(), plate_request(CoarseStart::kOn), hook);
+    EXPECT_EQ(o.result.reason, StopReason::kInterrupted);
+    ASSERT_TRUE(o.coarse.has_value());
+    EXPECT_EQ(o.coarse->result.reason, StopReason::kInterrupted);
+    EXPECT_EQ(o.coarse->result.iterations, 3);
+    EXPECT_EQ(coarse_steps, 3);
+    EXPECT_EQ(fine_steps, 0);
+    EXPECT_EQ(o.result.iterations, 0);
+}

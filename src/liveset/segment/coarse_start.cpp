@@ -18,11 +18,11 @@ struct Span {
 };
 Span block(int c, int d) { return {2 * c, std::min(2 * c + 2, d)}; }
 
-// f(sum of the block's values as double, voxel count) for every coarse point, in parallel (each
-// coarse point written from its own block only: the same bits on any thread count).
-template <class T, class U, class F>
-Grid<U> reduce_blocks(const Grid<T>& fine, const F& f) {
-    const Lattice coarse = coarse_lattice(fine.lattice());
+// f(sum of value(p) over the block's fine points p as double, their count) for every coarse point,
+// in parallel (each coarse point from its own block only: the same bits on any thread count).
+template <class U, class V, class F>
+Grid<U> reduce_blocks(const Lattice& fine, const V& value, const F& f) {
+    const Lattice coarse = coarse_lattice(fine);
     Grid<U> out(coarse);
     const Vec3i cd = coarse.dims(), fd = fine.dims();
     voxel_loops::for_each(coarse.size(), [&](std::size_t i) {
@@ -34,7 +34,7 @@ Grid<U> reduce_blocks(const Grid<T>& fine, const F& f) {
         int n = 0;
         for (int k = z.lo; k < z.hi; ++k)
             for (int j = y.lo; j < y.hi; ++j)
-                for (int a = x.lo; a < x.hi; ++a, ++n) sum += static_cast<double>(fine(Vec3i{a, j, k}));
+                for (int a = x.lo; a < x.hi; ++a, ++n) sum += static_cast<double>(value(Vec3i{a, j, k}));
         out[static_cast<PointIndex>(i)] = f(sum, n);
     });
     return out;
@@ -83,20 +83,27 @@ Lattice coarse_lattice(const Lattice& fine) {
                    fine.direction());
 }
 
-Grid<float> downsample_mean(const Grid<float>& fine) {
-    return reduce_blocks<float, float>(fine, [](double sum, int n) { return static_cast<float>(sum / n); });
-}
-
 Grid<std::uint8_t> downsample_majority(const Grid<std::uint8_t>& fine) {
-    // The sum of 0/1 values: non-zero voxels counted as one.
-    Grid<std::uint8_t> ones(fine.lattice());
-    voxel_loops::for_each(fine.size(), [&](std::size_t i) { ones[static_cast<PointIndex>(i)] = fine[static_cast<PointIndex>(i)] != 0; });
-    return reduce_blocks<std::uint8_t, std::uint8_t>(ones, [](double sum, int n) { return static_cast<std::uint8_t>(2.0 * sum >= n); });
+    return reduce_blocks<std::uint8_t>(fine.lattice(), [&](Vec3i p) { return fine(p) != 0 ? 1 : 0; },
+                                       [](double sum, int n) { return static_cast<std::uint8_t>(2.0 * sum >= n); });
 }
 
-SeedBall coarse_seed(const SeedBall& fine) {
+Grid<float> block_threshold_image(const ThresholdSpeed& fine, const Lattice& lattice) {
+    const ThresholdParams& p = fine.params();
+    const double w = 0.5 * (1.0 - p.alpha);  // propagation = w·D inside the ROI, +½ (D above 1) outside
+    return reduce_blocks<float>(
+        lattice, [&](Vec3i q) { return std::clamp(static_cast<double>(fine.propagation(q)) / w, -1.0, 1.0); },
+        [&](double sum, int n) {
+            const double d = std::min(sum / n, 1.0 - 1e-6);  // D̄ = (r − 1) / (r + 1): r = (1 + D̄) / (1 − D̄)
+            return static_cast<float>(p.mu + p.epsilon * std::pow((1.0 + d) / (1.0 - d), 1.0 / p.n));
+        });
+}
+
+SeedBall coarse_seed(const SeedBall& fine, const Lattice& coarse) {
     const Vec3d c = fine.center;
-    return {{(c.x - 0.5) / 2.0, (c.y - 0.5) / 2.0, (c.z - 0.5) / 2.0}, fine.radius / 2.0};
+    const Vec3i d = coarse.dims();
+    const auto at = [](double x, int dim) { return std::clamp((x - 0.5) / 2.0, 0.0, dim - 1.0); };
+    return {{at(c.x, d.x), at(c.y, d.y), at(c.z, d.z)}, fine.radius / 2.0};
 }
 
 Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice& fine, const Grid<std::uint8_t>* roi) {
@@ -124,11 +131,13 @@ Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice&
     return out;
 }
 
-std::optional<Grid<std::uint8_t>> run_coarse_start(const Grid<float>& unit_image, const ThresholdParams& params,
+std::optional<Grid<std::uint8_t>> run_coarse_start(const ThresholdSpeed& fine_speed, const Lattice& fine,
                                                    const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
                                                    const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
                                                    const std::atomic<bool>* interrupt, CoarseStartReport& report) {
-    const Grid<float> unit = downsample_mean(unit_image);
+    ThresholdParams params = fine_speed.params();
+    params.smooth_mm = 0.0;  // the fine speed read the blurred image already
+    const Grid<float> unit = block_threshold_image(fine_speed, fine);
     std::optional<Grid<std::uint8_t>> coarse_roi;
     if (roi) coarse_roi = downsample_majority(*roi);
     report.dims = unit.dims();
@@ -136,7 +145,7 @@ std::optional<Grid<std::uint8_t>> run_coarse_start(const Grid<float>& unit_image
     const ThresholdSpeed speed(unit, params, coarse_roi ? &*coarse_roi : nullptr);
     SparseField field(unit.lattice(), layers);
     std::vector<SeedBall> balls;
-    for (const SeedBall& s : seeds) balls.push_back(coarse_seed(s));
+    for (const SeedBall& s : seeds) balls.push_back(coarse_seed(s, unit.lattice()));
     init_from_seeds(field, balls);
     SegmentationHook coarse_hook;
     if (hook)
@@ -147,7 +156,7 @@ std::optional<Grid<std::uint8_t>> run_coarse_start(const Grid<float>& unit_image
         };
     report.result = run_segmentation(field, speed, loop, coarse_hook, interrupt);
     if (report.result.reason == StopReason::kInterrupted) return std::nullopt;
-    Grid<std::uint8_t> start = upsample_inside(field.phi(), unit_image.lattice(), roi);
+    Grid<std::uint8_t> start = upsample_inside(field.phi(), fine, roi);
     report.upsampled = voxel_loops::count_if(start.size(), [&](std::size_t i) { return start[static_cast<PointIndex>(i)] != 0; });
     report.used = report.upsampled > 0;
     if (!report.used) return std::nullopt;

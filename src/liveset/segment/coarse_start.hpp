@@ -18,7 +18,8 @@
 namespace liveset {
 
 // kAuto (the default) starts coarse where every voxel side is at most kCoarseStartMaxSpacing mm and
-// the run starts from seeds; kOn wherever it starts from seeds; kOff never.
+// the run starts from seeds; kOn wherever it starts from seeds; kOff never. Neither on a grid with
+// an axis shorter than kCoarseStartMinDim voxels.
 enum class CoarseStart { kAuto, kOn, kOff };
 
 // A 0.7 mm (HCP-like) grid's front travels twice the voxels of a 1.4 mm one's at half the time
@@ -37,12 +38,16 @@ bool coarse_start_applies(CoarseStart mode, const Lattice& lattice);
 // The grid of 2x2x2 blocks: dims ceil(d / 2), spacing doubled, the first point at the centre of the
 // first block (fine index 0.5 on each axis). Coarse point c lies at fine index 2c + 0.5.
 Lattice coarse_lattice(const Lattice& fine);
-// Each block's mean (a block cut by an odd border: the mean of the voxels it holds).
-Grid<float> downsample_mean(const Grid<float>& fine);
 // 1 where at least half of a block's voxels are non-zero.
 Grid<std::uint8_t> downsample_majority(const Grid<std::uint8_t>& fine);
-// A seed ball in the coarse grid's index space (centre mapped, radius halved).
-SeedBall coarse_seed(const SeedBall& fine);
+// The coarse image: at each block, the intensity whose threshold term D (Eq. 3, with `fine`'s µ, ε
+// and n) is the mean of `fine`'s D over the block's voxels (`lattice`: `fine`'s; D read as +1
+// outside its ROI, a block cut by an odd border averaging the voxels it holds):
+// I = µ + ε ((1 + D̄) / (1 − D̄))^(1/n). Not the mean intensity: a block of tissue and its neighbour
+// averages into the window (partial volume) where their mean D says half in, half out.
+Grid<float> block_threshold_image(const ThresholdSpeed& fine, const Lattice& lattice);
+// A seed ball in the index space of `coarse` (the centre mapped and clamped into it, the radius halved).
+SeedBall coarse_seed(const SeedBall& fine, const Lattice& coarse);
 // Inside (1) where the coarse φ, trilinear at each fine voxel's centre (clamped to the coarse grid),
 // is negative, and the ROI (when given, `fine`'s lattice) allows it.
 Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice& fine, const Grid<std::uint8_t>* roi = nullptr);
@@ -52,15 +57,16 @@ struct CoarseStartReport {
     Vec3i dims{0, 0, 0};
     Vec3d spacing{0, 0, 0};
     SegmentationResult result;   // the coarse run's iterations, stop reason and seconds
-    std::size_t upsampled = 0;   // inside points of the fine start
-    bool used = false;           // false: the coarse front vanished; the fine run started from the seeds
+    std::size_t upsampled = 0;   // inside points of the upsampled front (the fine start without the seeds' balls)
+    bool used = false;           // false: nothing of the coarse front was left inside the ROI; the fine run started from the seeds
 };
 
-// The coarse stage: the front from `seeds` (the fine grid's index space) under the threshold speed
-// with `params` on `unit_image` averaged over 2x2x2 voxels (the ROI by majority), run as `loop`
-// says; the hook sees its steps with level 1. Returns the fine start (upsample_inside), or nothing
-// when the run was interrupted (report.result.reason) or the front vanished (report.used false).
-std::optional<Grid<std::uint8_t>> run_coarse_start(const Grid<float>& unit_image, const ThresholdParams& params,
+// The coarse stage: the front from `seeds` (`fine`'s index space) under the threshold speed on the
+// block_threshold_image of `fine_speed` (its params, no blur: it read the blurred image) and the ROI
+// by majority, run as `loop` says; the hook sees its steps with level 1. Returns upsample_inside of
+// its φ (the fine start, to which segment_image unites the seeds' balls), or nothing when the run
+// was interrupted (report.result.reason) or nothing of its front is left (report.used false).
+std::optional<Grid<std::uint8_t>> run_coarse_start(const ThresholdSpeed& fine_speed, const Lattice& fine,
                                                    const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
                                                    const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
                                                    const std::atomic<bool>* interrupt, CoarseStartReport& report);

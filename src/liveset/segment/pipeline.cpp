@@ -128,9 +128,12 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     } else if (coarse_start_applies(req.coarse_start, image.lattice())) {
         out.coarse.emplace();
         const std::optional<Grid<std::uint8_t>> start =
-            run_coarse_start(unit, p, req.roi, req.seeds, req.loop, req.layers, hook, interrupt, *out.coarse);
+            run_coarse_start(speed, image.lattice(), req.roi, req.seeds, req.loop, req.layers, hook, interrupt, *out.coarse);
         if (start) {
             out.field->init_from_mask(*start);
+            // Every seed's ball too: a seed whose coarse front died (its tissue blurred out of the
+            // window by the blocks) is not lost while another seed's front lived.
+            unite_seeds(*out.field, req.seeds);
         } else {
             init_from_seeds(*out.field, req.seeds);
             if (out.coarse->result.reason == StopReason::kInterrupted) {

@@ -120,6 +120,16 @@ void init_from_seeds(SparseField& field, std::span<const SeedBall> seeds) {
     field.init_from_sdf(sdf, lo, hi);
 }
 
+void unite_seeds(SparseField& field, std::span<const SeedBall> seeds) {
+    for (const SeedBall& s : seeds) {
+        const shapes::Sphere ball(s.center, std::max(s.radius, 0.5));
+        const double reach = ball.radius + field.layers() + 1.0;  // beyond it the ball cannot undercut φ
+        const Vec3d lo = s.center - Vec3d{reach, reach, reach}, hi = s.center + Vec3d{reach, reach, reach};
+        field.unite_in_box({static_cast<int>(std::floor(lo.x)), static_cast<int>(std::floor(lo.y)), static_cast<int>(std::floor(lo.z))},
+                           {static_cast<int>(std::ceil(hi.x)), static_cast<int>(std::ceil(hi.y)), static_cast<int>(std::ceil(hi.z))}, ball);
+    }
+}
+
 Grid<std::uint8_t> inside_mask(const Grid<float>& phi, const Grid<std::uint8_t>* roi) {
     if (roi && !(roi->dims() == phi.dims())) throw std::invalid_argument("region-of-interest mask does not match phi");
     Grid<std::uint8_t> m(phi.lattice());

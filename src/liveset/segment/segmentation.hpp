@@ -139,6 +139,9 @@ SegmentationResult run_segmentation(SparseField& field, const Speed& speed, cons
 
 // Initialises `field` from seed balls (index space): φ is the signed distance to their union.
 void init_from_seeds(SparseField& field, std::span<const SeedBall> seeds);
+// The union of `field`'s inside with the seed balls (each re-initialised locally, as a seed the
+// viewer adds: SparseField::unite_in_box).
+void unite_seeds(SparseField& field, std::span<const SeedBall> seeds);
 
 // φ < 0, intersected with the ROI when given (non-zero voxels), as a 0/1 mask.
 Grid<std::uint8_t> inside_mask(const Grid<float>& phi, const Grid<std::uint8_t>* roi = nullptr);
