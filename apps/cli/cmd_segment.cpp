@@ -94,6 +94,28 @@ nlohmann::json segment_report(const SegmentArgs& a, const SegmentOutcome& o, con
     return j;
 }
 
+// Ctrl-C during the run: the iterations of the stage it stopped in, nothing written.
+int report_interrupt(const SegmentOutcome& o, bool quiet) {
+    const bool coarse = o.coarse && o.coarse->result.reason == StopReason::kInterrupted;
+    if (!quiet)
+        fmt::print(stderr, "liveset: interrupted after {} iterations{}; nothing written\n",
+                   coarse ? o.coarse->result.iterations : o.result.iterations, coarse ? " of the coarse start" : "");
+    return 130;
+}
+
+// The mask and the outputs asked for, each written atomically; the mesh's triangle count (0: none).
+std::size_t write_segment_outputs(const SegmentArgs& a, const Scan& scan, const SegmentOutcome& o, const std::optional<Roi>& roi) {
+    const WriteOptions as_read{.orientation_known = scan.header.orientation_known};
+    write_label_image(o.mask, a.out_mask, as_read);
+    if (!a.out_phi.empty()) write_image(o.field->phi(), a.out_phi, as_read);
+    if (!a.out_roi.empty()) write_label_image(roi->mask, a.out_roi, as_read);
+    if (!a.out_corrected.empty()) write_image(scan.restored(scan.image), a.out_corrected, as_read);
+    if (a.out_mesh.empty()) return 0;
+    const Mesh mesh = marching_cubes_band(o.field->phi(), o.field->zero_layer());
+    write_mesh(a.out_mesh, mesh.view(), scan.image.lattice());
+    return mesh.triangle_count();
+}
+
 int run_segment(const SegmentArgs& a, int threads) {
     const auto guard = limit_threads(threads);
     const InterruptGuard interrupt;
@@ -131,26 +153,9 @@ int run_segment(const SegmentArgs& a, int threads) {
     req.brain_mask = lookup.options;  // where no region was found: looked for again as the ROI was
     if (!a.quiet) scan.print_note(a.image);  // the inputs are good
     const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
-    if (run.interrupted) {
-        const SegmentOutcome& o = run.outcome;
-        const bool coarse = o.coarse && o.result.iterations == 0;  // stopped in the coarse start
-        if (!a.quiet)
-            fmt::print(stderr, "liveset: interrupted after {} iterations{}; nothing written\n",
-                       coarse ? o.coarse->result.iterations : o.result.iterations, coarse ? " of the coarse start" : "");
-        return 130;
-    }
+    if (run.interrupted) return report_interrupt(run.outcome, a.quiet);
     const SegmentOutcome& o = run.outcome;
-    const WriteOptions as_read{.orientation_known = header.orientation_known};
-    write_label_image(o.mask, a.out_mask, as_read);
-    if (!a.out_phi.empty()) write_image(o.field->phi(), a.out_phi, as_read);
-    if (!a.out_roi.empty()) write_label_image(roi->mask, a.out_roi, as_read);
-    if (!a.out_corrected.empty()) write_image(scan.restored(image), a.out_corrected, as_read);
-    std::size_t triangles = 0;
-    if (!a.out_mesh.empty()) {
-        const Mesh mesh = marching_cubes_band(o.field->phi(), o.field->zero_layer());
-        triangles = mesh.triangle_count();
-        write_mesh(a.out_mesh, mesh.view(), image.lattice());
-    }
+    const std::size_t triangles = write_segment_outputs(a, scan, o, roi);
 
     nlohmann::json j = segment_report(a, o, image.lattice(), roi, prepared, triangles);
     j["no_data_voxels"] = scan.no_data_voxels;

@@ -13,6 +13,7 @@
 
 #include "liveset/segment/coarse_start.hpp"
 #include "liveset/segment/pipeline.hpp"
+#include "liveset/segment/smoothing.hpp"
 
 using namespace liveset;
 
@@ -48,9 +49,9 @@ TEST(CoarseStart, BlockGridSitsAtTheBlocksCentres) {
     EXPECT_DOUBLE_EQ(b.center.z, 1.75);
 }
 
-// The coarse image's D at each block is the mean of the fine D over the block (+1 outside the
-// ROI), and the ROI's majority the brute-force count's.
-TEST(CoarseStart, BlockThresholdTermsAndMajoritiesMatchBruteForce) {
+// The coarse D at each block is the mean of the fine D over the block (+1 outside the ROI), the
+// fine D read after the blur when there is one; the ROI's majority is the brute-force count's.
+void check_block_terms(double smooth_mm) {
     const Lattice fine = odd_lattice();
     Grid<float> image(fine);
     Grid<std::uint8_t> mask(fine);
@@ -65,8 +66,10 @@ TEST(CoarseStart, BlockThresholdTermsAndMajoritiesMatchBruteForce) {
     params.epsilon = 0.2;
     params.n = 4.0;
     params.alpha = 0.2;
+    params.smooth_mm = smooth_mm;
     const ThresholdSpeed speed(image, params, &mask);
-    const Grid<float> coarse = block_threshold_image(speed, fine);
+    const Grid<float> coarse = block_threshold_terms(speed);
+    const Grid<float> seen = smooth_mm > 0.0 ? gaussian_smooth(image, smooth_mm) : image;
     const Grid<std::uint8_t> majority = downsample_majority(mask);
     ASSERT_EQ(coarse.dims(), (Vec3i{4, 3, 3}));
     const Vec3i d = fine.dims();
@@ -81,11 +84,11 @@ TEST(CoarseStart, BlockThresholdTermsAndMajoritiesMatchBruteForce) {
                         for (int x = 2 * cx; x < 2 * cx + 2; ++x) {
                             if (x >= d.x || y >= d.y || z >= d.z) continue;
                             const bool in = mask({x, y, z}) != 0;
-                            sum += in ? threshold_term(image({x, y, z}), params) : 1.0;
+                            sum += in ? threshold_term(seen({x, y, z}), params) : 1.0;
                             set += in;
                             ++n;
                         }
-                EXPECT_NEAR(threshold_term(coarse({cx, cy, cz}), params), sum / n, 1e-4) << cx << "," << cy << "," << cz;
+                EXPECT_NEAR(coarse({cx, cy, cz}), sum / n, 1e-6) << cx << "," << cy << "," << cz;
                 EXPECT_EQ(majority({cx, cy, cz}), 2 * set >= n ? 1 : 0) << cx << "," << cy << "," << cz;
                 inside += majority({cx, cy, cz});
                 ++checked;
@@ -93,6 +96,33 @@ TEST(CoarseStart, BlockThresholdTermsAndMajoritiesMatchBruteForce) {
     EXPECT_EQ(checked, 36);
     EXPECT_GT(inside, 0);
     EXPECT_LT(inside, 36);
+}
+
+TEST(CoarseStart, BlockThresholdTermsAndMajoritiesMatchBruteForce) { check_block_terms(0.0); }
+TEST(CoarseStart, BlockThresholdTermsReadTheBlurredImage) { check_block_terms(0.9); }
+
+// The coarse speed tabulates the block terms as given, even where the fine speed's n is so small
+// that no finite intensity has them (D = ±1 at the window's edge and beyond).
+TEST(CoarseStart, TermSpeedTabulatesTheTermsAsGiven) {
+    const Lattice lat({4, 3, 2}, {1.4, 1.4, 1.4});
+    Grid<float> terms(lat);
+    for (std::size_t i = 0; i < terms.size(); ++i) terms[static_cast<PointIndex>(i)] = -1.0f + 2.0f * static_cast<float>(i) / 23.0f;
+    Grid<std::uint8_t> roi(lat, 1);
+    roi({3, 2, 1}) = 0;
+    ThresholdParams params;
+    params.n = 0.01;
+    params.alpha = 0.3;
+    const ThresholdSpeed speed = ThresholdSpeed::from_terms(terms, params, &roi);
+    for (int z = 0; z < 2; ++z)
+        for (int y = 0; y < 3; ++y)
+            for (int x = 0; x < 4; ++x) {
+                const float want = x == 3 && y == 2 && z == 1 ? 0.5f : static_cast<float>(0.35 * terms({x, y, z}));
+                EXPECT_FLOAT_EQ(speed.propagation({x, y, z}), want);
+            }
+    terms({1, 1, 1}) = 1.5f;
+    EXPECT_THROW(ThresholdSpeed::from_terms(terms, params), std::invalid_argument);
+    terms({1, 1, 1}) = std::nanf("");
+    EXPECT_THROW(ThresholdSpeed::from_terms(terms, params), std::invalid_argument);
 }
 
 // Trilinear interpolation is exact for a linear φ: inside where the plane, at the fine voxel's
@@ -123,6 +153,34 @@ TEST(CoarseStart, UpsampledFrontIsTheLinearPlanesSide) {
     EXPECT_LT(inside, compared - 500);
     const Grid<std::uint8_t> wrong(coarse, 1);  // an ROI of another grid
     EXPECT_THROW(upsample_inside(phi, fine, &wrong), std::invalid_argument);
+}
+
+// An odd grid, edges included: the fine voxel's coarse coordinate (i - 0.5) / 2 clamped to the
+// coarse grid on each axis (the first voxel and the last of an odd axis lie beyond its points).
+TEST(CoarseStart, UpsamplingClampsAtTheEdgesOfAnOddGrid) {
+    const Lattice fine({9, 7, 5}, {0.7, 0.7, 0.7});
+    const Lattice coarse = coarse_lattice(fine);
+    ASSERT_EQ(coarse.dims(), (Vec3i{5, 4, 3}));
+    Grid<float> phi(coarse);
+    const auto plane = [](double x, double y, double z) { return 0.8 * x + 0.45 * y - 0.3 * z - 2.1; };
+    for (int z = 0; z < 3; ++z)
+        for (int y = 0; y < 4; ++y)
+            for (int x = 0; x < 5; ++x) phi({x, y, z}) = static_cast<float>(plane(x, y, z));
+    const Grid<std::uint8_t> up = upsample_inside(phi, fine);
+    const Vec3i c = coarse.dims();
+    const auto at = [](int i, int dim) { return std::clamp((i - 0.5) / 2.0, 0.0, dim - 1.0); };
+    int inside = 0, compared = 0;
+    for (int z = 0; z < 5; ++z)
+        for (int y = 0; y < 7; ++y)
+            for (int x = 0; x < 9; ++x) {
+                const double v = plane(at(x, c.x), at(y, c.y), at(z, c.z));
+                if (std::abs(v) < 1e-4) continue;
+                EXPECT_EQ(up({x, y, z}), v < 0 ? 1 : 0) << x << "," << y << "," << z;
+                inside += v < 0;
+                ++compared;
+            }
+    EXPECT_GT(inside, 40);
+    EXPECT_LT(inside, compared - 40);
 }
 
 TEST(CoarseStart, AutoRuleAndNames) {
@@ -275,6 +333,14 @@ std::size_t count_in(const Grid<std::uint8_t>& mask, bool (*region)(int, int, in
 // A seed whose coarse front died keeps its ball in the fine start, so its region is segmented as
 // the direct run segments it; a seed on the image's first slice is placed on the coarse grid.
 TEST(CoarseStart, ASeedWhoseCoarseFrontDiedIsNotLost) {
+    {  // the plate's seed alone: its coarse front dies (else this test would not test the balls)
+        SegmentRequest alone = plate_request(CoarseStart::kOn);
+        alone.seeds.erase(alone.seeds.begin());
+        const SegmentOutcome o = segment_image(plate_and_block(), alone);
+        ASSERT_TRUE(o.coarse.has_value());
+        EXPECT_FALSE(o.coarse->used);
+        EXPECT_EQ(o.coarse->result.reason, StopReason::kVanished);
+    }
     const SegmentOutcome direct = segment_image(plate_and_block(), plate_request(CoarseStart::kOff));
     const SegmentOutcome coarse = segment_image(plate_and_block(), plate_request(CoarseStart::kOn));
     ASSERT_TRUE(coarse.coarse && coarse.coarse->used);
@@ -302,6 +368,15 @@ TEST(CoarseStart, AnEmptyCoarseFrontFallsBackToTheSeeds) {
     ASSERT_EQ(a.size(), b.size());
     EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) { return std::bit_cast<std::uint32_t>(x) == std::bit_cast<std::uint32_t>(y); }));
     EXPECT_GT(count_in(direct.mask, in_block), 0u);
+}
+
+// A seed outside the image is refused as the direct run refuses it, not clamped onto the coarse grid.
+TEST(CoarseStart, ASeedOutsideTheImageIsRefused) {
+    for (const CoarseStart mode : {CoarseStart::kOff, CoarseStart::kOn}) {
+        SegmentRequest req = plate_request(mode);
+        req.seeds.push_back({{-40.0, 30.0, 30.0}, 2.0});
+        EXPECT_THROW(segment_image(plate_and_block(), req), std::invalid_argument) << to_string(mode);
+    }
 }
 
 // The hook stops the run during the coarse start: interrupted there, no fine step taken.

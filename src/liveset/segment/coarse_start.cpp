@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "liveset/levelset/shapes.hpp"
 #include "liveset/levelset/sparse_field.hpp"
 #include "liveset/segment/voxel_loops.hpp"
 
@@ -88,15 +89,11 @@ Grid<std::uint8_t> downsample_majority(const Grid<std::uint8_t>& fine) {
                                        [](double sum, int n) { return static_cast<std::uint8_t>(2.0 * sum >= n); });
 }
 
-Grid<float> block_threshold_image(const ThresholdSpeed& fine, const Lattice& lattice) {
-    const ThresholdParams& p = fine.params();
-    const double w = 0.5 * (1.0 - p.alpha);  // propagation = w·D inside the ROI, +½ (D above 1) outside
+Grid<float> block_threshold_terms(const ThresholdSpeed& fine) {
+    const double w = 0.5 * (1.0 - fine.params().alpha);  // propagation = w·D inside the ROI, +½ (D above 1) outside
     return reduce_blocks<float>(
-        lattice, [&](Vec3i q) { return std::clamp(static_cast<double>(fine.propagation(q)) / w, -1.0, 1.0); },
-        [&](double sum, int n) {
-            const double d = std::min(sum / n, 1.0 - 1e-6);  // D̄ = (r − 1) / (r + 1): r = (1 + D̄) / (1 − D̄)
-            return static_cast<float>(p.mu + p.epsilon * std::pow((1.0 + d) / (1.0 - d), 1.0 / p.n));
-        });
+        fine.lattice(), [&](Vec3i q) { return std::clamp(static_cast<double>(fine.propagation(q)) / w, -1.0, 1.0); },
+        [](double sum, int n) { return static_cast<float>(std::clamp(sum / n, -1.0, 1.0)); });
 }
 
 SeedBall coarse_seed(const SeedBall& fine, const Lattice& coarse) {
@@ -135,17 +132,21 @@ std::optional<Grid<std::uint8_t>> run_coarse_start(const ThresholdSpeed& fine_sp
                                                    const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
                                                    const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
                                                    const std::atomic<bool>* interrupt, CoarseStartReport& report) {
-    ThresholdParams params = fine_speed.params();
-    params.smooth_mm = 0.0;  // the fine speed read the blurred image already
-    const Grid<float> unit = block_threshold_image(fine_speed, fine);
+    if (!(fine_speed.lattice().dims() == fine.dims())) throw std::invalid_argument("the speed does not match the grid the coarse start refines");
+    // The seeds where the fine run would take them (centres inside the image, radii valid), before
+    // they are clamped onto the coarse grid.
+    std::vector<shapes::Sphere> spheres;
+    for (const SeedBall& s : seeds) spheres.emplace_back(s.center, std::max(s.radius, 0.5));
+    (void)shapes::SeedSpheres(fine, std::move(spheres));
+    const Grid<float> terms = block_threshold_terms(fine_speed);
     std::optional<Grid<std::uint8_t>> coarse_roi;
     if (roi) coarse_roi = downsample_majority(*roi);
-    report.dims = unit.dims();
-    report.spacing = unit.lattice().spacing();
-    const ThresholdSpeed speed(unit, params, coarse_roi ? &*coarse_roi : nullptr);
-    SparseField field(unit.lattice(), layers);
+    report.dims = terms.dims();
+    report.spacing = terms.lattice().spacing();
+    const ThresholdSpeed speed = ThresholdSpeed::from_terms(terms, fine_speed.params(), coarse_roi ? &*coarse_roi : nullptr);
+    SparseField field(terms.lattice(), layers);
     std::vector<SeedBall> balls;
-    for (const SeedBall& s : seeds) balls.push_back(coarse_seed(s, unit.lattice()));
+    for (const SeedBall& s : seeds) balls.push_back(coarse_seed(s, terms.lattice()));
     init_from_seeds(field, balls);
     SegmentationHook coarse_hook;
     if (hook)

@@ -40,12 +40,11 @@ bool coarse_start_applies(CoarseStart mode, const Lattice& lattice);
 Lattice coarse_lattice(const Lattice& fine);
 // 1 where at least half of a block's voxels are non-zero.
 Grid<std::uint8_t> downsample_majority(const Grid<std::uint8_t>& fine);
-// The coarse image: at each block, the intensity whose threshold term D (Eq. 3, with `fine`'s µ, ε
-// and n) is the mean of `fine`'s D over the block's voxels (`lattice`: `fine`'s; D read as +1
-// outside its ROI, a block cut by an odd border averaging the voxels it holds):
-// I = µ + ε ((1 + D̄) / (1 − D̄))^(1/n). Not the mean intensity: a block of tissue and its neighbour
-// averages into the window (partial volume) where their mean D says half in, half out.
-Grid<float> block_threshold_image(const ThresholdSpeed& fine, const Lattice& lattice);
+// The coarse threshold terms: at each block, the mean of `fine`'s D (Eq. 3, after its blur; +1
+// outside its ROI) over the block's voxels (a block cut by an odd border averaging those it holds).
+// Not D of the mean intensity: a block of tissue and its neighbour averages into the window (partial
+// volume) where their mean D says half in, half out.
+Grid<float> block_threshold_terms(const ThresholdSpeed& fine);
 // A seed ball in the index space of `coarse` (the centre mapped and clamped into it, the radius halved).
 SeedBall coarse_seed(const SeedBall& fine, const Lattice& coarse);
 // Inside (1) where the coarse φ, trilinear at each fine voxel's centre (clamped to the coarse grid),
@@ -62,7 +61,7 @@ struct CoarseStartReport {
 };
 
 // The coarse stage: the front from `seeds` (`fine`'s index space) under the threshold speed on the
-// block_threshold_image of `fine_speed` (its params, no blur: it read the blurred image) and the ROI
+// block_threshold_terms of `fine_speed` (with its α) and the ROI
 // by majority, run as `loop` says; the hook sees its steps with level 1. Returns upsample_inside of
 // its φ (the fine start, to which segment_image unites the seeds' balls), or nothing when the run
 // was interrupted (report.result.reason) or nothing of its front is left (report.used false).

@@ -45,21 +45,39 @@ ThresholdSpeed::ThresholdSpeed(const Grid<float>& unit_image, const ThresholdPar
     };
     if (roi) check_dims("region-of-interest mask", roi->dims());
     if (blurred) check_dims("blurred image", blurred->dims());
-    const double w = 0.5 * (1.0 - params.alpha);
     std::optional<Grid<float>> own;  // the blur, when the caller keeps none
     const Grid<float>* source = &unit_image;
     if (params.smooth_mm > 0.0) source = blurred ? blurred : &own.emplace(gaussian_smooth(unit_image, params.smooth_mm));
     const std::span<const float> img = source->values();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, img.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
+    tabulate([&](std::size_t i) {
+        const float v = img[i];
+        if (!std::isfinite(v)) throw std::invalid_argument("normalised image has non-finite voxels");
+        return threshold_term(v, params);
+    });
+}
+
+ThresholdSpeed::ThresholdSpeed(TermTag, const Grid<float>& term, const ThresholdParams& params, const Grid<std::uint8_t>* roi)
+    : params_(params), propagation_(term.lattice()), roi_(roi) {
+    validate(params);
+    if (roi && !(roi->dims() == term.dims())) throw std::invalid_argument("region-of-interest mask does not match the threshold terms");
+    tabulate([&](std::size_t i) {
+        const float d = term[static_cast<PointIndex>(i)];
+        if (!(d >= -1.0f && d <= 1.0f)) throw std::invalid_argument("threshold terms must lie in [-1, 1]");
+        return static_cast<double>(d);
+    });
+}
+
+ThresholdSpeed ThresholdSpeed::from_terms(const Grid<float>& term, const ThresholdParams& params, const Grid<std::uint8_t>* roi) {
+    return ThresholdSpeed(TermTag{}, term, params, roi);
+}
+
+template <class D>
+void ThresholdSpeed::tabulate(const D& term_at) {
+    const double w = 0.5 * (1.0 - params_.alpha);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, propagation_.size(), 1 << 14), [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const auto pi = static_cast<PointIndex>(i);
-            if (roi && (*roi)[pi] == 0) {
-                propagation_[pi] = 0.5f;
-                continue;
-            }
-            const float v = img[i];
-            if (!std::isfinite(v)) throw std::invalid_argument("normalised image has non-finite voxels");
-            propagation_[pi] = static_cast<float>(w * threshold_term(v, params));
+            propagation_[pi] = roi_ && (*roi_)[pi] == 0 ? 0.5f : static_cast<float>(w * term_at(i));
         }
     });
     // The sign table, a byte (four voxels) per index, so that no two tasks write one byte.

@@ -43,6 +43,9 @@ public:
     // it as `blurred`, which is then read instead of blurring again (ignored when smooth_mm is 0).
     ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi = nullptr,
                    const Grid<float>* blurred = nullptr);
+    // The speed of given threshold terms D ∈ [-1, 1] per voxel (in place of D(I) of an image; the
+    // coarse start's block means), with `params`' α; µ, ε, n and the blur are not used.
+    static ThresholdSpeed from_terms(const Grid<float>& term, const ThresholdParams& params, const Grid<std::uint8_t>* roi = nullptr);
 
     SpeedSample at(const Grid<float>& phi, Vec3i p) const override;
     void rates(const Grid<float>& phi, std::span<const PointIndex> points, std::span<double> out) const override;
@@ -52,8 +55,15 @@ public:
     const ThresholdParams& params() const { return params_; }
     // ½(1 − α)·D at a lattice point (+½ outside the ROI).
     float propagation(Vec3i p) const { return propagation_(p); }
+    const Lattice& lattice() const { return propagation_.lattice(); }
 
 private:
+    struct TermTag {};
+    ThresholdSpeed(TermTag, const Grid<float>& term, const ThresholdParams& params, const Grid<std::uint8_t>* roi);
+    // propagation_ = ½(1 − α)·term_at(i) inside the ROI (+½ outside), and its sign table.
+    template <class D>
+    void tabulate(const D& term_at);
+
     ThresholdParams params_;
     Grid<float> propagation_;             // ½(1 − α) D(p), or +½ outside the ROI
     // propagation_'s signs, 2 bits a voxel (four to a byte, the lowest first): 0 zero, 1 positive,
