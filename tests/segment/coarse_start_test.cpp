@@ -379,6 +379,24 @@ TEST(CoarseStart, ASeedOutsideTheImageIsRefused) {
     }
 }
 
+// A tiny n with blocks cut by the ROI (D̄ about ½ there): no intensity has that D (3^(1/n)
+// overflows), so the coarse speed takes the terms themselves; the run goes as the direct one does.
+TEST(CoarseStart, ATinyNWithBlocksCutByTheRoiRuns) {
+    Grid<std::uint8_t> roi(plate_and_block().lattice(), 0);
+    for (int z = 0; z < kPlateSize; ++z)
+        for (int y = 0; y < kPlateSize; ++y)
+            for (int x = 25; x < kPlateSize; ++x) roi({x, y, z}) = 1;  // cuts the blocks of x 24-25
+    SegmentRequest req = plate_request(CoarseStart::kOn);
+    req.seeds = {{{44.0, 30.0, 30.0}, 2.0}};
+    req.roi = &roi;
+    req.n = 0.01;
+    req.loop.max_iterations = 30;
+    const SegmentOutcome o = segment_image(plate_and_block(), req);
+    ASSERT_TRUE(o.coarse.has_value());
+    EXPECT_GT(o.coarse->result.iterations, 0);
+    EXPECT_GT(o.result.iterations, 0);
+}
+
 // The hook stops the run during the coarse start: interrupted there, no fine step taken.
 TEST(CoarseStart, AnInterruptDuringTheCoarseStartStopsTheRun) {
     int coarse_steps = 0, fine_steps = 0;
