@@ -191,7 +191,7 @@ void print_segmentation_summary(const nlohmann::json& j) {
     }
     if (j.contains("coarse_start") && j["coarse_start"].is_object()) {
         const nlohmann::json& c = j["coarse_start"];
-        fmt::print("  coarse start {} iterations ({}), {:.2f} s on the image averaged to {}x{}x{} ({:.3g} x {:.3g} x {:.3g} mm){}\n",
+        fmt::print("  coarse start {} iterations ({}), {:.2f} s on 2x2x2-voxel blocks, a {}x{}x{} grid ({:.3g} x {:.3g} x {:.3g} mm){}\n",
                    c["iterations"].get<int>(), c["stop"].get<std::string>(), c["seconds"].get<double>(), c["dims"][0].get<int>(),
                    c["dims"][1].get<int>(), c["dims"][2].get<int>(), c["spacing"][0].get<double>(), c["spacing"][1].get<double>(),
                    c["spacing"][2].get<double>(), c["used"].get<bool>() ? "" : "; nothing of its front was left in the ROI: started from the seeds");

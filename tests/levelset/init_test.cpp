@@ -4,6 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <random>
+
+#include <tbb/global_control.h>
 
 #include "levelset_test_util.hpp"
 #include "liveset/levelset/shapes.hpp"
@@ -139,4 +142,39 @@ TEST(SparseFieldInit, InABoxHasTheBitsOfTheWholeLattice) {
     EXPECT_THROW(boxed.init_from_sdf([](Vec3d p) { return p.x == 12 ? NAN : 10.0; }, {10, 8, 5}, {20, 18, 25}),
                  std::invalid_argument);
     EXPECT_TRUE(liveset::testing::same_state(whole, boxed));
+}
+
+// init_from_mask writes φ straight from the mask, its whole-box passes plane by plane in parallel:
+// the same φ, statuses and list order as init_from_sdf of the mask's distance written as a
+// function (±½ at a voxel with a neighbour across the boundary, ±(N + 1) elsewhere), on 1 and 2
+// threads. A random mask: specks, one-voxel sheets and the lattice's faces.
+TEST(SparseFieldInit, FromMaskHasTheBitsOfItsDistanceFunctionOnAnyThreadCount) {
+    Grid<std::uint8_t> mask(Lattice({33, 27, 30}), 0);
+    std::mt19937 rng(11);
+    for (std::size_t i = 0; i < mask.size(); ++i) mask[static_cast<PointIndex>(i)] = rng() % 7 < 3;
+    for (int z = 0; z < 30; ++z)
+        for (int y = 0; y < 27; ++y)
+            for (int x = 0; x < 33; ++x)
+                if (x > 8 && x < 24 && y > 5 && y < 20 && z > 4 && z < 25) mask({x, y, z}) = x != 16;  // a block cut by a sheet
+    const Lattice& lat = mask.lattice();
+    for (int layers : {1, 2, 3}) {
+        SparseField reference(lat, layers);
+        reference.init_from_sdf([&](Vec3d p) {
+            const Vec3i c = p.cast<int>();
+            const bool inside = mask(c) != 0;
+            bool boundary = false;
+            for (const Vec3i o : {Vec3i{1, 0, 0}, Vec3i{-1, 0, 0}, Vec3i{0, 1, 0}, Vec3i{0, -1, 0}, Vec3i{0, 0, 1}, Vec3i{0, 0, -1}})
+                if (lat.contains(c + o) && (mask(c + o) != 0) != inside) boundary = true;
+            return boundary ? (inside ? -0.5 : 0.5) : (inside ? -(layers + 1.0) : layers + 1.0);
+        });
+        for (int threads : {1, 2}) {
+            const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+            SparseField f(lat, layers);
+            f.init_from_sdf(shapes::Sphere({16, 13, 15}, 5));  // an earlier front, replaced
+            f.init_from_mask(mask);
+            EXPECT_TRUE(liveset::testing::same_state(reference, f)) << "layers " << layers << ", threads " << threads;
+            liveset::testing::expect_same_list_order(reference, f);
+            expect_valid(f, "random mask");
+        }
+    }
 }

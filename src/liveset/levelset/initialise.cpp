@@ -39,10 +39,7 @@ void SparseField::evaluate_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo
         if (!std::isfinite(values[static_cast<PointIndex>(i)]))
             throw std::invalid_argument("signed distance is not finite at " +
                                         point_text(lattice(), lattice().index(lo + values.lattice().coord(static_cast<PointIndex>(i)))));
-    activity_.reset();  // a new front: everything awake again
-    for (auto& l : lists_) l.clear();
-    slot_.fill(kNoSlot);
-    slots_stale_ = false;
+    clear_lists();
     // Copied, not moved: φ keeps its storage (the viewer's crash handler reads it in place).
     // Outside the box the function is at least the far value, which the clamp makes exactly far.
     if (!(n == lattice().dims())) phi_.fill(far);
@@ -57,6 +54,13 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf) {
     init_from_sdf(sdf, {0, 0, 0}, lattice().dims() - Vec3i{1, 1, 1});
 }
 
+void SparseField::clear_lists() {
+    activity_.reset();  // a new front: everything awake again
+    for (auto& l : lists_) l.clear();
+    slot_.fill(kNoSlot);
+    slots_stale_ = false;
+}
+
 void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo, Vec3i hi) {
     const Vec3i d = lattice().dims();
     for (int a = 0; a < 3; ++a) {
@@ -64,6 +68,46 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf, Vec3i l
         hi[a] = std::clamp(hi[a], lo[a], d[a] - 1);
     }
     evaluate_sdf(sdf, lo, hi);
+    band_from_phi(lo, hi);
+}
+
+namespace {
+
+// f(i) for every point of the box's z-planes [z0, z1), row by row, in index order.
+template <class F>
+void for_planes(const Lattice& lattice, Vec3i lo, Vec3i hi, int z0, int z1, const F& f) {
+    for (int z = z0; z < z1; ++z)
+        for (int y = lo.y; y <= hi.y; ++y) {
+            const PointIndex row = lattice.index({0, y, z});
+            for (int x = lo.x; x <= hi.x; ++x) f(row + static_cast<PointIndex>(x));
+        }
+}
+
+// The points of the box [lo, hi] for which `pick(i)` holds, in index order: the box's z-planes in
+// parallel, each into its own list, joined in plane order (the same list on any thread count).
+// `pick` may write point i's own entries, nothing else.
+template <class F>
+std::vector<PointIndex> pick_in_box(const Lattice& lattice, Vec3i lo, Vec3i hi, const F& pick) {
+    const int planes = hi.z - lo.z + 1;
+    std::vector<std::vector<PointIndex>> found(static_cast<std::size_t>(planes));
+    tbb::parallel_for(0, planes, [&](int k) {
+        std::vector<PointIndex>& out = found[static_cast<std::size_t>(k)];
+        for_planes(lattice, lo, hi, lo.z + k, lo.z + k + 1, [&](PointIndex i) {
+            if (pick(i)) out.push_back(i);
+        });
+    });
+    std::size_t n = 0;
+    for (const auto& v : found) n += v.size();
+    std::vector<PointIndex> all;
+    all.reserve(n);
+    for (const auto& v : found) all.insert(all.end(), v.begin(), v.end());
+    return all;
+}
+
+}  // namespace
+
+void SparseField::band_from_phi(Vec3i lo, Vec3i hi) {
+    const Vec3i d = lattice().dims();
     // The box grown by one point: outside it every point and all its neighbours hold the far
     // value, so neither pass below can find anything there.
     Vec3i glo = lo, ghi = hi;
@@ -71,40 +115,33 @@ void SparseField::init_from_sdf(const std::function<double(Vec3d)>& sdf, Vec3i l
         glo[a] = std::max(lo[a] - 1, 0);
         ghi[a] = std::min(hi[a] + 1, d[a] - 1);
     }
-    const auto for_box = [&](const auto& f) {
-        for (int z = glo.z; z <= ghi.z; ++z)
-            for (int y = glo.y; y <= ghi.y; ++y) {
-                const PointIndex row = lattice().index({0, y, z});
-                for (int x = glo.x; x <= ghi.x; ++x) f(row + static_cast<PointIndex>(x));
-            }
-    };
     // A sign change between two far points (a function steeper than a distance) would leave the
-    // front without zero-layer points: pull both sides onto the zero layer.
-    std::vector<PointIndex> steep;
-    for_box([&](PointIndex i) {
+    // front without zero-layer points: pull both sides onto the zero layer (found first, then
+    // pulled: every point is judged on the values as evaluated).
+    const std::vector<PointIndex> steep = pick_in_box(lattice(), glo, ghi, [&](PointIndex i) {
         const float v = phi_[i];
-        if (std::abs(v) <= 0.5f) return;
+        if (std::abs(v) <= 0.5f) return false;
         bool opposite = false;
         for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
             if (std::abs(phi_[q]) > 0.5f && ((phi_[q] < 0) != (v < 0))) opposite = true;
         });
-        if (opposite) steep.push_back(i);
+        return opposite;
     });
     for (PointIndex i : steep) phi_[i] = phi_[i] < 0 ? -0.5f : 0.5f;
 
     const float far = static_cast<float>(layers_ + 1);
     if (!(glo == Vec3i{0, 0, 0} && ghi == d - Vec3i{1, 1, 1})) status_.fill(far_outside());
-    std::vector<PointIndex> zero;
-    for_box([&](PointIndex i) {
+    // Each point's own status and φ set in parallel; the zero layer listed in index order.
+    const std::vector<PointIndex> zero = pick_in_box(lattice(), glo, ghi, [&](PointIndex i) {
         if (std::abs(phi_[i]) <= 0.5f) {
             status_[i] = 0;
-            zero.push_back(i);
-            list_add(i, 0);
-        } else {
-            status_[i] = phi_[i] < 0 ? far_inside() : far_outside();
-            phi_[i] = phi_[i] < 0 ? -far : far;
+            return true;
         }
+        status_[i] = phi_[i] < 0 ? far_inside() : far_outside();
+        phi_[i] = phi_[i] < 0 ? -far : far;
+        return false;
     });
+    for (PointIndex i : zero) list_add(i, 0);
     // Every other point is far: the sweep reaches the new layers from the zero layer.
     std::vector<RegionPoint> region;
     region.reserve(zero.size() * (2 * static_cast<std::size_t>(layers_) + 1));
@@ -117,18 +154,21 @@ void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
     if (!(mask.dims() == lattice().dims()))
         throw std::invalid_argument("mask dimensions " + mask.lattice().describe() +
                                     " differ from the level-set lattice " + lattice().describe());
-    // Boundary voxels of either side become the zero layer (±0.5: the front lies half-way).
+    // Boundary voxels of either side become the zero layer (±0.5: the front lies half-way), the
+    // others far: init_from_sdf's values, written straight into φ (nothing here can fail halfway).
+    clear_lists();
     const Lattice& lat = lattice();
-    const std::function<double(Vec3d)> from_mask = [&](Vec3d p) {
-        const PointIndex i = lat.index(p.cast<int>());
-        const bool inside = mask[i] != 0;
-        bool boundary = false;
-        for_each_neighbor6(lat, decoder_, i, [&](PointIndex q) { boundary = boundary || ((mask[q] != 0) != inside); });
-        const double far = layers_ + 1;
-        if (boundary) return inside ? -0.5 : 0.5;
-        return inside ? -far : far;
-    };
-    init_from_sdf(from_mask);
+    const float far = static_cast<float>(layers_ + 1);
+    const Vec3i d = lat.dims();
+    tbb::parallel_for(0, d.z, [&](int z) {
+        for_planes(lat, {0, 0, 0}, d - Vec3i{1, 1, 1}, z, z + 1, [&](PointIndex i) {
+            const bool inside = mask[i] != 0;
+            bool boundary = false;
+            for_each_neighbor6(lat, decoder_, i, [&](PointIndex q) { boundary = boundary || ((mask[q] != 0) != inside); });
+            phi_[i] = boundary ? (inside ? -0.5f : 0.5f) : (inside ? -far : far);
+        });
+    });
+    band_from_phi({0, 0, 0}, d - Vec3i{1, 1, 1});
 }
 
 }  // namespace liveset

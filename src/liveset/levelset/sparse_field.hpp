@@ -219,6 +219,8 @@ private:
     };
 
     void evaluate_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo, Vec3i hi);  // φ, far outside the box
+    void clear_lists();                     // no layer lists, no slots, everything awake (a new front)
+    void band_from_phi(Vec3i lo, Vec3i hi);  // the statuses, lists and band from φ set in [lo, hi] (far outside)
     std::vector<double> zero_rates(const Speed& speed) const;  // |∇φ|F at each zero-layer point
     double time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const;
     double parabolic_factor() const;  // the curvature's stability factor 1/h_min from the voxel sizes (time_step)
