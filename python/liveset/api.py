@@ -99,7 +99,7 @@ def segment(image, seeds: Sequence = (), *, seeds_mm: Sequence = (), seed_radius
         voxels thick (on by default since session 72, as the CLI's; ``False`` as ``--no-thin-fronts``,
         the paper's sparse field; docs/ARCHITECTURE.md, "Thin fronts"). coarse_start: as
         ``--coarse-start``: ``"auto"`` (the default) lets the front from seeds on a grid whose voxel
-        sides are all at most 0.85 mm converge first on the image averaged over 2x2x2 voxels and
+        sides are all at most 0.85 mm converge first on 2x2x2-voxel blocks (their mean threshold term) and
         refine from there; ``"on"`` wherever it starts from seeds on a grid of at least 16 voxels an axis; ``"off"`` never (the report's
         "coarse_start" says what ran; docs/ARCHITECTURE.md, "Coarse start").
     progress: called with a dict (iteration, zero_layer, band, awake, changed, flips, inside, dt, ms,

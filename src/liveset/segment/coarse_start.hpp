@@ -1,5 +1,5 @@
 // The coarse-to-fine start of a finely sampled scan (issue 16, docs/ARCHITECTURE.md "Coarse start"):
-// the front first runs to convergence from the seeds on the image averaged over 2x2x2 voxels, and
+// the front first runs to convergence from the seeds on 2x2x2-voxel blocks (their mean threshold term), and
 // that result, upsampled onto the image's own grid, is where the front starts there.
 #pragma once
 

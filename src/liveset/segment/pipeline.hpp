@@ -54,7 +54,7 @@ struct SegmentRequest {
     SegmentationOptions loop;
     int layers = 2;
     // From seeds on a fine grid (auto: every voxel side ≤ kCoarseStartMaxSpacing mm), the front first
-    // converges on the image averaged over 2x2x2 voxels and starts from there (coarse_start.hpp).
+    // converges on 2x2x2-voxel blocks (their mean threshold term) and starts from there (coarse_start.hpp).
     CoarseStart coarse_start = CoarseStart::kAuto;
 };
 
