@@ -132,6 +132,22 @@ TEST(LargePageGrid, AFreedBlockServesTheNextGridOfItsSizeWhichHoldsOnlyItsFill) 
     EXPECT_NE(other.values().data(), first);
 }
 
+TEST(LargePageGrid, ReleasedKeptBlocksServeNoLaterGrid) {
+    if (!detail::recycles_blocks()) GTEST_SKIP() << "blocks are not kept under AddressSanitizer";
+    const std::size_t bytes = detail::kLargeBlock + 3 * detail::kHugePage;
+    void* const p = detail::allocate_large(bytes);
+    detail::free_large(p, bytes);
+    ASSERT_GE(detail::recycled().first, 1u);
+    detail::release_recycled();
+    EXPECT_EQ(detail::recycled(), (std::pair<std::size_t, std::size_t>{0, 0}));
+    // The next block of its size is a fresh one from the system (freed, so the address may come
+    // back; what matters is that nothing was kept to serve it).
+    void* const q = detail::allocate_large(bytes);
+    EXPECT_EQ(detail::recycled(), (std::pair<std::size_t, std::size_t>{0, 0}));
+    detail::free_large(q, bytes);
+    EXPECT_EQ(detail::recycled().first, 1u);
+}
+
 TEST(LargePageGrid, KeptBlocksStayWithinTheirBounds) {
     if (!detail::recycles_blocks()) GTEST_SKIP() << "blocks are not kept under AddressSanitizer";
     // More blocks than are kept, of several sizes, freed in turn (never touched: no memory used).

@@ -26,6 +26,7 @@ void* allocate_large(std::size_t bytes);  // throws std::bad_alloc
 void free_large(void* p, std::size_t bytes) noexcept;  // bytes: as allocated
 bool recycles_blocks() noexcept;                        // false under AddressSanitizer
 std::pair<std::size_t, std::size_t> recycled() noexcept;  // blocks kept and their bytes
+void release_recycled() noexcept;                       // every kept block given back (a stage whose sizes no later one asks for ends)
 }  // namespace detail
 
 template <class T>

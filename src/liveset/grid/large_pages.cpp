@@ -65,14 +65,7 @@ void* allocate_large(std::size_t bytes) {
     }
     void* p = std::aligned_alloc(kHugePage, size);
     if (p == nullptr && kRecycle) {  // the kept blocks given back first
-        std::vector<std::pair<void*, std::size_t>> kept;
-        {
-            Recycled& r = recycled_blocks();
-            const std::lock_guard lock(r.mutex);
-            kept.swap(r.blocks);
-            r.bytes = 0;
-        }
-        for (const auto& block : kept) std::free(block.first);
+        release_recycled();
         p = std::aligned_alloc(kHugePage, size);
     }
     if (p == nullptr) throw std::bad_alloc();
@@ -123,6 +116,17 @@ void for_grid_blocks(std::size_t n, std::size_t grain, void (*f)(void*, std::siz
 }
 
 bool recycles_blocks() noexcept { return kRecycle; }
+
+void release_recycled() noexcept {
+    std::vector<std::pair<void*, std::size_t>> kept;
+    {
+        Recycled& r = recycled_blocks();
+        const std::lock_guard lock(r.mutex);
+        kept.swap(r.blocks);
+        r.bytes = 0;
+    }
+    for (const auto& block : kept) std::free(block.first);
+}
 
 std::pair<std::size_t, std::size_t> recycled() noexcept {
     Recycled& r = recycled_blocks();

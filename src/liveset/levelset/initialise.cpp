@@ -148,6 +148,11 @@ void SparseField::band_from_phi(Vec3i lo, Vec3i hi) {
     for (PointIndex i : zero) mark_pending(i, region);
     sweep_whole_band(region, zero);
     finish(region);
+    // The sweep's level buffers are not kept: an initialisation reaches the whole band at once,
+    // which no later step does on a large front (those repair locally, or sweep a front of at most
+    // StepOptions::dense_front_max points); a 0.5 mm brain's are 120 MB.
+    sweep_from_.v = PointList{};
+    sweep_next_.v = PointList{};
 }
 
 void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {

@@ -290,8 +290,9 @@ Grid<float> full_resolution_log_field(const ControlLattice::ConstPointer& lattic
     return evaluate_cubic_bspline(control, dims, plan.span, kIndexUnits, grid);
 }
 
-// image / exp(log field - mean log field over the fit mask); the field's range in the mask.
-Grid<float> divide_field(const Grid<float>& image, const Grid<float>& log_field, const Grid<std::uint8_t>& fit,
+// image / exp(log field - mean log field over the fit mask), written over the log field (each
+// voxel reads only its own: no third grid of the scan's size); the field's range in the mask.
+Grid<float> divide_field(const Grid<float>& image, Grid<float> log_field, const Grid<std::uint8_t>& fit,
                          BiasCorrectionReport& report) {
     double sum = 0.0, lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
     std::size_t count = 0;
@@ -310,14 +311,12 @@ Grid<float> divide_field(const Grid<float>& image, const Grid<float>& log_field,
     // In float (expf: a quarter of exp's time, 1-2 ulps of the double quotient; the field is smooth
     // and its log within a few tenths of 0).
     const auto shift = static_cast<float>(mean);
-    Grid<float> corrected(image.lattice());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, image.size(), 1 << 16), [&](const tbb::blocked_range<std::size_t>& r) {
         const float* in = image.values().data();
-        const float* log = log_field.values().data();
-        float* out = corrected.values().data();
-        for (std::size_t i = r.begin(); i != r.end(); ++i) out[i] = in[i] * std::exp(shift - log[i]);
+        float* out = log_field.values().data();
+        for (std::size_t i = r.begin(); i != r.end(); ++i) out[i] = in[i] * std::exp(shift - out[i]);
     });
-    return corrected;
+    return log_field;
 }
 
 }  // namespace

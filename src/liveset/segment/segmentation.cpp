@@ -8,6 +8,7 @@
 
 #include "liveset/levelset/shapes.hpp"
 #include "liveset/base/stopwatch.hpp"
+#include "liveset/segment/voxel_loops.hpp"
 
 namespace liveset {
 
@@ -133,10 +134,10 @@ void unite_seeds(SparseField& field, std::span<const SeedBall> seeds) {
 Grid<std::uint8_t> inside_mask(const Grid<float>& phi, const Grid<std::uint8_t>* roi) {
     if (roi && !(roi->dims() == phi.dims())) throw std::invalid_argument("region-of-interest mask does not match phi");
     Grid<std::uint8_t> m(phi.lattice());
-    for (std::size_t i = 0; i < phi.size(); ++i) {
+    voxel_loops::for_each(phi.size(), [&](std::size_t i) {
         const auto p = static_cast<PointIndex>(i);
         m[p] = phi[p] < 0.0f && (!roi || (*roi)[p] != 0);
-    }
+    });
     return m;
 }
 

@@ -36,8 +36,9 @@ double threshold_term(double intensity, const ThresholdParams& params);
 
 class ThresholdSpeed final : public Speed {
 public:
-    // `unit_image` (normalised to [0, 1]) and `roi` (optional, non-zero = allowed) must outlive
-    // the speed and match each other's dimensions; D is tabulated per voxel at construction (of the
+    // `unit_image` (normalised to [0, 1]) and `roi` (optional, non-zero = allowed) must match
+    // each other's dimensions, and `roi` must outlive the speed (the images are read only here);
+    // D is tabulated per voxel at construction (of the
     // image blurred by params.smooth_mm when it is positive). A caller that keeps that blurred image
     // (gaussian_smooth(unit_image, params.smooth_mm), e.g. a session whose window changes) passes
     // it as `blurred`, which is then read instead of blurring again (ignored when smooth_mm is 0).
