@@ -570,6 +570,9 @@ TEST(BrainMask, BadInputThrowsOneLine) {
     Grid<float> nan = shell;
     nan({1, 2, 3}) = std::nanf("");
     EXPECT_NE(message(nan).find("NaN"), std::string::npos);
+    Grid<float> inf = shell;  // in the last of the check's parts
+    inf({47, 47, 47}) = std::numeric_limits<float>::infinity();
+    EXPECT_NE(message(inf).find("NaN or infinite"), std::string::npos) << message(inf);
     BrainMaskOptions bad;
     bad.erosion_mm = -1;
     EXPECT_THROW(validate(bad), std::invalid_argument);

@@ -50,23 +50,42 @@ std::size_t count(const Mask& m) {
     return voxel_loops::count_if(m.size(), [&](std::size_t i) { return m[static_cast<PointIndex>(i)] != 0; });
 }
 
+// The image's lowest and highest values, and whether every voxel is finite (on every thread: min,
+// max and the test are exact, so any split gives the serial loop's answer).
+struct ValueRange {
+    float lo = std::numeric_limits<float>::infinity(), hi = -std::numeric_limits<float>::infinity();
+    bool finite = true;
+};
+
+ValueRange value_range(const Grid<float>& image) {
+    const float* const v = image.values().data();
+    return voxel_loops::reduce(
+        image.size(), voxel_loops::kBlock, ValueRange{},
+        [&](std::size_t b, std::size_t e, ValueRange r) {
+            for (std::size_t i = b; i != e; ++i) {
+                r.finite = r.finite && std::isfinite(v[i]);
+                r.lo = std::min(r.lo, v[i]);
+                r.hi = std::max(r.hi, v[i]);
+            }
+            return r;
+        },
+        [](ValueRange a, const ValueRange& b) { return ValueRange{std::min(a.lo, b.lo), std::max(a.hi, b.hi), a.finite && b.finite}; });
+}
+
 void check_image(const Grid<float>& image) {
     if (image.size() == 0) throw std::invalid_argument("brain mask: the image is empty");
-    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
-    for (float v : image.values()) {
-        if (!std::isfinite(v)) throw std::invalid_argument("brain mask: the image has NaN or infinite voxels");
-        lo = std::min(lo, v);
-        hi = std::max(hi, v);
-    }
-    if (!(hi > lo)) throw std::invalid_argument("brain mask: the image is constant (every voxel is " + std::to_string(lo) + ")");
+    const ValueRange r = value_range(image);
+    if (!r.finite) throw std::invalid_argument("brain mask: the image has NaN or infinite voxels");
+    if (!(r.hi > r.lo)) throw std::invalid_argument("brain mask: the image is constant (every voxel is " + std::to_string(r.lo) + ")");
 }
 
 // The image's lowest value when it fills at least 2 % of the voxels, as masking or resampling
-// leaves the outside (a skull-stripped background, zeros beyond a resampled field of view).
+// leaves the outside (a skull-stripped background, zeros beyond a resampled field of view). The
+// image is finite (check_image).
 std::optional<float> constant_fill(const Grid<float>& image) {
-    const float lowest = *std::min_element(image.values().begin(), image.values().end());
-    std::size_t at_lowest = 0;
-    for (float v : image.values()) at_lowest += v == lowest;
+    const float lowest = value_range(image).lo;
+    const float* const v = image.values().data();
+    const std::size_t at_lowest = voxel_loops::count_if(image.size(), [&](std::size_t i) { return v[i] == lowest; });
     if (static_cast<double>(at_lowest) < 0.02 * static_cast<double>(image.size())) return std::nullopt;
     return lowest;
 }
@@ -98,7 +117,7 @@ std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
         if (j - i > best) best = j - i, mode = face[i];
     }
     if (2 * best < face.size()) return std::nullopt;
-    const float lowest = *std::min_element(image.values().begin(), image.values().end());
+    const float lowest = value_range(image).lo;
     if (!(lowest < mode)) return std::nullopt;  // constant_fill's case
     Mask inside(image.lattice());
     voxel_loops::for_each(inside.size(), [&](std::size_t i) { inside[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != mode; });
