@@ -112,7 +112,7 @@ std::size_t write_segment_outputs(const SegmentArgs& a, const Scan& scan, const 
     if (!a.out_corrected.empty()) write_image(scan.restored(scan.image), a.out_corrected, as_read);
     if (a.out_mesh.empty()) return 0;
     const Mesh mesh = marching_cubes_band(o.field->phi(), o.field->zero_layer());
-    write_mesh(a.out_mesh, mesh.view(), scan.image.lattice());
+    write_mesh(a.out_mesh, mesh.view(), o.field->lattice());
     return mesh.triangle_count();
 }
 
@@ -152,12 +152,16 @@ int run_segment(const SegmentArgs& a, int threads) {
     add_regions(req, roi, init, fit, prepared);
     req.brain_mask = lookup.options;  // where no region was found: looked for again as the ROI was
     if (!a.quiet) scan.print_note(a.image);  // the inputs are good
-    const SegmentRun run = segment_with_progress(image, req, a.quiet, a.log);
+    const Lattice lattice = image.lattice();
+    // Unless it is to be written (--out-corrected), the image is handed over: freed once the speed
+    // is built, one grid of the scan's size less while the front moves.
+    const SegmentRun run = a.out_corrected.empty() ? segment_with_progress(std::move(image), req, a.quiet, a.log)
+                                                   : segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) return report_interrupt(run.outcome, a.quiet);
     const SegmentOutcome& o = run.outcome;
     const std::size_t triangles = write_segment_outputs(a, scan, o, roi);
 
-    nlohmann::json j = segment_report(a, o, image.lattice(), roi, prepared, triangles);
+    nlohmann::json j = segment_report(a, o, lattice, roi, prepared, triangles);
     j["no_data_voxels"] = scan.no_data_voxels;
     for (const std::string& w : seed_fit.warnings) j["warnings"].push_back(w);
     // The default limit reached before convergence: the mask is a front still moving (a grid whose

@@ -368,8 +368,11 @@ Grid<std::uint8_t> to_mask(const Grid<float>& image) {
     return m;
 }
 
-SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest& request, bool quiet,
-                                 const std::string& log_path) {
+namespace {
+
+// segment_with_progress for an image given (kept) or handed over (freed once the speed is built).
+template <class Image>
+SegmentRun run_with_progress(Image&& image, const SegmentRequest& request, bool quiet, const std::string& log_path) {
     InterruptGuard interrupt;
     ProgressLine progress(quiet);
     const int limit = request.loop.max_iterations;
@@ -383,13 +386,23 @@ SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest&
                                     p.iteration, limit, p.zero_layer, p.band, p.changed, p.flips));
         return true;
     };
-    SegmentRun run{segment_image(image, request, hook, &interrupt.flag()), false};
+    SegmentRun run{segment_image(std::forward<Image>(image), request, hook, &interrupt.flag()), false};
     progress.finish();
     if (!quiet)
         for (const std::string& w : run.outcome.warnings) fmt::print(stderr, "liveset: warning: {}\n", w);
     run.interrupted = run.outcome.result.reason == StopReason::kInterrupted;
     if (!log_path.empty() && !run.interrupted) write_atomically(log_path, log);
     return run;
+}
+
+}  // namespace
+
+SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest& request, bool quiet, const std::string& log_path) {
+    return run_with_progress(image, request, quiet, log_path);
+}
+
+SegmentRun segment_with_progress(Grid<float>&& image, const SegmentRequest& request, bool quiet, const std::string& log_path) {
+    return run_with_progress(std::move(image), request, quiet, log_path);
 }
 
 namespace {

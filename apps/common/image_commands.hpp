@@ -222,6 +222,8 @@ struct SegmentRun {
 // flips, inside, dt, ms) is written there (atomically, after the run).
 SegmentRun segment_with_progress(const Grid<float>& image, const SegmentRequest& request, bool quiet,
                                  const std::string& log_path = {});
+// The same, the image handed over (segment_image's: left empty once the speed is built).
+SegmentRun segment_with_progress(Grid<float>&& image, const SegmentRequest& request, bool quiet, const std::string& log_path = {});
 
 // The tissue model (classes with names, means, spreads, weights; partial-volume weights) and the
 // seeds' class when the window came from it.

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <random>
 #include <stdexcept>
+#include <utility>
 
 #include "liveset/segment/coarse_start.hpp"
 #include "liveset/segment/pipeline.hpp"
@@ -368,6 +369,28 @@ TEST(CoarseStart, AnEmptyCoarseFrontFallsBackToTheSeeds) {
     ASSERT_EQ(a.size(), b.size());
     EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) { return std::bit_cast<std::uint32_t>(x) == std::bit_cast<std::uint32_t>(y); }));
     EXPECT_GT(count_in(direct.mask, in_block), 0u);
+}
+
+// The image handed over (segment_image(Grid&&), as `liveset segment` hands it without
+// --out-corrected) is left empty, and the outcome is the kept image's bit for bit, coarse or direct.
+TEST(CoarseStart, AnImageHandedOverGivesTheSameOutcomeAndIsFreed) {
+    for (const CoarseStart mode : {CoarseStart::kOff, CoarseStart::kOn}) {
+        const SegmentRequest req = plate_request(mode);
+        const SegmentOutcome kept = segment_image(plate_and_block(), req);
+        Grid<float> image = plate_and_block();
+        const SegmentOutcome handed = segment_image(std::move(image), req);
+        EXPECT_EQ(image.size(), 0u) << to_string(mode);
+        EXPECT_EQ(handed.result.iterations, kept.result.iterations) << to_string(mode);
+        EXPECT_EQ(handed.coarse.has_value(), kept.coarse.has_value()) << to_string(mode);
+        EXPECT_EQ(handed.params.mu, kept.params.mu);
+        EXPECT_EQ(handed.params.alpha, kept.params.alpha);
+        const auto a = kept.field->phi().values(), b = handed.field->phi().values();
+        ASSERT_EQ(a.size(), b.size());
+        EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), [](float x, float y) { return std::bit_cast<std::uint32_t>(x) == std::bit_cast<std::uint32_t>(y); }))
+            << to_string(mode);
+        EXPECT_TRUE(std::equal(kept.mask.values().begin(), kept.mask.values().end(), handed.mask.values().begin(), handed.mask.values().end()));
+        EXPECT_GT(count_in(handed.mask, in_block), 0u);
+    }
 }
 
 // A seed outside the image is refused as the direct run refuses it, not clamped onto the coarse grid.

@@ -90,10 +90,9 @@ ThresholdSpeed tabulated_speed(const Grid<float>& image, const IntensityScale& s
     return ThresholdSpeed(source, p, roi, p.smooth_mm > 0.0 ? &source : nullptr);
 }
 
-}  // namespace
-
-SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req, const SegmentationHook& hook,
-                             const std::atomic<bool>* interrupt) {
+// The request checked, the window, α and the speed's table from the image (filling `out`'s scale,
+// window, model, α and parameters).
+ThresholdSpeed speed_for(const Grid<float>& image, const SegmentRequest& req, SegmentOutcome& out) {
     if (req.seeds.empty() && !req.initial_mask) throw std::invalid_argument("give at least one seed or an initial mask");
     if (req.initial_mask && !(req.initial_mask->dims() == image.dims())) {
         std::ostringstream os;
@@ -107,9 +106,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     if (req.smooth_mm && !req.alpha)
         throw std::invalid_argument("give the smoothing together with alpha: the automatic choice sets both");
 
-    SegmentOutcome out;
     out.scale = robust_scale(image, req.roi, req.scale);
-
     ThresholdParams p;
     p.n = req.n;
     choose_window(image, req, out, p);
@@ -130,9 +127,14 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     validate(p);
     out.params = p;
     out.step = req.loop.step;
+    return tabulated_speed(image, out.scale, p, req.roi);
+}
 
-    const ThresholdSpeed speed = tabulated_speed(image, out.scale, p, req.roi);
-    out.field = std::make_unique<SparseField>(image.lattice(), req.layers);
+// The front from the request's start (its initial mask, or its seeds with or without the coarse
+// start) evolved under `speed` on `lattice`, and the mask.
+void evolve(const Lattice& lattice, const ThresholdSpeed& speed, const SegmentRequest& req, const SegmentationHook& hook,
+            const std::atomic<bool>* interrupt, SegmentOutcome& out) {
+    out.field = std::make_unique<SparseField>(lattice, req.layers);
     // The blocks kept for the preprocessing's grids (large_page_allocator.hpp: the blur's, the
     // normalised image's) serve no request of the evolution: given back before the band is built
     // (a 0.5 mm brain's: 226 MB).
@@ -142,10 +144,10 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
         const std::size_t inside = voxel_loops::count_if(req.initial_mask->size(), [&](std::size_t i) { return init[i] != 0; });
         if (inside == 0) throw std::invalid_argument("the initial mask is empty");
         out.field->init_from_mask(*req.initial_mask);
-    } else if (coarse_start_applies(req.coarse_start, image.lattice())) {
+    } else if (coarse_start_applies(req.coarse_start, lattice)) {
         out.coarse.emplace();
         const std::optional<Grid<std::uint8_t>> start =
-            run_coarse_start(speed, image.lattice(), req.roi, req.seeds, req.loop, req.layers, hook, interrupt, *out.coarse);
+            run_coarse_start(speed, lattice, req.roi, req.seeds, req.loop, req.layers, hook, interrupt, *out.coarse);
         // So are the coarse grids' blocks (a 0.5 mm brain's: 140 MB).
         detail::release_recycled();
         if (start) {
@@ -158,7 +160,7 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
             if (out.coarse->result.reason == StopReason::kInterrupted) {
                 out.result.reason = StopReason::kInterrupted;
                 out.mask = inside_mask(out.field->phi(), req.roi);
-                return out;
+                return;
             }
         }
     } else {
@@ -167,6 +169,25 @@ SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req
     out.result = run_segmentation(*out.field, speed, req.loop, hook, interrupt);
     out.mask = inside_mask(out.field->phi(), req.roi);
     warn_if_stalled(req.seeds, out);
+}
+
+}  // namespace
+
+SegmentOutcome segment_image(const Grid<float>& image, const SegmentRequest& req, const SegmentationHook& hook,
+                             const std::atomic<bool>* interrupt) {
+    SegmentOutcome out;
+    const ThresholdSpeed speed = speed_for(image, req, out);
+    evolve(image.lattice(), speed, req, hook, interrupt, out);
+    return out;
+}
+
+SegmentOutcome segment_image(Grid<float>&& image, const SegmentRequest& req, const SegmentationHook& hook,
+                             const std::atomic<bool>* interrupt) {
+    SegmentOutcome out;
+    const ThresholdSpeed speed = speed_for(image, req, out);
+    const Lattice lattice = image.lattice();
+    image = Grid<float>();  // the evolution never reads it: one grid of the scan's size less while the front moves
+    evolve(lattice, speed, req, hook, interrupt, out);
     return out;
 }
 
