@@ -23,6 +23,7 @@
 #include "brain_mask_fixture.hpp"
 #include "noisy_phantom.hpp"
 #include "liveset/segment/brain_histogram.hpp"
+#include "liveset/segment/voxel_loops.hpp"
 #include "liveset/segment/brain_mask.hpp"
 #include "liveset/segment/morphology.hpp"
 #include "liveset/segment/smoothing.hpp"
@@ -570,9 +571,17 @@ TEST(BrainMask, BadInputThrowsOneLine) {
     Grid<float> nan = shell;
     nan({1, 2, 3}) = std::nanf("");
     EXPECT_NE(message(nan).find("NaN"), std::string::npos);
-    Grid<float> inf = shell;  // in the last of the check's parts
-    inf({47, 47, 47}) = std::numeric_limits<float>::infinity();
+    // In the last of the check's parts (a grid of several voxel_loops::kBlock voxels, so that the
+    // parts' fold runs), and NaN in the first.
+    Grid<float> big(Lattice({64, 64, 64}));
+    for (std::size_t i = 0; i < big.size(); ++i) big[static_cast<PointIndex>(i)] = static_cast<float>(i % 97);
+    ASSERT_GE(big.size(), 3 * voxel_loops::kBlock);
+    Grid<float> inf = big;
+    inf({63, 63, 63}) = std::numeric_limits<float>::infinity();
     EXPECT_NE(message(inf).find("NaN or infinite"), std::string::npos) << message(inf);
+    Grid<float> nan_first = big;
+    nan_first({0, 0, 0}) = std::nanf("");
+    EXPECT_NE(message(nan_first).find("NaN or infinite"), std::string::npos) << message(nan_first);
     BrainMaskOptions bad;
     bad.erosion_mm = -1;
     EXPECT_THROW(validate(bad), std::invalid_argument);

@@ -8,6 +8,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <random>
 #include <stdexcept>
 #include <utility>
@@ -371,9 +372,50 @@ TEST(CoarseStart, AnEmptyCoarseFrontFallsBackToTheSeeds) {
     EXPECT_GT(count_in(direct.mask, in_block), 0u);
 }
 
+// A bright ball in a 104³ grid: its float grids (4.5 MB) are large blocks, kept by the allocator
+// and given back by segment_image, which the 64³ plate's are not.
+const Grid<float>& large_ball() {
+    static const Grid<float> g = [] {
+        Grid<float> out(Lattice({104, 104, 104}), 20.0f);
+        for (int z = 0; z < 104; ++z)
+            for (int y = 0; y < 104; ++y)
+                for (int x = 0; x < 104; ++x)
+                    if (norm(Vec3d{x - 51.5, y - 52.0, z - 50.5}) < 24.0) out({x, y, z}) = 100.0f + static_cast<float>((x * 7 + y * 3 + z) % 9);
+        return out;
+    }();
+    return g;
+}
+
 // The image handed over (segment_image(Grid&&), as `liveset segment` hands it without
-// --out-corrected) is left empty, and the outcome is the kept image's bit for bit, coarse or direct.
+// --out-corrected) is left empty, and the outcome is the kept image's bit for bit: coarse or
+// direct, blurred or not, on grids of large blocks or small ones.
 TEST(CoarseStart, AnImageHandedOverGivesTheSameOutcomeAndIsFreed) {
+    SegmentRequest ball = plate_request(CoarseStart::kOff);
+    ball.seeds = {{{52.0, 52.0, 50.0}, 3.0}};
+    ball.smooth_mm = 0.8;
+    const auto check = [](const Grid<float>& given, const SegmentRequest& req) -> SegmentOutcome {
+        const SegmentOutcome kept = segment_image(given, req);
+        Grid<float> image = given;
+        SegmentOutcome handed = segment_image(std::move(image), req);
+        EXPECT_EQ(image.size(), 0u);
+        EXPECT_EQ(handed.result.iterations, kept.result.iterations);
+        EXPECT_EQ(handed.coarse.has_value(), kept.coarse.has_value());
+        EXPECT_EQ(handed.params.mu, kept.params.mu);
+        EXPECT_EQ(handed.params.smooth_mm, kept.params.smooth_mm);
+        const auto a = kept.field->phi().values(), b = handed.field->phi().values();
+        EXPECT_TRUE(std::equal(a.begin(), a.end(), b.begin(), b.end(), [](float x, float y) { return std::bit_cast<std::uint32_t>(x) == std::bit_cast<std::uint32_t>(y); }));
+        EXPECT_TRUE(std::equal(kept.mask.values().begin(), kept.mask.values().end(), handed.mask.values().begin(), handed.mask.values().end()));
+        return handed;
+    };
+    for (const CoarseStart mode : {CoarseStart::kOff, CoarseStart::kOn}) {
+        SCOPED_TRACE(to_string(mode));
+        ball.coarse_start = mode;
+        const SegmentOutcome o = check(large_ball(), ball);
+        EXPECT_GT(o.params.smooth_mm, 0.0);
+        EXPECT_EQ(o.result.reason, StopReason::kConverged);
+        EXPECT_NEAR(static_cast<double>(std::count(o.mask.values().begin(), o.mask.values().end(), std::uint8_t{1})),
+                    4.0 / 3.0 * std::numbers::pi * 24.0 * 24.0 * 24.0, 0.05 * 4.0 / 3.0 * std::numbers::pi * 24.0 * 24.0 * 24.0);
+    }
     for (const CoarseStart mode : {CoarseStart::kOff, CoarseStart::kOn}) {
         const SegmentRequest req = plate_request(mode);
         const SegmentOutcome kept = segment_image(plate_and_block(), req);

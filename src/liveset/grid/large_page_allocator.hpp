@@ -6,7 +6,8 @@
 // of its size: the automatic brain mask and N4 make and drop dozens of whole-lattice grids, each
 // of whose fresh pages the kernel would zero before the grid's own fill (16 % of a BrainWeb
 // preprocessing's samples, half of it saved; docs/BENCHMARKS.md, session 74). Not under
-// AddressSanitizer; every kept block is given back when an allocation fails.
+// AddressSanitizer; every kept block is given back when an allocation fails, or by
+// detail::release_recycled() when a stage whose sizes no later one asks for ends.
 #pragma once
 
 #include <cstddef>

@@ -149,8 +149,9 @@ void SparseField::band_from_phi(Vec3i lo, Vec3i hi) {
     sweep_whole_band(region, zero);
     finish(region);
     // The sweep's level buffers are not kept: an initialisation reaches the whole band at once,
-    // which no later step does on a large front (those repair locally, or sweep a front of at most
-    // StepOptions::dense_front_max points); a 0.5 mm brain's are 120 MB.
+    // which no incremental step does on a large front (those repair locally, or sweep a front of
+    // at most StepOptions::dense_front_max points); a 0.5 mm brain's are 120 MB. A kFullBand step
+    // grows them again on its first sweep.
     sweep_from_.v = PointList{};
     sweep_next_.v = PointList{};
 }

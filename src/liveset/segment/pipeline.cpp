@@ -80,9 +80,11 @@ void warn_if_stalled(const std::vector<SeedBall>& seeds, SegmentOutcome& out) {
     out.warnings.push_back(os.str());
 }
 
-// The speed's table from the normalised image, blurred where p.smooth_mm asks: each image is
-// freed as soon as the next is made, so that no more than two of the scan's size are held with the
-// caller's (a 0.5 mm brain's are 226 MB each).
+// The speed's table from the normalised image, blurred where p.smooth_mm asks, each image freed
+// once the next is made and the table made after the blur: besides the caller's image, three
+// grids of the scan's size at most (during the blur: the normalised image, the blur and its pass
+// buffer; then the blur and the table), where the speed blurring its own copy held four (a 0.5 mm
+// brain's are 226 MB each).
 ThresholdSpeed tabulated_speed(const Grid<float>& image, const IntensityScale& scale, const ThresholdParams& p,
                                const Grid<std::uint8_t>* roi) {
     Grid<float> source = normalise(image, scale);
@@ -137,7 +139,8 @@ void evolve(const Lattice& lattice, const ThresholdSpeed& speed, const SegmentRe
     out.field = std::make_unique<SparseField>(lattice, req.layers);
     // The blocks kept for the preprocessing's grids (large_page_allocator.hpp: the blur's, the
     // normalised image's) serve no request of the evolution: given back before the band is built
-    // (a 0.5 mm brain's: 226 MB).
+    // (a 0.5 mm brain's: 226 MB). Process-wide: a viewer's or Python's other thread then makes its
+    // next grids on fresh pages (time only).
     detail::release_recycled();
     if (req.initial_mask) {
         const std::uint8_t* const init = req.initial_mask->values().data();

@@ -37,11 +37,12 @@ double threshold_term(double intensity, const ThresholdParams& params);
 class ThresholdSpeed final : public Speed {
 public:
     // `unit_image` (normalised to [0, 1]) and `roi` (optional, non-zero = allowed) must match
-    // each other's dimensions, and `roi` must outlive the speed (the images are read only here);
-    // D is tabulated per voxel at construction (of the
-    // image blurred by params.smooth_mm when it is positive). A caller that keeps that blurred image
-    // (gaussian_smooth(unit_image, params.smooth_mm), e.g. a session whose window changes) passes
-    // it as `blurred`, which is then read instead of blurring again (ignored when smooth_mm is 0).
+    // each other's dimensions, and `roi` must outlive the speed (the images are read only here).
+    // D is tabulated per voxel at construction, of the image blurred by params.smooth_mm when it
+    // is positive. A caller that keeps that blurred image (gaussian_smooth(unit_image,
+    // params.smooth_mm), e.g. a session whose window changes) passes it as `blurred`, which is
+    // then read instead of blurring again (ignored when smooth_mm is 0); `unit_image` then gives
+    // only the lattice (segment_image passes the blur as both).
     ThresholdSpeed(const Grid<float>& unit_image, const ThresholdParams& params, const Grid<std::uint8_t>* roi = nullptr,
                    const Grid<float>* blurred = nullptr);
     // The speed of given threshold terms D ∈ [-1, 1] per voxel (in place of D(I) of an image; the
