@@ -72,11 +72,13 @@ ValueRange value_range(const Grid<float>& image) {
         [](ValueRange a, const ValueRange& b) { return ValueRange{std::min(a.lo, b.lo), std::max(a.hi, b.hi), a.finite && b.finite}; });
 }
 
-void check_image(const Grid<float>& image) {
+// The image's range, after the checks every look starts with.
+ValueRange check_image(const Grid<float>& image) {
     if (image.size() == 0) throw std::invalid_argument("brain mask: the image is empty");
     const ValueRange r = value_range(image);
     if (!r.finite) throw std::invalid_argument("brain mask: the image has NaN or infinite voxels");
     if (!(r.hi > r.lo)) throw std::invalid_argument("brain mask: the image is constant (every voxel is " + std::to_string(r.lo) + ")");
+    return r;
 }
 
 // The image's lowest value when it fills at least 2 % of the voxels, as masking or resampling
@@ -96,8 +98,9 @@ std::optional<float> constant_fill(const Grid<float>& image) {
 // of the voxels on the array's six faces, when it fills at least 2 % of the image and at least 5 %
 // of the rest lie below it (a few darker voxels — a resampler's undershoot at a stripped brain's
 // edge, stray negatives in integer air — do not count); `outside` receives the voxels of that
-// value connected to the faces. nullopt (and `outside` untouched) otherwise.
-std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
+// value connected to the faces. nullopt (and `outside` untouched) otherwise. `lowest`: the image's
+// lowest value (check_image's range).
+std::optional<float> mid_range_fill(const Grid<float>& image, float lowest, Mask& outside) {
     const Vec3i d = image.dims();
     std::vector<float> face;
     for (int z = 0; z < d.z; ++z)
@@ -117,7 +120,6 @@ std::optional<float> mid_range_fill(const Grid<float>& image, Mask& outside) {
         if (j - i > best) best = j - i, mode = face[i];
     }
     if (2 * best < face.size()) return std::nullopt;
-    const float lowest = value_range(image).lo;
     if (!(lowest < mode)) return std::nullopt;  // constant_fill's case
     Mask inside(image.lattice());
     voxel_loops::for_each(inside.size(), [&](std::size_t i) { inside[static_cast<PointIndex>(i)] = image[static_cast<PointIndex>(i)] != mode; });
@@ -519,7 +521,7 @@ Grid<std::uint8_t> find_brain(const Grid<float>& image, const BrainMaskOptions& 
 
 Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOptions& o, BrainMaskReport* report, BrainMaskHead* known) {
     validate(o);
-    check_image(image);
+    const ValueRange range = check_image(image);
     const bool reuse = known != nullptr && known->solid.size() > 0;
     if (reuse && (!(known->solid.dims() == image.dims()) || !(known->depth.dims() == image.dims()) ||
                   (known->outside.size() > 0 && !(known->outside.dims() == image.dims()))))
@@ -527,7 +529,7 @@ Grid<std::uint8_t> auto_brain_mask(const Grid<float>& image, const BrainMaskOpti
     Mask found;  // a masked outside found here (the head given keeps its own)
     double fill = reuse ? known->outside_value : std::numeric_limits<double>::quiet_NaN();
     if (!reuse)
-        if (const std::optional<float> f = mid_range_fill(image, found)) fill = *f;
+        if (const std::optional<float> f = mid_range_fill(image, range.lo, found)) fill = *f;
     const Mask& outside = reuse ? known->outside : found;
     if (outside.size() == 0) return find_brain(image, o, report, known);
     // A masked outside within the tissue's range: read as a skull-stripped image's dark background.
