@@ -15,7 +15,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
                                       const pyb::object& model_region, bool region_is_brain, bool region_grey_brighter, double n,
                                       std::optional<double> alpha, std::optional<double> smooth_mm, int layers, int fragment_size, std::size_t history,
                                       int agents, double p, std::uint64_t seed, bool sleeping, const std::string& decision,
-                                      double edit_range, bool oriented, bool thin_fronts) {
+                                      double edit_range, bool oriented, bool thin_fronts, const std::string& coarse_start) {
     if (v.ndim() != 3) throw std::invalid_argument("the image must be a 3D array");
     const Lattice l = lattice_from(pyb::make_tuple(v.shape(0), v.shape(1), v.shape(2)), geo[0], geo[1], geo[2]);
     Grid<float> image = grid_from_array(v, l);
@@ -46,6 +46,7 @@ std::unique_ptr<Session> make_session(const pyb::array& v, const pyb::tuple& geo
     o.repair.swarm.edit_range = edit_range;
     if (sleeping) o.segmentation.step = segment_step();  // as `liveset segment` (the rule as asked, below)
     o.segmentation.step.thin_fronts = thin_fronts;
+    o.coarse_start = parse_coarse_start(coarse_start);  // as segment(coarse_start=...)
     pyb::gil_scoped_release nogil;
     auto s = std::make_unique<Session>(std::move(image), o, std::move(r));
     // Scripts read φ and the mask, never the viewer's fragment meshes: the mesher only collects
@@ -58,7 +59,8 @@ pyb::dict status_of(const Session& s) {
     const SegmentStatus& st = s.segment_status();
     return pyb::dict(pyb::arg("iterations") = st.iterations, pyb::arg("converged") = st.converged,
                      pyb::arg("vanished") = st.vanished, pyb::arg("flips") = st.flips, pyb::arg("inside") = st.inside,
-                     pyb::arg("dt") = st.dt, pyb::arg("zero_layer") = s.field().zero_layer().size());
+                     pyb::arg("dt") = st.dt, pyb::arg("zero_layer") = s.field().zero_layer().size(), pyb::arg("coarse") = st.coarse,
+                     pyb::arg("coarse_iterations") = st.coarse_iterations, pyb::arg("coarse_inside") = st.coarse_inside);
 }
 
 // `count` calls of `one` (a segment or swarm step); segment runs stop early once converged.
@@ -107,7 +109,7 @@ void register_session(pyb::module_& m) {
              pyb::arg("region_is_brain"), pyb::arg("region_grey_brighter"), pyb::arg("n"),
              pyb::arg("alpha"), pyb::arg("smooth_mm"), pyb::arg("layers"), pyb::arg("fragment_size"), pyb::arg("history"), pyb::arg("agents"),
              pyb::arg("p"), pyb::arg("seed"), pyb::arg("sleeping"), pyb::arg("decision"), pyb::arg("edit_range"), pyb::arg("oriented"),
-             pyb::arg("thin_fronts"))
+             pyb::arg("thin_fronts"), pyb::arg("coarse_start"))
         .def("add_seed", [](Session& s, const std::vector<double>& c, double r) {
             if (!s.lattice().contains(point(c))) throw std::invalid_argument("the seed lies outside the image");
             s.add_seed({point(c), r});

@@ -60,7 +60,7 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
     req.alpha = s->params().alpha;
     req.smooth_mm = s->params().smooth_mm;  // the session's blur, automatic or given
     req.loop.step = s->options().segmentation.step;  // `view --step` as `segment --step` (default: sleeping, the thin-front rule on)
-    req.coarse_start = CoarseStart::kOff;  // the session evolves on the image's grid from the seeds
+    req.coarse_start = s->options().coarse_start;  // `view --coarse-start` as `segment --coarse-start` (same bits)
     const auto c0 = Clock::now();
     const SegmentOutcome cli = segment_image(s->image(), req);
     const double cli_ms = ms_since(c0);
@@ -88,11 +88,13 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
     }
     viewer.frame(window.id(), width, height, 1.0 / 60.0);  // the final picture
     const double viewer_ms = ms_since(v0);
-    const int iterations = s->segment_status().iterations;
-    const bool identical = iterations == cli.result.iterations && same_bits(s->field().phi(), cli.field->phi());
+    const int iterations = s->segment_status().iterations, coarse_iterations = s->segment_status().coarse_iterations;
+    const int cli_coarse = cli.coarse ? cli.coarse->result.iterations : 0;
+    const bool identical = iterations == cli.result.iterations && coarse_iterations == cli_coarse && same_bits(s->field().phi(), cli.field->phi());
     const Summary f = summarise(frame_ms), st = summarise(step_counts);
     const nlohmann::json j = {{"cli_ms", cli_ms}, {"viewer_ms", viewer_ms}, {"ratio", viewer_ms / cli_ms},
                               {"cli_iterations", cli.result.iterations}, {"viewer_iterations", iterations},
+                              {"cli_coarse_iterations", cli_coarse}, {"viewer_coarse_iterations", coarse_iterations},
                               {"identical_phi", identical}, {"frames", frame_ms.size()},
                               {"frame_ms_median", f.median}, {"frame_ms_worst", f.worst},
                               {"steps_per_frame_median", st.median}, {"triangles", s->mesher().triangle_count()},
@@ -101,11 +103,11 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
         fmt::print("{}\n", j.dump());
     } else {
         fmt::print("liveset view --bench-mode segment ({}x{} window)\n", width, height);
-        fmt::print("  CLI (segment_image)  {:9.1f} ms  {} iterations ({} step{})\n", cli_ms, cli.result.iterations,
+        fmt::print("  CLI (segment_image)  {:9.1f} ms  {} + {} coarse iterations ({} step{})\n", cli_ms, cli.result.iterations, cli_coarse,
                    step_name(req.loop.step), req.loop.step.thin_fronts ? ", thin fronts" : "");
-        fmt::print("  viewer (Run)         {:9.1f} ms  {} iterations  {} frames  frame median {:.1f} ms, worst {:.1f} ms, "
+        fmt::print("  viewer (Run)         {:9.1f} ms  {} + {} coarse iterations  {} frames  frame median {:.1f} ms, worst {:.1f} ms, "
                    "steps/frame median {:.0f}\n",
-                   viewer_ms, iterations, frame_ms.size(), f.median, f.worst, st.median);
+                   viewer_ms, iterations, coarse_iterations, frame_ms.size(), f.median, f.worst, st.median);
         fmt::print("  viewer time in: level set (steps) {:.1f} s, meshing {:.1f} s, upload {:.1f} s, 3D draws {:.1f} s, "
                    "the rest (slice panes, panel, history) {:.1f} s\n",
                    level_set / 1e3, mesh / 1e3, upload / 1e3, draw / 1e3, (viewer_ms - level_set - mesh - upload - draw) / 1e3);

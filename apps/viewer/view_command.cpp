@@ -40,6 +40,7 @@ struct ViewArgs : ThresholdArgs {
     double autosave_every = 120.0;
     std::string recovery_dir;
     std::string window_from = "model";  // µ, ε from the seeds: the tissue model or the seeds' statistics
+    std::string coarse_start = "auto";  // --coarse-start, as `segment`'s (coarse_start.hpp)
     bool bias_correct = true;           // N4 first, as `segment` (also for images opened from the panel)
     bool bias_given = false;            // --bias-correct or --no-bias-correct on the command line
     std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
@@ -75,6 +76,7 @@ SessionOptions session_options(const ViewArgs& a) {
     so.window.estimate = a.window_from == "seeds" ? WindowSource::kSeeds : WindowSource::kModel;
     so.repair = demo_repair_options();
     so.segmentation.step = step_options(a);  // as `liveset segment` (same bits)
+    so.coarse_start = parse_coarse_start(a.coarse_start);  // likewise: the run from seeds starts coarse on a fine grid
     so.alpha_automatic = !a.alpha_given;     // chosen once there is a window (choose_start_params says how)
     if (a.alpha_given && a.alpha) so.params.alpha = *a.alpha;
     if (a.alpha_given && a.smooth_mm) so.params.smooth_mm = *a.smooth_mm;
@@ -365,6 +367,7 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--roi", va.roi, "region-of-interest mask the front may not leave; 'auto': a brain mask computed from the T1; 'none': the whole image. "
                     "Default, as segment: the automatic brain mask when the image is a full head, else none");
     v->add_option("--seed", va.seeds, "seed I,J,K[:R] (voxels); repeatable");
+    v->add_option("--coarse-start", va.coarse_start, fmt::format("a run from the seeds first converges on 2x2x2-voxel blocks, one iteration a step, then refines from there, as `segment`: auto (where every voxel side is at most {} mm), on or off", kCoarseStartMaxSpacing))->check(CLI::IsMember({"auto", "on", "off"}))->capture_default_str();
     v->add_option("--window-from", va.window_from, "estimate the window from the tissue model (the seeds pick the class) or from the seeds' statistics, as `segment`")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     auto* bias = v->add_flag("--bias-correct,!--no-bias-correct", va.bias_correct, "correct the intensity non-uniformity first (N4), as `segment`. Default: on, skipped with a warning where it cannot run (asked for: an error); a continued workspace keeps its own setting");
     v->add_option("--seeds", va.seeds_file, "seed file: one I,J,K[:R] per line (the --seed format; the panel saves them)");

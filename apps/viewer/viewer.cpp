@@ -273,7 +273,9 @@ void Viewer::check_segment_end() {
     const bool was_running = segment_running_;
     segment_running_ = false;
     session_->end_action();
-    message_ = st.vanished ? "the front vanished" : fmt::format("converged after {} iterations", st.iterations);
+    message_ = st.vanished                  ? "the front vanished"
+               : st.coarse_iterations > 0 ? fmt::format("converged after {} iterations (and {} of the coarse start)", st.iterations, st.coarse_iterations)
+                                          : fmt::format("converged after {} iterations", st.iterations);
     message_is_error_ = st.vanished;
     // Without a ROI on a head, as `segment`: a front that leaked out of the automatic brain mask
     // (checked once per convergence, reset by a non-converged step, a run's start or a new

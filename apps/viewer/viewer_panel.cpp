@@ -97,7 +97,13 @@ void Viewer::draw_tools_section() {
 // µ, ε (or from the seeds), n, α; run, pause and step the segmentation.
 void Viewer::draw_segmentation_section() {
     const SegmentStatus& st = session_->segment_status();
-    ImGui::Text("%zu seed(s), %d iterations%s", session_->seeds().size(), st.iterations, st.converged ? ", converged" : "");
+    if (st.coarse)  // the coarse start's run (SessionOptions::coarse_start): φ changes when it ends
+        ImGui::Text("%zu seed(s), coarse start: %d iterations on 2x2x2 blocks", session_->seeds().size(), st.coarse_iterations);
+    else if (st.coarse_iterations > 0)
+        ImGui::Text("%zu seed(s), %d coarse + %d iterations%s", session_->seeds().size(), st.coarse_iterations, st.iterations,
+                    st.converged ? ", converged" : "");
+    else
+        ImGui::Text("%zu seed(s), %d iterations%s", session_->seeds().size(), st.iterations, st.converged ? ", converged" : "");
     if (st.converged && !leak_warning_.empty()) {  // next to the run, not only in the status line at the panel's foot
         ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.45f, 0.4f, 1.0f));
         ImGui::TextWrapped("%s", leak_warning_.c_str());

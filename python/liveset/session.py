@@ -31,8 +31,12 @@ class Session:
     (ValueError where it cannot run); False takes the image as given (pass False for an image that
     is already corrected, e.g. ``segment(...).corrected``). Without a ROI the tissue model is
     fitted in the automatic brain mask (found again on the corrected image), as ``segment`` fits it, so the same seeds give
-    ``segment``'s mask (``coarse_start="off"``'s on a grid of voxels at most 0.85 mm: a Session
-    evolves on the image's own grid). ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
+    ``segment``'s mask, bit for bit, with the same ``coarse_start``: ``"auto"`` (the default), ``"on"`` or
+    ``"off"`` as ``segment``'s. Where it applies (from seeds, on a grid of voxels at most 0.85 mm), the
+    first steps are the coarse start's iterations on 2x2x2-voxel blocks (``status["coarse"]`` True,
+    ``status["coarse_iterations"]`` counting them, φ unchanged), the one that ends that run puts its
+    upsampled front in place of the seeds, and the steps after it refine on the image's grid
+    (``status["iterations"]``); ``run``'s ``max_steps`` counts both kinds. ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
     a head, else none), ``"auto"``, ``"none"`` or a mask (Image, nibabel image or array) the front
     may not leave. ``image`` is the
     image the session works on (the corrected one when N4 ran; NaN voxels, a masked image's "no
@@ -54,10 +58,12 @@ class Session:
                  fragment_size: int = 16, history: int = 32, agents: int = 200, p: float = 0.1,
                  seed: int = 1, sleeping: bool = True, decision: str = "intensity",
                  edit_range: Optional[float] = None, bias_correct: Optional[bool] = None,
-                 thin_fronts: bool = _liveset.DEFAULT_THIN_FRONTS):
+                 thin_fronts: bool = _liveset.DEFAULT_THIN_FRONTS, coarse_start: str = "auto"):
         img = as_image(image)
         if decision not in ("intensity", "random", "cut") or int(agents) < 1:  # before N4's seconds
             raise ValueError("decision must be 'intensity', 'random' or 'cut', and agents at least 1")
+        if coarse_start not in ("auto", "on", "off"):
+            raise ValueError(f"coarse_start must be 'auto', 'on' or 'off', not {coarse_start!r}")
         if smooth_mm is not None and alpha is None:
             raise ValueError("smooth_mm needs alpha: the automatic choice sets both")
         prepared = _liveset._prepare_session_image(img.array, img.geometry, _mask_arg(roi, img, "roi", allow_auto=True),
@@ -72,7 +78,8 @@ class Session:
                                     None if smooth_mm is None else float(smooth_mm), int(layers),
                                     int(fragment_size), int(history), int(agents), float(p), int(seed),
                                     bool(sleeping), str(decision),
-                                    float(_edit_range(decision, edit_range)), bool(img.oriented), bool(thin_fronts))
+                                    float(_edit_range(decision, edit_range)), bool(img.oriented), bool(thin_fronts),
+                                    str(coarse_start))
 
     # seeds and parameters
     def add_seed(self, ijk: Sequence[float], radius: float = 2.0) -> None:
@@ -136,7 +143,8 @@ class Session:
 
     @property
     def status(self) -> dict:
-        """iterations, converged, vanished, flips, inside, dt, zero_layer."""
+        """iterations, converged, vanished, flips, inside, dt, zero_layer; coarse (the last step was
+        the coarse start's), coarse_iterations, coarse_inside (its blocks inside)."""
         return self._s.status()
 
     def set_target(self, ijk: Sequence[float]) -> None:

@@ -1,7 +1,7 @@
 """The coarse start (``coarse_start``, as ``liveset segment --coarse-start``): off by default on the
 phantom's 1 mm grid, on when asked, with its steps reported first through ``progress`` (level
 "coarse") and the same mask as the CLI's, bit for bit; a bad value, or "on" with an initial mask,
-is a ValueError."""
+is a ValueError; a Session starts coarse as segment does."""
 import nibabel as nib
 import numpy as np
 import pytest
@@ -31,3 +31,27 @@ def test_coarse_start_as_the_cli_runs_it(phantom, tmp_path):
         liveset.segment(img, phantom["seeds"], coarse_start="yes")
     with pytest.raises(ValueError, match="init_mask"):  # as the CLI's --coarse-start on --init-mask
         liveset.segment(img, phantom["seeds"], init_mask=plain.mask, coarse_start="on")
+
+
+def test_a_session_starts_coarse_as_segment_does(phantom):
+    """The Session's coarse start (the viewer's): its first steps are the coarse run's iterations,
+    then the image's grid refines, and the mask is segment's with the same coarse_start, bit for bit."""
+    img = liveset.read(phantom["image"])
+    seeds = [tuple(map(float, x.split(","))) for x in phantom["seeds"]]
+    seg = liveset.segment(img, seeds, coarse_start="on", bias_correct=False)
+    c = seg.report["coarse_start"]
+    s = liveset.Session(img, bias_correct=False, coarse_start="on")
+    for seed in seeds:
+        s.add_seed(seed)
+    st = s.step(3)
+    assert st["coarse"] and st["coarse_iterations"] == 3 and st["iterations"] == 0
+    st = s.run(5000)
+    assert st["converged"] and not st["coarse"]
+    assert st["coarse_iterations"] == c["iterations"] and st["iterations"] == seg.report["iterations"]
+    assert np.array_equal(s.mask().array, seg.mask.array)
+    # Off: the image's grid from the seeds, as segment's coarse_start="off".
+    t = liveset.Session(img, bias_correct=False, coarse_start="off")
+    t.add_seed(seeds[0])
+    assert not t.step()["coarse"] and t.status["iterations"] == 1
+    with pytest.raises(ValueError, match="coarse_start"):
+        liveset.Session(img, coarse_start="yes")

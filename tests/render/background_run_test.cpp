@@ -99,6 +99,31 @@ TEST(BackgroundRun, ASegmentationRunEqualsTheForegroundStepsAtAnyPace) {
     }
 }
 
+// With the coarse start (`view --coarse-start on`): the run's first steps are the coarse start's,
+// the surface jumps to its upsampled front at the step that ends it, and the run ends where the
+// foreground steps end, bit for bit; the message counts both kinds of iteration.
+TEST(BackgroundRun, ARunWithTheCoarseStartEqualsTheForegroundSteps) {
+    render::HeadlessContext context;
+    SessionOptions o = sleeping();
+    o.coarse_start = CoarseStart::kOn;
+    auto reference = seeded_session(o);
+    while (!reference->segment_status().converged && reference->segment_status().iterations < 5000) reference->segment_step();
+    ASSERT_GT(reference->segment_status().coarse_iterations, 0);
+    Viewer v(seeded_session(o), "phantom", config(5.0));
+    render::Framebuffer fb(640, 480);
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+    v.set_segment_running(true);
+    frames_while_running(v, fb, 100000);
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+    ASSERT_FALSE(v.segment_running());
+    const Session& s = *v.session();
+    EXPECT_EQ(s.segment_status().coarse_iterations, reference->segment_status().coarse_iterations);
+    EXPECT_EQ(s.segment_status().iterations, reference->segment_status().iterations);
+    EXPECT_TRUE(bits(s) == bits(*reference));
+    EXPECT_EQ(v.last_frame().triangles, s.mesher().triangle_count());
+    EXPECT_NE(v.message().find("of the coarse start"), std::string::npos) << v.message();
+}
+
 TEST(BackgroundRun, PauseSeedAndUndoDuringARunStopTheWorkerFirst) {
     render::HeadlessContext context;
     Viewer v(seeded_session(sleeping()), "phantom", config(5.0));

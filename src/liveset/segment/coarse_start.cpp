@@ -2,6 +2,7 @@
 #include "liveset/segment/coarse_start.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <stdexcept>
 
@@ -128,40 +129,77 @@ Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice&
     return out;
 }
 
-std::optional<Grid<std::uint8_t>> run_coarse_start(const ThresholdSpeed& fine_speed, const Lattice& fine,
-                                                   const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
-                                                   const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
-                                                   const std::atomic<bool>* interrupt, CoarseStartReport& report) {
-    if (!(fine_speed.lattice().dims() == fine.dims())) throw std::invalid_argument("the speed does not match the grid the coarse start refines");
-    // The seeds where the fine run would take them (centres inside the image, radii valid), before
-    // they are clamped onto the coarse grid.
+namespace {
+
+// The seeds where the fine run would take them (centres inside the image, radii valid), before they
+// are clamped onto the coarse grid; then mapped onto it.
+std::vector<SeedBall> coarse_seeds(const Lattice& fine, const Lattice& coarse, std::span<const SeedBall> seeds) {
     std::vector<shapes::Sphere> spheres;
     for (const SeedBall& s : seeds) spheres.emplace_back(s.center, std::max(s.radius, 0.5));
     (void)shapes::SeedSpheres(fine, std::move(spheres));
-    const Grid<float> terms = block_threshold_terms(fine_speed);
-    std::optional<Grid<std::uint8_t>> coarse_roi;
-    if (roi) coarse_roi = downsample_majority(*roi);
-    report.dims = terms.dims();
-    report.spacing = terms.lattice().spacing();
-    const ThresholdSpeed speed = ThresholdSpeed::from_terms(terms, fine_speed.params(), coarse_roi ? &*coarse_roi : nullptr);
-    SparseField field(terms.lattice(), layers);
     std::vector<SeedBall> balls;
-    for (const SeedBall& s : seeds) balls.push_back(coarse_seed(s, terms.lattice()));
+    for (const SeedBall& s : seeds) balls.push_back(coarse_seed(s, coarse));
+    return balls;
+}
+
+SparseField& seeded(SparseField& field, const std::vector<SeedBall>& balls) {
     init_from_seeds(field, balls);
-    SegmentationHook coarse_hook;
-    if (hook)
-        coarse_hook = [&](const SegmentationProgress& p, const ChangedPoints& x) {
-            SegmentationProgress q = p;
-            q.level = 1;
-            return hook(q, x);
-        };
-    report.result = run_segmentation(field, speed, loop, coarse_hook, interrupt);
-    if (report.result.reason == StopReason::kInterrupted) return std::nullopt;
-    Grid<std::uint8_t> start = upsample_inside(field.phi(), fine, roi);
+    return field;
+}
+
+const ThresholdSpeed& same_grid(const ThresholdSpeed& fine_speed, const Lattice& fine) {
+    if (!(fine_speed.lattice().dims() == fine.dims())) throw std::invalid_argument("the speed does not match the grid the coarse start refines");
+    return fine_speed;
+}
+
+}  // namespace
+
+CoarseRun::CoarseRun(const ThresholdSpeed& fine_speed, const Lattice& fine, const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
+                     const SegmentationOptions& loop, int layers)
+    : fine_(fine),
+      roi_(roi),
+      terms_(block_threshold_terms(same_grid(fine_speed, fine))),
+      coarse_roi_(roi ? std::optional(downsample_majority(*roi)) : std::nullopt),
+      speed_(ThresholdSpeed::from_terms(terms_, fine_speed.params(), coarse_roi_ ? &*coarse_roi_ : nullptr)),
+      field_(terms_.lattice(), layers),
+      run_(seeded(field_, coarse_seeds(fine, terms_.lattice(), seeds)), speed_, loop) {}
+
+bool CoarseRun::advance(const SegmentationHook& hook) {
+    if (!hook) return run_.advance();
+    return run_.advance([&](const SegmentationProgress& p, const ChangedPoints& x) {
+        SegmentationProgress q = p;
+        q.level = 1;
+        return hook(q, x);
+    });
+}
+
+std::optional<Grid<std::uint8_t>> CoarseRun::fine_start(CoarseStartReport& report) const {
+    report.dims = field_.lattice().dims();
+    report.spacing = field_.lattice().spacing();
+    report.result = run_.result();
+    if (!run_.ended() || report.result.reason == StopReason::kInterrupted) return std::nullopt;
+    Grid<std::uint8_t> start = upsample_inside(field_.phi(), fine_, roi_);
     report.upsampled = voxel_loops::count_if(start.size(), [&](std::size_t i) { return start[static_cast<PointIndex>(i)] != 0; });
     report.used = report.upsampled > 0;
     if (!report.used) return std::nullopt;
     return start;
+}
+
+std::optional<Grid<std::uint8_t>> run_coarse_start(const ThresholdSpeed& fine_speed, const Lattice& fine,
+                                                   const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
+                                                   const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
+                                                   const std::atomic<bool>* interrupt, CoarseStartReport& report) {
+    CoarseRun run(fine_speed, fine, roi, seeds, loop, layers);
+    const auto start = std::chrono::steady_clock::now();  // the run's seconds, as run_segmentation's
+    report.dims = run.field().lattice().dims();
+    report.spacing = run.field().lattice().spacing();
+    for (;;) {
+        if (interrupt && interrupt->load(std::memory_order_relaxed)) run.interrupt();
+        if (!run.advance(hook)) break;
+    }
+    std::optional<Grid<std::uint8_t>> fine_start = run.fine_start(report);
+    report.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return fine_start;
 }
 
 }  // namespace liveset

@@ -60,6 +60,39 @@ struct CoarseStartReport {
     bool used = false;           // false: nothing of the coarse front was left inside the ROI; the fine run started from the seeds
 };
 
+// The coarse stage as its caller steps it (run_coarse_start's loop; a session's coarse start, one
+// iteration per Session::segment_step): the front from `seeds` (`fine`'s index space) under the
+// threshold speed on the block_threshold_terms of `fine_speed` (with its α) and the ROI by
+// majority, on coarse_lattice(fine), stepped as `loop` says. Throws std::invalid_argument (from the
+// constructor) for a speed or ROI of another grid or a seed outside it. `roi` must outlive it.
+class CoarseRun {
+public:
+    CoarseRun(const ThresholdSpeed& fine_speed, const Lattice& fine, const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
+              const SegmentationOptions& loop, int layers);
+    CoarseRun(const CoarseRun&) = delete;
+    CoarseRun& operator=(const CoarseRun&) = delete;
+    // One coarse iteration (SegmentationRun::advance); the hook sees it with level 1. True while
+    // the run goes on.
+    bool advance(const SegmentationHook& hook = {});
+    void interrupt() { run_.interrupt(); }
+    bool ended() const { return run_.ended(); }
+    const SegmentationResult& result() const { return run_.result(); }
+    const SparseField& field() const { return field_; }
+    // After a run that ended otherwise than interrupted: upsample_inside of its φ (the fine start,
+    // to which the caller unites the seeds' balls), or nothing when nothing of its front is left
+    // inside the ROI. `report` gets the grid, the run's result, and what was upsampled.
+    std::optional<Grid<std::uint8_t>> fine_start(CoarseStartReport& report) const;
+
+private:
+    Lattice fine_;
+    const Grid<std::uint8_t>* roi_;
+    Grid<float> terms_;
+    std::optional<Grid<std::uint8_t>> coarse_roi_;  // read by speed_
+    ThresholdSpeed speed_;
+    SparseField field_;
+    SegmentationRun run_;
+};
+
 // The coarse stage: the front from `seeds` (`fine`'s index space) under the threshold speed on the
 // block_threshold_terms of `fine_speed` (with its α) and the ROI
 // by majority, run as `loop` says; the hook sees its steps with level 1. Returns upsample_inside of

@@ -58,48 +58,59 @@ bool FrontConvergence::converged(std::size_t zero_layer) {
     return net < std::max(1.0, tolerance_ * static_cast<double>(zero_layer));
 }
 
-SegmentationResult run_segmentation(SparseField& field, const Speed& speed, const SegmentationOptions& options,
-                                    const SegmentationHook& hook, const std::atomic<bool>* interrupt) {
-    validate(options);
-    using clock = std::chrono::steady_clock;
-    const auto start = clock::now();
-    FrontConvergence convergence(field.phi(), options);
+SegmentationRun::SegmentationRun(SparseField& field, const Speed& speed, const SegmentationOptions& options)
+    : field_(field), speed_(speed), options_(options), convergence_(field.phi(), options) {
+    result_.inside = convergence_.inside();
+}
 
-    SegmentationResult result;
-    for (int it = 1; it <= options.max_iterations; ++it) {
-        if (interrupt && interrupt->load(std::memory_order_relaxed)) {
-            result.reason = StopReason::kInterrupted;
-            break;
-        }
-        if (field.zero_layer().empty()) {
-            result.reason = StopReason::kVanished;
-            break;
-        }
-        const auto t0 = clock::now();
-        const StepResult step = field.step(speed, options.step);
+bool SegmentationRun::advance(const SegmentationHook& hook) {
+    if (ended_) return false;
+    using clock = std::chrono::steady_clock;
+    const auto t0 = clock::now();
+    const auto end = [&](StopReason reason) {
+        result_.reason = reason;
+        ended_ = true;
+    };
+    if (field_.zero_layer().empty()) {
+        end(StopReason::kVanished);
+    } else {
+        const int it = ++result_.iterations;
+        const StepResult step = field_.step(speed_, options_.step);
         SegmentationProgress pr;
         pr.iteration = it;
         pr.dt = step.dt;
         pr.changed = step.changed.size();
         pr.awake = step.awake;
-        pr.flips = convergence.record_step(field.phi(), step.changed.sign_changes.value());  // only steps change the field here
+        pr.flips = convergence_.record_step(field_.phi(), step.changed.sign_changes.value());  // only steps change the field here
         pr.ms = ms_since(t0);
-        pr.zero_layer = field.zero_layer().size();
-        pr.band = field.band_size();
-        pr.inside = convergence.inside();
-        result.iterations = it;
-        if (hook && !hook(pr, step.changed)) {
-            result.reason = StopReason::kInterrupted;
-            break;
-        }
-        if (convergence.converged(pr.zero_layer)) {
-            result.reason = StopReason::kConverged;
-            break;
-        }
-        if (it == options.max_iterations) result.reason = StopReason::kIterationLimit;
+        pr.zero_layer = field_.zero_layer().size();
+        pr.band = field_.band_size();
+        pr.inside = convergence_.inside();
+        result_.inside = pr.inside;
+        if (hook && !hook(pr, step.changed)) end(StopReason::kInterrupted);
+        else if (convergence_.converged(pr.zero_layer)) end(StopReason::kConverged);
+        else if (it == options_.max_iterations) end(StopReason::kIterationLimit);
     }
-    result.inside = convergence.inside();
-    result.seconds = std::chrono::duration<double>(clock::now() - start).count();
+    result_.seconds += std::chrono::duration<double>(clock::now() - t0).count();
+    return !ended_;
+}
+
+void SegmentationRun::interrupt() {
+    if (ended_) return;
+    result_.reason = StopReason::kInterrupted;
+    ended_ = true;
+}
+
+SegmentationResult run_segmentation(SparseField& field, const Speed& speed, const SegmentationOptions& options,
+                                    const SegmentationHook& hook, const std::atomic<bool>* interrupt) {
+    const auto start = std::chrono::steady_clock::now();
+    SegmentationRun run(field, speed, options);
+    for (;;) {
+        if (interrupt && interrupt->load(std::memory_order_relaxed)) run.interrupt();
+        if (!run.advance(hook)) break;
+    }
+    SegmentationResult result = run.result();
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }
 

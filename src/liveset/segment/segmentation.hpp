@@ -134,6 +134,34 @@ private:
 // must not change the field: the convergence test counts flips from each step's sign changes.
 using SegmentationHook = std::function<bool(const SegmentationProgress&, const ChangedPoints&)>;
 
+// A segmentation run its caller steps one iteration at a time (run_segmentation's loop; a session's
+// coarse start, one iteration per Session::segment_step): the same steps, tests and reasons as
+// run_segmentation, whoever calls. `field` and `speed` must outlive it; the field changes only
+// through advance() while it runs.
+class SegmentationRun {
+public:
+    // Validates `options` (std::invalid_argument) and counts the inside points of `field`.
+    SegmentationRun(SparseField& field, const Speed& speed, const SegmentationOptions& options);
+    // One iteration: the step, its progress (and X) to `hook` (false: the run is interrupted), the
+    // convergence test and the iteration limit. A field without a zero layer ends the run before
+    // stepping (kVanished). Returns true while the run goes on; a no-op once it ended.
+    bool advance(const SegmentationHook& hook = {});
+    // Ends the run as interrupted (the next advance() would have stepped).
+    void interrupt();
+    bool ended() const { return ended_; }
+    // Iterations, reason (kIterationLimit until it ended otherwise), the inside count, and the
+    // seconds spent in advance().
+    const SegmentationResult& result() const { return result_; }
+
+private:
+    SparseField& field_;
+    const Speed& speed_;
+    SegmentationOptions options_;
+    FrontConvergence convergence_;
+    SegmentationResult result_;
+    bool ended_ = false;
+};
+
 SegmentationResult run_segmentation(SparseField& field, const Speed& speed, const SegmentationOptions& options,
                                     const SegmentationHook& hook = {}, const std::atomic<bool>* interrupt = nullptr);
 

@@ -35,7 +35,7 @@ struct RecoveryState {
     std::string image;           // the image's path, as the viewer opened it
     int signal = 0;              // 0: written by an autosave; otherwise the signal that ended the run
     std::int64_t unix_time = 0;  // when it was written
-    SessionMarks marks;          // seeds, parameters, iterations (pristine is not stored: false)
+    SessionMarks marks;          // seeds, parameters, iterations (pristine is not stored: Session::load_recovered finds it)
     // The session's ROI when it was written: its mask_checksum, none without a ROI (read from
     // version 4; older files record nothing: roi_recorded false).
     bool roi_recorded = true;

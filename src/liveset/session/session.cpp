@@ -13,6 +13,7 @@
 #include "liveset/mesh/marching_cubes.hpp"
 #include "liveset/segment/pipeline.hpp"
 #include "liveset/segment/smoothing.hpp"
+#include "liveset/segment/voxel_loops.hpp"
 #include "liveset/base/stopwatch.hpp"
 
 namespace liveset {
@@ -34,6 +35,22 @@ const SessionOptions& checked(const SessionOptions& o) {
     validate(o.repair);
     validate(o.params);
     return o;
+}
+
+// Whether φ's inside is the union of the seeds' balls (as add_seed and init_from_seeds make it),
+// point for point: a recovered session that took no step since its seeds is pristine again (a
+// recovery file does not keep the flag), so that its first step is the coarse start's, as it would
+// have been, and removing a seed re-initialises from the others.
+bool is_seed_union(const Grid<float>& phi, const std::vector<SeedBall>& seeds) {
+    if (seeds.empty()) return false;
+    std::vector<shapes::Sphere> balls;
+    for (const SeedBall& s : seeds) balls.emplace_back(s.center, std::max(s.radius, 0.5));
+    const shapes::SeedSpheres sdf(phi.lattice(), std::move(balls));
+    const Lattice& lattice = phi.lattice();
+    return voxel_loops::count_if(phi.size(), [&](std::size_t i) {
+               const auto p = static_cast<PointIndex>(i);
+               return (phi[p] < 0.0f) != (static_cast<float>(sdf(lattice.coord(p).cast<double>())) < 0.0f);
+           }) == 0;
 }
 
 }  // namespace
@@ -100,7 +117,7 @@ bool Session::load_recovered(const Grid<float>& phi, const Grid<std::int8_t>& st
     else
         load_phi(phi);
     SessionMarks m = marks;
-    m.pristine = false;
+    m.pristine = marks.iterations == 0 && is_seed_union(field_.phi(), marks.seeds);
     adopt_marks(m);
     return exact;
 }
@@ -272,19 +289,73 @@ void Session::set_params(const ThresholdParams& params, bool window_from_seeds, 
 // ---------------------------------------------------------------------------------------------
 // Segmentation and repair
 
+void Session::ensure_speed() {
+    if (speed_) return;
+    // A level set loaded with no seed nor set window since: α for the window as it stands, within
+    // the action (the same value set_params and the seeds' refresh give elsewhere).
+    if (marks_.alpha_automatic) take_automatic(marks_.params, automatic_alpha_choice());
+    speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi(), &speed_image());  // the blur kept
+}
+
+// The coarse start is due while φ is the union of the seeds (no step, edit or load since) on a grid
+// where it applies; it then runs until its end replaces that union (marks_.pristine false).
+bool Session::coarse_start_due() const {
+    return marks_.pristine && !marks_.seeds.empty() && coarse_start_applies(options_.coarse_start, lattice());
+}
+
+// One iteration of the coarse start's run (begun, or begun again after any change since it began:
+// the revision counts them, and a coarse iteration changes nothing it counts). The iteration that
+// ends it replaces φ by its upsampled front and the seeds' balls, as segment_image's evolve does,
+// through the edit path; the fine steps then start from there with a fresh convergence count.
+SessionUpdate Session::coarse_step() {
+    begin_action("segment");  // the run's action, as a fine step's (its coarse iterations record nothing)
+    const auto t0 = Clock::now();
+    if (!coarse_ || coarse_revision_ != revision_) {
+        ensure_speed();
+        coarse_.reset();
+        coarse_ = std::make_unique<CoarseRun>(*speed_, lattice(), roi(), marks_.seeds, options_.segmentation, options_.layers);
+        coarse_revision_ = revision_;
+    }
+    coarse_->advance();
+    segment_.coarse = true;
+    segment_.coarse_iterations = coarse_->result().iterations;
+    segment_.coarse_inside = coarse_->result().inside;
+    segment_.converged = false;
+    if (!coarse_->ended()) {
+        SessionUpdate u;
+        u.level_set_ms = ms_since(t0);
+        return u;
+    }
+    return edit("segment", Action::kContinued, [&] {
+        CoarseStartReport report;
+        const std::optional<Grid<std::uint8_t>> start = coarse_->fine_start(report);
+        coarse_.reset();
+        if (start) {
+            field_.init_from_mask(*start);
+            unite_seeds(field_, marks_.seeds);
+        } else {
+            init_from_seeds(field_, marks_.seeds);  // nothing of the coarse front left: from the seeds, as evolve
+        }
+        marks_.pristine = false;
+        convergence_.reset();
+        segment_.vanished = field_.zero_layer().empty();
+        Change c{{}, true};
+        c.level_set_ms = ms_since(t0);
+        return c;
+    });
+}
+
 SessionUpdate Session::segment_step() {
     if (!has_surface()) {
         segment_.vanished = true;
         return {};
     }
+    if (coarse_start_due()) return coarse_step();
+    coarse_.reset();
     if (!convergence_) convergence_.emplace(field_.phi(), options_.segmentation);
     return edit("segment", Action::kContinued, [&] {
-        if (!speed_) {
-            // A level set loaded with no seed nor set window since: α for the window as it stands,
-            // within the action (the same value set_params and the seeds' refresh give elsewhere).
-            if (marks_.alpha_automatic) take_automatic(marks_.params, automatic_alpha_choice());
-            speed_ = std::make_unique<ThresholdSpeed>(unit_, marks_.params, roi(), &speed_image());  // the blur kept
-        }
+        ensure_speed();
+        segment_.coarse = false;
         StepResult step = field_.step(*speed_, options_.segmentation.step);
         segment_.flips = convergence_->record_step(field_.phi(), step.changed.points);
         segment_.inside = convergence_->inside();
@@ -302,6 +373,7 @@ void Session::make_repair_loop() { repair_ = std::make_unique<RepairLoop>(field_
 void Session::set_step(const StepOptions& step) {
     validate(step);
     options_.segmentation.step = step;
+    coarse_.reset();  // the coarse start's run steps as the session does: begun again
 }
 
 void Session::set_repair_options(const RepairOptions& options) {

@@ -29,6 +29,7 @@
 
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/segment/alpha.hpp"
+#include "liveset/segment/coarse_start.hpp"
 #include "liveset/segment/intensity.hpp"
 #include "liveset/segment/segmentation.hpp"
 #include "liveset/segment/threshold_speed.hpp"
@@ -55,7 +56,15 @@ struct SessionOptions {
     bool model_region_is_brain = false;  // as SegmentRequest::model_region_is_brain
     bool model_region_grey_brighter = false;  // as SegmentRequest::model_region_grey_brighter
     BrainMaskOptions brain_mask;         // as SegmentRequest::brain_mask (also the hole finder's, HoleScanOptions)
-    SegmentationOptions segmentation;  // convergence window/tolerance and CFL (max_iterations unused)
+    // Convergence window/tolerance and the step; max_iterations bounds only the coarse start's run
+    // (as `segment`'s), a session's own steps are counted by its caller.
+    SegmentationOptions segmentation;
+    // The coarse-to-fine start from seeds (coarse_start.hpp), as `liveset segment --coarse-start`:
+    // on a fine grid (auto: every voxel side at most 0.85 mm) the first segment_step()s run the front
+    // from the seeds to convergence on 2x2x2 blocks, one coarse iteration each, and the step that
+    // ends that run replaces the seeds with its front upsampled (and the seeds' balls): then the
+    // steps go on on the image's grid, bit for bit as segment_image's fine run.
+    CoarseStart coarse_start = CoarseStart::kAuto;
     RepairOptions repair;              // swarm settings (steps unused: the caller steps)
     ThresholdParams params;            // initial n and α (µ, ε too when there are no seeds)
     // α and the pre-smoothing chosen as `liveset segment` chooses them (segment/alpha.hpp) instead
@@ -75,7 +84,10 @@ struct SessionUpdate {
 };
 
 struct SegmentStatus {
-    int iterations = 0;        // steps taken since the level set was (re)initialised
+    int iterations = 0;        // steps taken on the image's grid since the level set was (re)initialised
+    bool coarse = false;       // the last step was one of the coarse start's (SessionOptions::coarse_start)
+    int coarse_iterations = 0; // the coarse start's iterations so far (kept after its front was upsampled)
+    std::size_t coarse_inside = 0;  // its inside points (2x2x2 blocks) after its last iteration
     bool converged = false;    // the last step met the convergence rule
     bool vanished = false;     // no zero layer left (nothing to evolve)
     std::size_t flips = 0;     // points that changed side in the last step
@@ -116,6 +128,8 @@ public:
     // Returns true when the sparse field was restored bit for bit; false when the saved status was
     // not a consistent sparse field and φ's signs were used instead (as load_phi). Throws
     // std::invalid_argument (changing nothing) on other dimensions, seeds outside, bad parameters.
+    // With no iteration recorded and φ's inside the union of the seeds' balls, the session is as
+    // before its first step again (its next step the coarse start's where that applies).
     bool load_recovered(const Grid<float>& phi, const Grid<std::int8_t>& status, const SessionMarks& marks);
 
     // --- seeds (undoable) -------------------------------------------------------------------
@@ -151,7 +165,11 @@ public:
     const std::optional<TissueModel>& tissue_model() const;
 
     // --- segmentation -----------------------------------------------------------------------
-    // One global sparse-field step of the threshold speed; consecutive steps form one action.
+    // One global sparse-field step of the threshold speed; consecutive steps form one action. While
+    // the level set is still the union of the seeds and the coarse start applies, one iteration of
+    // the coarse start's run instead (X empty: φ is not touched), and at its end the seeds are
+    // replaced by its upsampled front (X: every point that changed). Any change of the seeds, the
+    // parameters, the step or φ meanwhile starts that run again on the next step.
     SessionUpdate segment_step();
     const SegmentStatus& segment_status() const { return segment_; }
 
@@ -253,6 +271,9 @@ private:
     void refresh_window();
     AlphaChoice alpha_choice_for(const ThresholdParams& params, bool window_from_seeds) const;
     void make_repair_loop();
+    void ensure_speed();
+    bool coarse_start_due() const;
+    SessionUpdate coarse_step();
 
     SessionOptions options_;
     Grid<float> image_;
@@ -263,6 +284,8 @@ private:
     FragmentMesher mesher_;
     SessionMarks marks_;
     std::unique_ptr<ThresholdSpeed> speed_;  // for marks_.params; rebuilt lazily
+    std::unique_ptr<CoarseRun> coarse_;      // the coarse start's run in progress (built from speed_, then its own)
+    std::uint64_t coarse_revision_ = 0;      // revision_ when coarse_ was started: any change since restarts it
     mutable std::optional<std::optional<TissueModel>> model_;  // fitted lazily (inner nullopt: failed)
     mutable std::optional<std::pair<double, Grid<float>>> smoothed_;  // speed_image()'s σ and values
     std::optional<FrontConvergence> convergence_;
