@@ -63,29 +63,31 @@ pyb::dict status_of(const Session& s) {
                      pyb::arg("coarse_iterations") = st.coarse_iterations, pyb::arg("coarse_inside") = st.coarse_inside);
 }
 
-// `count` calls of `one` (a segment or swarm step); segment runs stop early once converged.
+// `count` calls of a segment or swarm step; a run until converged stops early once converged, and
+// counts only the steps on the image's grid against `count` (the coarse start's iterations are
+// bounded by its own limit, as segment's stages each are).
 pyb::dict run_steps(Session& s, int count, bool segment, bool until_converged) {
     if (count < 0) throw std::invalid_argument("steps must be >= 0");
     Interrupt interrupt;
-    int done = 0;
+    int counted = 0, taken = 0;
     {
         pyb::gil_scoped_release nogil;
-        for (; done < count && interrupt.poll(); ++done) {
-            if (segment) {
-                s.segment_step();
-                if (until_converged && (s.segment_status().converged || s.segment_status().vanished)) {
-                    ++done;
-                    break;
-                }
-            } else {
+        while (counted < count && interrupt.poll()) {
+            ++taken;
+            if (!segment) {
                 s.swarm_step();
+                ++counted;
+                continue;
             }
+            s.segment_step();
+            if (!until_converged || !s.segment_status().coarse) ++counted;
+            if (until_converged && (s.segment_status().converged || s.segment_status().vanished)) break;
         }
         s.end_action();
     }
     if (interrupt.raised()) interrupt.rethrow();
     pyb::dict d = status_of(s);
-    d["steps"] = done;
+    d["steps"] = taken;
     // A segmentation that converged without a ROI, out of the brain mask its model was fitted in:
     // the warning `segment` and the viewer give (image_commands.hpp).
     std::vector<std::string> warnings;

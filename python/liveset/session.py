@@ -36,7 +36,8 @@ class Session:
     first steps are the coarse start's iterations on 2x2x2-voxel blocks (``status["coarse"]`` True,
     ``status["coarse_iterations"]`` counting them, φ unchanged), the one that ends that run puts its
     upsampled front in place of the seeds, and the steps after it refine on the image's grid
-    (``status["iterations"]``); ``run``'s ``max_steps`` counts both kinds. ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
+    (``status["iterations"]``); ``step(n)`` takes n steps of either kind, ``run``'s ``max_steps``
+    bounds the image's grid's steps as ``segment``'s ``iterations`` bounds each stage. ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
     a head, else none), ``"auto"``, ``"none"`` or a mask (Image, nibabel image or array) the front
     may not leave. ``image`` is the
     image the session works on (the corrected one when N4 ran; NaN voxels, a masked image's "no
@@ -134,7 +135,9 @@ class Session:
         return _warned(self._s.segment_steps(int(steps), False))
 
     def run(self, max_steps: int = 2000) -> dict:
-        """Segmentation steps until the front converges (or vanishes), at most max_steps; returns
+        """Segmentation steps until the front converges (or vanishes), at most max_steps on the
+        image's grid (the coarse start's iterations before them, where it runs, are bounded by its
+        own limit of 2000, as ``segment``'s); returns
         the status and ``warnings``: with ``roi="none"`` on a head, a converged front with more
         than 5 % of its voxels outside the automatic brain mask is warned about as ``segment`` warns
         (also issued as a Python ``UserWarning``); the default ROI (or ``roi="auto"``) keeps brain

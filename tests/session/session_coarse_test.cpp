@@ -163,6 +163,16 @@ TEST(SessionCoarseStart, ARecoveredSessionBeforeItsFirstStepStartsCoarse) {
     EXPECT_EQ(converge(t), steps);
     EXPECT_TRUE(bits(t.field()) == bits(s->field()));
 
+    // Two seeds (one re-initialised after a third was removed: init_from_seeds' bits) likewise.
+    const double c = (liveset::testing::kShell - 1) / 2.0;
+    saved->add_seed({{c - 31.0, c - 5.0, c + 5.0}, 2.0});
+    saved->add_seed({{c, c - 31.0, c + 5.0}, 2.0});
+    saved->remove_seed(2);
+    Session two(shell().image, shell_options(CoarseStart::kAuto), shell().roi);
+    two.load_recovered(saved->field().phi(), saved->field().status(), saved->marks());
+    two.segment_step();
+    EXPECT_TRUE(two.segment_status().coarse);
+
     SessionMarks stepped = saved->marks();
     stepped.iterations = 1;
     Session u(shell().image, shell_options(CoarseStart::kAuto), shell().roi);
@@ -170,6 +180,50 @@ TEST(SessionCoarseStart, ARecoveredSessionBeforeItsFirstStepStartsCoarse) {
     u.segment_step();
     EXPECT_FALSE(u.segment_status().coarse);
     EXPECT_EQ(u.segment_status().iterations, 2);
+}
+
+// A step taken with no surface said "vanished"; the seeds added since are a surface: the coarse
+// steps say so, and a run does not stop after the first of them.
+TEST(SessionCoarseStart, ASeedAfterAStepWithoutOneIsAFrontAgain) {
+    Session s(shell().image, shell_options(CoarseStart::kAuto), shell().roi);
+    s.segment_step();
+    ASSERT_TRUE(s.segment_status().vanished);
+    s.add_seed({shell_seed(), 2.0});
+    s.segment_step();
+    EXPECT_TRUE(s.segment_status().coarse);
+    EXPECT_FALSE(s.segment_status().vanished);
+    SessionRunner runner(s);
+    runner.start(RunWork::kSegment, 10);
+    runner.wait_finished(60'000.0);
+    const RunState st = runner.poll();
+    EXPECT_EQ(st.steps, 10);
+    EXPECT_EQ(s.segment_status().coarse_iterations, 11);
+}
+
+// What the coarse run does not read - the swarm's target - does not begin it again.
+TEST(SessionCoarseStart, ATargetSetDuringTheCoarseRunDoesNotBeginItAgain) {
+    const std::unique_ptr<Session> s = shell_session();
+    for (int k = 0; k < 4; ++k) s->segment_step();
+    s->set_target(shell_seed() + Vec3d{2.0, 0.0, 0.0});
+    s->segment_step();
+    EXPECT_EQ(s->segment_status().coarse_iterations, 5);
+}
+
+// A brush stroke that moved the zero layer without changing a sign is no seeds' union: recovered,
+// the session steps on the image's grid from the stroke, as the uninterrupted one does.
+TEST(SessionCoarseStart, ARecoveredBrushStrokeIsNotTakenForTheSeeds) {
+    const std::unique_ptr<Session> s = shell_session();
+    const Vec3i c{static_cast<int>(shell_seed().x), static_cast<int>(shell_seed().y), static_cast<int>(shell_seed().z)};
+    const SessionUpdate u = s->edit_box(c - Vec3i{4, 4, 4}, c + Vec3i{4, 4, 4}, [](Vec3i, float v) { return -0.5f * v; });  // halfway to 0
+    ASSERT_FALSE(u.changed.empty());
+    ASSERT_TRUE(!u.changed.sign_changes || u.changed.sign_changes->empty());
+    Session t(shell().image, shell_options(CoarseStart::kAuto), shell().roi);
+    t.load_recovered(s->field().phi(), s->field().status(), s->marks());
+    s->segment_step();
+    t.segment_step();
+    EXPECT_FALSE(s->segment_status().coarse);
+    EXPECT_FALSE(t.segment_status().coarse);
+    EXPECT_TRUE(bits(t.field()) == bits(s->field()));
 }
 
 TEST(SessionCoarseStart, OffStepsTheImagesGridFromTheSeeds) {

@@ -190,15 +190,16 @@ std::optional<Grid<std::uint8_t>> run_coarse_start(const ThresholdSpeed& fine_sp
                                                    const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
                                                    const std::atomic<bool>* interrupt, CoarseStartReport& report) {
     CoarseRun run(fine_speed, fine, roi, seeds, loop, layers);
-    const auto start = std::chrono::steady_clock::now();  // the run's seconds, as run_segmentation's
+    const auto start = std::chrono::steady_clock::now();
     report.dims = run.field().lattice().dims();
     report.spacing = run.field().lattice().spacing();
     for (;;) {
         if (interrupt && interrupt->load(std::memory_order_relaxed)) run.interrupt();
         if (!run.advance(hook)) break;
     }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();  // the loop's, as before
     std::optional<Grid<std::uint8_t>> fine_start = run.fine_start(report);
-    report.result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report.result.seconds = seconds;
     return fine_start;
 }
 

@@ -37,19 +37,28 @@ const SessionOptions& checked(const SessionOptions& o) {
     return o;
 }
 
-// Whether φ's inside is the union of the seeds' balls (as add_seed and init_from_seeds make it),
-// point for point: a recovered session that took no step since its seeds is pristine again (a
-// recovery file does not keep the flag), so that its first step is the coarse start's, as it would
-// have been, and removing a seed re-initialises from the others.
-bool is_seed_union(const Grid<float>& phi, const std::vector<SeedBall>& seeds) {
+// Whether `field` is the union of the seeds' balls as add_seed and init_from_seeds make it: φ's
+// inside theirs point for point, and every zero-layer value their distance's, bit for bit (the
+// outer layers are a function of those). A recovered session that took no step since its seeds is
+// then pristine again (a recovery file does not keep the flag), so that its first step is the
+// coarse start's, as it would have been, and removing a seed re-initialises from the others; an
+// edit of the zero layer that changed no sign (a brush, the swarm) is told apart by its values.
+// Where overlapping balls' rounding differs it says no: the session then steps as before 81.
+bool is_seed_union(const SparseField& field, const std::vector<SeedBall>& seeds) {
     if (seeds.empty()) return false;
     std::vector<shapes::Sphere> balls;
     for (const SeedBall& s : seeds) balls.emplace_back(s.center, std::max(s.radius, 0.5));
-    const shapes::SeedSpheres sdf(phi.lattice(), std::move(balls));
-    const Lattice& lattice = phi.lattice();
-    return voxel_loops::count_if(phi.size(), [&](std::size_t i) {
+    const shapes::SeedSpheres sdf(field.lattice(), std::move(balls));
+    const Lattice& lattice = field.lattice();
+    const Grid<float>& phi = field.phi();
+    const auto distance = [&](PointIndex p) { return static_cast<float>(sdf(lattice.coord(p).cast<double>())); };
+    const std::span<const PointIndex> zero = field.zero_layer();
+    return voxel_loops::count_if(zero.size(), [&](std::size_t k) {
+               return std::bit_cast<std::uint32_t>(phi[zero[k]]) != std::bit_cast<std::uint32_t>(distance(zero[k]));
+           }) == 0 &&
+           voxel_loops::count_if(phi.size(), [&](std::size_t i) {
                const auto p = static_cast<PointIndex>(i);
-               return (phi[p] < 0.0f) != (static_cast<float>(sdf(lattice.coord(p).cast<double>())) < 0.0f);
+               return (phi[p] < 0.0f) != (distance(p) < 0.0f);
            }) == 0;
 }
 
@@ -117,7 +126,7 @@ bool Session::load_recovered(const Grid<float>& phi, const Grid<std::int8_t>& st
     else
         load_phi(phi);
     SessionMarks m = marks;
-    m.pristine = marks.iterations == 0 && is_seed_union(field_.phi(), marks.seeds);
+    m.pristine = marks.iterations == 0 && is_seed_union(field_, marks.seeds);
     adopt_marks(m);
     return exact;
 }
@@ -141,6 +150,7 @@ void Session::reset_after_load() {
     repair_.reset();
     target_.reset();
     ++revision_;
+    ++inputs_;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -284,6 +294,7 @@ void Session::set_params(const ThresholdParams& params, bool window_from_seeds, 
     speed_.reset();
     segment_.converged = false;
     ++revision_;
+    ++inputs_;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -303,24 +314,27 @@ bool Session::coarse_start_due() const {
     return marks_.pristine && !marks_.seeds.empty() && coarse_start_applies(options_.coarse_start, lattice());
 }
 
-// One iteration of the coarse start's run (begun, or begun again after any change since it began:
-// the revision counts them, and a coarse iteration changes nothing it counts). The iteration that
+// One iteration of the coarse start's run (begun, or begun again after a change of what it reads since
+// it began: inputs_ counts them; a coarse iteration changes none). The iteration that
 // ends it replaces φ by its upsampled front and the seeds' balls, as segment_image's evolve does,
 // through the edit path; the fine steps then start from there with a fresh convergence count.
 SessionUpdate Session::coarse_step() {
     begin_action("segment");  // the run's action, as a fine step's (its coarse iterations record nothing)
     const auto t0 = Clock::now();
-    if (!coarse_ || coarse_revision_ != revision_) {
+    if (!coarse_ || coarse_inputs_ != inputs_) {
         ensure_speed();
         coarse_.reset();
         coarse_ = std::make_unique<CoarseRun>(*speed_, lattice(), roi(), marks_.seeds, options_.segmentation, options_.layers);
-        coarse_revision_ = revision_;
+        coarse_inputs_ = inputs_;
     }
     coarse_->advance();
     segment_.coarse = true;
     segment_.coarse_iterations = coarse_->result().iterations;
     segment_.coarse_inside = coarse_->result().inside;
     segment_.converged = false;
+    segment_.vanished = false;  // the seeds are a surface (an earlier step without one may have said otherwise)
+    segment_.flips = 0;         // the image's grid's counts: nothing moved there
+    segment_.dt = 0.0;
     if (!coarse_->ended()) {
         SessionUpdate u;
         u.level_set_ms = ms_since(t0);
@@ -560,6 +574,7 @@ SessionUpdate Session::finish_update(ChangedPoints changed, double level_set_ms)
     }
     u.changed = std::move(changed);
     ++revision_;
+    ++inputs_;
     return u;
 }
 

@@ -168,8 +168,9 @@ public:
     // One global sparse-field step of the threshold speed; consecutive steps form one action. While
     // the level set is still the union of the seeds and the coarse start applies, one iteration of
     // the coarse start's run instead (X empty: φ is not touched), and at its end the seeds are
-    // replaced by its upsampled front (X: every point that changed). Any change of the seeds, the
-    // parameters, the step or φ meanwhile starts that run again on the next step.
+    // replaced by its upsampled front (X: every point that changed). A change of the seeds, the
+    // parameters, the step or φ meanwhile (not of the swarm's target or options) begins that run
+    // again on the next step.
     SessionUpdate segment_step();
     const SegmentStatus& segment_status() const { return segment_; }
 
@@ -285,7 +286,10 @@ private:
     SessionMarks marks_;
     std::unique_ptr<ThresholdSpeed> speed_;  // for marks_.params; rebuilt lazily
     std::unique_ptr<CoarseRun> coarse_;      // the coarse start's run in progress (built from speed_, then its own)
-    std::uint64_t coarse_revision_ = 0;      // revision_ when coarse_ was started: any change since restarts it
+    // Changes of what a coarse run reads - φ and the seeds (every edit, undo and redo), the
+    // parameters, a load - counted; coarse_ begun at another count is begun again (set_step drops it).
+    std::uint64_t inputs_ = 0;
+    std::uint64_t coarse_inputs_ = 0;        // inputs_ when coarse_ was begun
     mutable std::optional<std::optional<TissueModel>> model_;  // fitted lazily (inner nullopt: failed)
     mutable std::optional<std::pair<double, Grid<float>>> smoothed_;  // speed_image()'s σ and values
     std::optional<FrontConvergence> convergence_;
