@@ -106,7 +106,7 @@ std::vector<PointIndex> pick_in_box(const Lattice& lattice, Vec3i lo, Vec3i hi, 
 
 }  // namespace
 
-void SparseField::band_from_phi(Vec3i lo, Vec3i hi) {
+void SparseField::band_from_phi(Vec3i lo, Vec3i hi, bool steep_possible) {
     const Vec3i d = lattice().dims();
     // The box grown by one point: outside it every point and all its neighbours hold the far
     // value, so neither pass below can find anything there.
@@ -118,16 +118,19 @@ void SparseField::band_from_phi(Vec3i lo, Vec3i hi) {
     // A sign change between two far points (a function steeper than a distance) would leave the
     // front without zero-layer points: pull both sides onto the zero layer (found first, then
     // pulled: every point is judged on the values as evaluated).
-    const std::vector<PointIndex> steep = pick_in_box(lattice(), glo, ghi, [&](PointIndex i) {
-        const float v = phi_[i];
-        if (std::abs(v) <= 0.5f) return false;
-        bool opposite = false;
-        for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
-            if (std::abs(phi_[q]) > 0.5f && ((phi_[q] < 0) != (v < 0))) opposite = true;
+    // A whole-lattice pass with six reads a point: skipped where no such pair can exist.
+    if (steep_possible) {
+        const std::vector<PointIndex> steep = pick_in_box(lattice(), glo, ghi, [&](PointIndex i) {
+            const float v = phi_[i];
+            if (std::abs(v) <= 0.5f) return false;
+            bool opposite = false;
+            for_each_neighbor6(lattice(), decoder_, i, [&](PointIndex q) {
+                if (std::abs(phi_[q]) > 0.5f && ((phi_[q] < 0) != (v < 0))) opposite = true;
+            });
+            return opposite;
         });
-        return opposite;
-    });
-    for (PointIndex i : steep) phi_[i] = phi_[i] < 0 ? -0.5f : 0.5f;
+        for (PointIndex i : steep) phi_[i] = phi_[i] < 0 ? -0.5f : 0.5f;
+    }
 
     const float far = static_cast<float>(layers_ + 1);
     if (!(glo == Vec3i{0, 0, 0} && ghi == d - Vec3i{1, 1, 1})) status_.fill(far_outside());
@@ -174,7 +177,7 @@ void SparseField::init_from_mask(const Grid<std::uint8_t>& mask) {
             phi_[i] = boundary ? (inside ? -0.5f : 0.5f) : (inside ? -far : far);
         });
     });
-    band_from_phi({0, 0, 0}, d - Vec3i{1, 1, 1});
+    band_from_phi({0, 0, 0}, d - Vec3i{1, 1, 1}, /*steep=*/false);  // a sign change's both sides are ±0.5 here
 }
 
 }  // namespace liveset

@@ -220,7 +220,10 @@ private:
 
     void evaluate_sdf(const std::function<double(Vec3d)>& sdf, Vec3i lo, Vec3i hi);  // φ, far outside the box
     void clear_lists();                     // no layer lists, no slots, everything awake (a new front)
-    void band_from_phi(Vec3i lo, Vec3i hi);  // the statuses, lists and band from φ set in [lo, hi] (far outside)
+    // The statuses, lists and band from φ set in [lo, hi] (far outside). `steep`: φ may change sign
+    // between two points beyond ±0.5 (a function steeper than a distance), which are then pulled
+    // onto the zero layer; false where φ cannot (init_from_mask: both sides of a sign change are ±0.5).
+    void band_from_phi(Vec3i lo, Vec3i hi, bool steep = true);
     std::vector<double> zero_rates(const Speed& speed) const;  // |∇φ|F at each zero-layer point
     double time_step(std::span<const double> rate, const Speed& speed, const StepOptions& options) const;
     double parabolic_factor() const;  // the curvature's stability factor 1/h_min from the voxel sizes (time_step)
