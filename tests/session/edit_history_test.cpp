@@ -156,3 +156,54 @@ TEST(EditHistory, KeepsAtMostItsLimitAndDropsEmptyActions) {
 
 }  // namespace
 }  // namespace liveset
+
+namespace liveset {
+namespace {
+
+// record_differences after a whole-state replacement within an action that already recorded local
+// edits: X is exactly the points whose state differs from the action's start or that were recorded
+// earlier (brute force, index order), its sign changes hold every point whose sign differs from
+// the state just before the replacement, and undo gives back the action's start bit for bit.
+TEST(EditHistory, RecordDifferencesIsTheBruteForceDifferenceWithItsSignChanges) {
+    const Lattice lat({40, 36, 32});
+    SparseField f(lat, 2);
+    f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{20, 18, 16}) - 10.0; });
+    EditHistory h(f, 32);
+    const Snapshot start = snapshot(f);
+    std::mt19937 rng(11);
+    h.begin("whole", {});
+    h.record(random_edits(f, rng, {4, 4, 4}, {30, 30, 26}));
+    std::vector<std::uint8_t> recorded(lat.size(), 0);
+    for (std::size_t i = 0; i < lat.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        recorded[i] = std::bit_cast<std::uint32_t>(f.phi()[p]) != start.phi_bits[i] || f.status()[p] != start.status[i];
+    }
+    const Grid<float> before = f.phi();
+    f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{22, 17, 15}) - 9.0; });  // the whole state replaced
+    const ChangedPoints x = h.record_differences(f);
+    std::vector<PointIndex> expected;
+    for (std::size_t i = 0; i < lat.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if (recorded[i] || std::bit_cast<std::uint32_t>(f.phi()[p]) != start.phi_bits[i] || f.status()[p] != start.status[i])
+            expected.push_back(p);
+    }
+    EXPECT_EQ(x.points, expected);
+    ASSERT_TRUE(x.sign_changes.has_value());
+    std::vector<std::uint8_t> listed(lat.size(), 0);
+    for (PointIndex p : *x.sign_changes) listed[p] = 1;
+    std::size_t flips = 0;
+    for (std::size_t i = 0; i < lat.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if ((before[p] < 0.0f) != (f.phi()[p] < 0.0f)) {
+            ++flips;
+            ASSERT_TRUE(listed[i]) << "point " << i << " changed sign but is not listed";
+        }
+    }
+    EXPECT_GT(flips, 100u);
+    h.commit(f, {});
+    h.undo(f);
+    expect_same(snapshot(f), start, "undone", 0);
+}
+
+}  // namespace
+}  // namespace liveset

@@ -1,6 +1,8 @@
 // EditHistory: per-action first-touched old states against a shadow of the level set.
 #include "liveset/session/edit_history.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <bit>
 #include <stdexcept>
 
@@ -65,20 +67,56 @@ void EditHistory::record(const ChangedPoints& changed) {
 
 ChangedPoints EditHistory::record_differences(const SparseField& field) {
     if (!open_) throw std::logic_error("no action is open");
-    ChangedPoints changed;
     const Grid<float>& phi = field.phi();
     const Grid<std::int8_t>& status = field.status();
-    for (std::size_t n = 0; n < phi.size(); ++n) {
-        const auto i = static_cast<PointIndex>(n);
-        if (shadow_status_[i] == kRecorded) {
-            changed.points.push_back(i);  // changed earlier in this action: may have changed again
-            continue;
+    // The lattice's z-planes in parallel (each point is its plane's alone: its shadow mark too),
+    // each into its own lists, joined in plane order: X, its sign changes and the old states in
+    // index order, as one pass would give them, on any thread count.
+    const Vec3i d = phi.dims();
+    const std::size_t plane = static_cast<std::size_t>(d.x) * static_cast<std::size_t>(d.y);
+    struct Found {
+        std::vector<PointIndex> points, signs;
+        std::vector<PointState> before;
+    };
+    std::vector<Found> found(static_cast<std::size_t>(d.z));
+    tbb::parallel_for(0, d.z, [&](int z) {
+        Found& f = found[static_cast<std::size_t>(z)];
+        for (std::size_t n = static_cast<std::size_t>(z) * plane, end = n + plane; n < end; ++n) {
+            const auto i = static_cast<PointIndex>(n);
+            const std::int8_t old_status = shadow_status_[i];
+            if (old_status == kRecorded) {  // changed earlier in this action: may have changed again
+                f.points.push_back(i);
+                f.signs.push_back(i);  // its state before this change is not the shadow's: listed (harmless)
+                continue;
+            }
+            const float old_phi = shadow_phi_[i];
+            if (old_status == status[i] && std::bit_cast<std::uint32_t>(old_phi) == std::bit_cast<std::uint32_t>(phi[i])) continue;
+            f.points.push_back(i);
+            if ((old_phi < 0.0f) != (phi[i] < 0.0f)) f.signs.push_back(i);
+            f.before.push_back({i, old_phi, old_status});
+            shadow_status_[i] = kRecorded;
         }
-        if (shadow_status_[i] != status[i] ||
-            std::bit_cast<std::uint32_t>(shadow_phi_[i]) != std::bit_cast<std::uint32_t>(phi[i]))
-            changed.points.push_back(i);
+    });
+    ChangedPoints changed;
+    std::vector<PointIndex> signs;
+    std::size_t n_points = 0, n_signs = 0, n_before = 0;
+    for (const Found& f : found) {
+        n_points += f.points.size();
+        n_signs += f.signs.size();
+        n_before += f.before.size();
     }
-    record(changed);
+    changed.points.reserve(n_points);
+    signs.reserve(n_signs);
+    current_.before.reserve(current_.before.size() + n_before);
+    for (const Found& f : found) {
+        changed.points.insert(changed.points.end(), f.points.begin(), f.points.end());
+        signs.insert(signs.end(), f.signs.begin(), f.signs.end());
+        current_.before.insert(current_.before.end(), f.before.begin(), f.before.end());
+    }
+    // Every point whose sign may differ from what a mesher last meshed: those whose sign differs
+    // from the shadow (the state the last update left, for a point not recorded in this action) and
+    // every point recorded earlier in it.
+    changed.sign_changes = std::move(signs);
     return changed;
 }
 

@@ -59,7 +59,9 @@ public:
     // Records the first-touched old state of each point of X (an update within the open action).
     void record(const ChangedPoints& changed);
     // Records every point whose state differs from the shadow (after a whole-state replacement);
-    // O(volume). Returns them, as X for the mesher.
+    // O(volume), over the lattice's planes in parallel. Returns them, as X for the mesher, with
+    // the sign changes a mesher needs (ChangedPoints::sign_changes: those whose sign differs from
+    // the shadow's, and every point recorded earlier in the action).
     ChangedPoints record_differences(const SparseField& field);
     // Closes the open action with the field's states and `marks_after`. An action that changed no
     // point and no mark is dropped. Returns true when an action was pushed (the redo list is then
