@@ -34,7 +34,8 @@ FrontConvergence::FrontConvergence(const Grid<float>& phi, const SegmentationOpt
     validate(options);
     const std::span<const float> values = phi.values();
     inside_.resize(values.size());
-    for (std::size_t i = 0; i < values.size(); ++i) inside_count_ += inside_[i] = values[i] < 0.0f;
+    std::uint8_t* const inside = inside_.data();  // each element written from its own index: on every thread
+    inside_count_ = voxel_loops::count_if(values.size(), [&](std::size_t i) { return (inside[i] = values[i] < 0.0f) != 0; });
 }
 
 std::size_t FrontConvergence::record_step(const Grid<float>& phi, std::span<const PointIndex> candidates) {
