@@ -69,6 +69,21 @@ int frames_while_running(Viewer& v, const render::Framebuffer& fb, int limit, in
     return seen;
 }
 
+// The first picture, a Run until it stops by itself (converged), and the picture after it.
+void run_until_it_stops(Viewer& v, const render::Framebuffer& fb) {
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+    v.set_segment_running(true);
+    frames_while_running(v, fb, 100000);
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+}
+
+// The foreground reference: the seeded session stepped on the caller's thread until it converges.
+std::unique_ptr<Session> converged_in_the_foreground(const SessionOptions& o) {
+    auto s = seeded_session(o);
+    while (!s->segment_status().converged && s->segment_status().iterations < 5000) s->segment_step();
+    return s;
+}
+
 // A fixed number of frames is not enough before a pause: on a loaded machine the worker may not
 // have finished a step within a few 5 ms hand-overs, and a pause then closes an empty run, so an
 // undo takes back the action before it.
@@ -78,15 +93,11 @@ void frames_until_steps(Viewer& v, const render::Framebuffer& fb, int steps) {
 
 TEST(BackgroundRun, ASegmentationRunEqualsTheForegroundStepsAtAnyPace) {
     render::HeadlessContext context;
-    auto reference = seeded_session(sleeping());
-    while (!reference->segment_status().converged && reference->segment_status().iterations < 5000) reference->segment_step();
+    const auto reference = converged_in_the_foreground(sleeping());
     for (const double pace : {1.0, 40.0}) {
         Viewer v(seeded_session(sleeping()), "phantom", config(pace));
         render::Framebuffer fb(640, 480);
-        v.frame(fb.id(), 640, 480, 1.0 / 60.0);
-        v.set_segment_running(true);
-        frames_while_running(v, fb, 100000);
-        v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+        run_until_it_stops(v, fb);
         ASSERT_FALSE(v.segment_running());
         EXPECT_FALSE(v.background_active());
         const Session& s = *v.session();
@@ -106,15 +117,11 @@ TEST(BackgroundRun, ARunWithTheCoarseStartEqualsTheForegroundSteps) {
     render::HeadlessContext context;
     SessionOptions o = sleeping();
     o.coarse_start = CoarseStart::kOn;
-    auto reference = seeded_session(o);
-    while (!reference->segment_status().converged && reference->segment_status().iterations < 5000) reference->segment_step();
+    const auto reference = converged_in_the_foreground(o);
     ASSERT_GT(reference->segment_status().coarse_iterations, 0);
     Viewer v(seeded_session(o), "phantom", config(5.0));
     render::Framebuffer fb(640, 480);
-    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
-    v.set_segment_running(true);
-    frames_while_running(v, fb, 100000);
-    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+    run_until_it_stops(v, fb);
     ASSERT_FALSE(v.segment_running());
     const Session& s = *v.session();
     EXPECT_EQ(s.segment_status().coarse_iterations, reference->segment_status().coarse_iterations);
