@@ -185,14 +185,21 @@ std::optional<Grid<std::uint8_t>> CoarseRun::fine_start(CoarseStartReport& repor
     return start;
 }
 
+void init_fine_start(SparseField& fine, const std::optional<Grid<std::uint8_t>>& start, std::span<const SeedBall> seeds) {
+    if (!start) {
+        init_from_seeds(fine, seeds);
+        return;
+    }
+    fine.init_from_mask(*start);
+    unite_seeds(fine, seeds);
+}
+
 std::optional<Grid<std::uint8_t>> run_coarse_start(const ThresholdSpeed& fine_speed, const Lattice& fine,
                                                    const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
                                                    const SegmentationOptions& loop, int layers, const SegmentationHook& hook,
                                                    const std::atomic<bool>* interrupt, CoarseStartReport& report) {
     CoarseRun run(fine_speed, fine, roi, seeds, loop, layers);
     const auto start = std::chrono::steady_clock::now();
-    report.dims = run.field().lattice().dims();
-    report.spacing = run.field().lattice().spacing();
     for (;;) {
         if (interrupt && interrupt->load(std::memory_order_relaxed)) run.interrupt();
         if (!run.advance(hook)) break;

@@ -93,6 +93,11 @@ private:
     SegmentationRun run_;
 };
 
+// The fine start from the coarse stage's result: `start` (fine_start) with every seed's ball united
+// (a seed whose coarse front died - its tissue blurred out of the window by the blocks - is not lost
+// while another seed's front lived), or the seeds alone where nothing of the coarse front is left.
+void init_fine_start(SparseField& fine, const std::optional<Grid<std::uint8_t>>& start, std::span<const SeedBall> seeds);
+
 // The coarse stage: the front from `seeds` (`fine`'s index space) under the threshold speed on the
 // block_threshold_terms of `fine_speed` (with its α) and the ROI
 // by majority, run as `loop` says; the hook sees its steps with level 1. Returns upsample_inside of

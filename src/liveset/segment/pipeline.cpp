@@ -153,18 +153,11 @@ void evolve(const Lattice& lattice, const ThresholdSpeed& speed, const SegmentRe
             run_coarse_start(speed, lattice, req.roi, req.seeds, req.loop, req.layers, hook, interrupt, *out.coarse);
         // So are the coarse grids' blocks (a 0.5 mm brain's: 140 MB).
         detail::release_recycled();
-        if (start) {
-            out.field->init_from_mask(*start);
-            // Every seed's ball too: a seed whose coarse front died (its tissue blurred out of the
-            // window by the blocks) is not lost while another seed's front lived.
-            unite_seeds(*out.field, req.seeds);
-        } else {
-            init_from_seeds(*out.field, req.seeds);
-            if (out.coarse->result.reason == StopReason::kInterrupted) {
-                out.result.reason = StopReason::kInterrupted;
-                out.mask = inside_mask(out.field->phi(), req.roi);
-                return;
-            }
+        init_fine_start(*out.field, start, req.seeds);
+        if (out.coarse->result.reason == StopReason::kInterrupted) {
+            out.result.reason = StopReason::kInterrupted;
+            out.mask = inside_mask(out.field->phi(), req.roi);
+            return;
         }
     } else {
         init_from_seeds(*out.field, req.seeds);

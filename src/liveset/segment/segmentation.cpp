@@ -92,7 +92,6 @@ bool SegmentationRun::advance(const SegmentationHook& hook) {
         else if (convergence_.converged(pr.zero_layer)) end(StopReason::kConverged);
         else if (it == options_.max_iterations) end(StopReason::kIterationLimit);
     }
-    result_.seconds += std::chrono::duration<double>(clock::now() - t0).count();
     return !ended_;
 }
 

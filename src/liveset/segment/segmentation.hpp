@@ -149,8 +149,8 @@ public:
     // Ends the run as interrupted (the next advance() would have stepped).
     void interrupt();
     bool ended() const { return ended_; }
-    // Iterations, reason (kIterationLimit until it ended otherwise), the inside count, and the
-    // seconds spent in advance().
+    // Iterations, reason (kIterationLimit until it ended otherwise) and the inside count; the
+    // seconds are the caller's to time (0 here).
     const SegmentationResult& result() const { return result_; }
 
 private:

@@ -344,12 +344,7 @@ SessionUpdate Session::coarse_step() {
         CoarseStartReport report;
         const std::optional<Grid<std::uint8_t>> start = coarse_->fine_start(report);
         coarse_.reset();
-        if (start) {
-            field_.init_from_mask(*start);
-            unite_seeds(field_, marks_.seeds);
-        } else {
-            init_from_seeds(field_, marks_.seeds);  // nothing of the coarse front left: from the seeds, as evolve
-        }
+        init_fine_start(field_, start, marks_.seeds);  // as segment_image's evolve
         marks_.pristine = false;
         convergence_.reset();
         segment_.vanished = field_.zero_layer().empty();
