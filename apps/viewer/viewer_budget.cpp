@@ -59,6 +59,7 @@ void Viewer::upload() {
     if (!session_) return;
     if (background_active()) return handover();  // the worker's changes, at the hand-over pace
     upload_fine();
+    if (refresh_coarse_preview()) stale_ = true;
     if (session_->revision() != seen_revision_) {
         seen_revision_ = session_->revision();
         stale_ = true;
@@ -76,8 +77,13 @@ void Viewer::upload() {
 void Viewer::render_3d(const render::Framebuffer& fb) {
     const auto t0 = Clock::now();
     render::SceneContent content = scene_content();
-    view3d_coarse_ = lod_ && !capturing_ && budget_.coarse(now_ms(), segment_running_ || drag_.active);
-    if (view3d_coarse_) {
+    const bool preview = preview_mesher_ != nullptr;
+    view3d_coarse_ = !preview && lod_ && !capturing_ && budget_.coarse(now_ms(), segment_running_ || drag_.active);
+    if (preview) {  // the coarse start's front: its point c lies at the image's index 2c + 0.5 (coarse_lattice)
+        content.surface = &preview_surface_;
+        content.surface_scale = 2.0f;
+        content.surface_offset = 0.5f;
+    } else if (view3d_coarse_) {
         content.surface = &coarse_surface_;
         content.surface_scale = static_cast<float>(lod_->factor());  // LodMesher's index space
     }
@@ -87,7 +93,7 @@ void Viewer::render_3d(const render::Framebuffer& fb) {
     if (runner_) runner_->acquire();
     const double ms = ms_since(t0);
     current_.draw_ms += ms;
-    if (!view3d_coarse_ && !capturing_) budget_.record_full_draw(ms);
+    if (!view3d_coarse_ && !preview && !capturing_) budget_.record_full_draw(ms);
 }
 
 void Viewer::render_dirty_panes() {

@@ -43,13 +43,17 @@ void Viewer::render_slice_pane(Pane pane, render::Framebuffer& fb, const Rect& r
         slice_renderers_[i]->set_texels(g.width, g.height, texels);
         slice_shown_[i] = slice;
     }
-    if (contour_slice_[i] != slice || contour_revision_[i] != session_->revision()) {
-        contours_[i] = render::zero_contour(session_->field().phi(), g, slice);
+    // While the coarse start runs, its front upsampled (where the fine run will start) instead of φ, still the seeds.
+    const std::vector<float> phi = preview_mesher_ ? render::upsampled_phi_slice(preview_phi_, g, slice)
+                                                   : render::phi_slice(session_->field().phi(), g, slice);
+    if (contour_slice_[i] != slice || contour_revision_[i] != session_->revision() || contour_preview_[i] != preview_generation_) {
+        contours_[i] = render::zero_contour(phi, g);
         contour_slice_[i] = slice;
         contour_revision_[i] = session_->revision();
+        contour_preview_[i] = preview_generation_;
     }
     const ThresholdParams params = session_->params();
-    const std::vector<std::uint8_t> rgba = render::overlay_texels(g, slice, slices_.overlay, &session_->field().phi(), session_->roi(),
+    const std::vector<std::uint8_t> rgba = render::overlay_texels(g, slice, slices_.overlay, phi, session_->roi(),
                                                                   slices_.overlay.preview ? &session_->speed_image() : nullptr, &params);
     slice_renderers_[i]->set_overlay(g.width, g.height, rgba);
     render::SliceOverlay overlay;

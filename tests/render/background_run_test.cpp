@@ -2,7 +2,8 @@
 // segmentation run equals the session's foreground steps (and so `liveset segment`) bit for bit at
 // any hand-over pace; pause, a seed and undo during a run stop the worker first and leave a
 // consistent session (pause: the same φ as the same number of foreground steps; undo: the state
-// before the run); the 3D buffers end equal to the session's mesh. The session is read only
+// before the run); the 3D buffers end equal to the session's mesh; a coarse start's front is
+// previewed while it runs (marching cubes of its φ). The session is read only
 // between frames once the run stopped (the hand-over rule). No timing is asserted.
 #include <gtest/gtest.h>
 
@@ -11,6 +12,8 @@
 #include <thread>
 
 #include "liveset/levelset/invariants.hpp"
+#include "liveset/mesh/marching_cubes.hpp"
+#include "liveset/mesh/mesh_analysis.hpp"
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/render/framebuffer.hpp"
 #include "liveset/render/headless_context.hpp"
@@ -129,6 +132,46 @@ TEST(BackgroundRun, ARunWithTheCoarseStartEqualsTheForegroundSteps) {
     EXPECT_TRUE(bits(s) == bits(*reference));
     EXPECT_EQ(v.last_frame().triangles, s.mesher().triangle_count());
     EXPECT_NE(v.message().find("of the coarse start"), std::string::npos) << v.message();
+}
+
+// While the coarse start runs, φ is still the seeds: the 3D pane draws the coarse run's front
+// instead (marching cubes of its φ on its grid of blocks, updated from what changed) and from the
+// frame after the run ends, the session's surface again; the run ends as without the preview.
+TEST(BackgroundRun, TheCoarseStartsFrontIsPreviewedWhileItRuns) {
+    render::HeadlessContext context;
+    SessionOptions o = sleeping();
+    o.coarse_start = CoarseStart::kOn;
+    const auto reference = converged_in_the_foreground(o);
+    ASSERT_GT(reference->segment_status().coarse_iterations, 8);
+    auto session = seeded_session(o);
+    const Mesh seeds_mesh = session->mesher().merged();
+    for (int k = 0; k < 3; ++k) session->segment_step();  // coarse iterations: φ untouched
+    Viewer v(std::move(session), "phantom", config(5.0));
+    render::Framebuffer fb(640, 480);
+    const auto matches_the_coarse_front = [&] {
+        const SparseField* coarse = v.session()->coarse_field();
+        if (coarse == nullptr || v.coarse_preview_mesher() == nullptr) return false;
+        return canonical_triangles(v.coarse_preview_mesher()->merged()) ==
+               canonical_triangles(marching_cubes_band(coarse->phi(), coarse->zero_layer()));
+    };
+    v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+    ASSERT_TRUE(v.coarse_preview_shown());
+    EXPECT_TRUE(matches_the_coarse_front());
+    EXPECT_GT(v.coarse_preview_triangles(), 0u);
+    EXPECT_TRUE(canonical_triangles(v.session()->mesher().merged()) == canonical_triangles(seeds_mesh));  // the session's: the seeds
+    v.set_segment_running(true);
+    frames_until_steps(v, fb, 2);
+    v.set_segment_running(false);  // paused: the worker joined, the session is ours
+    if (v.session()->segment_status().coarse && v.session()->coarse_field() != nullptr) {
+        v.frame(fb.id(), 640, 480, 1.0 / 60.0);  // the preview catches up with where the run paused
+        EXPECT_TRUE(matches_the_coarse_front()) << v.session()->segment_status().coarse_iterations << " coarse iterations";
+    }
+    run_until_it_stops(v, fb);
+    ASSERT_FALSE(v.segment_running());
+    EXPECT_FALSE(v.coarse_preview_shown());
+    EXPECT_EQ(v.session()->coarse_field(), nullptr);
+    EXPECT_TRUE(bits(*v.session()) == bits(*reference));
+    EXPECT_EQ(v.last_frame().triangles, v.session()->mesher().triangle_count());
 }
 
 TEST(BackgroundRun, PauseSeedAndUndoDuringARunStopTheWorkerFirst) {

@@ -1,7 +1,7 @@
 // Slice display: zoom about a point keeps it fixed and pan moves it by the drag (analytic), window/
 // level and percentiles (brute force), the overlay's layers (label fill opacity, ROI outline,
 // speed preview exactly where D < 0), orientation letters from the direction cosines (and against
-// nibabel's aff2axcodes), 1-based voxels and LPS/RAS millimetres (against nibabel's affine), and
+// nibabel's aff2axcodes), a coarse start's preview (its fill = upsample_inside), 1-based voxels and LPS/RAS millimetres (against nibabel's affine), and
 // pixels of the rendered pane (headless EGL): grey from the window, overlay at opacity 0 and 1.
 #include <gtest/gtest.h>
 
@@ -15,6 +15,7 @@
 
 #include "liveset/io/image_io.hpp"
 #include "liveset/render/slice_display.hpp"
+#include "liveset/segment/coarse_start.hpp"
 #include "liveset/render/slice_renderer.hpp"
 #include "render/render_test_util.hpp"
 #include "scratch_dir.hpp"
@@ -140,20 +141,20 @@ TEST(SliceOverlay, LabelOpacityRoiOutlineAndPreviewWhereTheDataTermIsNegative) {
     render::OverlayStyle style;
     style.roi = render::RoiStyle::kOff;
     style.label_opacity = 1.0f;
-    auto t = render::overlay_texels(g, 10, style, &s.phi, &s.roi, nullptr, nullptr);
+    auto t = render::overlay_texels(g, 10, style, render::phi_slice(s.phi, g, 10), &s.roi, nullptr, nullptr);
     EXPECT_EQ(texel(t, g, {10, 10, 10}), (std::array<int, 4>{230, 60, 50, 255}));  // inside: the label colour
     EXPECT_EQ(texel(t, g, {1, 1, 10})[3], 0);                                       // outside: transparent
     style.label_opacity = 0.0f;
-    t = render::overlay_texels(g, 10, style, &s.phi, &s.roi, nullptr, nullptr);
+    t = render::overlay_texels(g, 10, style, render::phi_slice(s.phi, g, 10), &s.roi, nullptr, nullptr);
     EXPECT_EQ(texel(t, g, {10, 10, 10})[3], 0);
     style.roi = render::RoiStyle::kOutline;
-    t = render::overlay_texels(g, 10, style, &s.phi, &s.roi, nullptr, nullptr);
+    t = render::overlay_texels(g, 10, style, render::phi_slice(s.phi, g, 10), &s.roi, nullptr, nullptr);
     EXPECT_EQ(texel(t, g, {3, 10, 10})[3], 255);   // the ROI's edge
     EXPECT_EQ(texel(t, g, {16, 2, 10})[3], 255);   // a corner
     EXPECT_EQ(texel(t, g, {8, 10, 10})[3], 0);     // inside, off the edge
     EXPECT_EQ(texel(t, g, {1, 10, 10})[3], 0);     // outside
     style.roi = render::RoiStyle::kTint;
-    t = render::overlay_texels(g, 10, style, &s.phi, &s.roi, nullptr, nullptr);
+    t = render::overlay_texels(g, 10, style, render::phi_slice(s.phi, g, 10), &s.roi, nullptr, nullptr);
     EXPECT_EQ(texel(t, g, {8, 10, 10}), (std::array<int, 4>{255, 210, 40, 51}));  // inside: 0.2 of the ROI colour
     EXPECT_EQ(texel(t, g, {1, 10, 10})[3], 0);
     // Preview: tinted exactly where threshold_term < 0 inside the ROI, more where D is lower.
@@ -162,7 +163,7 @@ TEST(SliceOverlay, LabelOpacityRoiOutlineAndPreviewWhereTheDataTermIsNegative) {
     style.roi = render::RoiStyle::kOff;
     style.preview = true;
     const ThresholdParams params{0.5, 0.15, 4.0, 0.1};
-    t = render::overlay_texels(g, 10, style, nullptr, &s.roi, &s.unit, &params);
+    t = render::overlay_texels(g, 10, style, {}, &s.roi, &s.unit, &params);
     for (int y = 0; y < 20; ++y)
         for (int x = 0; x < 20; ++x) {
             const Vec3i v{x, y, 10};
@@ -171,6 +172,52 @@ TEST(SliceOverlay, LabelOpacityRoiOutlineAndPreviewWhereTheDataTermIsNegative) {
             if (s.roi(v) && d < 0.0) EXPECT_EQ(alpha, std::lround(255.0 * std::min(1.0, -d * 0.6))) << x << "," << y;
             else EXPECT_EQ(alpha, 0) << x << "," << y;
         }
+}
+
+// A coarse start's front previewed on the image's slices: the label fill is exactly the inside
+// upsample_inside gives the fine start (every view, an oblique storage, odd dimensions), and the
+// contour drawn from the preview's values lies where those values cross zero.
+TEST(SliceOverlay, TheCoarseRunsPreviewIsWhereItsFrontWouldStartOnTheImagesGrid) {
+    const Lattice fine({23, 18, 15}, {0.7, 0.7, 0.7}, {0, 0, 0}, Mat3d{0, 0, 1, -1, 0, 0, 0, 1, 0});
+    const Lattice coarse = coarse_lattice(fine);
+    Grid<float> phi(coarse);
+    for (int z = 0; z < coarse.dims().z; ++z)
+        for (int y = 0; y < coarse.dims().y; ++y)
+            for (int x = 0; x < coarse.dims().x; ++x)
+                phi({x, y, z}) = static_cast<float>(std::hypot(x - 5.3, 1.3 * (y - 4.1), z - 3.2) - 3.4);
+    const Grid<std::uint8_t> inside = upsample_inside(phi, fine);
+    render::OverlayStyle style;
+    style.roi = render::RoiStyle::kOff;
+    style.label_opacity = 1.0f;
+    int filled = 0;
+    for (const SliceAxis view : {SliceAxis::kAxial, SliceAxis::kCoronal, SliceAxis::kSagittal}) {
+        const auto g = render::slice_geometry(fine, view);
+        for (const int slice : {0, g.slices / 2, g.slices - 1}) {
+            const std::vector<float> values = render::upsampled_phi_slice(phi, g, slice);
+            const auto t = render::overlay_texels(g, slice, style, values, nullptr, nullptr, nullptr);
+            for (int r = 0; r < g.height; ++r)
+                for (int c = 0; c < g.width; ++c) {
+                    const Vec3i v = g.voxel(c, r, slice);
+                    const int alpha = t[4 * (static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(c)) + 3];
+                    EXPECT_EQ(alpha, inside(v) ? 255 : 0) << render::to_string(view) << " " << slice << " " << v;
+                    filled += inside(v);
+                }
+            for (const glm::dvec2 p : render::zero_contour(values, g)) {  // on a texel edge between centres of both signs
+                const auto c0 = static_cast<int>(std::floor(p.x - 0.5)), r0 = static_cast<int>(std::floor(p.y - 0.5));
+                bool in = false, out = false;
+                for (int dr = 0; dr <= 1; ++dr)
+                    for (int dc = 0; dc <= 1; ++dc) {
+                        const int c = std::clamp(c0 + dc, 0, g.width - 1), r = std::clamp(r0 + dr, 0, g.height - 1);
+                        (inside(g.voxel(c, r, slice)) ? in : out) = true;
+                    }
+                EXPECT_TRUE(in && out) << render::to_string(view) << " " << slice << " (" << p.x << ", " << p.y << ")";
+            }
+        }
+    }
+    EXPECT_GT(filled, 200);
+    const auto g = render::slice_geometry(fine, SliceAxis::kAxial);
+    EXPECT_THROW(render::overlay_texels(g, 0, style, std::vector<float>(3, -1.0f), nullptr, nullptr, nullptr), std::invalid_argument);
+    EXPECT_THROW(render::zero_contour(std::vector<float>(3, -1.0f), g), std::invalid_argument);
 }
 
 TEST(EdgeLetters, RadiologicalLettersFollowTheDirectionCosines) {
@@ -303,7 +350,7 @@ TEST(SliceRender, WindowGreyAndLabelOpacityAtAKnownVoxel) {
         render::OverlayStyle style;
         style.roi = render::RoiStyle::kOff;
         style.label_opacity = opacity;
-        renderer.set_overlay(g.width, g.height, render::overlay_texels(g, 10, style, &s.phi, nullptr, nullptr, nullptr));
+        renderer.set_overlay(g.width, g.height, render::overlay_texels(g, 10, style, render::phi_slice(s.phi, g, 10), nullptr, nullptr, nullptr));
         render::SliceOverlay overlay;
         overlay.layer = true;
         renderer.render(fb, vp, overlay, render::SliceStyle{});

@@ -186,6 +186,36 @@ TEST(CoarseStart, UpsamplingClampsAtTheEdgesOfAnOddGrid) {
     EXPECT_LT(inside, compared - 40);
 }
 
+// The value a viewer previews at each fine voxel: the plane at the clamped coarse coordinate, and
+// negative exactly where upsample_inside says inside (the same bits, on a curved φ too).
+TEST(CoarseStart, UpsampledValueIsWhatUpsamplingTests) {
+    const Lattice fine({11, 8, 7}, {0.7, 0.7, 0.7});
+    const Lattice coarse = coarse_lattice(fine);
+    Grid<float> plane(coarse), ball(coarse);
+    const auto linear = [](double x, double y, double z) { return 0.6 * x - 0.5 * y + 0.35 * z - 1.2; };
+    const auto curved = [](double x, double y, double z) { return std::hypot(x - 2.6, y - 1.7, z - 1.4) - 1.9; };
+    for (int z = 0; z < coarse.dims().z; ++z)
+        for (int y = 0; y < coarse.dims().y; ++y)
+            for (int x = 0; x < coarse.dims().x; ++x) {
+                plane({x, y, z}) = static_cast<float>(linear(x, y, z));
+                ball({x, y, z}) = static_cast<float>(curved(x, y, z));
+            }
+    const Grid<std::uint8_t> up = upsample_inside(ball, fine);
+    const Vec3i c = coarse.dims();
+    const auto at = [](int i, int dim) { return std::clamp((i - 0.5) / 2.0, 0.0, dim - 1.0); };
+    int inside = 0;
+    for (int z = 0; z < 7; ++z)
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 11; ++x) {
+                EXPECT_NEAR(upsampled_phi(plane, {x, y, z}), linear(at(x, c.x), at(y, c.y), at(z, c.z)), 1e-5) << x << "," << y << "," << z;
+                const bool in = upsampled_phi(ball, {x, y, z}) < 0.0f;
+                EXPECT_EQ(up({x, y, z}), in ? 1 : 0) << x << "," << y << "," << z;
+                inside += in;
+            }
+    EXPECT_GT(inside, 20);
+    EXPECT_LT(inside, 11 * 8 * 7 - 20);
+}
+
 TEST(CoarseStart, AutoRuleAndNames) {
     EXPECT_TRUE(coarse_start_applies(CoarseStart::kAuto, Lattice({200, 200, 200}, {0.7, 0.7, 0.7})));
     EXPECT_TRUE(coarse_start_applies(CoarseStart::kAuto, Lattice({200, 200, 200}, {0.85, 0.8, 0.8})));

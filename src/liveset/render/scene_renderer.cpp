@@ -170,8 +170,10 @@ void SceneRenderer::render(const Framebuffer& target, const OrbitCamera& camera,
 
     if (content.surface != nullptr && content.surface->triangle_count() > 0) {
         surface_.use();
-        // A coarse level of detail's vertices are in its own index space: scale them to the lattice's.
-        const glm::mat4 model_view = view * model * glm::mat4(glm::mat3(content.surface_scale));
+        // A coarser grid's vertices are in its own index space: scale and shift them to the lattice's.
+        glm::mat4 surface_to_index(glm::mat3(content.surface_scale));
+        surface_to_index[3] = glm::vec4(glm::vec3(content.surface_offset), 1.0f);
+        const glm::mat4 model_view = view * model * surface_to_index;
         surface_.set("u_model_view", model_view);
         surface_.set("u_projection", projection);
         surface_.set("u_normal_matrix", glm::mat3(glm::transpose(glm::inverse(model_view))));

@@ -36,6 +36,7 @@ struct SceneContent {
     const Lattice* lattice = nullptr;          // index -> world of everything below
     const SurfaceBuffers* surface = nullptr;
     float surface_scale = 1.0f;                // surface index = this x buffer position (2: LodMesher's)
+    float surface_offset = 0.0f;               // + this on each axis (0.5: a coarse start's grid of 2x2x2 blocks)
     std::span<const glm::vec3> agents;         // index space
     std::optional<glm::vec3> target;           // index space
     std::optional<glm::vec3> cursor;           // index space

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <stdexcept>
 
+#include "liveset/segment/coarse_start.hpp"
 #include "liveset/segment/intensity.hpp"
 
 namespace liveset::render {
@@ -87,17 +88,28 @@ void over(std::uint8_t* px, const std::array<std::uint8_t, 3>& c, float a) {
 
 }  // namespace
 
-std::vector<std::uint8_t> overlay_texels(const SliceGeometry& g, int slice, const OverlayStyle& style, const Grid<float>* phi,
+std::vector<float> upsampled_phi_slice(const Grid<float>& coarse_phi, const SliceGeometry& g, int slice) {
+    std::vector<float> out(static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height));
+    slice = std::clamp(slice, 0, g.slices - 1);
+    for (int r = 0; r < g.height; ++r)
+        for (int c = 0; c < g.width; ++c)
+            out[static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(c)] =
+                upsampled_phi(coarse_phi, g.voxel(c, r, slice));
+    return out;
+}
+
+std::vector<std::uint8_t> overlay_texels(const SliceGeometry& g, int slice, const OverlayStyle& style, std::span<const float> phi,
                                          const Grid<std::uint8_t>* roi, const Grid<float>* unit_image,
                                          const ThresholdParams* params) {
     const auto w = static_cast<std::size_t>(g.width), h = static_cast<std::size_t>(g.height);
+    if (!phi.empty() && phi.size() != w * h) throw std::invalid_argument("overlay_texels: one φ value per texel of the slice is needed");
     std::vector<std::uint8_t> out(4 * w * h, 0);
     slice = std::clamp(slice, 0, g.slices - 1);
     std::vector<std::uint8_t> in_roi(w * h, 1);  // the ROI on this slice (all 1 without one)
     if (roi)
         for (int r = 0; r < g.height; ++r)
             for (int c = 0; c < g.width; ++c) in_roi[static_cast<std::size_t>(r) * w + static_cast<std::size_t>(c)] = (*roi)(g.voxel(c, r, slice)) != 0;
-    const bool preview = style.preview && unit_image && params, fill = phi && style.label_opacity > 0.0f;
+    const bool preview = style.preview && unit_image && params, fill = !phi.empty() && style.label_opacity > 0.0f;
     const auto roi_at = [&](int c, int r) {
         return c >= 0 && r >= 0 && c < g.width && r < g.height && in_roi[static_cast<std::size_t>(r) * w + static_cast<std::size_t>(c)];
     };
@@ -113,7 +125,7 @@ std::vector<std::uint8_t> overlay_texels(const SliceGeometry& g, int slice, cons
                 const double d = threshold_term((*unit_image)(v), *params);
                 if (d < 0.0) over(px, style.preview_colour, static_cast<float>(-d) * style.preview_opacity);
             }
-            if (fill && (*phi)(v) < 0.0f) over(px, style.label_colour, style.label_opacity);
+            if (fill && phi[k] < 0.0f) over(px, style.label_colour, style.label_opacity);
             if (roi && inside_roi && style.roi == RoiStyle::kTint) over(px, style.roi_colour, style.roi_tint_opacity);
             if (roi && inside_roi && style.roi == RoiStyle::kOutline &&
                 (!roi_at(c - 1, r) || !roi_at(c + 1, r) || !roi_at(c, r - 1) || !roi_at(c, r + 1)))

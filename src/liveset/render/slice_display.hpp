@@ -9,6 +9,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -59,11 +60,18 @@ struct OverlayStyle {
     std::array<std::uint8_t, 3> preview_colour{60, 140, 255};
 };
 
+// A coarse start's φ (coarse_start.hpp) previewed on `slice` of the image's grid: upsampled_phi at
+// each texel's voxel, in phi_slice's order - negative exactly where its front, upsampled now, would
+// put the fine start (before the ROI and the seeds' balls).
+std::vector<float> upsampled_phi_slice(const Grid<float>& coarse_phi, const SliceGeometry& g, int slice);
+
 // Straight-alpha RGBA texels (row 0 at the bottom) of the overlay on `slice`, layered (each
-// "over" the one before): preview, label fill, ROI. The preview tints the voxels inside the ROI
-// where D(I) < 0 for the normalised intensity I of `unit_image` - where the data term alone would
-// expand the front (ThresholdSpeed: ∂φ/∂t = |∇φ| F, φ < 0 inside). Null inputs skip their layer.
-std::vector<std::uint8_t> overlay_texels(const SliceGeometry& g, int slice, const OverlayStyle& style, const Grid<float>* phi,
+// "over" the one before): preview, label fill (where `phi`, the slice's values in phi_slice's
+// order, is negative), ROI. The preview tints the voxels inside the ROI where D(I) < 0 for the
+// normalised intensity I of `unit_image` - where the data term alone would expand the front
+// (ThresholdSpeed: ∂φ/∂t = |∇φ| F, φ < 0 inside). Null or empty inputs skip their layer; a `phi`
+// of another size throws std::invalid_argument.
+std::vector<std::uint8_t> overlay_texels(const SliceGeometry& g, int slice, const OverlayStyle& style, std::span<const float> phi,
                                          const Grid<std::uint8_t>* roi, const Grid<float>* unit_image,
                                          const ThresholdParams* params);
 

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace liveset::render {
 
@@ -127,10 +128,27 @@ std::vector<std::uint8_t> slice_texels(const Grid<float>& unit_image, const Slic
     return out;
 }
 
+std::vector<float> phi_slice(const Grid<float>& phi, const SliceGeometry& g, int slice) {
+    std::vector<float> out(static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height));
+    slice = std::clamp(slice, 0, g.slices - 1);
+    for (int r = 0; r < g.height; ++r)
+        for (int c = 0; c < g.width; ++c)
+            out[static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(c)] = phi(g.voxel(c, r, slice));
+    return out;
+}
+
 std::vector<glm::dvec2> zero_contour(const Grid<float>& phi, const SliceGeometry& g, int slice) {
+    if (slice < 0 || slice >= g.slices) return {};
+    return zero_contour(phi_slice(phi, g, slice), g);
+}
+
+std::vector<glm::dvec2> zero_contour(std::span<const float> values, const SliceGeometry& g) {
     std::vector<glm::dvec2> segments;
-    if (slice < 0 || slice >= g.slices) return segments;
-    const auto at = [&](int c, int r) { return static_cast<double>(phi(g.voxel(c, r, slice))); };
+    if (values.size() != static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height))
+        throw std::invalid_argument("zero_contour: one value per texel of the slice is needed");
+    const auto at = [&](int c, int r) {
+        return static_cast<double>(values[static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(c)]);
+    };
     const auto crossing = [](glm::dvec2 a, double fa, glm::dvec2 b, double fb) {
         const double t = fa / (fa - fb);
         return a + t * (b - a);

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -56,8 +57,15 @@ struct SliceViewport {
 // Grey texels (row 0 at the bottom) of `unit_image` (values in [0, 1]) on `slice`.
 std::vector<std::uint8_t> slice_texels(const Grid<float>& unit_image, const SliceGeometry& g, int slice);
 
+// φ on `slice` (clamped), one value per texel in the order of slice_texels.
+std::vector<float> phi_slice(const Grid<float>& phi, const SliceGeometry& g, int slice);
+
 // Segments (pairs of end points, texel space) of φ = 0 on `slice`, by marching squares between
-// voxel centres; φ < 0 inside, as the mesher.
+// voxel centres; φ < 0 inside, as the mesher. Empty for a slice outside the lattice.
 std::vector<glm::dvec2> zero_contour(const Grid<float>& phi, const SliceGeometry& g, int slice);
+// The same from a slice's values (phi_slice's order; a field other than the lattice's own, e.g.
+// a coarse run's previewed on the image's grid). Throws std::invalid_argument unless there is
+// one value per texel.
+std::vector<glm::dvec2> zero_contour(std::span<const float> values, const SliceGeometry& g);
 
 }  // namespace liveset::render

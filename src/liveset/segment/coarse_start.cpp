@@ -53,6 +53,14 @@ Lerp lerp_at(int i, int coarse_dim) {
     return {a, std::min(a + 1, coarse_dim - 1), static_cast<float>(c - a)};
 }
 
+// The coarse φ at weights x, y, z: along x, then y, then z (one order, so every caller gets the same bits).
+float trilinear(const Grid<float>& coarse_phi, const Lerp& x, const Lerp& y, const Lerp& z) {
+    const auto at = [&](int a, int b, int c) { return coarse_phi(Vec3i{a, b, c}); };
+    const auto along_x = [&](int b, int c) { return at(x.a, b, c) + x.t * (at(x.b, b, c) - at(x.a, b, c)); };
+    const auto along_y = [&](int c) { return along_x(y.a, c) + y.t * (along_x(y.b, c) - along_x(y.a, c)); };
+    return along_y(z.a) + z.t * (along_y(z.b) - along_y(z.a));
+}
+
 }  // namespace
 
 std::string to_string(CoarseStart mode) {
@@ -104,6 +112,11 @@ SeedBall coarse_seed(const SeedBall& fine, const Lattice& coarse) {
     return {{at(c.x, d.x), at(c.y, d.y), at(c.z, d.z)}, fine.radius / 2.0};
 }
 
+float upsampled_phi(const Grid<float>& coarse_phi, Vec3i fine) {
+    const Vec3i cd = coarse_phi.dims();
+    return trilinear(coarse_phi, lerp_at(fine.x, cd.x), lerp_at(fine.y, cd.y), lerp_at(fine.z, cd.z));
+}
+
 Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice& fine, const Grid<std::uint8_t>* roi) {
     if (roi && !(roi->dims() == fine.dims())) throw std::invalid_argument("the ROI does not match the grid the coarse start refines");
     const Vec3i cd = coarse_phi.dims(), fd = fine.dims();
@@ -116,12 +129,8 @@ Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice&
     voxel_loops::for_each(rows, [&](std::size_t r) {  // one fine row each
         const Lerp& y = ly[r % static_cast<std::size_t>(fd.y)];
         const Lerp& z = lz[r / static_cast<std::size_t>(fd.y)];
-        const auto at = [&](int a, int b, int c) { return coarse_phi(Vec3i{a, b, c}); };
         for (int i = 0; i < fd.x; ++i) {
-            const Lerp& x = lx[static_cast<std::size_t>(i)];
-            const auto along_x = [&](int b, int c) { return at(x.a, b, c) + x.t * (at(x.b, b, c) - at(x.a, b, c)); };
-            const auto along_y = [&](int c) { return along_x(y.a, c) + y.t * (along_x(y.b, c) - along_x(y.a, c)); };
-            const float v = along_y(z.a) + z.t * (along_y(z.b) - along_y(z.a));
+            const float v = trilinear(coarse_phi, lx[static_cast<std::size_t>(i)], y, z);
             const auto p = static_cast<PointIndex>(r * static_cast<std::size_t>(fd.x) + static_cast<std::size_t>(i));
             out[p] = v < 0.0f && (!roi || (*roi)[p] != 0);
         }

@@ -47,6 +47,9 @@ Grid<std::uint8_t> downsample_majority(const Grid<std::uint8_t>& fine);
 Grid<float> block_threshold_terms(const ThresholdSpeed& fine);
 // A seed ball in the index space of `coarse` (the centre mapped and clamped into it, the radius halved).
 SeedBall coarse_seed(const SeedBall& fine, const Lattice& coarse);
+// The coarse φ, trilinear at fine voxel `fine`'s centre (clamped to the coarse grid): what
+// upsample_inside tests, bit for bit (a viewer's preview of the coarse run on the image's grid).
+float upsampled_phi(const Grid<float>& coarse_phi, Vec3i fine);
 // Inside (1) where the coarse φ, trilinear at each fine voxel's centre (clamped to the coarse grid),
 // is negative, and the ROI (when given, `fine`'s lattice) allows it.
 Grid<std::uint8_t> upsample_inside(const Grid<float>& coarse_phi, const Lattice& fine, const Grid<std::uint8_t>* roi = nullptr);

@@ -310,6 +310,10 @@ void Session::ensure_speed() {
 
 // The coarse start is due while φ is the union of the seeds (no step, edit or load since) on a grid
 // where it applies; it then runs until its end replaces that union (marks_.pristine false).
+const SparseField* Session::coarse_field() const {
+    return coarse_ && coarse_inputs_ == inputs_ && coarse_start_due() ? &coarse_->field() : nullptr;
+}
+
 bool Session::coarse_start_due() const {
     return marks_.pristine && !marks_.seeds.empty() && coarse_start_applies(options_.coarse_start, lattice());
 }

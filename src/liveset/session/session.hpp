@@ -173,6 +173,10 @@ public:
     // again on the next step.
     SessionUpdate segment_step();
     const SegmentStatus& segment_status() const { return segment_; }
+    // The coarse start's front while its run is under way (begun and still current: nothing it
+    // reads changed since), on coarse_lattice(lattice()); null otherwise. What a viewer previews
+    // (upsampled_phi) while φ is still the seeds. Valid until the session's next step or edit.
+    const SparseField* coarse_field() const;
 
     // --- swarm repair -----------------------------------------------------------------------
     const RepairOptions& repair_options() const { return repair_options_; }

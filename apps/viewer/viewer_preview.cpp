@@ -1,0 +1,62 @@
+// The coarse start's preview: while the session's coarse run is under way (φ still the seeds), the
+// 3D pane draws that run's front meshed on its grid of 2x2x2 blocks, and the slice panes fill and
+// outline its values upsampled onto the image's grid - where the fine run will start.
+#include <chrono>
+#include <cstring>
+
+#include "viewer.hpp"
+#include "liveset/base/stopwatch.hpp"
+
+namespace liveset::viewer {
+
+namespace {
+
+// The points whose φ differs (bits) between `now` and `before` (the same lattice), blocks of equal
+// memory skipped whole: a coarse iteration moves a thin sheet of a grid of millions of points.
+std::vector<PointIndex> changed_points(const Grid<float>& now, const Grid<float>& before) {
+    constexpr std::size_t kBlock = 4096;
+    std::vector<PointIndex> out;
+    const float* a = now.values().data();
+    const float* b = before.values().data();
+    for (std::size_t lo = 0; lo < now.size(); lo += kBlock) {
+        const std::size_t hi = std::min(now.size(), lo + kBlock);
+        if (std::memcmp(a + lo, b + lo, (hi - lo) * sizeof(float)) == 0) continue;
+        for (std::size_t i = lo; i < hi; ++i)
+            if (std::memcmp(a + i, b + i, sizeof(float)) != 0) out.push_back(static_cast<PointIndex>(i));
+    }
+    return out;
+}
+
+}  // namespace
+
+bool Viewer::refresh_coarse_preview() {
+    const SparseField* coarse = session_ ? session_->coarse_field() : nullptr;
+    if (!coarse) {
+        if (!preview_mesher_) return false;
+        preview_mesher_.reset();
+        preview_phi_ = Grid<float>();
+        ++preview_generation_;
+        return true;
+    }
+    const Grid<float>& phi = coarse->phi();
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<FragmentId> ids;
+    if (!preview_mesher_ || !(preview_mesher_->lattice().dims() == phi.dims())) {
+        preview_mesher_ = std::make_unique<FragmentMesher>(phi.lattice(), session_->mesher().fragment_size());
+        preview_mesher_->full_rebuild(phi, coarse->zero_layer());
+        preview_phi_ = phi;
+        current_.mesh_ms += ms_since(t0);
+        preview_surface_.upload_all(*preview_mesher_);
+    } else {
+        const std::vector<PointIndex> changed = changed_points(phi, preview_phi_);
+        if (changed.empty()) return false;
+        ids = preview_mesher_->update(phi, changed);
+        for (const PointIndex p : changed) preview_phi_[p] = phi[p];
+        current_.mesh_ms += ms_since(t0);
+        if (!ids.empty()) preview_surface_.upload(*preview_mesher_, ids);
+    }
+    ++preview_generation_;
+    return true;
+}
+
+}  // namespace liveset::viewer
