@@ -44,7 +44,9 @@ struct ViewArgs : ThresholdArgs {
     bool bias_correct = true;           // N4 first, as `segment` (also for images opened from the panel)
     bool bias_given = false;            // --bias-correct or --no-bias-correct on the command line
     std::optional<bool> workspace_bias; // a continued workspace's: its image corrected again, or not
+    bool coarse_start_given = false;            // --coarse-start
     std::optional<StepOptions> workspace_step;  // a continued workspace's step (continued_step)
+    std::optional<CoarseStart> workspace_coarse_start;  // and its coarse start (likewise)
     std::string workspace_step_note;            // how it differs from the saved one, as asked
     std::string workspace_warning;      // the workspace was refused, or its ROI is not the one it was saved with
     bool image_corrected = false;       // set by load_session: the session's image is N4-corrected
@@ -143,6 +145,7 @@ std::unique_ptr<Session> load_session(ViewArgs& a) {
                    r->brain_mask->mask_voxels, brain_mask_summary(*r->brain_mask));
     SessionOptions so = session_options(a);
     if (a.workspace_step) so.segmentation.step = *a.workspace_step;
+    if (a.workspace_coarse_start) so.coarse_start = *a.workspace_coarse_start;
     so.model_region_is_brain = prepared.fit_is_brain(r);
     so.model_region_grey_brighter = prepared.grey_brighter;
     so.brain_mask = lookup.options;
@@ -186,11 +189,12 @@ void refuse_workspace(ViewArgs& a, const std::exception& e) {
     a.workspace_warning = fmt::format("{}; opened without it", e.what());
 }
 
-// The step a continued workspace takes: the one it was saved with (an older file records only that
-// the rule was off: its --step is the command line's), but for what --step, --thin-fronts or
-// --no-thin-fronts ask, which `note` says (from there it does not step as one run would; printed
-// once the workspace is continued).
-StepOptions continued_step(const ViewArgs& a, const viewer::Workspace& ws, std::string& note) {
+// The step a continued workspace takes (a.workspace_step) and its coarse start
+// (a.workspace_coarse_start): the ones it was saved with (an older file records only that the rule
+// was off: its --step and --coarse-start are the command line's), but for what --step,
+// --thin-fronts, --no-thin-fronts or --coarse-start ask, which a.workspace_step_note says (from
+// there it does not step as one run would; printed once the workspace is continued).
+void continue_workspace_step(ViewArgs& a, const viewer::Workspace& ws) {
     ThresholdArgs t = a;
     std::vector<std::string> asked;
     if (ws.step && !a.step_given) t.step = *ws.step;
@@ -198,10 +202,16 @@ StepOptions continued_step(const ViewArgs& a, const viewer::Workspace& ws, std::
     if (ws.thin_fronts && !a.thin_fronts_given) t.thin_fronts = *ws.thin_fronts;
     if (ws.thin_fronts && t.thin_fronts != *ws.thin_fronts)
         asked.push_back(t.thin_fronts ? "--thin-fronts (saved without)" : "--no-thin-fronts (saved with --thin-fronts)");
-    note.clear();
+    CoarseStart coarse = parse_coarse_start(a.coarse_start);
+    if (ws.coarse_start && !a.coarse_start_given) coarse = *ws.coarse_start;
+    if (ws.coarse_start && coarse != *ws.coarse_start)
+        asked.push_back(fmt::format("--coarse-start {} (saved with --coarse-start {})", to_string(coarse), to_string(*ws.coarse_start)));
+    a.workspace_step_note.clear();
     if (!asked.empty())
-        note = fmt::format("workspace {} continues with {} as asked: from here it steps unlike one run", a.workspace, fmt::join(asked, " and "));
-    return step_options(t);
+        a.workspace_step_note =
+            fmt::format("workspace {} continues with {} as asked: from here it steps unlike one run", a.workspace, fmt::join(asked, " and "));
+    a.workspace_step = step_options(t);
+    a.workspace_coarse_start = coarse;
 }
 
 // --workspace W: read and check it; on any problem one line on stderr and the viewer opens
@@ -218,7 +228,7 @@ std::optional<viewer::Workspace> read_workspace_arg(ViewArgs& a) {
         if (a.image.empty()) a.image = ws.image;
         if (a.roi.empty()) a.roi = ws.roi;
         a.workspace_bias = ws.bias_corrected;
-        a.workspace_step = continued_step(a, ws, a.workspace_step_note);
+        continue_workspace_step(a, ws);
         return ws;
     } catch (const std::runtime_error& e) {
         refuse_workspace(a, e);
@@ -242,6 +252,7 @@ std::unique_ptr<Session> open_session(ViewArgs& a, std::optional<viewer::Workspa
             ws.reset();
             a.workspace_bias.reset();  // the command line's settings again
             a.workspace_step.reset();
+            a.workspace_coarse_start.reset();
             s = load_session(a);
         }
     }
@@ -371,7 +382,7 @@ void add_view_command(CLI::App& app, const int& threads) {
     v->add_option("--window-from", va.window_from, "estimate the window from the tissue model (the seeds pick the class) or from the seeds' statistics, as `segment`")->check(CLI::IsMember({"model", "seeds"}))->capture_default_str();
     auto* bias = v->add_flag("--bias-correct,!--no-bias-correct", va.bias_correct, "correct the intensity non-uniformity first (N4), as `segment`. Default: on, skipped with a warning where it cannot run (asked for: an error); a continued workspace keeps its own setting");
     v->add_option("--seeds", va.seeds_file, "seed file: one I,J,K[:R] per line (the --seed format; the panel saves them)");
-    v->add_option("--workspace", va.workspace, "continue a saved workspace (image, ROI, phi, seeds, parameters, step, swarm, camera); the panel saves it; --step, --thin-fronts or --no-thin-fronts override its step, with a note");
+    v->add_option("--workspace", va.workspace, "continue a saved workspace (image, ROI, phi, seeds, parameters, step and coarse start, swarm, camera); the panel saves it; --step, --thin-fronts, --no-thin-fronts or --coarse-start override what it saved, with a note");
     add_threshold_options(*v, va);  // as `liveset segment`: --mu, --epsilon, --mu-raw, --epsilon-raw, --n, --alpha
     v->get_option("--alpha")->description("curvature weight in [0,1), per millimetre (default: automatic, as `segment` chooses it for the window and re-chosen as seeds move it - said in the start note; or the workspace's)");
     v->add_option("--seed-radius", va.seed_radius, "default seed radius, voxels")->check(CLI::PositiveNumber)->capture_default_str();
@@ -404,6 +415,7 @@ void add_view_command(CLI::App& app, const int& threads) {
         va.bias_given = bias->count() > 0;
         va.step_given = v->count("--step") > 0;
         va.thin_fronts_given = v->count("--thin-fronts") > 0;
+        va.coarse_start_given = v->count("--coarse-start") > 0;
         const int rc = run_view(va, threads);
         if (rc != 0) std::exit(rc);
     });

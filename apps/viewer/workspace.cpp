@@ -202,6 +202,12 @@ Workspace parse_workspace(const json& j) {
         if (!field(st, "thin_fronts").is_boolean()) throw std::runtime_error("field 'thin_fronts' is not true or false");
         ws.step = kind;
         ws.thin_fronts = st["thin_fronts"].get<bool>();
+        if (st.contains("coarse_start")) {  // absent in files written before session 82
+            const json& c = st["coarse_start"];
+            if (!c.is_string() || (c != "auto" && c != "on" && c != "off"))
+                throw std::runtime_error(fmt::format("field 'coarse_start' is {}, not \"auto\", \"on\" or \"off\"", c.dump()));
+            ws.coarse_start = parse_coarse_start(c.get<std::string>());
+        }
     }
     ws.marks.pristine = false;
     ws.repair = swarm_from(field(j, "swarm"), ws.repair);
@@ -270,7 +276,8 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
                        {"smooth_mm", m.params.smooth_mm}, {"window_from_seeds", m.window_from_seeds}, {"alpha_automatic", m.alpha_automatic},
                        {"mu_raw", session.scale().to_raw(m.params.mu)}, {"epsilon_raw", session.scale().raw_length(m.params.epsilon)}}},
            {"iterations", m.iterations},
-           {"step", {{"kind", step_name(session.options().segmentation.step)}, {"thin_fronts", session.options().segmentation.step.thin_fronts}}},
+           {"step", {{"kind", step_name(session.options().segmentation.step)}, {"thin_fronts", session.options().segmentation.step.thin_fronts},
+                     {"coarse_start", to_string(session.options().coarse_start)}}},
            {"activity", activity_json(session.activity_snapshot())},
            {"swarm", swarm_json(session.repair_options())},
            {"target", session.target() ? vec(*session.target()) : json(nullptr)},

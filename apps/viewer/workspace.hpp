@@ -1,6 +1,6 @@
 // The viewer's workspace: everything needed to continue where the user left off, in one versioned
 // JSON file W (image and ROI paths, the image's geometry and a checksum of its voxels, seeds, µ, ε,
-// n, α, the iteration count, the level-set step (--step, --thin-fronts) and the sleeping step's
+// n, α, the iteration count, the level-set step (--step, --thin-fronts, --coarse-start) and the sleeping step's
 // wake stamps, swarm settings and target, camera, cursor) plus φ and the sparse
 // field's layers bit for bit in W.state next to it (the recovery file's checksummed binary format,
 // liveset/session/recovery.hpp). Both are written atomically, the state first; W records the
@@ -39,6 +39,9 @@ struct Workspace {
     // was off unless asked for).
     std::optional<std::string> step;
     std::optional<bool> thin_fronts;
+    // Its --coarse-start (absent in files written before session 82: the command line's). It
+    // matters while φ is still the seeds: a Run from there starts coarse or not as saved.
+    std::optional<CoarseStart> coarse_start;
     RepairOptions repair;            // swarm settings
     std::optional<Vec3d> target;     // the swarm's target (the swarm respawns there)
     WorkspaceView view;

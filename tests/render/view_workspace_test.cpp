@@ -134,6 +134,57 @@ TEST(ViewCommand, AWorkspaceKeepsItsStep) {
     EXPECT_EQ(r.err.find("thin-fronts"), std::string::npos) << r.err;
 }
 
+// A workspace keeps its --coarse-start: saved before the first step with `--coarse-start on` (the
+// phantom's 1 mm grid would not start coarse by default), reopened without the flag, its Run starts
+// coarse and gives bit for bit the φ of one run with the flag (not the default's); --coarse-start
+// off over it is honoured and said in a note. A bad value in the file is one line.
+TEST(ViewCommand, AWorkspaceKeepsItsCoarseStart) {
+    const Fixture& f = fixture();
+    const std::string w = (f.dir / "coarse.json").string(), cont = (f.dir / "coarse_cont.nii.gz").string();
+    const std::string one = (f.dir / "coarse_one.nii.gz").string(), plain = (f.dir / "coarse_plain.nii.gz").string();
+    const std::string off = (f.dir / "coarse_off.nii.gz").string();
+    CliResult r = run_cli(fmt::format("view {} --seeds {} --coarse-start on --headless --script {}", f.image, f.seeds,
+                                      script("co_a.json", R"([{"save_workspace": ")" + w + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    const viewer::Workspace ws = viewer::read_workspace(w);
+    ASSERT_TRUE(ws.coarse_start.has_value());
+    EXPECT_EQ(*ws.coarse_start, CoarseStart::kOn);
+    const std::string run = R"([{"segment": "converge", "max": 3000}, {"save_phi": ")";
+    r = run_cli(fmt::format("view --workspace {} --headless --script {}", w, script("co_b.json", run + cont + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_EQ(r.err.find("continues with"), std::string::npos) << r.err;
+    r = run_cli(fmt::format("view {} --seeds {} --coarse-start on --headless --script {}", f.image, f.seeds, script("co_c.json", run + one + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    r = run_cli(fmt::format("view {} --seeds {} --headless --script {}", f.image, f.seeds, script("co_d.json", run + plain + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_TRUE(same_bits(read_image(cont), read_image(one)));
+    EXPECT_FALSE(same_bits(read_image(plain), read_image(one)));
+
+    r = run_cli(fmt::format("view --workspace {} --coarse-start off --headless --script {}", w, script("co_e.json", run + off + R"("}])")));
+    ASSERT_EQ(r.rc, 0) << r.err;
+    EXPECT_NE(r.err.find("continues with --coarse-start off (saved with --coarse-start on) as asked"), std::string::npos) << r.err;
+    EXPECT_TRUE(same_bits(read_image(off), read_image(plain)));
+
+    std::ifstream in(w);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t at = text.find("\"coarse_start\": \"on\"");
+    ASSERT_NE(at, std::string::npos) << text;
+    text.replace(at, std::string("\"coarse_start\": \"on\"").size(), "\"coarse_start\": \"sometimes\"");
+    const fs::path bad = f.dir / "coarse_bad.json";
+    std::ofstream(bad) << text;
+    fs::copy_file(viewer::workspace_state_path(w), viewer::workspace_state_path(bad), fs::copy_options::overwrite_existing);
+    EXPECT_THROW(
+        {
+            try {
+                viewer::read_workspace(bad);
+            } catch (const std::runtime_error& e) {
+                EXPECT_NE(std::string(e.what()).find("'coarse_start' is \"sometimes\""), std::string::npos) << e.what();
+                throw;
+            }
+        },
+        std::runtime_error);
+}
+
 // The viewer segments the image `liveset segment` does: N4-corrected by default (the workspace
 // records it and holds the checksum of the corrected image `segment --out-corrected` writes), raw
 // with --no-bias-correct; a workspace saved with N4 refuses --no-bias-correct in one line.
