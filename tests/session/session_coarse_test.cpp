@@ -182,6 +182,30 @@ TEST(SessionCoarseStart, ARecoveredSessionBeforeItsFirstStepStartsCoarse) {
     EXPECT_EQ(u.segment_status().iterations, 2);
 }
 
+// Seeds clicked one after another, overlapping (each united with φ in a box around it, not
+// init_from_seeds): a session recovered before its first step still starts coarse, and ends bit for
+// bit where the uninterrupted one does.
+TEST(SessionCoarseStart, OverlappingSeedsClickedOneByOneAreRecognisedWhenRecovered) {
+    const double c = (liveset::testing::kShell - 1) / 2.0;
+    const auto clicked = [&] {
+        std::unique_ptr<Session> s = shell_session();
+        s->add_seed({shell_seed() + Vec3d{1.3, 0.6, -0.4}, 2.0});  // overlapping the first
+        s->add_seed({{c - 31.0, c - 5.0, c + 5.0}, 2.5});
+        s->add_seed({{c - 30.2, c - 4.1, c + 5.7}, 1.7});            // overlapping the third
+        return s;
+    };
+    const std::unique_ptr<Session> s = clicked();
+    const int steps = converge(*s);
+    ASSERT_GT(s->segment_status().coarse_iterations, 0);
+    const std::unique_ptr<Session> saved = clicked();
+    Session t(shell().image, shell_options(CoarseStart::kAuto), shell().roi);
+    ASSERT_TRUE(t.load_recovered(saved->field().phi(), saved->field().status(), saved->marks()));
+    t.segment_step();
+    EXPECT_TRUE(t.segment_status().coarse);
+    EXPECT_EQ(converge(t) + 1, steps);
+    EXPECT_TRUE(bits(t.field()) == bits(s->field()));
+}
+
 // A step taken with no surface said "vanished"; the seeds added since are a surface: the coarse
 // steps say so, and a run does not stop after the first of them.
 TEST(SessionCoarseStart, ASeedAfterAStepWithoutOneIsAFrontAgain) {
