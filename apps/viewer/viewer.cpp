@@ -474,6 +474,10 @@ std::optional<render::Pick> Viewer::click_3d(double x, double y, bool as_target)
         fail("no surface under the pointer");
         return std::nullopt;
     }
+    if (as_target && preview_mesher_) {  // the front drawn is the coarse start's; φ is still the seeds
+        fail("the coarse start is still running: set a target once the surface has refined (Run on)");
+        return std::nullopt;
+    }
     Vec3d index{p->index.x, p->index.y, p->index.z};
     if (view3d_coarse_)  // the coarse surface lies within a voxel or two of the real one
         if (const auto q = session_->nearest_surface_point(index, 3.0)) index = *q;

@@ -131,7 +131,7 @@ public:
     // outline its values upsampled onto the image's grid; from the frame after it ends, the surface.
     bool coarse_preview_shown() const { return preview_mesher_ != nullptr; }
     const FragmentMesher* coarse_preview_mesher() const { return preview_mesher_.get(); }
-    std::size_t coarse_preview_triangles() const { return preview_surface_.triangle_count(); }
+    std::size_t coarse_preview_triangles() const { return preview_surface_ ? preview_surface_->triangle_count() : 0; }
     // Over the frames of the last second: frames shown per second (0 when idle: the viewer draws
     // only on change) and their mean work in ms (input to composed panes); fps() * frame_ms() <= 1000.
     double fps() const { return fps_; }
@@ -293,9 +293,10 @@ private:
     void upload_fine();     // the session's dirty fragments (meshed now if deferred), and the coarse ones they change
     void render_3d(const render::Framebuffer& fb);
     void render_dirty_panes();
-    // viewer_preview.cpp: the coarse start's preview brought up to the session (begun, updated from
-    // the points that changed, or dropped); true when what it shows changed.
-    bool refresh_coarse_preview();
+    // viewer_preview.cpp: the coarse start's preview brought up to the session - dropped at once when
+    // no coarse run is under way, begun at once, and updated from the points that changed when `due`
+    // (the redraw pace) and the run took a step since; true when what it shows changed.
+    bool refresh_coarse_preview(bool due);
     // viewer_input.cpp
     void process_events();
     bool routes_to_imgui(const InputEvent& e) const;
@@ -382,9 +383,10 @@ private:
     bool view3d_coarse_ = false;             // the 3D pane was drawn from coarse_surface_
     std::unique_ptr<FragmentMesher> preview_mesher_;  // the coarse start's front (null: no coarse run under way)
     Grid<float> preview_phi_;                         // the coarse φ it meshed
+    std::uint64_t preview_serial_ = 0;                // the session's coarse_serial() it shows
     std::uint64_t preview_generation_ = 0;            // bumped whenever what the preview shows changed
     std::array<std::uint64_t, 3> contour_preview_{};  // preview_generation_ of each slice's contour
-    render::SurfaceBuffers preview_surface_;          // preview_mesher_'s fragments on the GPU
+    std::unique_ptr<render::SurfaceBuffers> preview_surface_;  // preview_mesher_'s fragments on the GPU (released with it)
     bool stale_ = false;                     // the session changed; panes not yet redrawn
     bool capturing_ = false;                 // capture_pane: the 3D pane at full quality
     int redraw_frames_ = 2;

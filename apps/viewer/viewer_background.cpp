@@ -80,7 +80,7 @@ void Viewer::run_in_background() {
 void Viewer::handover() {
     if (!handover_due()) return;
     last_handover_ms_ = now_ms();
-    if (budget_.redraw_due(now_ms()) && refresh_coarse_preview()) mark_all_panes();  // a coarse run moves no φ of the session's
+    if (refresh_coarse_preview(budget_.redraw_due(now_ms()))) mark_all_panes();  // a coarse run moves no φ of the session's
     if (session_->revision() == seen_revision_ || !budget_.redraw_due(now_ms())) return;
     seen_revision_ = session_->revision();
     if (lod_ && budget_.coarse(now_ms(), segment_running_ || drag_.active)) {

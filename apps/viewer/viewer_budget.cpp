@@ -59,7 +59,7 @@ void Viewer::upload() {
     if (!session_) return;
     if (background_active()) return handover();  // the worker's changes, at the hand-over pace
     upload_fine();
-    if (refresh_coarse_preview()) stale_ = true;
+    if (refresh_coarse_preview(!busy() || budget_.redraw_due(now_ms()))) stale_ = true;
     if (session_->revision() != seen_revision_) {
         seen_revision_ = session_->revision();
         stale_ = true;
@@ -80,7 +80,7 @@ void Viewer::render_3d(const render::Framebuffer& fb) {
     const bool preview = preview_mesher_ != nullptr;
     view3d_coarse_ = !preview && lod_ && !capturing_ && budget_.coarse(now_ms(), segment_running_ || drag_.active);
     if (preview) {  // the coarse start's front: its point c lies at the image's index 2c + 0.5 (coarse_lattice)
-        content.surface = &preview_surface_;
+        content.surface = preview_surface_.get();
         content.surface_scale = 2.0f;
         content.surface_offset = 0.5f;
     } else if (view3d_coarse_) {

@@ -357,7 +357,7 @@ void Viewer::draw_pane_labels() {
         const Pane pane = static_cast<Pane>(i);
         std::string text;
         if (pane == Pane::kView3d) {
-            text = preview_mesher_ ? fmt::format("3D  coarse start's front: {} triangles on 2x2x2 blocks", preview_surface_.triangle_count())
+            text = preview_mesher_ ? fmt::format("3D  coarse start's front: {} triangles on 2x2x2 blocks", coarse_preview_triangles())
                                    : fmt::format("3D  {} triangles", surface_.triangle_count());
         } else if (session_) {
             const render::SliceGeometry g = slice_viewport(pane, 1, 1).geometry;

@@ -134,9 +134,11 @@ TEST(BackgroundRun, ARunWithTheCoarseStartEqualsTheForegroundSteps) {
     EXPECT_NE(v.message().find("of the coarse start"), std::string::npos) << v.message();
 }
 
-// While the coarse start runs, φ is still the seeds: the 3D pane draws the coarse run's front
-// instead (marching cubes of its φ on its grid of blocks, updated from what changed) and from the
-// frame after the run ends, the session's surface again; the run ends as without the preview.
+// While the coarse start runs, φ is still the seeds: the viewer previews the coarse run's front.
+// Stepped one coarse iteration a frame: the 3D pane's preview is marching cubes of the coarse φ on
+// its grid after every frame, drawn where it lies on the image's grid (a pick on it lies on the
+// coarse front at index 2c + 0.5), the axial pane fills more than the seeds, and a target cannot be
+// set on it; a Run from there (background) ends as without the preview, which is then gone.
 TEST(BackgroundRun, TheCoarseStartsFrontIsPreviewedWhileItRuns) {
     render::HeadlessContext context;
     SessionOptions o = sleeping();
@@ -144,8 +146,7 @@ TEST(BackgroundRun, TheCoarseStartsFrontIsPreviewedWhileItRuns) {
     const auto reference = converged_in_the_foreground(o);
     ASSERT_GT(reference->segment_status().coarse_iterations, 8);
     auto session = seeded_session(o);
-    const Mesh seeds_mesh = session->mesher().merged();
-    for (int k = 0; k < 3; ++k) session->segment_step();  // coarse iterations: φ untouched
+    const auto seeds_mesh = canonical_triangles(session->mesher().merged());
     Viewer v(std::move(session), "phantom", config(5.0));
     render::Framebuffer fb(640, 480);
     const auto matches_the_coarse_front = [&] {
@@ -154,21 +155,46 @@ TEST(BackgroundRun, TheCoarseStartsFrontIsPreviewedWhileItRuns) {
         return canonical_triangles(v.coarse_preview_mesher()->merged()) ==
                canonical_triangles(marching_cubes_band(coarse->phi(), coarse->zero_layer()));
     };
+    const auto reddish = [](const render::Image& img) {  // the label colour over grey
+        std::size_t n = 0;
+        for (std::size_t i = 0; i + 3 < img.rgba.size(); i += 4) n += img.rgba[i] > img.rgba[i + 1] + 25;
+        return n;
+    };
     v.frame(fb.id(), 640, 480, 1.0 / 60.0);
-    ASSERT_TRUE(v.coarse_preview_shown());
-    EXPECT_TRUE(matches_the_coarse_front());
-    EXPECT_GT(v.coarse_preview_triangles(), 0u);
-    EXPECT_TRUE(canonical_triangles(v.session()->mesher().merged()) == canonical_triangles(seeds_mesh));  // the session's: the seeds
-    v.set_segment_running(true);
-    frames_until_steps(v, fb, 2);
-    v.set_segment_running(false);  // paused: the worker joined, the session is ours
-    if (v.session()->segment_status().coarse && v.session()->coarse_field() != nullptr) {
-        v.frame(fb.id(), 640, 480, 1.0 / 60.0);  // the preview catches up with where the run paused
-        EXPECT_TRUE(matches_the_coarse_front()) << v.session()->segment_status().coarse_iterations << " coarse iterations";
+    EXPECT_FALSE(v.coarse_preview_shown());  // no coarse run yet
+    const std::size_t seeds_fill = reddish(v.capture_pane(Pane::kAxial, 240, 240));
+    std::size_t last = 0;
+    int changes = 0;
+    for (int k = 0; k < 8; ++k) {
+        v.segment_step();  // one coarse iteration
+        v.frame(fb.id(), 640, 480, 1.0 / 60.0);
+        ASSERT_TRUE(v.session()->segment_status().coarse) << k;
+        ASSERT_TRUE(v.coarse_preview_shown()) << k;
+        ASSERT_TRUE(matches_the_coarse_front()) << k;
+        changes += k > 0 && v.coarse_preview_triangles() != last;
+        last = v.coarse_preview_triangles();
     }
+    EXPECT_GT(changes, 0);
+    EXPECT_TRUE(canonical_triangles(v.session()->mesher().merged()) == seeds_mesh);  // the session's surface: the seeds
+    EXPECT_GT(reddish(v.capture_pane(Pane::kAxial, 240, 240)), seeds_fill + seeds_fill / 4);
+
+    const Rect r = v.pane_rect(Pane::kView3d);
+    std::optional<render::Pick> pick;
+    double px = 0.0, py = 0.0;
+    for (int d = 0; d < 40 && !pick; d += 4) pick = v.click_3d(px = 0.5 * r.w + d, py = 0.5 * r.h + d, false);
+    ASSERT_TRUE(pick.has_value()) << v.message();
+    const Grid<float>& coarse = v.session()->coarse_field()->phi();
+    const Vec3d at = (Vec3d{pick->index.x, pick->index.y, pick->index.z} - Vec3d{0.5, 0.5, 0.5}) / 2.0;  // coarse coordinates
+    const Vec3i c{static_cast<int>(std::lround(at.x)), static_cast<int>(std::lround(at.y)), static_cast<int>(std::lround(at.z))};
+    ASSERT_TRUE(coarse.lattice().contains(c.cast<double>())) << at;
+    EXPECT_LT(std::abs(coarse(c)), 1.5f) << "the pick " << at << " (coarse) is off the coarse front";
+    EXPECT_FALSE(v.click_3d(px, py, true).has_value());
+    EXPECT_NE(v.message().find("coarse start is still running"), std::string::npos) << v.message();
+
     run_until_it_stops(v, fb);
     ASSERT_FALSE(v.segment_running());
     EXPECT_FALSE(v.coarse_preview_shown());
+    EXPECT_EQ(v.coarse_preview_triangles(), 0u);
     EXPECT_EQ(v.session()->coarse_field(), nullptr);
     EXPECT_TRUE(bits(*v.session()) == bits(*reference));
     EXPECT_EQ(v.last_frame().triangles, v.session()->mesher().triangle_count());

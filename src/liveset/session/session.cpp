@@ -332,6 +332,7 @@ SessionUpdate Session::coarse_step() {
         coarse_inputs_ = inputs_;
     }
     coarse_->advance();
+    ++coarse_serial_;
     segment_.coarse = true;
     segment_.coarse_iterations = coarse_->result().iterations;
     segment_.coarse_inside = coarse_->result().inside;

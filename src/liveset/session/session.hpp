@@ -177,6 +177,9 @@ public:
     // reads changed since), on coarse_lattice(lattice()); null otherwise. What a viewer previews
     // (upsampled_phi) while φ is still the seeds. Valid until the session's next step or edit.
     const SparseField* coarse_field() const;
+    // Coarse iterations this session has taken (never reset): while coarse_field() is the same
+    // run, an unchanged count means an unchanged coarse front.
+    std::uint64_t coarse_serial() const { return coarse_serial_; }
 
     // --- swarm repair -----------------------------------------------------------------------
     const RepairOptions& repair_options() const { return repair_options_; }
@@ -294,6 +297,7 @@ private:
     // parameters, a load - counted; coarse_ begun at another count is begun again (set_step drops it).
     std::uint64_t inputs_ = 0;
     std::uint64_t coarse_inputs_ = 0;        // inputs_ when coarse_ was begun
+    std::uint64_t coarse_serial_ = 0;        // coarse_serial()
     mutable std::optional<std::optional<TissueModel>> model_;  // fitted lazily (inner nullopt: failed)
     mutable std::optional<std::pair<double, Grid<float>>> smoothed_;  // speed_image()'s σ and values
     std::optional<FrontConvergence> convergence_;
