@@ -132,7 +132,7 @@ nlohmann::json segmentation_report(const SegmentOutcome& o, const Lattice& latti
         const CoarseStartReport& c = *o.coarse;
         j["coarse_start"] = {{"dims", {c.dims.x, c.dims.y, c.dims.z}}, {"spacing", {c.spacing.x, c.spacing.y, c.spacing.z}},
                              {"iterations", c.result.iterations}, {"stop", to_string(c.result.reason)},
-                             {"seconds", c.result.seconds}, {"used", c.used}, {"start_voxels", c.upsampled}};
+                             {"seconds", c.result.seconds}, {"used", c.used}, {"start_voxels", c.upsampled}, {"refused_voxels", c.refused}};
     } else {
         j["coarse_start"] = nullptr;
     }

@@ -231,6 +231,7 @@ TEST(CoarseStart, AutoRuleAndNames) {
 using liveset::testing::kShell;
 using liveset::testing::Shell;
 using liveset::testing::shell;
+using liveset::testing::shell_seed;
 
 SegmentOutcome segment_shell(CoarseStart mode) {
     const Shell& s = shell();
@@ -272,6 +273,45 @@ TEST(CoarseStart, FineShellFromTheCoarseStartMatchesTheDirectRun) {
     EXPECT_GT(shell_dice(direct.mask, coarse.mask), 0.98);
     // The fine grid's iterations: a few dozen refining ones instead of the whole way from the seed.
     EXPECT_LT(coarse.result.iterations * 2, direct.result.iterations);
+}
+
+// The fine start is the upsampled coarse front without the voxels the image's own data term
+// refuses (propagation > 0): brute force on the shell, whose one-voxel sulci the 2x2x2 blocks blur
+// into the grey - the coarse front covers them, the fine start leaves them out.
+TEST(CoarseStart, TheFineStartLeavesOutWhatTheImagesDataTermRefuses) {
+    const Shell& s = shell();
+    Grid<float> unit(s.image.lattice());
+    for (std::size_t i = 0; i < unit.size(); ++i) unit[static_cast<PointIndex>(i)] = s.image[static_cast<PointIndex>(i)] / 200.0f;
+    ThresholdParams params;
+    params.mu = 0.5;
+    params.epsilon = 0.125;
+    params.alpha = 0.05;
+    const ThresholdSpeed speed(unit, params, &s.roi);
+    SegmentationOptions loop;
+    loop.step = segment_step();
+    const std::vector<SeedBall> seeds{{shell_seed(), 2.0}};
+    CoarseRun run(speed, unit.lattice(), &s.roi, seeds, loop, 2);
+    while (run.advance()) {
+    }
+    CoarseStartReport report;
+    const std::optional<Grid<std::uint8_t>> start = run.fine_start(report);
+    ASSERT_TRUE(start.has_value());
+    const Grid<std::uint8_t> up = upsample_inside(run.field().phi(), unit.lattice(), &s.roi);
+    std::size_t refused = 0, kept = 0, sulci = 0;
+    for (int z = 0; z < kShell; ++z)
+        for (int y = 0; y < kShell; ++y)
+            for (int x = 0; x < kShell; ++x) {
+                const Vec3i q{x, y, z};
+                const bool refuses = speed.propagation(q) > 0.0f;
+                ASSERT_EQ((*start)(q), up(q) && !refuses ? 1 : 0) << q;
+                refused += up(q) && refuses;
+                kept += (*start)(q) != 0;
+                sulci += up(q) && s.image(q) < 70.0f && s.truth(q) == 0 && norm(unit.lattice().to_world(q.cast<double>()) - unit.lattice().to_world(Vec3d{43.5, 43.5, 43.5})) < 19.0;
+            }
+    EXPECT_EQ(report.refused, refused);
+    EXPECT_EQ(report.upsampled, kept);
+    EXPECT_GT(sulci, 100u);    // the coarse front covered the sulci...
+    EXPECT_GT(refused, sulci);  // ...which the fine start leaves out, with the noise's outliers
 }
 
 TEST(CoarseStart, SameBitsOnOneAndTwoThreads) {

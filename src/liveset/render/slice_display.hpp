@@ -61,8 +61,8 @@ struct OverlayStyle {
 };
 
 // A coarse start's φ (coarse_start.hpp) previewed on `slice` of the image's grid: upsampled_phi at
-// each texel's voxel, in phi_slice's order - negative exactly where its front, upsampled now, would
-// put the fine start (before the ROI and the seeds' balls).
+// each texel's voxel, in phi_slice's order - negative exactly where upsample_inside puts its front
+// (the fine start before the ROI, the voxels the image's data term refuses and the seeds' balls).
 std::vector<float> upsampled_phi_slice(const Grid<float>& coarse_phi, const SliceGeometry& g, int slice);
 
 // Straight-alpha RGBA texels (row 0 at the bottom) of the overlay on `slice`, layered (each

@@ -166,6 +166,7 @@ const ThresholdSpeed& same_grid(const ThresholdSpeed& fine_speed, const Lattice&
 CoarseRun::CoarseRun(const ThresholdSpeed& fine_speed, const Lattice& fine, const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
                      const SegmentationOptions& loop, int layers)
     : fine_(fine),
+      fine_speed_(fine_speed),
       roi_(roi),
       terms_(block_threshold_terms(same_grid(fine_speed, fine))),
       coarse_roi_(roi ? std::optional(downsample_majority(*roi)) : std::nullopt),
@@ -188,6 +189,12 @@ std::optional<Grid<std::uint8_t>> CoarseRun::fine_start(CoarseStartReport& repor
     report.result = run_.result();
     if (!run_.ended() || report.result.reason == StopReason::kInterrupted) return std::nullopt;
     Grid<std::uint8_t> start = upsample_inside(field_.phi(), fine_, roi_);
+    report.refused = voxel_loops::count_if(start.size(), [&](std::size_t i) {  // each point written by its own index only
+        const auto p = static_cast<PointIndex>(i);
+        if (start[p] == 0 || !(fine_speed_.propagation(fine_.coord(p)) > 0.0f)) return false;
+        start[p] = 0;
+        return true;
+    });
     report.upsampled = voxel_loops::count_if(start.size(), [&](std::size_t i) { return start[static_cast<PointIndex>(i)] != 0; });
     report.used = report.upsampled > 0;
     if (!report.used) return std::nullopt;

@@ -59,7 +59,8 @@ struct CoarseStartReport {
     Vec3i dims{0, 0, 0};
     Vec3d spacing{0, 0, 0};
     SegmentationResult result;   // the coarse run's iterations, stop reason and seconds
-    std::size_t upsampled = 0;   // inside points of the upsampled front (the fine start without the seeds' balls)
+    std::size_t upsampled = 0;   // inside points of the fine start without the seeds' balls (after `refused`)
+    std::size_t refused = 0;     // voxels of the upsampled front the image's data term refuses (D > 0), left out
     bool used = false;           // false: nothing of the coarse front was left inside the ROI; the fine run started from the seeds
 };
 
@@ -67,7 +68,8 @@ struct CoarseStartReport {
 // iteration per Session::segment_step): the front from `seeds` (`fine`'s index space) under the
 // threshold speed on the block_threshold_terms of `fine_speed` (with its α) and the ROI by
 // majority, on coarse_lattice(fine), stepped as `loop` says. Throws std::invalid_argument (from the
-// constructor) for a speed or ROI of another grid or a seed outside it. `roi` must outlive it.
+// constructor) for a speed or ROI of another grid or a seed outside it. `fine_speed` and `roi`
+// must outlive it.
 class CoarseRun {
 public:
     CoarseRun(const ThresholdSpeed& fine_speed, const Lattice& fine, const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,
@@ -81,13 +83,19 @@ public:
     bool ended() const { return run_.ended(); }
     const SegmentationResult& result() const { return run_.result(); }
     const SparseField& field() const { return field_; }
-    // After a run that ended otherwise than interrupted: upsample_inside of its φ (the fine start,
-    // to which the caller unites the seeds' balls), or nothing when nothing of its front is left
-    // inside the ROI. `report` gets the grid, the run's result, and what was upsampled.
+    // After a run that ended otherwise than interrupted: the fine start, to which the caller unites
+    // the seeds' balls - upsample_inside of its φ without the voxels where the image's own data
+    // term is positive (the fine speed's propagation > 0: outside the window or the ROI), or
+    // nothing when nothing of its front is left. A block half in the window lets in voxels the
+    // image's grid refuses; a run from the seeds would never enter them, and a front started there
+    // leaves them only as fast as their D, barely positive near the window's edge, pushes it
+    // (docs/BENCHMARKS.md, session 82). `report` gets the grid, the run's result, what was upsampled
+    // and what was refused.
     std::optional<Grid<std::uint8_t>> fine_start(CoarseStartReport& report) const;
 
 private:
     Lattice fine_;
+    const ThresholdSpeed& fine_speed_;  // the image's speed (must outlive the run)
     const Grid<std::uint8_t>* roi_;
     Grid<float> terms_;
     std::optional<Grid<std::uint8_t>> coarse_roi_;  // read by speed_
