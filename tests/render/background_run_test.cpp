@@ -48,6 +48,13 @@ std::vector<std::uint32_t> bits(const Session& s) {
     return out;
 }
 
+// `view --coarse-start on`: the sleeping step after the coarse start, on the phantom's 1 mm grid too.
+SessionOptions coarse_on() {
+    SessionOptions o = sleeping();
+    o.coarse_start = CoarseStart::kOn;
+    return o;
+}
+
 ViewerConfig config(double handover_ms) {
     ViewerConfig c;
     c.headless = true;
@@ -118,8 +125,7 @@ TEST(BackgroundRun, ASegmentationRunEqualsTheForegroundStepsAtAnyPace) {
 // foreground steps end, bit for bit; the message counts both kinds of iteration.
 TEST(BackgroundRun, ARunWithTheCoarseStartEqualsTheForegroundSteps) {
     render::HeadlessContext context;
-    SessionOptions o = sleeping();
-    o.coarse_start = CoarseStart::kOn;
+    const SessionOptions o = coarse_on();
     const auto reference = converged_in_the_foreground(o);
     ASSERT_GT(reference->segment_status().coarse_iterations, 0);
     Viewer v(seeded_session(o), "phantom", config(5.0));
@@ -141,8 +147,7 @@ TEST(BackgroundRun, ARunWithTheCoarseStartEqualsTheForegroundSteps) {
 // set on it; a Run from there (background) ends as without the preview, which is then gone.
 TEST(BackgroundRun, TheCoarseStartsFrontIsPreviewedWhileItRuns) {
     render::HeadlessContext context;
-    SessionOptions o = sleeping();
-    o.coarse_start = CoarseStart::kOn;
+    const SessionOptions o = coarse_on();
     const auto reference = converged_in_the_foreground(o);
     ASSERT_GT(reference->segment_status().coarse_iterations, 8);
     auto session = seeded_session(o);
