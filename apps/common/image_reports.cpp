@@ -194,7 +194,9 @@ void print_segmentation_summary(const nlohmann::json& j) {
         fmt::print("  coarse start {} iterations ({}), {:.2f} s on 2x2x2-voxel blocks, a {}x{}x{} grid ({:.3g} x {:.3g} x {:.3g} mm){}\n",
                    c["iterations"].get<int>(), c["stop"].get<std::string>(), c["seconds"].get<double>(), c["dims"][0].get<int>(),
                    c["dims"][1].get<int>(), c["dims"][2].get<int>(), c["spacing"][0].get<double>(), c["spacing"][1].get<double>(),
-                   c["spacing"][2].get<double>(), c["used"].get<bool>() ? "" : "; nothing of its front was left in the ROI: started from the seeds");
+                   c["spacing"][2].get<double>(), c["used"].get<bool>() ? fmt::format("; {} voxels of its upsampled front left out where the image's own data term refuses them",
+                                                                   c.value("refused_voxels", std::size_t{0}))
+                                                     : "; nothing of its front was left (the ROI, the data term): started from the seeds");
     }
     fmt::print("  segmentation {} iterations ({}), {:.2f} s, {:.2f} ms/iteration\n", j["iterations"].get<int>(),
                j["stop"].get<std::string>(), j["seconds"].get<double>(), j["ms_per_iteration"].get<double>());

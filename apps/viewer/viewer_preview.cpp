@@ -1,6 +1,7 @@
 // The coarse start's preview: while the session's coarse run is under way (φ still the seeds), the
 // 3D pane draws that run's front meshed on its grid of 2x2x2 blocks, and the slice panes fill and
-// outline its values upsampled onto the image's grid - where the fine run will start.
+// outline its values upsampled onto the image's grid - where the fine run will start, but for the
+// voxels the image's own data term refuses (CoarseRun::fine_start leaves those out).
 #include <algorithm>
 #include <chrono>
 #include <cstring>

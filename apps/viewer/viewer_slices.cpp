@@ -43,7 +43,7 @@ void Viewer::render_slice_pane(Pane pane, render::Framebuffer& fb, const Rect& r
         slice_renderers_[i]->set_texels(g.width, g.height, texels);
         slice_shown_[i] = slice;
     }
-    // While the coarse start runs, its front upsampled (where the fine run will start) instead of φ, still the seeds.
+    // While the coarse start runs, its front upsampled (the fine start but for what the image refuses) instead of φ, still the seeds.
     const std::vector<float> phi = preview_mesher_ ? render::upsampled_phi_slice(preview_phi_, g, slice)
                                                    : render::phi_slice(session_->field().phi(), g, slice);
     if (contour_slice_[i] != slice || contour_revision_[i] != session_->revision() || contour_preview_[i] != preview_generation_) {

@@ -35,7 +35,7 @@ class Session:
     ``"off"`` as ``segment``'s. Where it applies (from seeds, on a grid of voxels at most 0.85 mm), the
     first steps are the coarse start's iterations on 2x2x2-voxel blocks (``status["coarse"]`` True,
     ``status["coarse_iterations"]`` counting them, φ unchanged), the one that ends that run puts its
-    upsampled front in place of the seeds, and the steps after it refine on the image's grid
+    upsampled front (less the voxels the image's own data term refuses) in place of the seeds, and the steps after it refine on the image's grid
     (``status["iterations"]``); ``step(n)`` takes n steps of either kind, ``run``'s ``max_steps``
     bounds the image's grid's steps as ``segment``'s ``iterations`` bounds each stage. ``roi``: as ``segment``'s: None (the automatic brain mask when the image is
     a head, else none), ``"auto"``, ``"none"`` or a mask (Image, nibabel image or array) the front

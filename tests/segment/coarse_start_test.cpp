@@ -282,6 +282,11 @@ TEST(CoarseStart, TheFineStartLeavesOutWhatTheImagesDataTermRefuses) {
     const Shell& s = shell();
     Grid<float> unit(s.image.lattice());
     for (std::size_t i = 0; i < unit.size(); ++i) unit[static_cast<PointIndex>(i)] = s.image[static_cast<PointIndex>(i)] / 200.0f;
+    // Voxels in the grey at the window's edge, |µ - I| = ε exactly: D = 0, which the cut keeps.
+    const Vec3i seed_voxel{static_cast<int>(std::lround(shell_seed().x)), static_cast<int>(std::lround(shell_seed().y)),
+                           static_cast<int>(std::lround(shell_seed().z))};
+    const std::vector<Vec3i> edge{seed_voxel + Vec3i{0, 3, 0}, seed_voxel + Vec3i{0, -3, 0}, seed_voxel + Vec3i{0, 0, 3}};
+    for (const Vec3i& q : edge) unit(q) = 0.625f;
     ThresholdParams params;
     params.mu = 0.5;
     params.epsilon = 0.125;
@@ -308,6 +313,13 @@ TEST(CoarseStart, TheFineStartLeavesOutWhatTheImagesDataTermRefuses) {
                 kept += (*start)(q) != 0;
                 sulci += up(q) && s.image(q) < 70.0f && s.truth(q) == 0 && norm(unit.lattice().to_world(q.cast<double>()) - unit.lattice().to_world(Vec3d{43.5, 43.5, 43.5})) < 19.0;
             }
+    int edge_kept = 0;
+    for (const Vec3i& q : edge) {
+        ASSERT_EQ(speed.propagation(q), 0.0f) << q;
+        EXPECT_EQ((*start)(q), up(q)) << q;  // kept wherever the coarse front covered it
+        edge_kept += (*start)(q);
+    }
+    EXPECT_GT(edge_kept, 0);
     EXPECT_EQ(report.refused, refused);
     EXPECT_EQ(report.upsampled, kept);
     EXPECT_GT(sulci, 100u);    // the coarse front covered the sulci...

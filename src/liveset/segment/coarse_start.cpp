@@ -189,13 +189,14 @@ std::optional<Grid<std::uint8_t>> CoarseRun::fine_start(CoarseStartReport& repor
     report.result = run_.result();
     if (!run_.ended() || report.result.reason == StopReason::kInterrupted) return std::nullopt;
     Grid<std::uint8_t> start = upsample_inside(field_.phi(), fine_, roi_);
-    report.refused = voxel_loops::count_if(start.size(), [&](std::size_t i) {  // each point written by its own index only
+    const auto inside = [&] { return voxel_loops::count_if(start.size(), [&](std::size_t i) { return start[static_cast<PointIndex>(i)] != 0; }); };
+    const std::size_t upsampled = inside();
+    voxel_loops::for_each(start.size(), [&](std::size_t i) {  // the image's own data term refuses it: left out
         const auto p = static_cast<PointIndex>(i);
-        if (start[p] == 0 || !(fine_speed_.propagation(fine_.coord(p)) > 0.0f)) return false;
-        start[p] = 0;
-        return true;
+        if (start[p] != 0 && fine_speed_.propagation(fine_.coord(p)) > 0.0f) start[p] = 0;
     });
-    report.upsampled = voxel_loops::count_if(start.size(), [&](std::size_t i) { return start[static_cast<PointIndex>(i)] != 0; });
+    report.upsampled = inside();
+    report.refused = upsampled - report.upsampled;
     report.used = report.upsampled > 0;
     if (!report.used) return std::nullopt;
     return start;

@@ -1,6 +1,7 @@
 // The coarse-to-fine start of a finely sampled scan (issue 16, docs/ARCHITECTURE.md "Coarse start"):
 // the front first runs to convergence from the seeds on 2x2x2-voxel blocks (their mean threshold term), and
-// that result, upsampled onto the image's own grid, is where the front starts there.
+// that result, upsampled onto the image's own grid less what the image's own data term refuses, is where
+// the front starts there.
 #pragma once
 
 #include <atomic>
@@ -61,7 +62,7 @@ struct CoarseStartReport {
     SegmentationResult result;   // the coarse run's iterations, stop reason and seconds
     std::size_t upsampled = 0;   // inside points of the fine start without the seeds' balls (after `refused`)
     std::size_t refused = 0;     // voxels of the upsampled front the image's data term refuses (D > 0), left out
-    bool used = false;           // false: nothing of the coarse front was left inside the ROI; the fine run started from the seeds
+    bool used = false;           // false: nothing of the coarse front was left (the ROI, the data term's refusal); the fine run started from the seeds
 };
 
 // The coarse stage as its caller steps it (run_coarse_start's loop; a session's coarse start, one
@@ -111,8 +112,8 @@ void init_fine_start(SparseField& fine, const std::optional<Grid<std::uint8_t>>&
 
 // The coarse stage: the front from `seeds` (`fine`'s index space) under the threshold speed on the
 // block_threshold_terms of `fine_speed` (with its α) and the ROI
-// by majority, run as `loop` says; the hook sees its steps with level 1. Returns upsample_inside of
-// its φ (the fine start, to which segment_image unites the seeds' balls), or nothing when the run
+// by majority, run as `loop` says; the hook sees its steps with level 1. Returns CoarseRun::fine_start
+// (the fine start, to which segment_image unites the seeds' balls), or nothing when the run
 // was interrupted (report.result.reason) or nothing of its front is left (report.used false).
 std::optional<Grid<std::uint8_t>> run_coarse_start(const ThresholdSpeed& fine_speed, const Lattice& fine,
                                                    const Grid<std::uint8_t>* roi, std::span<const SeedBall> seeds,

@@ -311,7 +311,8 @@ void Session::ensure_speed() {
 // The coarse start is due while φ is the union of the seeds (no step, edit or load since) on a grid
 // where it applies; it then runs until its end replaces that union (marks_.pristine false).
 const SparseField* Session::coarse_field() const {
-    return coarse_ && coarse_inputs_ == inputs_ && coarse_start_due() ? &coarse_->field() : nullptr;
+    return coarse_ && coarse_inputs_ == inputs_ && speed_ && coarse_speed_ == speed_->serial() && coarse_start_due() ? &coarse_->field()
+                                                                                                           : nullptr;
 }
 
 bool Session::coarse_start_due() const {
@@ -319,17 +320,19 @@ bool Session::coarse_start_due() const {
 }
 
 // One iteration of the coarse start's run (begun, or begun again after a change of what it reads since
-// it began: inputs_ counts them; a coarse iteration changes none). The iteration that
-// ends it replaces φ by its upsampled front and the seeds' balls, as segment_image's evolve does,
-// through the edit path; the fine steps then start from there with a fresh convergence count.
+// it began: inputs_ counts them; a coarse iteration changes none; or on another speed than the
+// one it holds, whatever replaced it). The iteration that ends it replaces φ by its fine start
+// (CoarseRun::fine_start) and the seeds' balls, as segment_image's evolve does, through the edit
+// path; the fine steps then start from there with a fresh convergence count.
 SessionUpdate Session::coarse_step() {
     begin_action("segment");  // the run's action, as a fine step's (its coarse iterations record nothing)
     const auto t0 = Clock::now();
-    if (!coarse_ || coarse_inputs_ != inputs_) {
-        ensure_speed();
+    ensure_speed();
+    if (!coarse_ || coarse_inputs_ != inputs_ || coarse_speed_ != speed_->serial()) {
         coarse_.reset();
         coarse_ = std::make_unique<CoarseRun>(*speed_, lattice(), roi(), marks_.seeds, options_.segmentation, options_.layers);
         coarse_inputs_ = inputs_;
+        coarse_speed_ = speed_->serial();
     }
     coarse_->advance();
     ++coarse_serial_;

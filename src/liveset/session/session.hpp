@@ -168,7 +168,7 @@ public:
     // One global sparse-field step of the threshold speed; consecutive steps form one action. While
     // the level set is still the union of the seeds and the coarse start applies, one iteration of
     // the coarse start's run instead (X empty: φ is not touched), and at its end the seeds are
-    // replaced by its upsampled front (X: every point that changed). A change of the seeds, the
+    // replaced by its fine start (CoarseRun::fine_start; X: every point that changed). A change of the seeds, the
     // parameters, the step or φ meanwhile (not of the swarm's target or options) begins that run
     // again on the next step.
     SessionUpdate segment_step();
@@ -292,7 +292,8 @@ private:
     FragmentMesher mesher_;
     SessionMarks marks_;
     std::unique_ptr<ThresholdSpeed> speed_;  // for marks_.params; rebuilt lazily
-    std::unique_ptr<CoarseRun> coarse_;      // the coarse start's run in progress (built from speed_, then its own)
+    std::unique_ptr<CoarseRun> coarse_;      // the coarse start's run in progress (it holds *speed_ for its fine start)
+    std::uint64_t coarse_speed_ = 0;         // speed_'s serial when coarse_ was begun: another speed begins it again
     // Changes of what a coarse run reads - φ and the seeds (every edit, undo and redo), the
     // parameters, a load - counted; coarse_ begun at another count is begun again (set_step drops it).
     std::uint64_t inputs_ = 0;
