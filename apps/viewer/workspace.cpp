@@ -204,9 +204,12 @@ Workspace parse_workspace(const json& j) {
         ws.thin_fronts = st["thin_fronts"].get<bool>();
         if (st.contains("coarse_start")) {  // absent in files written before session 82
             const json& c = st["coarse_start"];
-            if (!c.is_string() || (c != "auto" && c != "on" && c != "off"))
+            try {
+                if (!c.is_string()) throw std::invalid_argument("not a name");
+                ws.coarse_start = parse_coarse_start(c.get<std::string>());
+            } catch (const std::invalid_argument&) {
                 throw std::runtime_error(fmt::format("field 'coarse_start' is {}, not \"auto\", \"on\" or \"off\"", c.dump()));
-            ws.coarse_start = parse_coarse_start(c.get<std::string>());
+            }
         }
     }
     ws.marks.pristine = false;

@@ -89,13 +89,7 @@ void over(std::uint8_t* px, const std::array<std::uint8_t, 3>& c, float a) {
 }  // namespace
 
 std::vector<float> upsampled_phi_slice(const Grid<float>& coarse_phi, const SliceGeometry& g, int slice) {
-    std::vector<float> out(static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height));
-    slice = std::clamp(slice, 0, g.slices - 1);
-    for (int r = 0; r < g.height; ++r)
-        for (int c = 0; c < g.width; ++c)
-            out[static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(c)] =
-                upsampled_phi(coarse_phi, g.voxel(c, r, slice));
-    return out;
+    return slice_values(g, slice, [&](Vec3i v) { return upsampled_phi(coarse_phi, v); });
 }
 
 std::vector<std::uint8_t> overlay_texels(const SliceGeometry& g, int slice, const OverlayStyle& style, std::span<const float> phi,

@@ -129,12 +129,7 @@ std::vector<std::uint8_t> slice_texels(const Grid<float>& unit_image, const Slic
 }
 
 std::vector<float> phi_slice(const Grid<float>& phi, const SliceGeometry& g, int slice) {
-    std::vector<float> out(static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height));
-    slice = std::clamp(slice, 0, g.slices - 1);
-    for (int r = 0; r < g.height; ++r)
-        for (int c = 0; c < g.width; ++c)
-            out[static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(c)] = phi(g.voxel(c, r, slice));
-    return out;
+    return slice_values(g, slice, [&](Vec3i v) { return phi(v); });
 }
 
 std::vector<glm::dvec2> zero_contour(const Grid<float>& phi, const SliceGeometry& g, int slice) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <glm/glm.hpp>
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -57,7 +58,17 @@ struct SliceViewport {
 // Grey texels (row 0 at the bottom) of `unit_image` (values in [0, 1]) on `slice`.
 std::vector<std::uint8_t> slice_texels(const Grid<float>& unit_image, const SliceGeometry& g, int slice);
 
-// φ on `slice` (clamped), one value per texel in the order of slice_texels.
+// `at(voxel)` for every texel of `slice` (clamped), one value per texel in the order of slice_texels.
+template <class At>
+std::vector<float> slice_values(const SliceGeometry& g, int slice, const At& at) {
+    std::vector<float> out(static_cast<std::size_t>(g.width) * static_cast<std::size_t>(g.height));
+    slice = std::clamp(slice, 0, g.slices - 1);
+    for (int r = 0; r < g.height; ++r)
+        for (int c = 0; c < g.width; ++c)
+            out[static_cast<std::size_t>(r) * static_cast<std::size_t>(g.width) + static_cast<std::size_t>(c)] = at(g.voxel(c, r, slice));
+    return out;
+}
+// φ on `slice` (clamped): slice_values of φ.
 std::vector<float> phi_slice(const Grid<float>& phi, const SliceGeometry& g, int slice);
 
 // Segments (pairs of end points, texel space) of φ = 0 on `slice`, by marching squares between
