@@ -2,12 +2,14 @@
 #include "autosave.hpp"
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <cstdlib>
 #include <ctime>
 #include <string>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 namespace liveset::viewer {
 
@@ -97,12 +99,13 @@ bool Autosave::restore() {
     message_.clear();
     bool step_changed = false;
     try {
-        const auto [step, note] = continued_step();  // decided and checked first: nothing after the load throws
+        const ContinuedRun run = continued_run();  // decided and checked first: nothing after the load throws
         if (!session_->load_recovered(offer_->phi, offer_->status, offer_->marks))
             message_ = "the recovery file's sparse field was inconsistent: restored from the signs of its phi";
-        step_changed = step.has_value();
-        if (step) session_->set_step(*step);
-        if (!note.empty()) message_ = message_.empty() ? note : message_ + "; " + note;
+        step_changed = run.step || run.coarse_start;
+        if (run.step) session_->set_step(*run.step);
+        if (run.coarse_start) session_->set_coarse_start(*run.coarse_start);
+        if (!run.note.empty()) message_ = message_.empty() ? run.note : message_ + "; " + run.note;
     } catch (const std::exception& e) {
         message_ = fmt::format("cannot restore {}: {}", file_.string(), e.what());
         offer_.reset();
@@ -114,29 +117,40 @@ bool Autosave::restore() {
     restored_ = true;
     // The restored work is still unsaved: keep the file until the user saves.
     clean_revision_ = ~std::uint64_t{0};
-    // A changed step is written with the next autosave (the crash path takes it at once).
+    // A changed step or coarse start is written with the next autosave (the crash path takes it at once).
     written_revision_ = step_changed ? ~std::uint64_t{0} : session_->revision();
     crash_.emplace(file_);
     return true;
 }
 
-std::pair<std::optional<StepOptions>, std::string> Autosave::continued_step() const {
-    // The work continues with the step it was saved with (a file from before session 73 records
-    // none: the command line's), but for what --step, --thin-fronts or --no-thin-fronts ask.
-    if (!offer_->step) return {};
-    const RecordedStep now = recorded_step(session_->options().segmentation.step), saved = *offer_->step;
-    const RecordedStep next{config_.step_given ? now.sleeping : saved.sleeping, config_.thin_fronts_given ? now.thin_fronts : saved.thin_fronts};
-    std::optional<StepOptions> step;
-    if (next != now) {
-        step = step_options(next);
-        validate(*step);
+Autosave::ContinuedRun Autosave::continued_run() const {
+    // The work continues with the step and the coarse start it was saved with (a file from before
+    // session 73 records no step, one from before session 83 no coarse start: the command line's
+    // there), but for what --step, --thin-fronts, --no-thin-fronts or --coarse-start ask.
+    ContinuedRun run;
+    std::vector<std::string> asked, kept;
+    if (offer_->step) {
+        const RecordedStep now = recorded_step(session_->options().segmentation.step), saved = *offer_->step;
+        const RecordedStep next{config_.step_given ? now.sleeping : saved.sleeping, config_.thin_fronts_given ? now.thin_fronts : saved.thin_fronts};
+        if (next != now) {
+            run.step = step_options(next);
+            validate(*run.step);
+        }
+        if (next != saved) asked.push_back(fmt::format("{} as asked (saved with {})", describe(next), describe(saved)));
+        else if (next != now) kept.push_back(describe(saved));
     }
-    std::string note;
-    if (next != saved)
-        note = fmt::format("continued with {} as asked (saved with {}): from here it steps unlike the saved run", describe(next), describe(saved));
-    else if (next != now)
-        note = fmt::format("continued with its saved {}", describe(saved));
-    return {step, note};
+    if (offer_->coarse_start) {
+        const CoarseStart now = session_->options().coarse_start, saved = *offer_->coarse_start;
+        const CoarseStart next = config_.coarse_start_given ? now : saved;
+        if (next != now) run.coarse_start = next;
+        if (next != saved) asked.push_back(fmt::format("--coarse-start {} as asked (saved with --coarse-start {})", to_string(next), to_string(saved)));
+        else if (next != now) kept.push_back("--coarse-start " + to_string(saved));
+    }
+    if (!asked.empty())
+        run.note = fmt::format("continued with {}: from here it steps unlike the saved run", fmt::join(asked, " and "));
+    else if (!kept.empty())
+        run.note = fmt::format("continued with its saved {}", fmt::join(kept, " "));
+    return run;
 }
 
 void Autosave::discard() {
@@ -160,7 +174,7 @@ void Autosave::tick() {
     if (tracked_revision_ != revision) {
         try {
             crash_->track(image_, session_->marks(), roi_checksum_, recorded_step(session_->options().segmentation.step),
-                          session_->field().phi(), session_->field().status());
+                          session_->options().coarse_start, session_->field().phi(), session_->field().status());
         } catch (const std::exception& e) {
             message_ = e.what();
         }
@@ -174,8 +188,8 @@ void Autosave::tick() {
 void Autosave::write(const char* why) {
     try {
         write_recovery(file_, RecoveryView(image_, 0, static_cast<std::int64_t>(std::time(nullptr)), session_->marks(), roi_checksum_,
-                                           recorded_step(session_->options().segmentation.step), session_->field().phi(),
-                                           session_->field().status()));
+                                           recorded_step(session_->options().segmentation.step), session_->options().coarse_start,
+                                           session_->field().phi(), session_->field().status()));
         message_ = fmt::format("{} unsaved work in {}", why, file_.string());
         routine_ = !exited_;
     } catch (const std::exception& e) {

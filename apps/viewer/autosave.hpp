@@ -22,9 +22,9 @@ struct AutosaveConfig {
     std::filesystem::path dir;      // empty: no autosave and no recovery offer
     double interval_seconds = 120;  // between periodic writes of unsaved work (0: at every change)
     bool recover = false;           // restore a recovery file without asking
-    // --step given, --thin-fronts or --no-thin-fronts given: a restored file continues with the
-    // command line's step kind or rule there, its saved ones elsewhere.
-    bool step_given = false, thin_fronts_given = false;
+    // --step given, --thin-fronts or --no-thin-fronts given, --coarse-start given: a restored file
+    // continues with the command line's step kind, rule or coarse start there, its saved ones elsewhere.
+    bool step_given = false, thin_fronts_given = false, coarse_start_given = false;
 };
 
 // $XDG_STATE_HOME/liveset/recovery, else ~/.local/state/liveset/recovery (empty without HOME).
@@ -68,9 +68,14 @@ public:
 
 private:
     bool dirty() const;
-    // restore()'s step: the offer's (none where the session's is already the one to take) and the
-    // note that says so, or that the command line asked for another.
-    std::pair<std::optional<StepOptions>, std::string> continued_step() const;
+    // restore()'s step and coarse start: the offer's (none where the session's is already the one
+    // to take) and the note that says so, or that the command line asked for another.
+    struct ContinuedRun {
+        std::optional<StepOptions> step;
+        std::optional<CoarseStart> coarse_start;
+        std::string note;
+    };
+    ContinuedRun continued_run() const;
     void write(const char* why);
     void remove_file();
 

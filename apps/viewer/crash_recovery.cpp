@@ -111,9 +111,9 @@ CrashRecovery::~CrashRecovery() {
 }
 
 void CrashRecovery::track(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum,
-                          RecordedStep step, const Grid<float>& phi, const Grid<std::int8_t>& status) {
+                          RecordedStep step, CoarseStart coarse_start, const Grid<float>& phi, const Grid<std::int8_t>& status) {
     if (status.size() != phi.size()) throw std::invalid_argument("CrashRecovery::track: status and phi differ in size");
-    const std::vector<std::uint8_t> header = recovery_format::encode_header(image, marks, roi_checksum, step, phi.lattice());
+    const std::vector<std::uint8_t> header = recovery_format::encode_header(image, marks, roi_checksum, step, coarse_start, phi.lattice());
     const int slot = g_active.load() == 0 ? 1 : 0;
     TrackedState& s = g_slots[static_cast<std::size_t>(slot)];
     s.header = std::make_unique<std::uint8_t[]>(header.size());

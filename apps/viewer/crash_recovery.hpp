@@ -23,10 +23,10 @@ public:
 
     // What a crash would save: `phi` and `status` are read in place by the handler (they must
     // outlive the registration or be replaced first); the image path, the marks and the ROI's
-    // checksum (mask_checksum; none without a ROI) and the session's step are serialised now.
+    // checksum (mask_checksum; none without a ROI), the session's step and coarse start are serialised now.
     // Call again whenever the marks change or the grids move.
     void track(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum, RecordedStep step,
-               const Grid<float>& phi, const Grid<std::int8_t>& status);
+               CoarseStart coarse_start, const Grid<float>& phi, const Grid<std::int8_t>& status);
     void untrack();  // a crash now writes nothing (e.g. the work was saved)
     const std::filesystem::path& path() const { return path_; }
 

@@ -317,6 +317,7 @@ int run_view(ViewArgs& a, int threads) {
     config.autosave.recover = a.recover;
     config.autosave.step_given = a.step_given;
     config.autosave.thin_fronts_given = a.thin_fronts_given;
+    config.autosave.coarse_start_given = a.coarse_start_given;
     const std::string name = a.image.empty() ? std::string() : std::filesystem::path(a.image).filename().string();
 
     if (a.headless) {

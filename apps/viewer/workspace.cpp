@@ -261,7 +261,8 @@ void save_workspace(const fs::path& path, const Session& session, const std::str
     const std::optional<std::uint64_t> roi_fnv = session.roi() ? std::optional(mask_checksum(*session.roi())) : std::nullopt;
     const std::vector<std::uint8_t> state = encode_recovery(
         RecoveryView(image, 0, static_cast<std::int64_t>(now), m, roi_fnv, recorded_step(session.options().segmentation.step),
-                     session.field().phi(), session.field().status()));  // the JSON's "step" is the one read back
+                     session.options().coarse_start, session.field().phi(),
+                     session.field().status()));  // the JSON's "step" and "coarse_start" are the ones read back
     const Lattice& l = session.lattice();
     json seeds = json::array();
     for (const SeedBall& s : m.seeds) seeds.push_back({s.center.x, s.center.y, s.center.z, s.radius});

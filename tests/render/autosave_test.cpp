@@ -21,6 +21,7 @@
 #include "liveset/phantom/phantom.hpp"
 #include "liveset/session/recovery.hpp"
 #include "scratch_dir.hpp"
+#include "viewer_test_util.hpp"
 
 namespace liveset {
 namespace {
@@ -203,6 +204,46 @@ TEST(Autosave, ARestoredWorkContinuesWithItsStep) {
         ASSERT_TRUE(after.step.has_value());
         EXPECT_FALSE(after.step->sleeping);
         EXPECT_EQ(after.step->thin_fronts, ask_rule);
+    }
+}
+
+// The recovery file records the session's coarse start: work saved before its first step with
+// --coarse-start on (the 1 mm phantom's default, auto, would not start coarse), restored in a viewer
+// opened without the flag, runs coarse and ends on the φ of one uninterrupted run with `on`, bit for
+// bit, not on the default's; with --coarse-start off asked, it says so and ends on the default's.
+TEST(Autosave, ARestoredWorkContinuesWithItsCoarseStart) {
+    const Fixture& f = fixture();
+    const std::string converge = R"({"segment": "converge", "max": 3000}, {"save_phi": ")";
+    auto phi_of = [&](const std::string& name, const fs::path& rec, const std::string& head, const std::string& extra) {
+        const std::string out = (f.dir / (name + ".nii.gz")).string();
+        const CliResult r = run_cli(view(f, rec, script(f.dir, name + ".json", "[" + head + converge + out + R"("}])"), extra));
+        EXPECT_EQ(r.rc, 0) << r.err;
+        return std::pair(read_image(out), r.err);
+    };
+    fs::remove_all(f.dir / "rec_coarse_one");
+    fs::remove_all(f.dir / "rec_coarse_plain");
+    const auto [one, one_err] = phi_of("coarse_one", f.dir / "rec_coarse_one", f.seeds, "--coarse-start on");
+    const auto [plain, plain_err] = phi_of("coarse_plain", f.dir / "rec_coarse_plain", f.seeds, "");
+    ASSERT_FALSE(testing::same_bits(one, plain)) << "the coarse start changed nothing here: the test cannot tell them apart";
+    for (const bool ask_off : {false, true}) {
+        const fs::path rec = f.dir / (ask_off ? "rec_coarse_asked" : "rec_coarse");
+        fs::remove_all(rec);
+        const CliResult first = run_cli(view(f, rec, script(f.dir, "coarse_first.json", "[" + f.seeds.substr(0, f.seeds.size() - 2) + "]"), "--coarse-start on"));
+        ASSERT_EQ(first.rc, 0) << first.err;
+        const auto files = recovery_files(rec);
+        ASSERT_EQ(files.size(), 1u);
+        const RecoveryState kept = read_recovery(files[0]);
+        ASSERT_TRUE(kept.coarse_start.has_value());
+        EXPECT_EQ(*kept.coarse_start, CoarseStart::kOn);
+        EXPECT_EQ(kept.marks.iterations, 0);
+        const auto [got, err] = phi_of(ask_off ? "coarse_asked" : "coarse_next", rec, "", ask_off ? "--recover --coarse-start off" : "--recover");
+        if (!ask_off) {
+            EXPECT_NE(err.find("continued with its saved --coarse-start on"), std::string::npos) << err;
+            EXPECT_TRUE(testing::same_bits(got, one));
+        } else {
+            EXPECT_NE(err.find("continued with --coarse-start off as asked (saved with --coarse-start on)"), std::string::npos) << err;
+            EXPECT_TRUE(testing::same_bits(got, plain));
+        }
     }
 }
 

@@ -34,7 +34,7 @@ TEST(Recovery, ACrashOrTerminationSignalWritesTheTrackedState) {
     for (int sig : {SIGSEGV, SIGABRT, SIGTERM, SIGINT}) {
         const fs::path path = dir / ("crash" + std::to_string(sig) + ".lsrecovery");
         CrashRecovery crash(path);
-        crash.track(s.image, s.marks, s.roi_checksum, *s.step, s.phi, s.status);
+        crash.track(s.image, s.marks, s.roi_checksum, *s.step, *s.coarse_start, s.phi, s.status);
         ASSERT_EQ(die_by(sig), sig) << "signal " << sig;
         ASSERT_TRUE(fs::exists(path)) << "signal " << sig << " wrote no recovery file";
         EXPECT_FALSE(fs::exists(path.string() + ".part"));
@@ -49,7 +49,7 @@ TEST(Recovery, ACrashOrTerminationSignalWritesTheTrackedState) {
     {  // untracked (the work was saved): the signal writes nothing
         const fs::path path = dir / "untracked.lsrecovery";
         CrashRecovery crash(path);
-        crash.track(s.image, s.marks, s.roi_checksum, *s.step, s.phi, s.status);
+        crash.track(s.image, s.marks, s.roi_checksum, *s.step, *s.coarse_start, s.phi, s.status);
         crash.untrack();
         ASSERT_EQ(die_by(SIGTERM), SIGTERM);
         EXPECT_FALSE(fs::exists(path));

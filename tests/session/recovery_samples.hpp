@@ -29,6 +29,7 @@ inline RecoveryState sample_state() {
     s.marks.iterations = 137;
     s.roi_checksum = 0x0123456789abcdefull;
     s.step = RecordedStep{false, false};  // not the default: the exact step without the rule
+    s.coarse_start = CoarseStart::kOn;     // nor the default coarse start
     s.phi = Grid<float>(lattice);
     int k = 0;
     for (float& v : s.phi.values()) v = static_cast<float>(k++ % 11) * 0.37f - 1.5f;
@@ -61,6 +62,10 @@ inline void expect_same(const RecoveryState& a, const RecoveryState& b) {
     if (a.step && b.step) {
         EXPECT_EQ(a.step->sleeping, b.step->sleeping);
         EXPECT_EQ(a.step->thin_fronts, b.step->thin_fronts);
+    }
+    EXPECT_EQ(a.coarse_start.has_value(), b.coarse_start.has_value());
+    if (a.coarse_start && b.coarse_start) {
+        EXPECT_EQ(*a.coarse_start, *b.coarse_start);
     }
     EXPECT_TRUE(a.phi.lattice().same_geometry(b.phi.lattice(), 0.0));
     ASSERT_EQ(a.phi.size(), b.phi.size());

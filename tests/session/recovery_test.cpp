@@ -50,14 +50,19 @@ std::size_t spacing_offset(const RecoveryState& s) { return dims_offset(s) + 12;
 std::size_t params_offset(const RecoveryState& s) { return spacing_offset(s) + 15 * 8; }
 std::size_t roi_offset(const RecoveryState& s) { return params_offset(s) + 5 * 8 + 1 + 4 + 4 + s.marks.seeds.size() * 32; }
 std::size_t step_offset(const RecoveryState& s) { return roi_offset(s) + 1 + 8; }
-std::size_t voxels_offset(const RecoveryState& s) { return step_offset(s) + 2; }
+std::size_t coarse_offset(const RecoveryState& s) { return step_offset(s) + 2; }
+std::size_t voxels_offset(const RecoveryState& s) { return coarse_offset(s) + 1; }
 
-// The same state in an older layout: `version` 1-4 recorded no step, 1-3 no ROI, 1 and 2 had no
-// smoothing σ after α.
+// The same state in an older layout: `version` 1-5 recorded no coarse start, 1-4 no step, 1-3 no
+// ROI, 1 and 2 had no smoothing σ after α.
 std::vector<std::uint8_t> older(const RecoveryState& s, std::uint32_t version) {
     std::vector<std::uint8_t> bytes = encode_recovery(s);
-    const auto step = bytes.begin() + static_cast<std::ptrdiff_t>(step_offset(s));
-    bytes.erase(step, step + 2);
+    const auto coarse = bytes.begin() + static_cast<std::ptrdiff_t>(coarse_offset(s));
+    bytes.erase(coarse, coarse + 1);
+    if (version < 5) {
+        const auto step = bytes.begin() + static_cast<std::ptrdiff_t>(step_offset(s));
+        bytes.erase(step, step + 2);
+    }
     if (version < 4) {
         const auto roi = bytes.begin() + static_cast<std::ptrdiff_t>(roi_offset(s));
         bytes.erase(roi, roi + 9);
@@ -79,11 +84,19 @@ TEST(Recovery, EncodedStateDecodesBitForBit) {
     expect_same(s, decode_recovery(bytes.data(), bytes.size()));
 }
 
-// small_v5 is small (version 1) in today's layout: σ 0 and "no ROI" inserted, the exact step with
-// the rule, the version and checksum rewritten.
+// small_v5 is small (version 1) in version 5's layout: σ 0 and "no ROI" inserted, the exact step
+// with the rule, the version and checksum rewritten; small_v6 is small_v5 in today's layout, with
+// the coarse start off inserted.
 TEST(Recovery, TheFuzzingSeedsAreValidFiles) {
+    const RecoveryState v6 = read_recovery(fs::path(LIVESET_SOURCE_DIR) / "fuzz/corpus/recovery/small_v6.lsrecovery");
+    ASSERT_TRUE(v6.coarse_start.has_value());  // today's version
+    EXPECT_EQ(*v6.coarse_start, CoarseStart::kOff);
     const RecoveryState v5 = read_recovery(fs::path(LIVESET_SOURCE_DIR) / "fuzz/corpus/recovery/small_v5.lsrecovery");
-    ASSERT_TRUE(v5.step.has_value());  // today's version: the exact step with the rule
+    EXPECT_FALSE(v5.coarse_start.has_value());
+    RecoveryState v5_as_v6 = v5;
+    v5_as_v6.coarse_start = CoarseStart::kOff;
+    expect_same(v6, v5_as_v6);
+    ASSERT_TRUE(v5.step.has_value());  // version 5: the exact step with the rule
     EXPECT_FALSE(v5.step->sleeping);
     EXPECT_TRUE(v5.step->thin_fronts);
     EXPECT_TRUE(v5.roi_recorded);
@@ -135,7 +148,7 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
     auto f32 = [](float v) { std::vector<std::uint8_t> b(4); std::memcpy(b.data(), &v, 4); return b; };
     const std::vector<Case> cases{
         {"wrong magic", 0, {'N', 'I', 'F', 'T'}, "wrong magic"},
-        {"version 6", 8, u32(6), "version 6"},
+        {"version 7", 8, u32(7), "version 7"},
         {"version 0", 8, u32(0), "version 0"},
         {"path length beyond the file", kPathLength, u32(1000000), "too long"},
         {"zero dimension", dims_offset(s), i32(0), "invalid geometry"},
@@ -156,6 +169,7 @@ TEST(Recovery, DamagedFieldsAreRefusedWithTheirReason) {
         {"a ROI checksum without a ROI", roi_offset(s), {0}, "without a ROI"},
         {"step 2", step_offset(s), {2}, "invalid step"},
         {"thin-front flag 2", step_offset(s) + 1, {2}, "invalid step"},
+        {"coarse start 3", coarse_offset(s), {3}, "invalid coarse start"},
         {"voxel count off by one", voxels_offset(s), u64(s.phi.size() + 1), "voxel count"},
         {"NaN in phi", voxels_offset(s) + 8 + 4 * 17, f32(std::numeric_limits<float>::quiet_NaN()), "NaN"},
         {"infinity in phi", voxels_offset(s) + 8, f32(std::numeric_limits<float>::infinity()), "NaN or infinite"},
@@ -199,6 +213,7 @@ TEST(Recovery, VersionTwoFilesReadWithoutSmoothing) {
     expected.roi_recorded = false;
     expected.roi_checksum.reset();
     expected.step.reset();
+    expected.coarse_start.reset();
     expect_same(old, expected);  // everything else as saved, φ and statuses bit for bit
 }
 
@@ -211,6 +226,7 @@ TEST(Recovery, TheROIIsRecordedAndOlderFilesSayTheyRecordedNone) {
     expected.roi_recorded = false;
     expected.roi_checksum.reset();
     expected.step.reset();
+    expected.coarse_start.reset();
     expect_same(decode_recovery(v3.data(), v3.size()), expected);
     s.roi_checksum.reset();
     const std::vector<std::uint8_t> none = encode_recovery(s);
@@ -239,6 +255,7 @@ TEST(Recovery, TheStepIsRecordedAndOlderFilesSayTheyRecordedNone) {
     const std::vector<std::uint8_t> v4 = older(s, 4);
     RecoveryState expected = s;
     expected.step.reset();
+    expected.coarse_start.reset();
     expect_same(decode_recovery(v4.data(), v4.size()), expected);
     for (const bool sleeping : {false, true})
         for (const bool thin : {false, true}) {
@@ -256,6 +273,28 @@ TEST(Recovery, TheStepIsRecordedAndOlderFilesSayTheyRecordedNone) {
     EXPECT_TRUE(recorded_step(segment_step()) == RecordedStep{});  // the default: sleeping, with the rule
     EXPECT_EQ(describe(RecordedStep{false, false}), "--step exact --no-thin-fronts");
     EXPECT_EQ(describe(RecordedStep{}), "--step sleeping --thin-fronts");
+}
+
+// Version 6 records the session's coarse start from seeds (auto, on or off); version 5 recorded
+// none, and reads as such (the command line's continues it), all else as saved.
+TEST(Recovery, TheCoarseStartIsRecordedAndOlderFilesSayTheyRecordedNone) {
+    const RecoveryState s = sample_state();
+    ASSERT_TRUE(s.coarse_start.has_value());
+    const std::vector<std::uint8_t> v5 = older(s, 5);
+    RecoveryState expected = s;
+    expected.coarse_start.reset();
+    expect_same(decode_recovery(v5.data(), v5.size()), expected);
+    const std::pair<CoarseStart, std::uint8_t> modes[] = {{CoarseStart::kAuto, 0}, {CoarseStart::kOn, 1}, {CoarseStart::kOff, 2}};
+    for (const auto& [mode, byte] : modes) {
+        RecoveryState t = s;
+        t.coarse_start = mode;
+        const std::vector<std::uint8_t> bytes = encode_recovery(t);
+        EXPECT_EQ(bytes[coarse_offset(t)], byte) << to_string(mode);
+        const RecoveryState back = decode_recovery(bytes.data(), bytes.size());
+        ASSERT_TRUE(back.coarse_start.has_value());
+        EXPECT_EQ(*back.coarse_start, mode);
+        expect_same(t, back);
+    }
 }
 
 TEST(Recovery, FilesAreWrittenWholeOrNotAtAll) {

@@ -20,7 +20,7 @@ static_assert(std::endian::native == std::endian::little, "recovery files are wr
 namespace {
 
 constexpr char kMagic[8] = {'L', 'S', 'R', 'E', 'C', 'O', 'V', '1'};
-constexpr std::uint32_t kVersion = 5;  // 1: the flags byte held window_from_seeds only; 2: no smooth_mm; 3: no ROI; 4: no step
+constexpr std::uint32_t kVersion = 6;  // 1: the flags byte held window_from_seeds only; 2: no smooth_mm; 3: no ROI; 4: no step; 5: no coarse start
 constexpr std::uint32_t kMaxPath = 4096;
 constexpr std::uint32_t kMaxSeeds = 100000;
 
@@ -36,7 +36,7 @@ void put(std::vector<std::uint8_t>& out, T value) {
 namespace recovery_format {
 
 std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum,
-                                        RecordedStep step, const Lattice& lattice) {
+                                        RecordedStep step, CoarseStart coarse_start, const Lattice& lattice) {
     if (image.size() > kMaxPath) throw std::runtime_error("recovery: the image path is too long");
     if (marks.seeds.size() > kMaxSeeds) throw std::runtime_error("recovery: too many seeds");
     std::vector<std::uint8_t> out;
@@ -63,6 +63,7 @@ std::vector<std::uint8_t> encode_header(const std::string& image, const SessionM
     put(out, roi_checksum.value_or(0));
     put(out, static_cast<std::uint8_t>(step.sleeping ? 1 : 0));
     put(out, static_cast<std::uint8_t>(step.thin_fronts ? 1 : 0));
+    put(out, static_cast<std::uint8_t>(coarse_start == CoarseStart::kAuto ? 0 : coarse_start == CoarseStart::kOn ? 1 : 2));
     put(out, static_cast<std::uint64_t>(lattice.size()));
     return out;
 }
@@ -143,7 +144,8 @@ std::filesystem::path recovery_path(const std::filesystem::path& dir, const std:
 
 std::vector<std::uint8_t> encode_recovery(const RecoveryView& state) {
     if (state.status.size() != state.phi.size()) throw std::runtime_error("recovery: status and phi differ in size");
-    std::vector<std::uint8_t> out = recovery_format::encode_header(state.image, state.marks, state.roi_checksum, state.step, state.phi.lattice());
+    std::vector<std::uint8_t> out = recovery_format::encode_header(state.image, state.marks, state.roi_checksum, state.step, state.coarse_start,
+                                                                              state.phi.lattice());
     const auto sig = static_cast<std::uint32_t>(state.signal);
     std::memcpy(out.data() + kSignalOffset, &sig, sizeof sig);
     std::memcpy(out.data() + kTimeOffset, &state.unix_time, sizeof state.unix_time);
@@ -245,6 +247,11 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
         const std::uint8_t thin_fronts = r.get<std::uint8_t>("step");
         if (sleeping > 1 || thin_fronts > 1) throw std::runtime_error("invalid step");
         s.step = RecordedStep{sleeping == 1, thin_fronts == 1};
+    }
+    if (version >= 6) {
+        const std::uint8_t coarse = r.get<std::uint8_t>("coarse start");
+        if (coarse > 2) throw std::runtime_error("invalid coarse start");
+        s.coarse_start = coarse == 0 ? CoarseStart::kAuto : coarse == 1 ? CoarseStart::kOn : CoarseStart::kOff;
     }
     const std::uint64_t voxels = r.get<std::uint64_t>("voxel count");
     if (voxels != lattice.size()) throw std::runtime_error("the voxel count does not match the dimensions");

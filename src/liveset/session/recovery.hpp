@@ -2,18 +2,20 @@
 // periodically, at exit without saving, and from a crash signal handler, so that the next start can
 // offer to restore it. One small binary format of our own (little-endian):
 //
-//   "LSRECOV1"  u32 version (5)  u32 signal (0: autosave)  i64 unix time
+//   "LSRECOV1"  u32 version (6)  u32 signal (0: autosave)  i64 unix time
 //   u32 n + n bytes: the image's path          i32 dims[3]  f64 spacing[3] origin[3] direction[9]
 //   f64 µ ε n α σ  u8 flags  i32 iterations  u32 seeds + (f64 x y z radius) per seed
 //   u8 ROI (0: none, 1: one)  u64 its mask_checksum (0 without one)
 //   u8 step (0: exact, 1: sleeping)  u8 thin-front rule (0: off, 1: on)
+//   u8 coarse start (0: auto, 1: on, 2: off)
 //   u64 voxels (= dims product)  f32 φ[voxels]  i8 sparse-field status[voxels]
 //   u64 FNV-1a of every byte before it
 //
 // flags: bit 0 window_from_seeds, bit 1 alpha_automatic (version 1, still read, had bit 0 only;
 // versions 1 and 2 have no smoothing σ: read as 0 - with a fixed α as they ran; an automatic α
 // takes today's rule, blur included, when the session next builds its speed; versions 1-3 record
-// no ROI: RecoveryState::roi_recorded false; versions 1-4 record no step: RecoveryState::step none).
+// no ROI: RecoveryState::roi_recorded false; versions 1-4 record no step: RecoveryState::step none;
+// versions 1-5 record no coarse start: RecoveryState::coarse_start none).
 // The viewer's crash path (apps/viewer/crash_recovery) writes the same bytes with async-signal-safe
 // calls only, from the pieces in recovery_format. Every read is checked (sizes, magic, checksum,
 // geometry) and refused with one line. Standard library only.
@@ -26,6 +28,7 @@
 #include <vector>
 
 #include "liveset/grid/grid.hpp"
+#include "liveset/segment/coarse_start.hpp"  // CoarseStart
 #include "liveset/segment/segmentation.hpp"  // RecordedStep
 #include "liveset/session/edit_history.hpp"
 
@@ -41,6 +44,7 @@ struct RecoveryState {
     bool roi_recorded = true;
     std::optional<std::uint64_t> roi_checksum;
     std::optional<RecordedStep> step;  // the session's global step (version 5; older files record none)
+    std::optional<CoarseStart> coarse_start;  // the session's coarse start from seeds (version 6; older files record none)
     Grid<float> phi;             // < 0 inside, with the image's geometry
     Grid<std::int8_t> status;    // the sparse field's layer of each point (same lattice)
 };
@@ -57,20 +61,24 @@ std::string roi_difference(std::optional<std::uint64_t> saved, std::optional<std
 // serialises the session's grids without copying them first. A RecoveryState converts to it.
 struct RecoveryView {
     RecoveryView(const std::string& image_, int signal_, std::int64_t unix_time_, const SessionMarks& marks_,
-                 std::optional<std::uint64_t> roi_checksum_, RecordedStep step_, const Grid<float>& phi_, const Grid<std::int8_t>& status_)
-        : image(image_), signal(signal_), unix_time(unix_time_), marks(marks_), roi_checksum(roi_checksum_), step(step_), phi(phi_),
-          status(status_) {}
+                 std::optional<std::uint64_t> roi_checksum_, RecordedStep step_, CoarseStart coarse_start_, const Grid<float>& phi_,
+                 const Grid<std::int8_t>& status_)
+        : image(image_), signal(signal_), unix_time(unix_time_), marks(marks_), roi_checksum(roi_checksum_), step(step_),
+          coarse_start(coarse_start_), phi(phi_), status(status_) {}
     // Implicit on purpose. A state read from a version 1-3 file (roi_recorded false) is written as
-    // one saved without a ROI, and one from a version 1-4 file (no step) with the default step:
-    // nothing re-encodes such a state but the tests and the fuzzer.
+    // one saved without a ROI, one from a version 1-4 file (no step) with the default step, and one
+    // from a version 1-5 file (no coarse start) with `auto`: nothing re-encodes such a state but
+    // the tests and the fuzzer.
     RecoveryView(const RecoveryState& s)
-        : RecoveryView(s.image, s.signal, s.unix_time, s.marks, s.roi_checksum, s.step.value_or(RecordedStep{}), s.phi, s.status) {}
+        : RecoveryView(s.image, s.signal, s.unix_time, s.marks, s.roi_checksum, s.step.value_or(RecordedStep{}),
+                       s.coarse_start.value_or(CoarseStart::kAuto), s.phi, s.status) {}
     const std::string& image;
     int signal;
     std::int64_t unix_time;
     const SessionMarks& marks;
     std::optional<std::uint64_t> roi_checksum;  // mask_checksum of the session's ROI; none without one
     RecordedStep step;
+    CoarseStart coarse_start;
     const Grid<float>& phi;
     const Grid<std::int8_t>& status;
 };
@@ -112,7 +120,7 @@ struct Fnv {
 // The file up to and including the voxel count, with signal 0 and time 0. Throws
 // std::runtime_error when the path or the seed list is too long for the format.
 std::vector<std::uint8_t> encode_header(const std::string& image, const SessionMarks& marks, std::optional<std::uint64_t> roi_checksum,
-                                        RecordedStep step, const Lattice& lattice);
+                                        RecordedStep step, CoarseStart coarse_start, const Lattice& lattice);
 }  // namespace recovery_format
 
 }  // namespace liveset

@@ -393,6 +393,11 @@ void Session::set_step(const StepOptions& step) {
     coarse_.reset();  // the coarse start's run steps as the session does: begun again
 }
 
+void Session::set_coarse_start(CoarseStart mode) {
+    options_.coarse_start = mode;
+    coarse_.reset();
+}
+
 void Session::set_repair_options(const RepairOptions& options) {
     validate(options);
     repair_options_ = options;

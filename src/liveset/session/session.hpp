@@ -187,6 +187,9 @@ public:
     // The global step from the next one on (a recovery file's, restored: StepOptions as `liveset
     // view --step` builds them). Throws std::invalid_argument (changing nothing) on invalid options.
     void set_step(const StepOptions& step);
+    // The coarse start from seeds from the next step on (a recovery file's or a workspace's,
+    // restored before the first step): SessionOptions::coarse_start; a coarse run under way begins again.
+    void set_coarse_start(CoarseStart mode);
     // The sleeping step's memory, saved with φ and the statuses (a workspace) so that a continued
     // session steps bit for bit as the uninterrupted one; restore it after load_recovered().
     ActivitySnapshot activity_snapshot() const { return field_.activity_snapshot(speed_ ? speed_->serial() : 0); }
