@@ -69,6 +69,8 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
     viewer.frame(window.id(), width, height, 1.0 / 60.0);  // the first picture (not timed)
     std::vector<double> frame_ms, step_counts;
     double level_set = 0, mesh = 0, upload = 0, draw = 0;  // summed over the run's frames
+    FrameStats worst;  // the slowest frame's parts
+    double worst_ms = -1.0;
     const auto v0 = Clock::now();
     viewer.set_segment_running(true);
     while (viewer.segment_running()) {
@@ -80,6 +82,10 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
         viewer.frame(window.id(), width, height, 1.0 / 60.0);
         frame_ms.push_back(ms_since(f0));
         const FrameStats& fs = viewer.last_frame();
+        if (frame_ms.back() > worst_ms) {
+            worst_ms = frame_ms.back();
+            worst = fs;
+        }
         step_counts.push_back(fs.segment_steps);
         level_set += fs.level_set_ms;
         mesh += fs.mesh_ms;
@@ -98,7 +104,9 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
                               {"identical_phi", identical}, {"frames", frame_ms.size()},
                               {"frame_ms_median", f.median}, {"frame_ms_worst", f.worst},
                               {"steps_per_frame_median", st.median}, {"triangles", s->mesher().triangle_count()},
-                              {"level_set_ms", level_set}, {"mesh_ms", mesh}, {"upload_ms", upload}, {"draw3d_ms", draw}};
+                              {"level_set_ms", level_set}, {"mesh_ms", mesh}, {"upload_ms", upload}, {"draw3d_ms", draw},
+                              {"worst_frame", {{"ms", worst_ms}, {"wait_ms", worst.wait_ms}, {"mesh_ms", worst.mesh_ms},
+                                               {"upload_ms", worst.upload_ms}, {"draw3d_ms", worst.draw_ms}}}};
     if (o.json) {
         fmt::print("{}\n", j.dump());
     } else {
@@ -111,6 +119,8 @@ int run_segment_bench(Viewer& viewer, const BenchOptions& o, int width, int heig
         fmt::print("  viewer time in: level set (steps) {:.1f} s, meshing {:.1f} s, upload {:.1f} s, 3D draws {:.1f} s, "
                    "the rest (slice panes, panel, history) {:.1f} s\n",
                    level_set / 1e3, mesh / 1e3, upload / 1e3, draw / 1e3, (viewer_ms - level_set - mesh - upload - draw) / 1e3);
+        fmt::print("  worst frame          {:9.1f} ms: waiting for the run's step {:.1f}, meshing {:.1f}, upload {:.1f}, 3D draw {:.1f}\n",
+                   worst_ms, worst.wait_ms, worst.mesh_ms, worst.upload_ms, worst.draw_ms);
         fmt::print("  viewer / CLI         {:9.3f}   φ identical bit for bit: {}\n", viewer_ms / cli_ms, identical ? "yes" : "NO");
     }
     return identical ? 0 : 1;

@@ -202,6 +202,7 @@ void Viewer::push_event(const InputEvent& event) {
 void Viewer::frame(GLuint target, int width, int height, double dt_seconds) {
     const auto t0 = Clock::now();
     begin_handover();  // a background run's worker waits between steps until end_handover()
+    current_.wait_ms += ms_since(t0);
     set_window_size(width, height);
     fit_3d_if_pending();
     log_.set_frame(frames_);

@@ -69,6 +69,7 @@ struct InputEvent {
 // What one frame cost (milliseconds) and did.
 struct FrameStats {
     double level_set_ms = 0.0, agents_ms = 0.0, mesh_ms = 0.0, upload_ms = 0.0, draw_ms = 0.0;
+    double wait_ms = 0.0;            // waiting for a background run's hand-over (the worker's step in progress)
     std::size_t fragments = 0;       // rebuilt by the mesher this frame
     std::size_t uploaded = 0;        // fragment buffers re-uploaded this frame
     std::size_t triangles = 0;       // on the GPU after the frame

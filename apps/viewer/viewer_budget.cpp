@@ -90,10 +90,17 @@ void Viewer::render_3d(const render::Framebuffer& fb) {
     if (runner_) runner_->release();  // the draw reads only GPU buffers and copies: the worker may step meanwhile
     scene_renderer_->render(fb, camera_, content, scene_style);
     glFinish();  // llvmpipe draws at flush time: count the drawing in this frame
-    if (runner_) runner_->acquire();
     const double ms = ms_since(t0);
     current_.draw_ms += ms;
-    if (!view3d_coarse_ && !preview && !capturing_) budget_.record_full_draw(ms);
+    if (runner_) {  // the hand-over back: after the step the worker began meanwhile
+        const auto w0 = Clock::now();
+        runner_->acquire();
+        current_.wait_ms += ms_since(w0);
+    }
+    // The coarse start's front, drawn at half the resolution: the image's grid's surface of that front
+    // has about 2² times its triangles, so the frame after the switch knows to draw the level of
+    // detail rather than meshing and drawing a whole fine surface at full quality first.
+    if (!view3d_coarse_ && !capturing_) budget_.record_full_draw(preview ? 4.0 * ms : ms);
 }
 
 void Viewer::render_dirty_panes() {
