@@ -1,6 +1,7 @@
 // Recovery files: encoding, strict decoding, atomic writes (the crash-signal writer is the viewer's).
 #include "liveset/session/recovery.hpp"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -23,6 +24,8 @@ constexpr char kMagic[8] = {'L', 'S', 'R', 'E', 'C', 'O', 'V', '1'};
 constexpr std::uint32_t kVersion = 6;  // 1: the flags byte held window_from_seeds only; 2: no smooth_mm; 3: no ROI; 4: no step; 5: no coarse start
 constexpr std::uint32_t kMaxPath = 4096;
 constexpr std::uint32_t kMaxSeeds = 100000;
+// The coarse start's byte in the file is its index here.
+constexpr std::array<CoarseStart, 3> kCoarseStarts{CoarseStart::kAuto, CoarseStart::kOn, CoarseStart::kOff};
 
 template <class T>
 void put(std::vector<std::uint8_t>& out, T value) {
@@ -63,7 +66,7 @@ std::vector<std::uint8_t> encode_header(const std::string& image, const SessionM
     put(out, roi_checksum.value_or(0));
     put(out, static_cast<std::uint8_t>(step.sleeping ? 1 : 0));
     put(out, static_cast<std::uint8_t>(step.thin_fronts ? 1 : 0));
-    put(out, static_cast<std::uint8_t>(coarse_start == CoarseStart::kAuto ? 0 : coarse_start == CoarseStart::kOn ? 1 : 2));
+    put(out, static_cast<std::uint8_t>(std::ranges::find(kCoarseStarts, coarse_start) - kCoarseStarts.begin()));
     put(out, static_cast<std::uint64_t>(lattice.size()));
     return out;
 }
@@ -250,8 +253,8 @@ RecoveryState decode_recovery(const std::uint8_t* data, std::size_t size) {
     }
     if (version >= 6) {
         const std::uint8_t coarse = r.get<std::uint8_t>("coarse start");
-        if (coarse > 2) throw std::runtime_error("invalid coarse start");
-        s.coarse_start = coarse == 0 ? CoarseStart::kAuto : coarse == 1 ? CoarseStart::kOn : CoarseStart::kOff;
+        if (coarse >= kCoarseStarts.size()) throw std::runtime_error("invalid coarse start");
+        s.coarse_start = kCoarseStarts[coarse];
     }
     const std::uint64_t voxels = r.get<std::uint64_t>("voxel count");
     if (voxels != lattice.size()) throw std::runtime_error("the voxel count does not match the dimensions");

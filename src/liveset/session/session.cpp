@@ -310,9 +310,10 @@ void Session::ensure_speed() {
 
 // The coarse start is due while φ is the union of the seeds (no step, edit or load since) on a grid
 // where it applies; it then runs until its end replaces that union (marks_.pristine false).
-const SparseField* Session::coarse_field() const {
-    return coarse_ && coarse_inputs_ == inputs_ && speed_ && coarse_speed_ == speed_->serial() && coarse_start_due() ? &coarse_->field()
-                                                                                                           : nullptr;
+const SparseField* Session::coarse_field() const { return coarse_run_current() && coarse_start_due() ? &coarse_->field() : nullptr; }
+
+bool Session::coarse_run_current() const {
+    return coarse_ && coarse_inputs_ == inputs_ && speed_ && coarse_speed_ == speed_->serial();
 }
 
 bool Session::coarse_start_due() const {
@@ -328,7 +329,7 @@ SessionUpdate Session::coarse_step() {
     begin_action("segment");  // the run's action, as a fine step's (its coarse iterations record nothing)
     const auto t0 = Clock::now();
     ensure_speed();
-    if (!coarse_ || coarse_inputs_ != inputs_ || coarse_speed_ != speed_->serial()) {
+    if (!coarse_run_current()) {
         coarse_.reset();
         coarse_ = std::make_unique<CoarseRun>(*speed_, lattice(), roi(), marks_.seeds, options_.segmentation, options_.layers);
         coarse_inputs_ = inputs_;

@@ -284,6 +284,8 @@ private:
     void make_repair_loop();
     void ensure_speed();
     bool coarse_start_due() const;
+    // coarse_ exists and was begun on the inputs and the speed the session has now.
+    bool coarse_run_current() const;
     SessionUpdate coarse_step();
 
     SessionOptions options_;
