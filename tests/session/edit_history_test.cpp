@@ -205,5 +205,38 @@ TEST(EditHistory, RecordDifferencesIsTheBruteForceDifferenceWithItsSignChanges) 
     expect_same(snapshot(f), start, "undone", 0);
 }
 
+// A whole-state replacement large enough for the commit's parallel parts (some 130 000 recorded
+// points, several parts of the list): X is the brute-force difference in index order, undo gives
+// back the start and redo the replacement bit for bit, and a point brought back to its old state
+// before the commit is left out of the action (its memory: only the points that changed).
+TEST(EditHistory, ALargeWholeStateActionIsExactInEveryPartOfItsLists) {
+    const Lattice lat({100, 90, 80});
+    SparseField f(lat, 2);
+    f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{30, 45, 40}) - 25.0; });
+    EditHistory h(f, 32);
+    const Snapshot start = snapshot(f);
+    h.begin("whole", {});
+    f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{70, 45, 40}) - 25.0; });
+    const ChangedPoints x = h.record_differences(f);
+    std::vector<PointIndex> expected;
+    for (std::size_t i = 0; i < lat.size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if (std::bit_cast<std::uint32_t>(f.phi()[p]) != start.phi_bits[i] || f.status()[p] != start.status[i]) expected.push_back(p);
+    }
+    ASSERT_GT(expected.size(), 100000u);
+    EXPECT_EQ(x.points, expected);
+    // One recorded point put back as it was: the commit leaves it out.
+    const PointIndex back = expected[expected.size() / 3];
+    f.restore(std::vector<PointState>{{back, std::bit_cast<float>(start.phi_bits[back]), start.status[back]}});
+    const Snapshot end = snapshot(f);
+    ASSERT_TRUE(h.commit(f, {}));
+    EXPECT_LT(h.bytes(), 2 * expected.size() * sizeof(PointState) + 4096);
+    EXPECT_GE(h.bytes(), 2 * (expected.size() - 1) * sizeof(PointState));
+    h.undo(f);
+    expect_same(snapshot(f), start, "undone", 0);
+    h.redo(f);
+    expect_same(snapshot(f), end, "redone", 0);
+}
+
 }  // namespace
 }  // namespace liveset

@@ -144,13 +144,17 @@ void SparseField::band_from_phi(Vec3i lo, Vec3i hi, bool steep_possible) {
         phi_[i] = phi_[i] < 0 ? -far : far;
         return false;
     });
-    for (PointIndex i : zero) list_add(i, 0);
-    // Every other point is far: the sweep reaches the new layers from the zero layer.
+    // Every other point is far: the sweep reaches the new layers from the zero layer, keeping
+    // each level's points, which become the outer lists as a whole-band repair rebuilds its lists
+    // (relist: the zero list in index order, slots written when next needed); the lists are empty
+    // here (clear_lists), so no point is moved between them one by one.
     std::vector<RegionPoint> region;
     region.reserve(zero.size() * (2 * static_cast<std::size_t>(layers_) + 1));
     for (PointIndex i : zero) mark_pending(i, region);
-    sweep_whole_band(region, zero);
-    finish(region);
+    sweep_whole_band(region, zero, /*keep_levels=*/true);
+    finish(region, /*rebuilding_lists=*/true);
+    PointList zero_list(zero.begin(), zero.end());
+    relist(zero_list);
     // The sweep's level buffers are not kept: an initialisation reaches the whole band at once,
     // which no incremental step does on a large front (those repair locally, or sweep a front of
     // at most StepOptions::dense_front_max points); a 0.5 mm brain's are 120 MB. A kFullBand step

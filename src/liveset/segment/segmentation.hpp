@@ -123,7 +123,9 @@ public:
     bool converged(std::size_t zero_layer);
 
 private:
-    std::vector<std::uint8_t> inside_;
+    // One byte per point, first touched by the constructor's pass on every thread (the grid's
+    // allocator: left unset until written, huge-page blocks), not by a serial zero fill.
+    std::vector<std::uint8_t, detail::GridAllocator<std::uint8_t>> inside_;
     std::size_t inside_count_ = 0;
     std::deque<std::size_t> recent_;
     int window_;

@@ -29,10 +29,15 @@ struct SessionMarks {
     int iterations = 0;             // segmentation steps taken
 };
 
+// An action's point states: elements left unset until written and arrays of 4 MiB or more on
+// huge-page blocks (grid.hpp's allocator), so that the millions of states of a fine scan's run are
+// first touched by the parallel passes that write them, a page fault per 2 MiB.
+using StateList = std::vector<PointState, detail::GridAllocator<PointState>>;
+
 // One undoable action.
 struct EditAction {
     std::string label;
-    std::vector<PointState> before, after;  // the same points, in the same order
+    StateList before, after;  // the same points, in the same order
     SessionMarks marks_before, marks_after;
     std::size_t bytes() const;
 };

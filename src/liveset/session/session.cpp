@@ -1,6 +1,8 @@
 // Session: every change of φ goes through Session::edit, then to the history and the mesher.
 #include "liveset/session/session.hpp"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <bit>
 #include <chrono>
@@ -35,6 +37,41 @@ const SessionOptions& checked(const SessionOptions& o) {
     validate(o.repair);
     validate(o.params);
     return o;
+}
+
+// Appends to `list` the points of `add` whose flag `bit` is clear, setting it: X joined into the
+// points deferred for the mesher, each once, in order. A strictly increasing `add` of many points
+// (a whole-state change: the coarse start's end lists 11 M at 0.5 mm) in fixed parts in parallel,
+// counted, then written at each part's offset (its points are distinct: each flag is one part's);
+// any other one point by point.
+void append_unflagged(UninitVector<PointIndex>& list, Grid<std::uint8_t>& flags, std::span<const PointIndex> add, std::uint8_t bit) {
+    constexpr std::size_t kGrain = std::size_t{1} << 15, kParts = 64;
+    const std::size_t n = add.size();
+    if (n < 2 * kGrain || voxel_loops::count_if(n - 1, [&](std::size_t k) { return add[k] >= add[k + 1]; }) != 0) {
+        for (PointIndex p : add)
+            if (!(flags[p] & bit)) {
+                list.push_back(p);
+                flags[p] |= bit;
+            }
+        return;
+    }
+    const std::size_t parts = std::min(n / kGrain, kParts);
+    const auto part = [&](std::size_t k) { return add.subspan(n * k / parts, n * (k + 1) / parts - n * k / parts); };
+    std::vector<std::size_t> offset(parts + 1, 0);
+    offset[0] = list.size();
+    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t k) {
+        for (PointIndex p : part(k)) offset[k + 1] += (flags[p] & bit) ? 0 : 1;
+    });
+    for (std::size_t k = 0; k < parts; ++k) offset[k + 1] += offset[k];
+    list.resize(offset[parts]);
+    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t k) {
+        std::size_t at = offset[k];
+        for (PointIndex p : part(k))
+            if (!(flags[p] & bit)) {
+                list[at++] = p;
+                flags[p] |= bit;
+            }
+    });
 }
 
 // Whether `field` is the union of the seeds' balls as add_seed and init_from_seeds make it: φ's
@@ -132,7 +169,7 @@ bool Session::load_recovered(const Grid<float>& phi, const Grid<std::int8_t>& st
 }
 
 void Session::reset_after_load() {
-    for (PointIndex p : pending_) pending_flags_[p] = 0;  // the full rebuild covers them
+    clear_pending_flags();  // the full rebuild covers them
     pending_.clear();
     pending_signs_.clear();
     pending_signs_known_ = true;
@@ -563,17 +600,8 @@ SessionUpdate Session::finish_update(ChangedPoints changed, double level_set_ms)
     if (defer_mesh_) {
         // pending_flags_: bit 0 in pending_, bit 1 in pending_signs_ (a subset: a sign change is a change).
         if (!changed.sign_changes && !changed.points.empty()) pending_signs_known_ = false;
-        if (changed.sign_changes)
-            for (PointIndex p : *changed.sign_changes)
-                if (!(pending_flags_[p] & 2)) {
-                    pending_signs_.push_back(p);
-                    pending_flags_[p] |= 2;
-                }
-        for (PointIndex p : changed.points)
-            if (!(pending_flags_[p] & 1)) {
-                pending_.push_back(p);
-                pending_flags_[p] |= 1;
-            }
+        if (changed.sign_changes) append_unflagged(pending_signs_, pending_flags_, *changed.sign_changes, 2);
+        append_unflagged(pending_, pending_flags_, changed.points, 1);
     } else {
         const auto t0 = Clock::now();
         u.fragments = changed.sign_changes ? mesher_.update(field_.phi(), changed.points, *changed.sign_changes)
@@ -599,7 +627,7 @@ void Session::set_deferred_meshing(bool on) {
     if (on == defer_mesh_) return;
     if (!on) flush_mesh();
     defer_mesh_ = on;
-    if (on) pending_flags_.assign(lattice().size(), 0);
+    if (on) pending_flags_ = Grid<std::uint8_t>(lattice(), 0);  // filled on every thread
     else pending_flags_ = {};
 }
 
@@ -610,11 +638,15 @@ double Session::flush_mesh() {
     }
     const auto t0 = Clock::now();
     queue_dirty(pending_signs_known_ ? mesher_.update(field_.phi(), pending_, pending_signs_) : mesher_.update(field_.phi(), pending_));
-    for (PointIndex p : pending_) pending_flags_[p] = 0;
+    clear_pending_flags();
     pending_.clear();
     pending_signs_.clear();
     pending_signs_known_ = true;
     return ms_since(t0);
+}
+
+void Session::clear_pending_flags() {
+    voxel_loops::for_each(pending_.size(), [&](std::size_t k) { pending_flags_[pending_[k]] = 0; });  // distinct: each flag once
 }
 
 std::vector<FragmentId> Session::take_dirty_fragments() {

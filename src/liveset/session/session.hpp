@@ -277,6 +277,7 @@ private:
     void begin_action(const char* label);  // continues an open action of the same label
     SessionUpdate finish_update(ChangedPoints changed, double level_set_ms);
     void queue_dirty(const std::vector<FragmentId>& fragments);
+    void clear_pending_flags();  // every pending point's flags cleared (pending_ holds each point once)
     void adopt_marks(const SessionMarks& marks);
     void reset_after_load();
     void refresh_window();
@@ -315,9 +316,9 @@ private:
     std::vector<std::uint8_t> dirty_flags_;
     std::vector<FragmentId> dirty_;
     bool defer_mesh_ = false;
-    std::vector<PointIndex> pending_;           // X accumulated while meshing is deferred
-    std::vector<std::uint8_t> pending_flags_;   // lattice-sized while deferring: bit 0 in pending_, bit 1 in pending_signs_
-    std::vector<PointIndex> pending_signs_;     // the union of their sign changes (a subset of pending_)...
+    UninitVector<PointIndex> pending_;          // X accumulated while meshing is deferred
+    Grid<std::uint8_t> pending_flags_;          // lattice-sized while deferring: bit 0 in pending_, bit 1 in pending_signs_
+    UninitVector<PointIndex> pending_signs_;    // the union of their sign changes (a subset of pending_)...
     bool pending_signs_known_ = true;           // ...while every update with points reported them
     std::uint64_t revision_ = 0;
 };
