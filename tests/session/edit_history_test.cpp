@@ -160,6 +160,18 @@ TEST(EditHistory, KeepsAtMostItsLimitAndDropsEmptyActions) {
 namespace liveset {
 namespace {
 
+// Brute force: the points whose φ bits or status differ from `start`, or that `also` marks, in
+// index order.
+std::vector<PointIndex> differing(const SparseField& f, const Snapshot& start, const std::vector<std::uint8_t>* also = nullptr) {
+    std::vector<PointIndex> out;
+    for (std::size_t i = 0; i < f.lattice().size(); ++i) {
+        const auto p = static_cast<PointIndex>(i);
+        if ((also && (*also)[i]) || std::bit_cast<std::uint32_t>(f.phi()[p]) != start.phi_bits[i] || f.status()[p] != start.status[i])
+            out.push_back(p);
+    }
+    return out;
+}
+
 // record_differences after a whole-state replacement within an action that already recorded local
 // edits: X is exactly the points whose state differs from the action's start or that were recorded
 // earlier (brute force, index order), its sign changes hold every point whose sign differs from
@@ -181,12 +193,7 @@ TEST(EditHistory, RecordDifferencesIsTheBruteForceDifferenceWithItsSignChanges) 
     const Grid<float> before = f.phi();
     f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{22, 17, 15}) - 9.0; });  // the whole state replaced
     const ChangedPoints x = h.record_differences(f);
-    std::vector<PointIndex> expected;
-    for (std::size_t i = 0; i < lat.size(); ++i) {
-        const auto p = static_cast<PointIndex>(i);
-        if (recorded[i] || std::bit_cast<std::uint32_t>(f.phi()[p]) != start.phi_bits[i] || f.status()[p] != start.status[i])
-            expected.push_back(p);
-    }
+    const std::vector<PointIndex> expected = differing(f, start, &recorded);
     EXPECT_EQ(x.points, expected);
     ASSERT_TRUE(x.sign_changes.has_value());
     std::vector<std::uint8_t> listed(lat.size(), 0);
@@ -218,11 +225,7 @@ TEST(EditHistory, ALargeWholeStateActionIsExactInEveryPartOfItsLists) {
     h.begin("whole", {});
     f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{70, 45, 40}) - 25.0; });
     const ChangedPoints x = h.record_differences(f);
-    std::vector<PointIndex> expected;
-    for (std::size_t i = 0; i < lat.size(); ++i) {
-        const auto p = static_cast<PointIndex>(i);
-        if (std::bit_cast<std::uint32_t>(f.phi()[p]) != start.phi_bits[i] || f.status()[p] != start.status[i]) expected.push_back(p);
-    }
+    const std::vector<PointIndex> expected = differing(f, start);
     ASSERT_GT(expected.size(), 100000u);
     EXPECT_EQ(x.points, expected);
     // One recorded point put back as it was: the commit leaves it out.
