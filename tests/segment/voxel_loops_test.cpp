@@ -90,6 +90,33 @@ TEST(VoxelLoops, ReductionsFoldFixedPartsInOrder) {
         });
 }
 
+// counted_writes: the kept items in item order after `first`, as the serial filter gives them, on
+// any thread count and whatever the parts (a wrong offset drops or overwrites an item).
+TEST(VoxelLoops, CountedWritesAreTheSerialFilter) {
+    std::mt19937 rng(5);
+    std::vector<std::uint32_t> items(100000);
+    for (auto& v : items) v = rng();
+    const auto keep = [](std::uint32_t v) { return v % 3 != 0; };
+    std::vector<std::uint32_t> expected{7, 8};
+    for (std::uint32_t v : items)
+        if (keep(v)) expected.push_back(v);
+    for (const int threads : {1, 3})
+        on_threads(threads, [&] {
+            for (const std::size_t grain : {std::size_t{1} << 20, std::size_t{1000}, std::size_t{7}}) {
+                std::vector<std::uint32_t> out{7, 8};
+                voxel_loops::counted_writes(
+                    items.size(), grain, out.size(),
+                    [&](std::size_t b, std::size_t e) { return static_cast<std::size_t>(std::count_if(items.begin() + b, items.begin() + e, keep)); },
+                    [&](std::size_t total) { out.resize(total); },
+                    [&](std::size_t b, std::size_t e, std::size_t at) {
+                        for (std::size_t k = b; k < e; ++k)
+                            if (keep(items[k])) out[at++] = items[k];
+                    });
+                EXPECT_EQ(out, expected) << "grain " << grain << ", " << threads << " threads";
+            }
+        });
+}
+
 // brain_detail::histogram: its bins as the serial `+= 1.0` over the voxels in the mask within
 // [lo, hi] (the top value in the last bin; NaN, below lo and above hi left out).
 TEST(VoxelLoops, BrainHistogramCountsAsTheSerialLoop) {

@@ -87,7 +87,7 @@ void for_planes(const Lattice& lattice, Vec3i lo, Vec3i hi, int z0, int z1, cons
 // parallel, each into its own list, joined in plane order (the same list on any thread count).
 // `pick` may write point i's own entries, nothing else.
 template <class F>
-std::vector<PointIndex> pick_in_box(const Lattice& lattice, Vec3i lo, Vec3i hi, const F& pick) {
+UninitVector<PointIndex> pick_in_box(const Lattice& lattice, Vec3i lo, Vec3i hi, const F& pick) {
     const int planes = hi.z - lo.z + 1;
     std::vector<std::vector<PointIndex>> found(static_cast<std::size_t>(planes));
     tbb::parallel_for(0, planes, [&](int k) {
@@ -98,7 +98,7 @@ std::vector<PointIndex> pick_in_box(const Lattice& lattice, Vec3i lo, Vec3i hi, 
     });
     std::size_t n = 0;
     for (const auto& v : found) n += v.size();
-    std::vector<PointIndex> all;
+    UninitVector<PointIndex> all;
     all.reserve(n);
     for (const auto& v : found) all.insert(all.end(), v.begin(), v.end());
     return all;
@@ -120,7 +120,7 @@ void SparseField::band_from_phi(Vec3i lo, Vec3i hi, bool steep_possible) {
     // pulled: every point is judged on the values as evaluated).
     // A whole-lattice pass with six reads a point: skipped where no such pair can exist.
     if (steep_possible) {
-        const std::vector<PointIndex> steep = pick_in_box(lattice(), glo, ghi, [&](PointIndex i) {
+        const UninitVector<PointIndex> steep = pick_in_box(lattice(), glo, ghi, [&](PointIndex i) {
             const float v = phi_[i];
             if (std::abs(v) <= 0.5f) return false;
             bool opposite = false;
@@ -135,7 +135,7 @@ void SparseField::band_from_phi(Vec3i lo, Vec3i hi, bool steep_possible) {
     const float far = static_cast<float>(layers_ + 1);
     if (!(glo == Vec3i{0, 0, 0} && ghi == d - Vec3i{1, 1, 1})) status_.fill(far_outside());
     // Each point's own status and φ set in parallel; the zero layer listed in index order.
-    const std::vector<PointIndex> zero = pick_in_box(lattice(), glo, ghi, [&](PointIndex i) {
+    PointList zero = pick_in_box(lattice(), glo, ghi, [&](PointIndex i) {
         if (std::abs(phi_[i]) <= 0.5f) {
             status_[i] = 0;
             return true;
@@ -153,8 +153,7 @@ void SparseField::band_from_phi(Vec3i lo, Vec3i hi, bool steep_possible) {
     for (PointIndex i : zero) mark_pending(i, region);
     sweep_whole_band(region, zero, /*keep_levels=*/true);
     finish(region, /*rebuilding_lists=*/true);
-    PointList zero_list(zero.begin(), zero.end());
-    relist(zero_list);
+    relist(zero);
     // The sweep's level buffers are not kept: an initialisation reaches the whole band at once,
     // which no incremental step does on a large front (those repair locally, or sweep a front of
     // at most StepOptions::dense_front_max points); a 0.5 mm brain's are 120 MB. A kFullBand step

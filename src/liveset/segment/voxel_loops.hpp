@@ -39,6 +39,22 @@ T reduce(std::size_t n, std::size_t grain, const T& zero, const Body& body, cons
     return out;
 }
 
+// An ordered compaction over reduce's parts of [0, n): count(begin, end) what each part writes, in
+// parallel; size(total) once; then write(begin, end, at) in parallel, each part from `at` = first
+// plus the counts of the parts before it. The outputs land in item order, the same on any thread
+// count; each part must write only its own items' entries (and its own slots from `at`).
+template <class Count, class Size, class Write>
+void counted_writes(std::size_t n, std::size_t grain, std::size_t first, const Count& count, const Size& size, const Write& write) {
+    const std::size_t parts = std::clamp<std::size_t>(n / std::max<std::size_t>(grain, 1), 1, kMaxParts);
+    const auto begin = [&](std::size_t p) { return n * p / parts; };
+    std::vector<std::size_t> at(parts + 1, 0);
+    at[0] = first;
+    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t p) { at[p + 1] = count(begin(p), begin(p + 1)); });
+    for (std::size_t p = 0; p < parts; ++p) at[p + 1] += at[p];
+    size(at[parts]);
+    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t p) { write(begin(p), begin(p + 1), at[p]); });
+}
+
 // How many i in [0, n) satisfy pred(i).
 template <class P>
 std::size_t count_if(std::size_t n, const P& pred) {

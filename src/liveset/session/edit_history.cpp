@@ -3,10 +3,10 @@
 
 #include <tbb/parallel_for.h>
 
-#include <algorithm>
 #include <bit>
 #include <stdexcept>
-#include <utility>
+
+#include "liveset/segment/voxel_loops.hpp"
 
 namespace liveset {
 
@@ -16,10 +16,8 @@ namespace {
 // no sparse field uses: its layers are within ±(kMaxLayers + 1)).
 constexpr std::int8_t kRecorded = 127;
 
-// A commit's recorded states in at most kCommitParts parts of at least kCommitGrain (fixed by their
-// count alone, so the lists come out the same on any thread count).
+// A commit's recorded states in parts of at least kCommitGrain (voxel_loops::counted_writes).
 constexpr std::size_t kCommitGrain = std::size_t{1} << 15;
-constexpr std::size_t kCommitParts = 64;
 
 bool same_marks(const SessionMarks& a, const SessionMarks& b) {
     if (a.seeds.size() != b.seeds.size()) return false;
@@ -151,31 +149,30 @@ bool EditHistory::commit(const SparseField& field, SessionMarks marks_after) {
     // shadow points in parallel: counted first, then written at each part's offset into lists of
     // the exact size, in the list's order on any thread count (a 0.5 mm brain's run records 11 M).
     const StateList& recorded = action.before;
-    const std::size_t n = recorded.size();
-    const std::size_t parts = std::clamp<std::size_t>(n / kCommitGrain, 1, kCommitParts);
     const auto now = [&](const PointState& b) { return PointState{b.point, field.phi()[b.point], field.status()[b.point]}; };
-    const auto range = [&](std::size_t p) { return std::pair{n * p / parts, n * (p + 1) / parts}; };
-    std::vector<std::size_t> offset(parts + 1, 0);
-    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t p) {
-        const auto [b, e] = range(p);
-        for (std::size_t k = b; k < e; ++k) offset[p + 1] += same_state(recorded[k], now(recorded[k])) ? 0 : 1;
-    });
-    for (std::size_t p = 0; p < parts; ++p) offset[p + 1] += offset[p];
-    StateList before(offset[parts]);
-    action.after.resize(offset[parts]);
-    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t p) {
-        const auto [b, e] = range(p);
-        std::size_t at = offset[p];
-        for (std::size_t k = b; k < e; ++k) {
-            const PointState s = now(recorded[k]);
-            shadow_phi_[s.point] = s.phi;
-            shadow_status_[s.point] = s.status;
-            if (same_state(recorded[k], s)) continue;
-            before[at] = recorded[k];
-            action.after[at] = s;
-            ++at;
-        }
-    });
+    StateList before;
+    voxel_loops::counted_writes(
+        recorded.size(), kCommitGrain, 0,
+        [&](std::size_t b, std::size_t e) {
+            std::size_t kept = 0;
+            for (std::size_t k = b; k < e; ++k) kept += same_state(recorded[k], now(recorded[k])) ? 0 : 1;
+            return kept;
+        },
+        [&](std::size_t total) {
+            before.resize(total);
+            action.after.resize(total);
+        },
+        [&](std::size_t b, std::size_t e, std::size_t at) {
+            for (std::size_t k = b; k < e; ++k) {
+                const PointState s = now(recorded[k]);
+                shadow_phi_[s.point] = s.phi;
+                shadow_status_[s.point] = s.status;
+                if (same_state(recorded[k], s)) continue;
+                before[at] = recorded[k];
+                action.after[at] = s;
+                ++at;
+            }
+        });
     action.before = std::move(before);
     if (action.before.empty() && same_marks(action.marks_before, action.marks_after)) return false;
     undo_.push_back(std::move(action));

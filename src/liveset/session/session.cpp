@@ -1,12 +1,11 @@
 // Session: every change of φ goes through Session::edit, then to the history and the mesher.
 #include "liveset/session/session.hpp"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -41,13 +40,12 @@ const SessionOptions& checked(const SessionOptions& o) {
 
 // Appends to `list` the points of `add` whose flag `bit` is clear, setting it: X joined into the
 // points deferred for the mesher, each once, in order. A strictly increasing `add` of many points
-// (a whole-state change: the coarse start's end lists 11 M at 0.5 mm) in fixed parts in parallel,
-// counted, then written at each part's offset (its points are distinct: each flag is one part's);
-// any other one point by point.
+// (a whole-state change: the coarse start's end lists 11 M at 0.5 mm) by parts in parallel
+// (voxel_loops::counted_writes; its points are distinct, so each flag is one part's); any other
+// one point by point.
 void append_unflagged(UninitVector<PointIndex>& list, Grid<std::uint8_t>& flags, std::span<const PointIndex> add, std::uint8_t bit) {
-    constexpr std::size_t kGrain = std::size_t{1} << 15, kParts = 64;
-    const std::size_t n = add.size();
-    if (n < 2 * kGrain || voxel_loops::count_if(n - 1, [&](std::size_t k) { return add[k] >= add[k + 1]; }) != 0) {
+    constexpr std::size_t kGrain = std::size_t{1} << 15;
+    if (add.size() < 2 * kGrain || std::adjacent_find(add.begin(), add.end(), std::greater_equal<>()) != add.end()) {
         for (PointIndex p : add)
             if (!(flags[p] & bit)) {
                 list.push_back(p);
@@ -55,23 +53,21 @@ void append_unflagged(UninitVector<PointIndex>& list, Grid<std::uint8_t>& flags,
             }
         return;
     }
-    const std::size_t parts = std::min(n / kGrain, kParts);
-    const auto part = [&](std::size_t k) { return add.subspan(n * k / parts, n * (k + 1) / parts - n * k / parts); };
-    std::vector<std::size_t> offset(parts + 1, 0);
-    offset[0] = list.size();
-    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t k) {
-        for (PointIndex p : part(k)) offset[k + 1] += (flags[p] & bit) ? 0 : 1;
-    });
-    for (std::size_t k = 0; k < parts; ++k) offset[k + 1] += offset[k];
-    list.resize(offset[parts]);
-    tbb::parallel_for(std::size_t{0}, parts, [&](std::size_t k) {
-        std::size_t at = offset[k];
-        for (PointIndex p : part(k))
-            if (!(flags[p] & bit)) {
-                list[at++] = p;
-                flags[p] |= bit;
-            }
-    });
+    voxel_loops::counted_writes(
+        add.size(), kGrain, list.size(),
+        [&](std::size_t b, std::size_t e) {
+            std::size_t n = 0;
+            for (std::size_t k = b; k < e; ++k) n += (flags[add[k]] & bit) ? 0 : 1;
+            return n;
+        },
+        [&](std::size_t total) { list.resize(total); },
+        [&](std::size_t b, std::size_t e, std::size_t at) {
+            for (std::size_t k = b; k < e; ++k)
+                if (!(flags[add[k]] & bit)) {
+                    list[at++] = add[k];
+                    flags[add[k]] |= bit;
+                }
+        });
 }
 
 // Whether `field` is the union of the seeds' balls as add_seed and init_from_seeds make it: φ's
