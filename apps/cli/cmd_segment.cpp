@@ -3,9 +3,14 @@
 // run and writes nothing.
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -103,6 +108,36 @@ int report_interrupt(const SegmentOutcome& o, bool quiet) {
     return 130;
 }
 
+// The wall time of a run's consecutive phases (the report's "phase_seconds", the summary's "time"
+// line): where a fine scan's seconds go (docs/BENCHMARKS.md, session 85).
+class PhaseTimes {
+public:
+    void mark(const char* phase) {
+        const auto now = Clock::now();
+        phases_.emplace_back(phase, std::chrono::duration<double>(now - last_).count());
+        last_ = now;
+    }
+    nlohmann::json json() const {
+        nlohmann::json j = nlohmann::json::object();
+        for (const auto& [name, s] : phases_) j[name] = s;
+        j["total"] = std::chrono::duration<double>(last_ - start_).count();
+        return j;
+    }
+    std::string line() const {
+        std::string s;
+        for (auto [name, t] : phases_) {
+            std::replace(name.begin(), name.end(), '_', ' ');
+            s += fmt::format("{}{} {:.1f} s", s.empty() ? "" : ", ", name, t);
+        }
+        return s + fmt::format(" ({:.1f} s in all)", std::chrono::duration<double>(last_ - start_).count());
+    }
+
+private:
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point start_ = Clock::now(), last_ = start_;
+    std::vector<std::pair<std::string, double>> phases_;
+};
+
 // The mask and the outputs asked for, each written atomically; the mesh's triangle count (0: none).
 std::size_t write_segment_outputs(const SegmentArgs& a, const Scan& scan, const SegmentOutcome& o, const std::optional<Roi>& roi) {
     const WriteOptions as_read{.orientation_known = scan.header.orientation_known};
@@ -120,8 +155,10 @@ int run_segment(const SegmentArgs& a, int threads) {
     const auto guard = limit_threads(threads);
     const InterruptGuard interrupt;
     check_segment_args(a);
+    PhaseTimes phases;
 
     Scan scan = read_scan(a.image);
+    phases.mark("read");
     Grid<float>& image = scan.image;
     const ImageHeader& header = scan.header;
     std::optional<Grid<std::uint8_t>> init;
@@ -131,11 +168,13 @@ int run_segment(const SegmentArgs& a, int threads) {
     if (!a.out_roi.empty() && !roi)
         throw UsageError("--out-roi: no ROI to write (a skull-stripped brain, an image where no head is found, or a head where no brain is "
                          "found gets none by default: give --roi auto or a mask)");
+    phases.mark("roi");
     SegmentRequest req = segment_request(a, image.lattice());
     if (!a.init_mask.empty()) init = load_mask_like(a.init_mask, image.lattice(), "--init-mask");
     // N4 first, on by default; asked for (or its image to be written), a failure is an error.
     const BiasCorrection mode = bias_mode(a.bias_correct, a.bias_given || !a.out_corrected.empty());
     PreparedImage prepared = prepare_image(image, roi, mode, &interrupt.flag(), &lookup, scan.no_data_mask());
+    phases.mark("bias_correction");
     if (prepared.bias && prepared.bias->interrupted) {
         if (!a.quiet) fmt::print(stderr, "liveset: interrupted during bias correction; nothing written\n");
         return 130;
@@ -158,11 +197,14 @@ int run_segment(const SegmentArgs& a, int threads) {
     const SegmentRun run = a.out_corrected.empty() ? segment_with_progress(std::move(image), req, a.quiet, a.log)
                                                    : segment_with_progress(image, req, a.quiet, a.log);
     if (run.interrupted) return report_interrupt(run.outcome, a.quiet);
+    phases.mark("segmentation");
     const SegmentOutcome& o = run.outcome;
     const std::size_t triangles = write_segment_outputs(a, scan, o, roi);
+    phases.mark("write");
 
     nlohmann::json j = segment_report(a, o, lattice, roi, prepared, triangles);
     j["no_data_voxels"] = scan.no_data_voxels;
+    j["phase_seconds"] = phases.json();
     for (const std::string& w : seed_fit.warnings) j["warnings"].push_back(w);
     // The default limit reached before convergence: the mask is a front still moving (a grid whose
     // fine voxels keep the time step small, docs/BENCHMARKS.md session 49, or a very large image).
@@ -186,6 +228,7 @@ int run_segment(const SegmentArgs& a, int threads) {
         fmt::print("  wrote        {}{}{}{}{}\n", a.out_mask, a.out_phi.empty() ? "" : ", " + a.out_phi,
                    a.out_mesh.empty() ? "" : ", " + a.out_mesh, a.out_roi.empty() ? "" : ", " + a.out_roi,
                    a.out_corrected.empty() ? "" : ", " + a.out_corrected);
+        fmt::print("  time         {}\n", phases.line());
     }
     return 0;
 }

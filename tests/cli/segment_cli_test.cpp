@@ -120,12 +120,34 @@ TEST(SegmentCli, PhantomSegmentMeshEval) {
     for (const char* f : {"t1.nii.gz", "labels.nii.gz", "truth_gm.nii.gz", "bias.nii.gz", "phantom.json"})
         EXPECT_TRUE(fs::exists(ph.dir / f)) << f;
     const fs::path mask = work_dir() / "seg.nii.gz", phi = work_dir() / "phi.nii.gz", mesh = work_dir() / "seg.ply";
+    const auto t0 = std::chrono::steady_clock::now();
     const Result seg = run_cli("segment " + (ph.dir / "t1.nii.gz").string() + ph.seeds + " --json --out-mask " +
                                mask.string() + " --out-phi " + phi.string() + " --out-mesh " + mesh.string());
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     ASSERT_EQ(seg.rc, 0) << seg.err;
     EXPECT_EQ(lines(seg.out), 1);
     const nlohmann::json sj = nlohmann::json::parse(seg.out);
     EXPECT_EQ(sj["stop"], "converged");
+    // Where the time went: consecutive phases making up the total, within the command's wall time;
+    // the segmentation's holds the loop's seconds, the bias correction's N4's.
+    const nlohmann::json& ps = sj["phase_seconds"];
+    double sum = 0.0;
+    for (const char* k : {"read", "roi", "bias_correction", "segmentation", "write"}) {
+        ASSERT_TRUE(ps.contains(k)) << k;
+        EXPECT_GE(ps[k].get<double>(), 0.0) << k;
+        sum += ps[k].get<double>();
+    }
+    EXPECT_EQ(ps.size(), 6u);
+    EXPECT_NEAR(sum, ps["total"].get<double>(), 1e-6);
+    EXPECT_LE(ps["total"].get<double>(), wall);
+    EXPECT_GE(ps["segmentation"].get<double>(), sj["seconds"].get<double>());
+    EXPECT_GE(ps["bias_correction"].get<double>(), sj["bias_correction"]["ms"].get<double>() / 1000.0);
+    const Result said = run_cli("segment " + (ph.dir / "t1.nii.gz").string() + ph.seeds + " --iterations 3 --out-mask " +
+                                (work_dir() / "said.nii.gz").string());
+    ASSERT_EQ(said.rc, 0) << said.err;
+    EXPECT_NE(said.out.find("  time         read "), std::string::npos) << said.out;
+    EXPECT_NE(said.out.find(", bias correction "), std::string::npos) << said.out;
+    EXPECT_NE(said.out.find(" s in all)\n"), std::string::npos) << said.out;
     EXPECT_TRUE(sj["window_estimated"].get<bool>());
     // α chosen from the image (alpha.hpp): the report says how, and it is the α the run used.
     EXPECT_EQ(sj["alpha_choice"]["source"], "automatic");
