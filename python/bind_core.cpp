@@ -9,6 +9,7 @@
 #include "cli_support.hpp"
 #include "finder_repair.hpp"
 #include "image_commands.hpp"
+#include "phase_times.hpp"
 #include "liveset/eval/holes.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/levelset/sparse_field.hpp"
@@ -103,11 +104,13 @@ cli::BiasCorrection bias_mode(const std::optional<bool>& bias_correct) {
 }
 
 pyb::dict segment(const pyb::array& values, const Lattice& lattice, const SegmentArgs& a, const pyb::object& progress) {
+    cli::PhaseTimes phases;
     cli::Scan scan = scan_from_array(values, lattice);
     Grid<float>& image = scan.image;
     SegmentRequest req = request_for(a, lattice);
     cli::BrainLookup lookup = lookup_for(a.oriented);
     std::optional<cli::Roi> roi = roi_of(a.roi, image, &lookup);
+    phases.mark("roi");
     std::optional<Grid<std::uint8_t>> init;
     if (!a.init_mask.is_none()) init = mask_from_array(a.init_mask.cast<pyb::array>(), lattice);
     Interrupt interrupt;
@@ -120,6 +123,7 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     {
         pyb::gil_scoped_release nogil;
         prepared = cli::prepare_image(image, roi, mode, &interrupt.flag(), &lookup, scan.no_data_mask());
+        phases.mark("bias_correction");
         seed_fit = cli::fit_seeds_to_roi(roi, prepared, req.seeds, init ? &*init : nullptr, "roi='none'");
         roi_mask = roi ? &roi->mask : nullptr;
         const Grid<std::uint8_t>* fit = prepared.fit(roi_mask);
@@ -141,7 +145,9 @@ pyb::dict segment(const pyb::array& values, const Lattice& lattice, const Segmen
     }
     if (interrupt.raised()) interrupt.rethrow();
     if (!out || out->result.reason == StopReason::kInterrupted) throw pyb::error_already_set();  // a pending KeyboardInterrupt
+    phases.mark("segmentation");
     nlohmann::json j = cli::segmentation_report(*out, lattice);
+    j["phase_seconds"] = phases.json();
     cli::add_bias_report(j, prepared, roi_mask);
     j["no_data_voxels"] = scan.no_data_voxels;
     for (const std::string& w : seed_fit.warnings) j["warnings"].push_back(w);

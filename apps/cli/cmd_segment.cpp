@@ -3,19 +3,16 @@
 // run and writes nothing.
 #include <fmt/core.h>
 
-#include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
-#include <utility>
-#include <vector>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "cli_support.hpp"
 #include "image_commands.hpp"
+#include "phase_times.hpp"
 #include "liveset/io/image_io.hpp"
 #include "liveset/mesh/fragment_mesher.hpp"
 #include "liveset/mesh/marching_cubes.hpp"
@@ -107,36 +104,6 @@ int report_interrupt(const SegmentOutcome& o, bool quiet) {
                    coarse ? o.coarse->result.iterations : o.result.iterations, coarse ? " of the coarse start" : "");
     return 130;
 }
-
-// The wall time of a run's consecutive phases (the report's "phase_seconds", the summary's "time"
-// line): where a fine scan's seconds go (docs/BENCHMARKS.md, session 85).
-class PhaseTimes {
-public:
-    void mark(const char* phase) {
-        const auto now = Clock::now();
-        phases_.emplace_back(phase, std::chrono::duration<double>(now - last_).count());
-        last_ = now;
-    }
-    nlohmann::json json() const {
-        nlohmann::json j = nlohmann::json::object();
-        for (const auto& [name, s] : phases_) j[name] = s;
-        j["total"] = std::chrono::duration<double>(last_ - start_).count();
-        return j;
-    }
-    std::string line() const {
-        std::string s;
-        for (auto [name, t] : phases_) {
-            std::replace(name.begin(), name.end(), '_', ' ');
-            s += fmt::format("{}{} {:.1f} s", s.empty() ? "" : ", ", name, t);
-        }
-        return s + fmt::format(" ({:.1f} s in all)", std::chrono::duration<double>(last_ - start_).count());
-    }
-
-private:
-    using Clock = std::chrono::steady_clock;
-    Clock::time_point start_ = Clock::now(), last_ = start_;
-    std::vector<std::pair<std::string, double>> phases_;
-};
 
 // The mask and the outputs asked for, each written atomically; the mesh's triangle count (0: none).
 std::size_t write_segment_outputs(const SegmentArgs& a, const Scan& scan, const SegmentOutcome& o, const std::optional<Roi>& roi) {

@@ -108,6 +108,13 @@ def test_segment_equals_cli_bitwise(phantom, cli_segmentation):
     for k in ("iterations", "stop", "voxels", "mu_raw", "epsilon_raw", "alpha", "alpha_choice"):
         assert seg.report[k] == rep[k], k
     assert rep["alpha_choice"]["source"] == "automatic"
+    # where the seconds went: consecutive phases making up the total (no read nor write: arrays in memory)
+    ps = seg.report["phase_seconds"]
+    assert set(ps) == {"roi", "bias_correction", "segmentation", "total"}
+    assert all(v >= 0 for v in ps.values())
+    assert ps["roi"] + ps["bias_correction"] + ps["segmentation"] == pytest.approx(ps["total"], abs=1e-6)
+    assert ps["segmentation"] >= seg.report["seconds"]
+    assert set(rep["phase_seconds"]) == {"read", "roi", "bias_correction", "segmentation", "write", "total"}
     # masks/phi go out with the input's affine
     np.testing.assert_allclose(seg.mask.to_nibabel().affine, nib.load(phantom["image"]).affine, atol=1e-6)
     # the tissue model gives the window segment used
