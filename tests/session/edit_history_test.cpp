@@ -186,10 +186,7 @@ TEST(EditHistory, RecordDifferencesIsTheBruteForceDifferenceWithItsSignChanges) 
     h.begin("whole", {});
     h.record(random_edits(f, rng, {4, 4, 4}, {30, 30, 26}));
     std::vector<std::uint8_t> recorded(lat.size(), 0);
-    for (std::size_t i = 0; i < lat.size(); ++i) {
-        const auto p = static_cast<PointIndex>(i);
-        recorded[i] = std::bit_cast<std::uint32_t>(f.phi()[p]) != start.phi_bits[i] || f.status()[p] != start.status[i];
-    }
+    for (PointIndex p : differing(f, start)) recorded[p] = 1;
     const Grid<float> before = f.phi();
     f.init_from_sdf([](Vec3d p) { return norm(p - Vec3d{22, 17, 15}) - 9.0; });  // the whole state replaced
     const ChangedPoints x = h.record_differences(f);
